@@ -1,0 +1,1 @@
+//! Host side of gyro: log reading, replay through the `gyro-core` pipeline, reports.

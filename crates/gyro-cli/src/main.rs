@@ -1,0 +1,2 @@
+//! `gyro-cli`: replay gyro logs through the core pipeline.
+fn main() {}

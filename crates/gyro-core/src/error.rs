@@ -1,0 +1,39 @@
+//! Errors of the core: small, `Copy`, naming the offending setting.
+
+use core::fmt;
+
+/// Why a setting was refused. Carries the name of the setting (as in [`crate::Config`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Error {
+    /// The setting is NaN or infinite.
+    NonFinite(&'static str),
+    /// The setting is finite but outside its valid range.
+    OutOfRange(&'static str),
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::NonFinite(name) => write!(f, "setting `{name}` is not a finite number"),
+            Error::OutOfRange(name) => write!(f, "setting `{name}` is out of its valid range"),
+        }
+    }
+}
+
+impl core::error::Error for Error {}
+
+/// `Ok(value)` if `value` is finite and within `[min, max]`, else the matching error.
+pub(crate) fn check_range(
+    name: &'static str,
+    value: f64,
+    min: f64,
+    max: f64,
+) -> Result<f64, Error> {
+    if !value.is_finite() {
+        Err(Error::NonFinite(name))
+    } else if value < min || value > max {
+        Err(Error::OutOfRange(name))
+    } else {
+        Ok(value)
+    }
+}

@@ -1,0 +1,331 @@
+//! Static/dynamic motion detection with hysteresis and minimum dwell times.
+//!
+//! Works on the filtered, decimated rate minus the bias reference (the mean rate of the
+//! last rest). A sample is *quiet* if `|rate - bias| ≤ exit_dps`.
+//!
+//! - Static → dynamic: a run of non-quiet samples lasting `min_motion_s` that reaches
+//!   `|rate - bias| > enter_dps` at least once. A run that never reaches `enter_dps` within
+//!   `min_rest_s` is a slow bias change, not motion, and is folded into the rest.
+//! - Dynamic → static: `min_rest_s` of consecutive quiet samples.
+//!
+//! A movement spans from the last quiet sample before its run to the first quiet sample
+//! after it; [`Phase`] tells an integrator, sample by sample, what to do so that exactly
+//! that span is integrated, although both ends are only confirmed later.
+
+use crate::error::{check_range, Error};
+use crate::kahan::KahanSum;
+
+/// Motion detector settings, in physical units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
+pub struct MotionConfig {
+    /// A movement must exceed this |rate − bias| (deg/s) at least once.
+    pub enter_dps: f32,
+    /// At or below this |rate − bias| (deg/s) a sample is quiet (≤ `enter_dps`).
+    pub exit_dps: f32,
+    /// Minimum duration of a run of non-quiet samples to count as a movement (s).
+    pub min_motion_s: f32,
+    /// Quiet time that ends a movement (s).
+    pub min_rest_s: f32,
+    /// Bias reference (deg/s) used until the first rest of `min_rest_s` has been seen.
+    pub initial_bias_dps: f32,
+}
+
+impl Default for MotionConfig {
+    fn default() -> Self {
+        Self {
+            enter_dps: 1.0,
+            exit_dps: 0.3,
+            min_motion_s: 0.06,
+            min_rest_s: 0.2,
+            initial_bias_dps: 0.0,
+        }
+    }
+}
+
+/// Whether the sensor is at rest or moving (confirmed state).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum MotionState {
+    /// At rest: the angle is held.
+    Static,
+    /// Moving: the rate is integrated.
+    Dynamic,
+}
+
+/// What one sample means for integration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// Static and quiet: not integrated; a rest (bias) observation.
+    Rest,
+    /// Static, inside a run that may become a movement: integrate tentatively.
+    Onset,
+    /// The run is confirmed as a movement: integrate, keep everything tentative.
+    /// `run` samples (this one included) belong to the movement.
+    Started {
+        /// Length of the confirming run in samples.
+        run: u16,
+    },
+    /// The run was not a movement: drop what was integrated tentatively.
+    Aborted,
+    /// Dynamic and not quiet: integrate, keep everything tentative.
+    Moving,
+    /// Dynamic, first quiet sample: integrate and keep (a movement may end here).
+    SettleFirst,
+    /// Dynamic, further quiet samples: integrate tentatively.
+    Settling,
+    /// Rest confirmed: drop what was integrated since the first quiet sample.
+    /// The movement ended `quiet - 1` samples ago.
+    Ended {
+        /// Length of the confirming quiet run in samples.
+        quiet: u16,
+    },
+}
+
+/// Running mean with compensated summation.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Mean {
+    sum: KahanSum,
+    count: u32,
+}
+
+impl Mean {
+    fn add(&mut self, x: f32) {
+        self.sum.add(x);
+        self.count = self.count.saturating_add(1);
+    }
+    fn merge(&mut self, other: &Mean) {
+        self.sum.add(other.sum.value());
+        self.count = self.count.saturating_add(other.count);
+    }
+    fn mean(&self) -> Option<f32> {
+        (self.count > 0).then(|| self.sum.value() / self.count as f32)
+    }
+}
+
+/// Motion detector state (settings converted to samples at the output rate).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MotionDetector {
+    enter_dps: f32,
+    exit_dps: f32,
+    min_motion: u16,
+    min_rest: u16,
+    state: MotionState,
+    run: u16,
+    run_reached_enter: bool,
+    rest: Mean,
+    run_mean: Mean,
+    bias_dps: f32,
+}
+
+/// Whole samples covering `seconds` at `rate_hz`, at least 1.
+fn samples(seconds: f32, rate_hz: f32) -> u16 {
+    let n = libm::ceilf(seconds * rate_hz - 1e-3);
+    if n < 1.0 {
+        1
+    } else if n > f32::from(u16::MAX) {
+        u16::MAX
+    } else {
+        n as u16
+    }
+}
+
+impl MotionDetector {
+    /// Detector for samples arriving at `rate_hz`.
+    pub fn try_new(config: &MotionConfig, rate_hz: f32) -> Result<Self, Error> {
+        let exit = check_range("motion.exit_dps", config.exit_dps.into(), 0.0, 1e4)?;
+        check_range("motion.enter_dps", config.enter_dps.into(), exit, 1e4)?;
+        check_range("motion.min_motion_s", config.min_motion_s.into(), 0.0, 60.0)?;
+        check_range("motion.min_rest_s", config.min_rest_s.into(), 0.0, 60.0)?;
+        check_range(
+            "motion.initial_bias_dps",
+            config.initial_bias_dps.into(),
+            -1e4,
+            1e4,
+        )?;
+        check_range("output_rate_hz", rate_hz.into(), 1e-3, 1e6)?;
+        Ok(Self {
+            enter_dps: config.enter_dps,
+            exit_dps: config.exit_dps,
+            min_motion: samples(config.min_motion_s, rate_hz),
+            min_rest: samples(config.min_rest_s, rate_hz),
+            state: MotionState::Static,
+            run: 0,
+            run_reached_enter: false,
+            rest: Mean::default(),
+            run_mean: Mean::default(),
+            bias_dps: config.initial_bias_dps,
+        })
+    }
+
+    /// The confirmed state.
+    pub const fn state(&self) -> MotionState {
+        self.state
+    }
+
+    /// The bias reference (deg/s) the thresholds are applied around.
+    pub const fn bias_dps(&self) -> f32 {
+        self.bias_dps
+    }
+
+    /// Mean rate over the current rest (deg/s) and its sample count, while static.
+    pub fn rest_mean_dps(&self) -> Option<(f32, u32)> {
+        match self.state {
+            MotionState::Static => self.rest.mean().map(|m| (m, self.rest.count)),
+            MotionState::Dynamic => None,
+        }
+    }
+
+    /// Classify one (finite) sample.
+    pub fn update(&mut self, rate_dps: f32) -> Phase {
+        let deviation = libm::fabsf(rate_dps - self.bias_dps);
+        let quiet = deviation <= self.exit_dps;
+        match self.state {
+            MotionState::Static if quiet => {
+                let aborted = self.run > 0;
+                if aborted {
+                    self.fold_run_into_rest();
+                }
+                self.add_rest(rate_dps);
+                if aborted {
+                    Phase::Aborted
+                } else {
+                    Phase::Rest
+                }
+            }
+            MotionState::Static => {
+                self.run = self.run.saturating_add(1);
+                self.run_reached_enter |= deviation > self.enter_dps;
+                self.run_mean.add(rate_dps);
+                if self.run >= self.min_motion && self.run_reached_enter {
+                    let run = self.run;
+                    self.state = MotionState::Dynamic;
+                    self.run = 0;
+                    self.run_mean = Mean::default();
+                    Phase::Started { run }
+                } else if self.run >= self.min_rest && !self.run_reached_enter {
+                    // A slow bias change, not a movement.
+                    self.fold_run_into_rest();
+                    Phase::Aborted
+                } else {
+                    Phase::Onset
+                }
+            }
+            MotionState::Dynamic if quiet => {
+                self.run = self.run.saturating_add(1);
+                self.run_mean.add(rate_dps);
+                if self.run >= self.min_rest {
+                    let quiet = self.run;
+                    self.state = MotionState::Static;
+                    self.run = 0;
+                    self.rest = self.run_mean;
+                    self.run_mean = Mean::default();
+                    self.refresh_bias();
+                    Phase::Ended { quiet }
+                } else if self.run == 1 {
+                    Phase::SettleFirst
+                } else {
+                    Phase::Settling
+                }
+            }
+            MotionState::Dynamic => {
+                self.run = 0;
+                self.run_mean = Mean::default();
+                Phase::Moving
+            }
+        }
+    }
+
+    fn add_rest(&mut self, rate_dps: f32) {
+        self.rest.add(rate_dps);
+        self.refresh_bias();
+    }
+
+    fn fold_run_into_rest(&mut self) {
+        self.rest.merge(&self.run_mean);
+        self.run = 0;
+        self.run_reached_enter = false;
+        self.run_mean = Mean::default();
+        self.refresh_bias();
+    }
+
+    fn refresh_bias(&mut self) {
+        if self.rest.count >= u32::from(self.min_rest) {
+            if let Some(mean) = self.rest.mean() {
+                self.bias_dps = mean;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn detector() -> MotionDetector {
+        MotionDetector::try_new(&MotionConfig::default(), 50.0).unwrap()
+    }
+
+    #[test]
+    fn dwell_times_in_samples() {
+        let d = detector();
+        assert_eq!(d.min_motion, 3);
+        assert_eq!(d.min_rest, 10);
+    }
+
+    #[test]
+    fn a_short_spike_is_not_motion() {
+        let mut d = detector();
+        assert_eq!(d.update(5.0), Phase::Onset);
+        assert_eq!(d.update(5.0), Phase::Onset);
+        assert_eq!(d.update(0.0), Phase::Aborted);
+        assert_eq!(d.state(), MotionState::Static);
+    }
+
+    #[test]
+    fn movement_starts_and_ends() {
+        let mut d = detector();
+        for _ in 0..20 {
+            assert_eq!(d.update(0.1), Phase::Rest);
+        }
+        assert!((d.bias_dps() - 0.1).abs() < 1e-6);
+        assert_eq!(d.update(10.0), Phase::Onset);
+        assert_eq!(d.update(10.0), Phase::Onset);
+        assert_eq!(d.update(10.0), Phase::Started { run: 3 });
+        assert_eq!(d.update(10.0), Phase::Moving);
+        assert_eq!(d.update(0.2), Phase::SettleFirst);
+        for _ in 0..8 {
+            assert_eq!(d.update(0.2), Phase::Settling);
+        }
+        assert_eq!(d.update(0.2), Phase::Ended { quiet: 10 });
+        assert_eq!(d.state(), MotionState::Static);
+        // The new rest (the quiet run) becomes the bias reference.
+        assert!((d.bias_dps() - 0.2).abs() < 1e-6);
+    }
+
+    #[test]
+    fn slow_drift_between_thresholds_is_folded_into_rest() {
+        let mut d = detector();
+        for _ in 0..9 {
+            assert_eq!(d.update(0.5), Phase::Onset);
+        }
+        assert_eq!(d.update(0.5), Phase::Aborted);
+        assert!((d.bias_dps() - 0.5).abs() < 1e-6);
+        assert_eq!(d.update(0.5), Phase::Rest);
+    }
+
+    #[test]
+    fn invalid_settings_refused() {
+        let bad = MotionConfig {
+            enter_dps: 0.1,
+            exit_dps: 0.3,
+            ..MotionConfig::default()
+        };
+        assert_eq!(
+            MotionDetector::try_new(&bad, 50.0),
+            Err(Error::OutOfRange("motion.enter_dps"))
+        );
+    }
+}
