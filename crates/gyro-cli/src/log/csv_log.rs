@@ -1,0 +1,311 @@
+//! CSV logs: `# key: value` metadata lines, a header, one row per sample.
+
+use super::{Log, LogError, Row};
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+
+/// Unit of the time column.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum TimeUnit {
+    /// Seconds.
+    #[default]
+    S,
+    /// Milliseconds.
+    Ms,
+    /// Microseconds.
+    Us,
+    /// Nanoseconds.
+    Ns,
+}
+
+impl TimeUnit {
+    fn to_seconds(self) -> f64 {
+        match self {
+            TimeUnit::S => 1.0,
+            TimeUnit::Ms => 1e-3,
+            TimeUnit::Us => 1e-6,
+            TimeUnit::Ns => 1e-9,
+        }
+    }
+}
+
+/// Unit of the rate column.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum RateUnit {
+    /// Degrees per second.
+    #[default]
+    Dps,
+    /// Radians per second.
+    Rads,
+}
+
+/// Which columns hold what, and in which units.
+#[derive(Clone, Debug, PartialEq, Eq, clap::Args)]
+pub struct ColumnOptions {
+    /// Name of the time column.
+    #[arg(long, default_value = "time_s")]
+    pub time_column: String,
+    /// Unit of the time column.
+    #[arg(long, value_enum, default_value_t = TimeUnit::S)]
+    pub time_unit: TimeUnit,
+    /// Name of the rate column.
+    #[arg(long, default_value = "rate_dps")]
+    pub rate_column: String,
+    /// Unit of the rate column.
+    #[arg(long, value_enum, default_value_t = RateUnit::Dps)]
+    pub rate_unit: RateUnit,
+    /// Name of the reference (encoder) angle column, in degrees; optional in the log.
+    #[arg(long, default_value = "reference_deg")]
+    pub reference_column: String,
+    /// Name of the temperature column, in °C; optional in the log.
+    #[arg(long, default_value = "temperature_c")]
+    pub temperature_column: String,
+}
+
+impl Default for ColumnOptions {
+    fn default() -> Self {
+        Self {
+            time_column: "time_s".into(),
+            time_unit: TimeUnit::S,
+            rate_column: "rate_dps".into(),
+            rate_unit: RateUnit::Dps,
+            reference_column: "reference_deg".into(),
+            temperature_column: "temperature_c".into(),
+        }
+    }
+}
+
+/// Parse a field: `Ok(None)` if empty, NaN or infinite (a missing value), an error if it
+/// is not a number at all.
+fn parse_field(field: &[u8]) -> Result<Option<f64>, ()> {
+    let text = std::str::from_utf8(field).map_err(|_| ())?.trim();
+    if text.is_empty() {
+        return Ok(None);
+    }
+    let value: f64 = text.parse().map_err(|_| ())?;
+    Ok(value.is_finite().then_some(value))
+}
+
+/// Read a CSV log whole.
+pub fn read_csv(path: &Path, columns: &ColumnOptions) -> Result<Log, LogError> {
+    let io_err = |source| LogError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = File::open(path).map_err(io_err)?;
+    let mut reader = BufReader::with_capacity(1 << 20, file);
+
+    // Metadata: `# key: value` lines before the header.
+    let mut metadata = BTreeMap::new();
+    let mut prelude_lines = 0_u64;
+    loop {
+        let buf = reader.fill_buf().map_err(io_err)?;
+        if buf.first() != Some(&b'#') {
+            break;
+        }
+        let mut line = String::new();
+        reader.read_line(&mut line).map_err(io_err)?;
+        prelude_lines += 1;
+        if let Some((key, value)) = line.trim_start_matches('#').split_once(':') {
+            metadata.insert(key.trim().to_string(), value.trim().to_string());
+        }
+    }
+
+    let mut csv = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .comment(Some(b'#'))
+        .from_reader(reader);
+    let header_line = prelude_lines + 1;
+    let headers = csv
+        .byte_headers()
+        .map_err(|e| csv_error(path, prelude_lines, e))?
+        .clone();
+    if headers.is_empty() || headers.iter().all(|h| h.is_empty()) {
+        return Err(LogError::NoHeader {
+            path: path.to_path_buf(),
+        });
+    }
+    let names: Vec<String> = headers
+        .iter()
+        .map(|h| String::from_utf8_lossy(h).trim().to_string())
+        .collect();
+    let find = |name: &str| names.iter().position(|n| n == name);
+    let required = |name: &str| {
+        find(name).ok_or_else(|| LogError::MissingColumn {
+            path: path.to_path_buf(),
+            line: header_line,
+            column: name.to_string(),
+            available: names.join(", "),
+        })
+    };
+    let time_idx = required(&columns.time_column)?;
+    let rate_idx = required(&columns.rate_column)?;
+    let reference_idx = find(&columns.reference_column);
+    let temperature_idx = find(&columns.temperature_column);
+    let time_scale = columns.time_unit.to_seconds();
+    let rate_scale = match columns.rate_unit {
+        RateUnit::Dps => 1.0,
+        RateUnit::Rads => 180.0 / std::f64::consts::PI,
+    };
+
+    let mut rows = Vec::new();
+    let mut record = csv::ByteRecord::new();
+    loop {
+        match csv.read_byte_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => return Err(csv_error(path, prelude_lines, e)),
+        }
+        let line = prelude_lines + record.position().map_or(0, |p| p.line());
+        let field = |idx: usize, column: &str| -> Result<Option<f64>, LogError> {
+            let raw = record.get(idx).unwrap_or_default();
+            parse_field(raw).map_err(|()| LogError::NotANumber {
+                path: path.to_path_buf(),
+                line,
+                column: column.to_string(),
+                value: String::from_utf8_lossy(raw).into_owned(),
+            })
+        };
+        let time_s = field(time_idx, &columns.time_column)?
+            .map(|t| t * time_scale)
+            .ok_or_else(|| LogError::BadTime {
+                path: path.to_path_buf(),
+                line,
+                column: columns.time_column.clone(),
+            })?;
+        let rate_dps = field(rate_idx, &columns.rate_column)?.map(|r| r * rate_scale);
+        let reference_deg = match reference_idx {
+            Some(idx) => field(idx, &columns.reference_column)?,
+            None => None,
+        };
+        let temperature_c = match temperature_idx {
+            Some(idx) => field(idx, &columns.temperature_column)?,
+            None => None,
+        };
+        rows.push(Row {
+            line,
+            time_s,
+            rate_dps,
+            reference_deg,
+            temperature_c,
+        });
+    }
+    Ok(Log {
+        path: path.to_path_buf(),
+        metadata,
+        has_reference: reference_idx.is_some(),
+        has_temperature: temperature_idx.is_some(),
+        rows,
+    })
+}
+
+fn csv_error(path: &Path, prelude_lines: u64, e: csv::Error) -> LogError {
+    let line = prelude_lines + e.position().map_or(0, |p| p.line());
+    let message = match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!("row has {len} fields, the header has {expected_len}"),
+        csv::ErrorKind::Io(err) => format!("read error: {err}"),
+        _ => e.to_string(),
+    };
+    LogError::Csv {
+        path: path.to_path_buf(),
+        line,
+        message,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Write;
+
+    fn write_temp(name: &str, text: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("gyro-csv-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::File::create(&path)
+            .unwrap()
+            .write_all(text.as_bytes())
+            .unwrap();
+        path
+    }
+
+    #[test]
+    fn reads_metadata_header_and_rows() {
+        let path = write_temp(
+            "ok.csv",
+            "# sensor: CRM100\n# sample_rate_hz: 1000\ntime_s,rate_dps,temperature_c,reference_deg,extra\n0.000,0.125,25.1,0.00,x\n0.001,,25.1,0.01,y\n0.002,nan,25.1,,z\n",
+        );
+        let log = read_csv(&path, &ColumnOptions::default()).unwrap();
+        assert_eq!(log.metadata["sensor"], "CRM100");
+        assert_eq!(log.metadata_rate_hz(), Some(1000.0));
+        assert!(log.has_reference && log.has_temperature);
+        assert_eq!(log.rows.len(), 3);
+        assert_eq!(log.rows[0].line, 4);
+        assert_eq!(log.rows[0].rate_dps, Some(0.125));
+        assert_eq!(log.rows[1].rate_dps, None);
+        assert_eq!(log.rows[2].rate_dps, None);
+        assert_eq!(log.rows[2].reference_deg, None);
+        assert_eq!(log.rows[2].line, 6);
+    }
+
+    #[test]
+    fn units_are_converted() {
+        let path = write_temp("units.csv", "t_ms,w\n1000,3.141592653589793\n");
+        let columns = ColumnOptions {
+            time_column: "t_ms".into(),
+            time_unit: TimeUnit::Ms,
+            rate_column: "w".into(),
+            rate_unit: RateUnit::Rads,
+            ..ColumnOptions::default()
+        };
+        let log = read_csv(&path, &columns).unwrap();
+        assert_eq!(log.rows[0].time_s, 1.0);
+        assert!((log.rows[0].rate_dps.unwrap() - 180.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn errors_name_file_line_and_column() {
+        let path = write_temp("bad.csv", "# a: b\ntime_s,rate_dps\n0.0,1.0\n0.001,abc\n");
+        let err = read_csv(&path, &ColumnOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("bad.csv:4: column `rate_dps`: `abc` is not a number"),
+            "{err}"
+        );
+
+        let path = write_temp("nocol.csv", "time_s,gyro\n0.0,1.0\n");
+        let err = read_csv(&path, &ColumnOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("nocol.csv:1: no column `rate_dps`"), "{err}");
+        assert!(err.contains("time_s, gyro"), "{err}");
+
+        let path = write_temp("ragged.csv", "time_s,rate_dps\n0.0,1.0\n0.001,1.0,7\n");
+        let err = read_csv(&path, &ColumnOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("ragged.csv:3: row has 3 fields, the header has 2"),
+            "{err}"
+        );
+
+        let path = write_temp("notime.csv", "time_s,rate_dps\n,1.0\n");
+        let err = read_csv(&path, &ColumnOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("notime.csv:2: missing or non-finite time"),
+            "{err}"
+        );
+
+        let err = read_csv(Path::new("/nonexistent/x.csv"), &ColumnOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("/nonexistent/x.csv"), "{err}");
+    }
+}

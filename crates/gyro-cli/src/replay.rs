@@ -1,0 +1,301 @@
+//! Replay a regular log through the core [`Pipeline`] and score it against the reference.
+//!
+//! The reference angle goes through the same decimator and low-pass as the rate (both
+//! linear, so filtering the angle equals integrating the filtered rate): the comparison
+//! measures sensor and integration error, not the filter's intended lag. Both start at 0.
+
+use crate::log::{Quality, RegularLog};
+use gyro_core::{Compensation, Config, Decimator, Event, MotionState, Pipeline, Sos, SosState};
+use serde::Serialize;
+
+/// One output sample of the run, with the reference where present.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SeriesPoint {
+    /// Time (s).
+    pub time_s: f64,
+    /// Filtered rate (deg/s).
+    pub rate_dps: f32,
+    /// Motion state.
+    pub motion: MotionState,
+    /// Compensated angle (deg).
+    pub angle_deg: f32,
+    /// Uncompensated angle (deg).
+    pub raw_angle_deg: f32,
+    /// Standard deviation of the angle (deg), Kalman mode.
+    pub angle_std_deg: Option<f32>,
+    /// Bias estimate (deg/s).
+    pub bias_dps: f32,
+    /// Reference angle change since the start, filtered like the rate (deg).
+    pub reference_deg: Option<f64>,
+}
+
+impl SeriesPoint {
+    /// Compensated angle minus reference (deg).
+    pub fn error_deg(&self) -> Option<f64> {
+        self.reference_deg.map(|r| f64::from(self.angle_deg) - r)
+    }
+}
+
+/// One movement found in the run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MovementResult {
+    /// 1-based number.
+    pub index: usize,
+    /// Start (s).
+    pub start_time_s: f64,
+    /// End (s), or the last sample's time if the log ends while moving.
+    pub end_time_s: f64,
+    /// Duration (s).
+    pub duration_s: f64,
+    /// False if the log ended during the movement.
+    pub complete: bool,
+    /// Angle turned, compensated (deg).
+    pub angle_deg: f32,
+    /// Angle turned, uncompensated (deg).
+    pub raw_angle_deg: f32,
+    /// Reference angle change over the movement (deg).
+    pub reference_deg: Option<f64>,
+    /// `angle_deg − reference_deg`.
+    pub error_deg: Option<f64>,
+    /// `raw_angle_deg − reference_deg`.
+    pub raw_error_deg: Option<f64>,
+}
+
+/// Error statistics over the run.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Summary {
+    /// Compensation used.
+    pub compensation: Compensation,
+    /// Output samples.
+    pub outputs: usize,
+    /// Duration covered (s).
+    pub duration_s: f64,
+    /// Movements (complete or not).
+    pub movements: usize,
+    /// Input samples the pipeline rejected (non-finite or implausible).
+    pub rejected_samples: u32,
+    /// Final compensated angle (deg).
+    pub final_angle_deg: f32,
+    /// Final uncompensated angle (deg).
+    pub final_raw_angle_deg: f32,
+    /// Max |angle − reference| over the run (deg).
+    pub max_abs_error_deg: Option<f64>,
+    /// RMS of angle − reference (deg).
+    pub rms_error_deg: Option<f64>,
+    /// angle − reference at the last sample (deg).
+    pub final_error_deg: Option<f64>,
+    /// Max |raw angle − reference| (deg).
+    pub raw_max_abs_error_deg: Option<f64>,
+    /// RMS of raw angle − reference (deg).
+    pub raw_rms_error_deg: Option<f64>,
+    /// Raw angle − reference at the last sample (deg).
+    pub raw_final_error_deg: Option<f64>,
+}
+
+/// The result of replaying one log.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunReport {
+    /// Input grid rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Decimation factor.
+    pub decimation_factor: u16,
+    /// Output rate (Hz).
+    pub output_rate_hz: f32,
+    /// What was irregular in the input.
+    pub input: Quality,
+    /// The configuration used.
+    pub config: Config,
+    /// Error statistics.
+    pub summary: Summary,
+    /// The movements.
+    pub movements: Vec<MovementResult>,
+    /// The output series (written by `--out`, not in JSON).
+    #[serde(skip)]
+    pub series: Vec<SeriesPoint>,
+}
+
+/// Max |e|, RMS and last value of a series of errors.
+fn error_stats(errors: impl Iterator<Item = f64>) -> (Option<f64>, Option<f64>, Option<f64>) {
+    let (mut max_abs, mut sum_sq, mut n, mut last) = (0.0_f64, 0.0_f64, 0_usize, None);
+    for e in errors {
+        max_abs = max_abs.max(e.abs());
+        sum_sq += e * e;
+        n += 1;
+        last = Some(e);
+    }
+    if n == 0 {
+        (None, None, None)
+    } else {
+        (Some(max_abs), Some((sum_sq / n as f64).sqrt()), last)
+    }
+}
+
+/// Replay `log` through a pipeline configured by `config` (its sample rate replaced by the
+/// log's).
+pub fn replay(log: &RegularLog, config: &Config) -> Result<RunReport, gyro_core::Error> {
+    let config = Config {
+        sample_rate_hz: log.sample_rate_hz as f32,
+        ..*config
+    };
+    let mut pipeline = Pipeline::try_new(&config)?;
+    let factor = config.decimation_factor()?;
+    let output_rate_hz = config.effective_output_rate_hz()?;
+
+    // The reference path: same decimation and low-pass, on the angle relative to its start.
+    let reference_origin = log.slots.iter().find_map(|s| s.reference_deg);
+    let mut ref_decimator = Decimator::try_new(factor)?;
+    let ref_sos: Sos = config.filter.sos(output_rate_hz.into())?;
+    let mut ref_state = SosState::new();
+    let mut ref_last = 0.0_f32;
+    let mut ref_block_complete = true;
+
+    let mut series = Vec::with_capacity(log.slots.len() / usize::from(factor) + 1);
+    let mut movements = Vec::new();
+    let mut open: Option<(f64, usize)> = None;
+    for slot in &log.slots {
+        let reference = match (slot.reference_deg, reference_origin) {
+            (Some(r), Some(origin)) => {
+                ref_last = (r - origin) as f32;
+                Some(ref_last)
+            }
+            _ => {
+                ref_block_complete = false;
+                None
+            }
+        };
+        let ref_mean = ref_decimator.push(reference.unwrap_or(ref_last));
+        let Some(out) = pipeline.push(slot.time_s, slot.rate_dps as f32) else {
+            continue;
+        };
+        let reference_deg = match ref_mean {
+            Some(mean) if reference_origin.is_some() => {
+                if series.is_empty() {
+                    ref_sos.settle(&mut ref_state, mean);
+                }
+                let filtered = ref_sos.process(&mut ref_state, mean);
+                let complete = ref_block_complete;
+                ref_block_complete = true;
+                complete.then_some(f64::from(filtered))
+            }
+            _ => None,
+        };
+        series.push(SeriesPoint {
+            time_s: out.time_s,
+            rate_dps: out.rate_dps,
+            motion: out.motion,
+            angle_deg: out.angle_deg,
+            raw_angle_deg: out.raw_angle_deg,
+            angle_std_deg: out.angle_std_deg,
+            bias_dps: out.bias_dps,
+            reference_deg,
+        });
+        match out.event {
+            Some(Event::MovementStarted { start_time_s }) => {
+                open = Some((start_time_s, index_at(&series, start_time_s)));
+            }
+            Some(Event::MovementEnded(m)) => {
+                let start = open
+                    .take()
+                    .map_or(index_at(&series, m.start_time_s), |o| o.1);
+                let end = index_at(&series, m.end_time_s);
+                movements.push(movement_result(
+                    movements.len() + 1,
+                    (m.start_time_s, m.end_time_s),
+                    true,
+                    (m.angle_deg, m.raw_angle_deg),
+                    reference_change(&series, start, end),
+                ));
+            }
+            None => {}
+        }
+    }
+    if let (Some((start_time_s, start)), Some(last)) = (open, series.last()) {
+        let first = &series[start];
+        movements.push(movement_result(
+            movements.len() + 1,
+            (start_time_s, last.time_s),
+            false,
+            (
+                last.angle_deg - first.angle_deg,
+                last.raw_angle_deg - first.raw_angle_deg,
+            ),
+            reference_change(&series, start, series.len() - 1),
+        ));
+    }
+
+    let (max_abs, rms, final_e) = error_stats(series.iter().filter_map(SeriesPoint::error_deg));
+    let (raw_max_abs, raw_rms, raw_final) = error_stats(
+        series
+            .iter()
+            .filter_map(|p| p.reference_deg.map(|r| f64::from(p.raw_angle_deg) - r)),
+    );
+    let summary = Summary {
+        compensation: config.compensation,
+        outputs: series.len(),
+        duration_s: match (series.first(), series.last()) {
+            (Some(a), Some(b)) => b.time_s - a.time_s,
+            _ => 0.0,
+        },
+        movements: movements.len(),
+        rejected_samples: pipeline.rejected_samples(),
+        final_angle_deg: series.last().map_or(0.0, |p| p.angle_deg),
+        final_raw_angle_deg: series.last().map_or(0.0, |p| p.raw_angle_deg),
+        max_abs_error_deg: max_abs,
+        rms_error_deg: rms,
+        final_error_deg: final_e,
+        raw_max_abs_error_deg: raw_max_abs,
+        raw_rms_error_deg: raw_rms,
+        raw_final_error_deg: raw_final,
+    };
+    Ok(RunReport {
+        sample_rate_hz: log.sample_rate_hz,
+        decimation_factor: factor,
+        output_rate_hz,
+        input: log.quality.clone(),
+        config,
+        summary,
+        movements,
+        series,
+    })
+}
+
+/// Index of the output sample nearest to `time_s`.
+fn index_at(series: &[SeriesPoint], time_s: f64) -> usize {
+    let i = series.partition_point(|p| p.time_s < time_s);
+    if i == 0 {
+        return 0;
+    }
+    if i >= series.len() {
+        return series.len() - 1;
+    }
+    if (series[i].time_s - time_s).abs() < (time_s - series[i - 1].time_s).abs() {
+        i
+    } else {
+        i - 1
+    }
+}
+
+fn reference_change(series: &[SeriesPoint], start: usize, end: usize) -> Option<f64> {
+    Some(series.get(end)?.reference_deg? - series.get(start)?.reference_deg?)
+}
+
+fn movement_result(
+    index: usize,
+    (start_time_s, end_time_s): (f64, f64),
+    complete: bool,
+    (angle_deg, raw_angle_deg): (f32, f32),
+    reference_deg: Option<f64>,
+) -> MovementResult {
+    MovementResult {
+        index,
+        start_time_s,
+        end_time_s,
+        duration_s: end_time_s - start_time_s,
+        complete,
+        angle_deg,
+        raw_angle_deg,
+        reference_deg,
+        error_deg: reference_deg.map(|r| f64::from(angle_deg) - r),
+        raw_error_deg: reference_deg.map(|r| f64::from(raw_angle_deg) - r),
+    }
+}
