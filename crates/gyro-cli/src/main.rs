@@ -1,18 +1,15 @@
-//! `gyro-cli`: replay gyro logs through the core pipeline.
+//! `gyro-cli`: rotation angle from a single-axis gyro; replay, simulate, calibrate, diagnose.
 
-use anyhow::{Context, Result};
-use clap::{Parser, Subcommand, ValueEnum};
-use gyro_core::{Compensation, Config};
-use gyro_host::{log, model, replay, report};
-use std::io::Write;
-use std::path::PathBuf;
+mod cmd;
+
+use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 #[derive(Parser)]
 #[command(
     name = "gyro-cli",
     version,
-    about = "Rotation angle from a single-axis gyro: replay, calibrate, diagnose"
+    about = "Rotation angle from a single-axis gyro: replay, simulate, calibrate, diagnose"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -22,98 +19,17 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Replay a log through the pipeline: angles, movements, errors against the reference.
-    Run(RunArgs),
-}
-
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum Format {
-    Table,
-    Json,
-    Csv,
-}
-
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum CompensationArg {
-    None,
-    Paper,
-    Kalman,
-}
-
-#[derive(clap::Args)]
-struct RunArgs {
-    /// The log (CSV: `time_s,rate_dps[,temperature_c][,reference_deg]`).
-    log: PathBuf,
-    /// Model file (JSON, from `calibrate`); default: the built-in configuration.
-    #[arg(long)]
-    model: Option<PathBuf>,
-    /// Override the model's compensation.
-    #[arg(long, value_enum)]
-    compensation: Option<CompensationArg>,
-    /// Output format on stdout (csv: the movements).
-    #[arg(long, value_enum, default_value_t = Format::Table)]
-    format: Format,
-    /// Write the output-rate series (angle, reference, error, state) as CSV here.
-    #[arg(long)]
-    out: Option<PathBuf>,
-    /// Sample rate of the log (Hz); default: its `sample_rate_hz` metadata, else the
-    /// median time step.
-    #[arg(long)]
-    sample_rate_hz: Option<f64>,
-    /// Longest stretch of missing data (s) bridged by interpolation; longer is an error.
-    #[arg(long, default_value_t = 0.5)]
-    max_gap_s: f64,
-    #[command(flatten)]
-    columns: log::ColumnOptions,
-}
-
-fn run(args: &RunArgs) -> Result<()> {
-    let mut config = match &args.model {
-        Some(path) => model::load(path)?.config,
-        None => Config::default(),
-    };
-    if let Some(c) = args.compensation {
-        config.compensation = match c {
-            CompensationArg::None => Compensation::None,
-            CompensationArg::Paper => Compensation::Paper,
-            CompensationArg::Kalman => Compensation::Kalman,
-        };
-    }
-    let raw = log::read_csv(&args.log, &args.columns)?;
-    let regular = log::regularize(
-        &raw,
-        &log::GridOptions {
-            sample_rate_hz: args.sample_rate_hz,
-            max_gap_s: args.max_gap_s,
-        },
-    )?;
-    let result = replay::replay(&regular, &config).with_context(|| {
-        format!(
-            "{}: cannot configure the pipeline for this log",
-            args.log.display()
-        )
-    })?;
-    let file = args.log.display().to_string();
-    let mut stdout = std::io::stdout().lock();
-    match args.format {
-        Format::Table => write!(stdout, "{}", report::table(&file, &result))?,
-        Format::Json => writeln!(stdout, "{}", report::json(&file, &result)?)?,
-        Format::Csv => report::movements_csv(&mut stdout, &result.movements)?,
-    }
-    if let Some(out) = &args.out {
-        let write = || -> std::io::Result<()> {
-            let mut w = std::io::BufWriter::new(std::fs::File::create(out)?);
-            report::series_csv(&mut w, &result)?;
-            w.flush()
-        };
-        write().with_context(|| format!("cannot write {}", out.display()))?;
-    }
-    Ok(())
+    Run(cmd::run::Args),
+    /// Simulate a sensor log: the nominal model plus optional effects, on bench-like
+    /// motion or on the motion recorded in a log's reference.
+    Simulate(cmd::simulate::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
-        Command::Run(args) => run(args),
+        Command::Run(args) => cmd::run::run(args),
+        Command::Simulate(args) => cmd::simulate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,6 +6,7 @@
 //! Missing settings take the core's defaults; unknown keys are errors (a typo must not be
 //! silently ignored). `config.sample_rate_hz` is replaced by the log's rate when replaying.
 
+use crate::sim::SensorModel;
 use gyro_core::{Config, Pipeline};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -26,6 +27,9 @@ pub struct ModelFile {
     /// The pipeline configuration.
     #[serde(default)]
     pub config: Config,
+    /// The sensor's noise and error model (for `simulate`, from `noise`/`calibrate`).
+    #[serde(default)]
+    pub sensor: SensorModel,
 }
 
 impl ModelFile {
@@ -35,6 +39,7 @@ impl ModelFile {
             format: FORMAT.into(),
             version: VERSION,
             config,
+            sensor: SensorModel::default(),
         }
     }
 }
@@ -74,6 +79,14 @@ pub enum ModelError {
         /// Version found.
         version: u32,
     },
+    /// The sensor model is invalid.
+    #[error("{path}: {message}")]
+    Sensor {
+        /// File.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// A setting is invalid.
     #[error("{path}: {source}")]
     Invalid {
@@ -107,6 +120,13 @@ pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
         path: path.to_path_buf(),
         source,
     })?;
+    model
+        .sensor
+        .validate()
+        .map_err(|message| ModelError::Sensor {
+            path: path.to_path_buf(),
+            message,
+        })?;
     Ok(model)
 }
 

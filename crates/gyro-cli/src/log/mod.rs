@@ -4,7 +4,7 @@
 mod csv_log;
 mod regular;
 
-pub use csv_log::{read_csv, ColumnOptions, RateUnit, TimeUnit};
+pub use csv_log::{read_csv, write_csv, ColumnOptions, RateUnit, TimeUnit};
 pub use regular::{regularize, GridOptions, Quality, RegularLog, Slot};
 
 use std::collections::BTreeMap;

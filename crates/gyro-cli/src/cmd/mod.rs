@@ -1,0 +1,4 @@
+//! One module per `gyro-cli` subcommand: its arguments (`Args`) and `run`.
+
+pub mod run;
+pub mod simulate;

@@ -1,0 +1,97 @@
+//! `gyro-cli run`: replay a log through the pipeline and score it against the reference.
+
+use anyhow::{Context, Result};
+use clap::ValueEnum;
+use gyro_core::{Compensation, Config};
+use gyro_host::{log, model, replay, report};
+use std::io::Write;
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// Human-readable.
+    Table,
+    /// JSON.
+    Json,
+    /// CSV of the movements.
+    Csv,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CompensationArg {
+    None,
+    Paper,
+    Kalman,
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The log (CSV: `time_s,rate_dps[,temperature_c][,reference_deg]`).
+    log: PathBuf,
+    /// Model file (JSON, from `calibrate`); default: the built-in configuration.
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Override the model's compensation.
+    #[arg(long, value_enum)]
+    compensation: Option<CompensationArg>,
+    /// Output format on stdout (csv: the movements).
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+    /// Write the output-rate series (angle, reference, error, state) as CSV here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Sample rate of the log (Hz); default: its `sample_rate_hz` metadata, else the
+    /// median time step.
+    #[arg(long)]
+    sample_rate_hz: Option<f64>,
+    /// Longest stretch of missing data (s) bridged by interpolation; longer is an error.
+    #[arg(long, default_value_t = 0.5)]
+    max_gap_s: f64,
+    #[command(flatten)]
+    columns: log::ColumnOptions,
+}
+
+/// Run the command.
+pub fn run(args: &Args) -> Result<()> {
+    let mut config = match &args.model {
+        Some(path) => model::load(path)?.config,
+        None => Config::default(),
+    };
+    if let Some(c) = args.compensation {
+        config.compensation = match c {
+            CompensationArg::None => Compensation::None,
+            CompensationArg::Paper => Compensation::Paper,
+            CompensationArg::Kalman => Compensation::Kalman,
+        };
+    }
+    let raw = log::read_csv(&args.log, &args.columns)?;
+    let regular = log::regularize(
+        &raw,
+        &log::GridOptions {
+            sample_rate_hz: args.sample_rate_hz,
+            max_gap_s: args.max_gap_s,
+        },
+    )?;
+    let result = replay::replay(&regular, &config).with_context(|| {
+        format!(
+            "{}: cannot configure the pipeline for this log",
+            args.log.display()
+        )
+    })?;
+    let file = args.log.display().to_string();
+    let mut stdout = std::io::stdout().lock();
+    match args.format {
+        Format::Table => write!(stdout, "{}", report::table(&file, &result))?,
+        Format::Json => writeln!(stdout, "{}", report::json(&file, &result)?)?,
+        Format::Csv => report::movements_csv(&mut stdout, &result.movements)?,
+    }
+    if let Some(out) = &args.out {
+        let write = || -> std::io::Result<()> {
+            let mut w = std::io::BufWriter::new(std::fs::File::create(out)?);
+            report::series_csv(&mut w, &result)?;
+            w.flush()
+        };
+        write().with_context(|| format!("cannot write {}", out.display()))?;
+    }
+    Ok(())
+}

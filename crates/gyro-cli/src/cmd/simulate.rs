@@ -1,0 +1,155 @@
+//! `gyro-cli simulate`: the sensor simulator.
+
+use anyhow::{Context, Result};
+use gyro_host::sim::{self, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+use gyro_host::{log, model};
+use std::io::Write;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Output log (CSV).
+    #[arg(short, long, required_unless_present = "list_effects")]
+    out: Option<PathBuf>,
+    /// Model file whose `sensor` section gives the nominal model; default: a CRM100
+    /// in the ±300 °/s range.
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Seed of all random streams (same seed, same log).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Duration of the generated bench-like motion (s).
+    #[arg(long, default_value_t = 90.0)]
+    duration_s: f64,
+    /// Re-simulate the motion of this log's `reference_deg` instead of generating motion.
+    #[arg(long)]
+    motion_from: Option<PathBuf>,
+    /// Add an effect: `id` or `id:name=value,...` (e.g. `scale_factor:k=0.01`); repeatable.
+    /// `--list-effects` shows them.
+    #[arg(long = "effect")]
+    effects: Vec<String>,
+    /// List the effects, their parameters and signatures, and exit.
+    #[arg(long)]
+    list_effects: bool,
+    /// Sample rate (Hz), overriding the model's.
+    #[arg(long)]
+    sample_rate_hz: Option<f64>,
+    /// Temperature rise during the run (°C, warm-up with a 120 s time constant).
+    #[arg(long, default_value_t = 5.0)]
+    temperature_rise_c: f64,
+    /// Quantise the reference like an encoder with this many counts per revolution.
+    #[arg(long)]
+    encoder_counts: Option<u32>,
+}
+
+fn list_effects() {
+    println!("{:<18} {:<36} signature", "id", "parameters (typical)");
+    for info in sim::EFFECTS {
+        let params: Vec<String> = info
+            .params
+            .iter()
+            .zip(info.typical.params())
+            .map(|((name, unit), v)| format!("{name}={v} {unit}"))
+            .collect();
+        println!(
+            "{:<18} {:<36} {}",
+            info.id,
+            params.join(", "),
+            info.signature
+        );
+    }
+}
+
+/// Run the command.
+pub fn run(args: &Args) -> Result<()> {
+    if args.list_effects {
+        list_effects();
+        return Ok(());
+    }
+    let mut sensor = match &args.model {
+        Some(path) => model::load(path)?.sensor,
+        None => SensorModel::default(),
+    };
+    if let Some(rate) = args.sample_rate_hz {
+        sensor.sample_rate_hz = rate;
+    }
+    sensor.validate().map_err(anyhow::Error::msg)?;
+    let effects = args
+        .effects
+        .iter()
+        .map(|spec| Effect::parse(spec).map_err(anyhow::Error::msg))
+        .collect::<Result<Vec<_>>>()?;
+    let motion = match &args.motion_from {
+        Some(path) => {
+            let raw = log::read_csv(path, &log::ColumnOptions::default())?;
+            if !raw.has_reference {
+                anyhow::bail!(
+                    "{}: no reference_deg column to take the motion from",
+                    path.display()
+                );
+            }
+            let regular = log::regularize(&raw, &log::GridOptions::default())?;
+            let period_s = 1.0 / regular.sample_rate_hz;
+            let reference: Vec<f64> = regular
+                .slots
+                .iter()
+                .map(|s| s.reference_deg)
+                .collect::<Option<Vec<_>>>()
+                .with_context(|| {
+                    format!(
+                        "{}: the reference has gaps longer than 0.5 s",
+                        path.display()
+                    )
+                })?;
+            // Smooth over ~20 ms: encoder steps would otherwise be rate spikes.
+            let smooth = ((0.02 * regular.sample_rate_hz).round() as usize).max(1);
+            Motion::from_reference(0.0, period_s, &reference, smooth)
+        }
+        None => {
+            if !(args.duration_s > 0.0 && args.duration_s <= 86_400.0) {
+                anyhow::bail!("--duration-s must be in (0, 86400]");
+            }
+            Motion::bench(
+                &BenchProfile {
+                    duration_s: args.duration_s,
+                    ..BenchProfile::default()
+                },
+                args.seed,
+            )
+        }
+    };
+    let options = SimOptions {
+        seed: args.seed,
+        temperature_rise_c: args.temperature_rise_c,
+        encoder_counts: args.encoder_counts,
+        ..SimOptions::default()
+    };
+    let Some(out) = &args.out else {
+        anyhow::bail!("--out is required");
+    };
+    let log = sim::simulate(&sensor, &effects, &motion, &options);
+    let write = || -> std::io::Result<()> {
+        let mut w = std::io::BufWriter::new(std::fs::File::create(out)?);
+        log::write_csv(&mut w, &log)?;
+        w.flush()
+    };
+    write().with_context(|| format!("cannot write {}", out.display()))?;
+    eprintln!(
+        "wrote {} samples ({:.1} s at {} Hz, {} rotations, effects: {}) to {}",
+        log.rows.len(),
+        motion.duration_s(),
+        sensor.sample_rate_hz,
+        motion.rotations().len(),
+        if effects.is_empty() {
+            "none".to_string()
+        } else {
+            effects
+                .iter()
+                .map(Effect::id)
+                .collect::<Vec<_>>()
+                .join(", ")
+        },
+        out.display()
+    );
+    Ok(())
+}
