@@ -1,12 +1,16 @@
 //! # crm100-driver
 //!
-//! Silicon Sensing PinPoint CRM100 single-axis gyroscope: SPI frame codec and embedded-hal
-//! 1.0 driver. `no_std`, no allocation, no panics on any input bytes.
+//! Silicon Sensing PinPoint CRM100 single-axis gyroscope: SPI frame codec, embedded-hal 1.0
+//! driver, and the serial-bridge framing that carries its frames to a host. `no_std`, no
+//! allocation, no panics on any input bytes.
 //!
 //! - [`frame`]: the 6-byte SPI frame. [`command_frame`] encodes `[CMD, 0, 0, 0, 0, CHK]`,
 //!   [`decode`] turns `[STATUS, RATE_H, RATE_L, TEMP_H, TEMP_L, CHK]` into a [`Measurement`]
 //!   (°/s, °C, raw status), with switchable [`Checks`].
 //! - [`driver`]: [`Crm100`] over any [`embedded_hal::spi::SpiDevice`] in SPI [`MODE`] 0.
+//! - [`bridge`] and [`sequence`]: the framing a bridge MCU uses to forward raw responses over
+//!   UART/USB ([`encode`]), and the host's resynchronising [`BridgeDecoder`], loss-counting
+//!   [`SequenceTracker`] and the [`BridgeReceiver`] that combines them.
 //!
 //! The CRM100 datasheet was not available. Protocol facts come from public working code;
 //! what could not be confirmed is a setting, not a constant: the poll command
@@ -45,15 +49,27 @@
 //! ```
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 
+pub mod bridge;
+mod crc16;
 pub mod driver;
 mod error;
 pub mod frame;
+pub mod sequence;
 mod types;
 
+pub use bridge::{
+    encode, encode_to_array, BridgeDecoder, BridgeError, BridgeFrame, DecoderStats, Feed,
+    BRIDGE_FRAME_LEN, FORMAT_V1, SYNC,
+};
+pub use crc16::{crc16_ccitt_false, crc16_ccitt_false_update};
 pub use driver::{Crm100, RawSample, Settings, DEFAULT_CS_LEAD_NS, MODE};
 pub use error::{Error, FrameError};
 pub use frame::{
     checksum, command_frame, decode, decode_slice, verify_checksum, Response, FRAME_LEN,
+};
+pub use sequence::{
+    BridgeReceiver, Gap, Received, ReceiverFeed, ReceiverStats, SeqEvent, SequenceStats,
+    SequenceTracker, MAX_FORWARD_STEP,
 };
 pub use types::{
     temperature_c_to_word, temperature_word_to_c, Checks, Measurement, PollCommand, Range,

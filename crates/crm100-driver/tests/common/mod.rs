@@ -1,7 +1,9 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)] // each test binary uses a different subset
 
-use crm100_driver::{command_frame, Crm100, Range, Response, Settings, Status};
+use crm100_driver::{
+    command_frame, encode_to_array, BridgeFrame, Crm100, Range, Response, Settings, Status,
+};
 use embedded_hal::spi::{ErrorKind, ErrorType, Operation, SpiDevice};
 use embedded_hal_mock::eh1::spi::{Mock, Transaction};
 
@@ -93,4 +95,25 @@ impl<S: SpiDevice<u8, Error = ErrorKind>> SpiDevice<u8> for Flaky<S> {
         }
         self.inner.transaction(operations)
     }
+}
+
+/// A bridge frame with a valid CRM100 response derived from the sequence number.
+pub fn bridge_frame(sequence: u32) -> BridgeFrame {
+    let counts = (sequence as i32 % 14_401 - 7_200) as i16;
+    BridgeFrame {
+        sequence,
+        timestamp_us: 1_000 * u64::from(sequence) + 17,
+        command: 0x38,
+        response: Response {
+            status: Status(0),
+            rate_counts: counts,
+            temperature_word: 600,
+        }
+        .to_bytes(),
+    }
+}
+
+/// The 24 wire bytes of a frame.
+pub fn wire(frame: &BridgeFrame) -> Vec<u8> {
+    encode_to_array(frame).to_vec()
 }
