@@ -34,6 +34,14 @@
 //! starts inside a corrupt or truncated one is still found. Counters: bytes received, bytes
 //! skipped, frames decoded, CRC errors ([`DecoderStats`]).
 //!
+//! Limit of the format: a damaged or truncated frame, read together with the bytes that
+//! follow it, passes the 16-bit CRC by chance with probability 2⁻¹⁶. The decoder then returns
+//! a frame made of two frames' bytes, and the good frame it overlapped is lost. Depending on
+//! where the damage lies, the loss count is then one too low (the mixed frame carries the
+//! damaged frame's own sequence number) or a spurious gap or step backwards is reported.
+//! Validating the forwarded response with the CRM100 checksum ([`crate::decode`]) catches
+//! most mixed frames.
+//!
 //! [`crate::SequenceTracker`] turns sequence numbers into reported gaps, and
 //! [`crate::BridgeReceiver`] runs both. A host reader wraps either around any byte source:
 //!
