@@ -5,8 +5,8 @@
 //! for odd orders the first-order section comes first; the other sections follow in order
 //! of increasing pole radius (the pair nearest the unit circle last); the overall gain sits
 //! in the first section's numerator. The runtime cascade is f32 ([`Sos`]): the same
-//! sections, each scaled to unit DC gain and run in the state-variable form described in
-//! the `sos` module, which keeps low cutoffs accurate in f32.
+//! sections, each scaled to unit DC gain and run in the state-variable form described at
+//! [`Biquad`], which keeps low cutoffs accurate in f32.
 
 use crate::error::{check_range, Error};
 use crate::sos::{Biquad, Sos, MAX_SECTIONS};

@@ -3,46 +3,46 @@
 //! One [`Sos`] (settings) can run any number of [`SosState`]s (channels); the state resets
 //! without redesign.
 //!
-//! # Section structure
-//!
-//! A section has the transfer function of one row `[b0, b1, b2, a0, a1, a2]` of scipy's
-//! `sos` array, but it does not run in the transposed direct form II of
-//! `scipy.signal.sosfilt`. In f32 that form cannot hold low-cutoff designs: their poles
-//! sit near z = 1, so `a1 ≈ −2` and `a2 ≈ 1` carry the pole positions in their last few
-//! bits, and the state words (of the size of the output) cancel each other at every step.
-//! Measured against `sosfilt` on a unit step, f32 direct form is off by 6e-5 for an
-//! order-8 low-pass at fc = 0.01·fs and by 1.6e-4 at fc = 0.005·fs.
-//!
-//! Each section therefore runs as a trapezoidal (topology-preserving) state-variable
-//! filter (A. Simper, "Linear trapezoidal integrated SVF", 2013; V. Zavalishin, "The Art
-//! of VA Filter Design"), which realises any stable biquad exactly (in exact arithmetic)
-//! with coefficients that are small numbers stored at full relative precision:
-//!
-//! ```text
-//! c1 = A(−1)/4,  c3 = A(1)/4,  c2 = √(c1·c3),   A(z) = 1 + a1 z⁻¹ + a2 z⁻²
-//! v3 = x − s2
-//! v1 = c1·s1 + c2·v3            s1 ← 2·v1 − s1
-//! v2 = s2 + c2·s1 + c3·v3       s2 ← 2·v2 − s2
-//! y  = m0·x + m1·v1 + m2·v2
-//! ```
-//!
-//! and two refinements for f32:
-//! - `c1` is stored as `u − e` with `u` = 1 (and `e` = 1 − c1, small, at low cutoffs) or
-//!   `u` = 0 (and `e` = −c1), so that the damping, which low cutoffs put in the last bits of
-//!   `c1 ≈ 1`, is not rounded away;
-//! - `s2`, the state that sits at the output level and moves by tiny steps at low cutoffs,
-//!   is kept as an unevaluated sum `hi + lo` of two f32 (error-free "TwoSum" update);
-//!   without it the update `2·(c2·s1 + c3·v3)` falls below half an ulp of `s2` and the
-//!   output sticks up to `ulp / c3` away from its target (2e-5 for fc = 0.001·fs).
-//!
-//! The DC gain of a section is `m0 + m2` exactly, whatever the rounding of `c1..c3`: a
-//! constant input settles to `v3 = 0`, `v1 = 0`, `v2 = x`.
+//! Each section runs as a trapezoidal state-variable filter, not in the direct form of
+//! `scipy.signal.sosfilt`: see [`Biquad`] for why and how.
 
 /// Most sections a cascade holds: enough for a Butterworth design of order 8.
 pub const MAX_SECTIONS: usize = 4;
 
-/// One second-order section, in the trapezoidal state-variable form described in the
-/// [module documentation](self).
+/// One second-order section.
+///
+/// A section has the transfer function of one row `[b0, b1, b2, a0, a1, a2]` of scipy's
+/// `sos` array, but it does not run in the transposed direct form II of
+/// `scipy.signal.sosfilt`. In f32 that form cannot hold low-cutoff designs: their poles
+/// sit near z = 1, so `a1 ≈ −2` and `a2 ≈ 1` carry the pole positions in their last few
+/// bits, and the state words (of the size of the output) cancel each other at every step.
+/// Measured against `sosfilt` on a unit step, f32 direct form was off by 6e-5 for an
+/// order-8 low-pass at fc = 0.01·fs and by 1.6e-4 at fc = 0.005·fs.
+///
+/// Each section therefore runs as a trapezoidal (topology-preserving) state-variable
+/// filter (A. Simper, "Linear trapezoidal integrated SVF", 2013; V. Zavalishin, "The Art
+/// of VA Filter Design"), which realises any stable biquad exactly (in exact arithmetic)
+/// with coefficients that are small numbers stored at full relative precision:
+///
+/// ```text
+/// c1 = A(−1)/4,  c3 = A(1)/4,  c2 = √(c1·c3),   A(z) = 1 + a1 z⁻¹ + a2 z⁻²
+/// v3 = x − s2
+/// v1 = c1·s1 + c2·v3            s1 ← 2·v1 − s1
+/// v2 = s2 + c2·s1 + c3·v3       s2 ← 2·v2 − s2
+/// y  = m0·x + m1·v1 + m2·v2
+/// ```
+///
+/// and two refinements for f32:
+/// - `c1` is stored as `u − e` with `u` = 1 (and `e` = 1 − c1, small, at low cutoffs) or
+///   `u` = 0 (and `e` = −c1), so that the damping, which low cutoffs put in the last bits of
+///   `c1 ≈ 1`, is not rounded away;
+/// - `s2`, the state that sits at the output level and moves by tiny steps at low cutoffs,
+///   is kept as an unevaluated sum `hi + lo` of two f32 (error-free "TwoSum" update);
+///   without it the update `2·(c2·s1 + c3·v3)` falls below half an ulp of `s2` and the
+///   output sticks up to `ulp / c3` away from its target (2e-5 for fc = 0.001·fs).
+///
+/// The DC gain of a section is `m0 + m2` exactly, whatever the rounding of `c1..c3`: a
+/// constant input settles to `v3 = 0`, `v1 = 0`, `v2 = x`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Biquad {
