@@ -12,5 +12,6 @@
 
 pub mod log;
 pub mod model;
+pub mod nelder_mead;
 pub mod replay;
 pub mod report;
