@@ -16,3 +16,4 @@ pub mod nelder_mead;
 pub mod replay;
 pub mod report;
 pub mod sim;
+pub mod calibrate;

@@ -20,6 +20,8 @@ struct Cli {
 enum Command {
     /// Replay a log through the pipeline: angles, movements, errors against the reference.
     Run(cmd::run::Args),
+    /// Fit the error model on bench runs with an encoder reference; write a model file.
+    Calibrate(cmd::calibrate::Args),
     /// Simulate a sensor log: the nominal model plus optional effects, on bench-like
     /// motion or on the motion recorded in a log's reference.
     Simulate(cmd::simulate::Args),
@@ -30,6 +32,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Run(args) => cmd::run::run(args),
         Command::Simulate(args) => cmd::simulate::run(args),
+        Command::Calibrate(args) => cmd::calibrate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

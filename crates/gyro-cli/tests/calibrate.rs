@@ -1,0 +1,148 @@
+//! Calibration: the fast paper-mode path equals the pipeline, and a fit on runs made by
+//! the paper's own error model recovers its parameters.
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+use gyro_core::{Compensation, Config, GaussMarkov};
+use gyro_host::calibrate::{calibrate, BenchRun, CalibrateOptions, Objective, Trace};
+use gyro_host::log::{regularize, GridOptions, Log, Row};
+use gyro_host::replay::replay;
+use gyro_host::sim::{self, BenchProfile, Motion, SensorModel, SimOptions};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
+
+const FS: f64 = 200.0;
+
+/// A bench run whose gyro error follows the paper's model exactly: during each rotation
+/// the bias decays from b0 with rate β (at rest it is b0), and each rotation gains o0 from
+/// a short rate pulse at its start; plus white noise.
+fn paper_model_run(truth: &GaussMarkov, seed: u64) -> BenchRun {
+    let motion = Motion::bench(&BenchProfile::default(), seed);
+    let rotations = motion.rotations().to_vec();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed + 1000);
+    let noise = Normal::new(0.0, 0.02).unwrap();
+    let (beta, b0, o0) = (
+        f64::from(truth.beta_per_s),
+        f64::from(truth.b0_dps),
+        f64::from(truth.o0_deg),
+    );
+    let pulse_s = 0.1;
+    let n = (motion.duration_s() * FS) as usize;
+    let rows = (0..n)
+        .map(|k| {
+            let t = k as f64 / FS;
+            let bias = match rotations
+                .iter()
+                .find(|r| t >= r.start_s && t < r.start_s + r.duration_s)
+            {
+                Some(r) => {
+                    let pulse = if t < r.start_s + pulse_s { o0 / pulse_s } else { 0.0 };
+                    b0 * (-beta * (t - r.start_s)).exp() + pulse
+                }
+                None => b0,
+            };
+            Row {
+                line: k as u64 + 2,
+                time_s: t,
+                rate_dps: Some(motion.rate_dps(t) + bias + noise.sample(&mut rng)),
+                reference_deg: Some(motion.angle_deg(t)),
+                temperature_c: None,
+            }
+        })
+        .collect();
+    let log = Log {
+        path: format!("paper-model-{seed}").into(),
+        metadata: [("sample_rate_hz".to_string(), FS.to_string())].into(),
+        has_reference: true,
+        has_temperature: false,
+        rows,
+    };
+    BenchRun {
+        name: format!("paper-model-{seed}"),
+        log: regularize(&log, &GridOptions::default()).unwrap(),
+    }
+}
+
+#[test]
+fn fast_paper_path_equals_the_pipeline() {
+    let sensor = SensorModel {
+        sample_rate_hz: FS,
+        ..SensorModel::default()
+    };
+    let motion = Motion::bench(&BenchProfile::default(), 11);
+    let log = sim::simulate(&sensor, &[], &motion, &SimOptions::default());
+    let regular = regularize(&log, &GridOptions::default()).unwrap();
+    let config = Config::default();
+    let trace = Trace::new(&regular, &config).unwrap();
+    for gm in [
+        GaussMarkov { beta_per_s: 0.5, b0_dps: 0.3, o0_deg: 0.1 },
+        GaussMarkov { beta_per_s: 0.0, b0_dps: -0.2, o0_deg: 0.0 },
+        GaussMarkov { beta_per_s: 3.0, b0_dps: 1.5, o0_deg: -0.4 },
+    ] {
+        let paper = Config {
+            compensation: Compensation::Paper,
+            paper: gm,
+            ..config
+        };
+        let report = replay(&regular, &paper).unwrap();
+        let fast = trace.paper_angles(&gm);
+        assert_eq!(fast.len(), report.series.len());
+        let worst = fast
+            .iter()
+            .zip(&report.series)
+            .map(|(a, p)| (a - f64::from(p.angle_deg)).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-3, "{gm:?}: fast path differs from the pipeline by {worst} deg");
+        let (max_abs, _) = trace.paper_errors(&gm);
+        let real = report.summary.max_abs_error_deg.unwrap();
+        assert!((max_abs - real).abs() < 1e-3, "{max_abs} vs {real}");
+    }
+}
+
+#[test]
+fn fit_recovers_the_paper_model_and_halves_holdout_error() {
+    let truth = GaussMarkov {
+        beta_per_s: 0.5,
+        b0_dps: 0.4,
+        o0_deg: 0.1,
+    };
+    let runs: Vec<BenchRun> = (1..=20).map(|seed| paper_model_run(&truth, seed)).collect();
+    let (train, holdout) = runs.split_at(10);
+    let options = CalibrateOptions {
+        objective: Objective::MeanMaxAbs,
+        leave_one_out: true,
+        initial_tau_s: None,
+    };
+    let result = calibrate(train, holdout, &Config::default(), &options, &mut |_, _, _| {}).unwrap();
+    let fit = result.paper;
+    println!("truth {truth:?}\nfit   {fit:?}\nspread {:?}", result.spread);
+    assert!((fit.beta_per_s - truth.beta_per_s).abs() < 0.15 * truth.beta_per_s, "{fit:?}");
+    assert!((fit.b0_dps - truth.b0_dps).abs() < 0.1 * truth.b0_dps, "{fit:?}");
+    assert!((fit.o0_deg - truth.o0_deg).abs() < 0.05, "{fit:?}");
+    let spread = result.spread.unwrap();
+    assert_eq!(spread.refits, 10);
+    assert!(spread.b0_dps[1] < 0.05, "{spread:?}");
+
+    let max = |f: fn(&gyro_host::calibrate::RunScore) -> f64| {
+        result.holdout.iter().map(f).fold(0.0, f64::max)
+    };
+    let (none, paper) = (max(|s| s.none_max_abs_deg), max(|s| s.paper_max_abs_deg));
+    println!("hold-out worst max abs error: none {none:.3} deg, paper {paper:.3} deg");
+    assert!(paper <= 0.5 * none, "paper {paper} vs none {none}");
+    for s in &result.holdout {
+        assert!(s.paper_max_abs_deg <= 0.5 * s.none_max_abs_deg, "{s:?}");
+    }
+}
+
+#[test]
+fn runs_without_reference_are_refused() {
+    let mut run = paper_model_run(&GaussMarkov::default(), 1);
+    run.log.has_reference = false;
+    let options = CalibrateOptions {
+        objective: Objective::MeanMaxAbs,
+        leave_one_out: false,
+        initial_tau_s: None,
+    };
+    let err = calibrate(&[run], &[], &Config::default(), &options, &mut |_, _, _| {}).unwrap_err();
+    assert!(err.to_string().contains("no reference_deg column"), "{err}");
+}
