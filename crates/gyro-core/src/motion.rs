@@ -184,6 +184,14 @@ impl MotionDetector {
         self.bias_dps
     }
 
+    /// True if the state is finite (it always is for finite input).
+    pub fn is_finite(&self) -> bool {
+        self.bias_dps.is_finite()
+            && self.rest.sum.is_finite()
+            && self.run_mean.sum.is_finite()
+            && self.level.sum.is_finite()
+    }
+
     /// Mean rate over the current rest (deg/s) and its sample count, while static.
     pub fn rest_mean_dps(&self) -> Option<(f32, u32)> {
         match self.state {

@@ -184,6 +184,7 @@ impl Pipeline {
         let sos = config.filter.sos(output_rate_hz.into())?;
         config.paper.validate()?;
         let output_period_s = 1.0 / output_rate_hz;
+        let detector = MotionDetector::try_new(&config.motion, output_rate_hz)?;
         Ok(Self {
             config: *config,
             input_period_s: 1.0 / f64::from(config.sample_rate_hz),
@@ -191,7 +192,7 @@ impl Pipeline {
             decimator: Decimator::try_new(factor)?,
             sos,
             sos_state: SosState::new(),
-            detector: MotionDetector::try_new(&config.motion, output_rate_hz)?,
+            detector,
             raw: Integrator::new(output_period_s),
             corrected: Integrator::new(output_period_s),
             kalman: KalmanBias::try_new(&config.kalman, output_period_s)?,
@@ -226,6 +227,7 @@ impl Pipeline {
     /// True if all internal state is finite (it always should be).
     pub fn is_finite(&self) -> bool {
         self.sos_state.is_finite()
+            && self.detector.is_finite()
             && self.raw.is_finite()
             && self.corrected.is_finite()
             && self.kalman.is_finite()
@@ -255,7 +257,8 @@ impl Pipeline {
         }
         self.last_time_s = time_s;
         let mean_dps = self.decimator.push(rate_dps)?;
-        let centre_s = 0.5 * (self.block_start_time_s + time_s);
+        // Halves first: the sum of two huge times would overflow.
+        let centre_s = 0.5 * self.block_start_time_s + 0.5 * time_s;
         Some(self.step(centre_s, mean_dps))
     }
 
@@ -268,7 +271,13 @@ impl Pipeline {
         let rate_dps = self.sos.process(&mut self.sos_state, mean_dps);
         let phase = self.detector.update(rate_dps);
 
-        let integrates = !matches!(phase, Phase::Rest | Phase::Aborted | Phase::Ended { .. });
+        // With `min_rest` of one sample, `Ended` comes on the first quiet sample, which is
+        // the movement's last: it is integrated like `SettleFirst`.
+        let integrates = match phase {
+            Phase::Rest | Phase::Aborted => false,
+            Phase::Ended { quiet } => quiet <= 1,
+            _ => true,
+        };
         self.kalman.predict(integrates);
         let corrected_dps = rate_dps - self.kalman.bias_dps();
         let (previous_rate, previous_corrected) =
@@ -294,11 +303,12 @@ impl Pipeline {
                 // The movement starts at the quiet sample before the run.
                 let start_index = self.index.saturating_sub(u32::from(run));
                 let start_time_s = time_s - f64::from(run) * f64::from(self.output_period_s);
+                // The run so far is still pending: it belongs to the movement.
                 self.track = Some(Track {
                     start_time_s,
                     start_index,
                     raw_at_start_deg: self.raw.committed_deg(),
-                    angle_at_start_deg: self.angle_deg(),
+                    angle_at_start_deg: self.committed_angle_deg(),
                     settle: None,
                 });
                 self.commit();
@@ -318,9 +328,17 @@ impl Pipeline {
                 }
                 None
             }
-            Phase::Ended { .. } => {
-                self.discard();
-                self.finish_movement().map(Event::MovementEnded)
+            Phase::Ended { quiet } => {
+                if quiet <= 1 {
+                    // This first quiet sample is the end (see `integrates`).
+                    self.commit();
+                    if let Some(track) = self.track.as_mut() {
+                        track.settle = Some((self.index, time_s));
+                    }
+                } else {
+                    self.discard();
+                }
+                self.finish_movement(time_s).map(Event::MovementEnded)
             }
         };
         let output = Output {
@@ -352,9 +370,9 @@ impl Pipeline {
     }
 
     /// Close the movement in progress, folding paper-mode compensation into the total.
-    fn finish_movement(&mut self) -> Option<Movement> {
+    fn finish_movement(&mut self, time_s: f64) -> Option<Movement> {
         let track = self.track.take()?;
-        let (end_index, end_time_s) = track.settle.unwrap_or((self.index, self.last_time_s));
+        let (end_index, end_time_s) = track.settle.unwrap_or((self.index, time_s));
         let raw_angle_deg = self.raw.committed_deg() - track.raw_at_start_deg;
         let duration_s = (end_index - track.start_index) as f32 * self.output_period_s;
         self.paper_total
@@ -365,6 +383,16 @@ impl Pipeline {
             angle_deg: self.angle_deg() - track.angle_at_start_deg,
             raw_angle_deg,
         })
+    }
+
+    /// The angle under the configured compensation, without the pending (tentative)
+    /// integration (deg). Only called while no movement is tracked.
+    fn committed_angle_deg(&self) -> f32 {
+        match self.config.compensation {
+            Compensation::None => self.raw.committed_deg(),
+            Compensation::Kalman => self.corrected.committed_deg() + self.kalman_correction.value(),
+            Compensation::Paper => self.paper_total.value(),
+        }
     }
 
     /// The angle under the configured compensation (deg).
