@@ -184,6 +184,11 @@ impl MotionDetector {
         self.bias_dps
     }
 
+    /// Quiet samples that end a movement (`min_rest_s` at the sample rate).
+    pub(crate) const fn min_rest_samples(&self) -> u16 {
+        self.min_rest
+    }
+
     /// True if the state is finite (it always is for finite input).
     pub fn is_finite(&self) -> bool {
         self.bias_dps.is_finite()

@@ -146,6 +146,57 @@ struct Track {
     settle: Option<(u32, f64)>,
 }
 
+/// Most rest samples held back from the Kalman filter (see [`RestDelay`]).
+const MAX_REST_DELAY: usize = 32;
+
+/// A delay line for rest samples on their way to the Kalman filter's zero-rate update.
+///
+/// The quiet samples just before a movement already carry the start of its rate (below
+/// `exit_dps`, but not zero); used as bias observations they pull the bias estimate
+/// towards the movement's rate, and the error is then integrated over the whole movement.
+/// Held back for `min_rest_s` (as many samples as end a movement, at most
+/// [`MAX_REST_DELAY`]), they are dropped instead when a movement starts: both ends of a
+/// movement get the same margin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct RestDelay {
+    rates_dps: [f32; MAX_REST_DELAY],
+    head: usize,
+    len: usize,
+    capacity: usize,
+}
+
+impl RestDelay {
+    fn new(capacity: usize) -> Self {
+        Self {
+            rates_dps: [0.0; MAX_REST_DELAY],
+            head: 0,
+            len: 0,
+            capacity: capacity.min(MAX_REST_DELAY),
+        }
+    }
+
+    /// Queue `rate_dps`; returns the sample it pushes out, if the line is full.
+    fn push(&mut self, rate_dps: f32) -> Option<f32> {
+        if self.capacity == 0 {
+            return Some(rate_dps);
+        }
+        if self.len < self.capacity {
+            self.rates_dps[(self.head + self.len) % self.capacity] = rate_dps;
+            self.len += 1;
+            None
+        } else {
+            let oldest = core::mem::replace(&mut self.rates_dps[self.head], rate_dps);
+            self.head = (self.head + 1) % self.capacity;
+            Some(oldest)
+        }
+    }
+
+    fn clear(&mut self) {
+        self.head = 0;
+        self.len = 0;
+    }
+}
+
 /// The pipeline. Push input samples; every `decimation_factor`-th push returns an output.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pipeline {
@@ -159,6 +210,7 @@ pub struct Pipeline {
     raw: Integrator,
     corrected: Integrator,
     kalman: KalmanBias,
+    rest_delay: RestDelay,
     kalman_correction: KahanSum,
     paper_total: KahanSum,
     track: Option<Track>,
@@ -196,6 +248,7 @@ impl Pipeline {
             raw: Integrator::new(output_period_s),
             corrected: Integrator::new(output_period_s),
             kalman: KalmanBias::try_new(&config.kalman, output_period_s)?,
+            rest_delay: RestDelay::new(usize::from(detector.min_rest_samples())),
             kalman_correction: KahanSum::ZERO,
             paper_total: KahanSum::ZERO,
             track: None,
@@ -290,8 +343,10 @@ impl Pipeline {
 
         let event = match phase {
             Phase::Rest => {
-                let correction = self.kalman.update_at_rest(rate_dps);
-                self.kalman_correction.add(correction);
+                if let Some(rest_dps) = self.rest_delay.push(rate_dps) {
+                    let correction = self.kalman.update_at_rest(rest_dps);
+                    self.kalman_correction.add(correction);
+                }
                 None
             }
             Phase::Onset | Phase::Settling => None,
@@ -303,6 +358,8 @@ impl Pipeline {
                 // The movement starts at the quiet sample before the run.
                 let start_index = self.index.saturating_sub(u32::from(run));
                 let start_time_s = time_s - f64::from(run) * f64::from(self.output_period_s);
+                // The rest samples still held back lead into the movement: drop them.
+                self.rest_delay.clear();
                 // The run so far is still pending: it belongs to the movement.
                 self.track = Some(Track {
                     start_time_s,
