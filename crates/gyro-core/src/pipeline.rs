@@ -90,11 +90,15 @@ impl Config {
 }
 
 /// A movement start or end, reported once at the sample that confirms it.
+///
+/// Movement times are on the input's time line: the time of the output sample that
+/// bounds the movement minus the low-pass filter's group delay at DC
+/// ([`Pipeline::filter_delay_s`]), by which the filtered rate lags the input.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Event {
     /// A movement was confirmed; it started at `start_time_s` (its last quiet sample).
     MovementStarted {
-        /// Time of the movement's start (s).
+        /// Time of the movement's start (s), on the input's time line.
         start_time_s: f64,
     },
     /// A rest was confirmed after a movement.
@@ -104,9 +108,9 @@ pub enum Event {
 /// One movement, from its last quiet sample before to its first quiet sample after.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Movement {
-    /// Start time (s).
+    /// Start time (s), on the input's time line (see [`Event`]).
     pub start_time_s: f64,
-    /// End time (s).
+    /// End time (s), on the input's time line (see [`Event`]).
     pub end_time_s: f64,
     /// Angle turned, with the configured compensation (deg).
     pub angle_deg: f32,
@@ -197,12 +201,31 @@ impl RestDelay {
     }
 }
 
+/// Group delay at DC of a cascade (output samples): for each section `B/A`,
+/// `Σ k b_k / Σ b_k − Σ k a_k / Σ a_k`. Zero if not finite (no DC gain).
+fn dc_group_delay_samples(sos: &Sos) -> f64 {
+    let delay: f64 = sos
+        .sections()
+        .iter()
+        .map(|section| {
+            let [b0, b1, b2, a1, a2] = section.ba.map(f64::from);
+            (b1 + 2.0 * b2) / (b0 + b1 + b2) - (a1 + 2.0 * a2) / (1.0 + a1 + a2)
+        })
+        .sum();
+    if delay.is_finite() {
+        delay
+    } else {
+        0.0
+    }
+}
+
 /// The pipeline. Push input samples; every `decimation_factor`-th push returns an output.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pipeline {
     config: Config,
     input_period_s: f64,
     output_period_s: f32,
+    filter_delay_s: f64,
     decimator: Decimator,
     sos: Sos,
     sos_state: SosState,
@@ -241,6 +264,7 @@ impl Pipeline {
             config: *config,
             input_period_s: 1.0 / f64::from(config.sample_rate_hz),
             output_period_s,
+            filter_delay_s: dc_group_delay_samples(&sos) * f64::from(output_period_s),
             decimator: Decimator::try_new(factor)?,
             sos,
             sos_state: SosState::new(),
@@ -269,6 +293,12 @@ impl Pipeline {
     /// Output sample period (s).
     pub const fn output_period_s(&self) -> f32 {
         self.output_period_s
+    }
+
+    /// Group delay of the low-pass filter at DC (s): how far the filtered rate, and the
+    /// movement boundaries found on it, lag the input. Movement times are corrected by it.
+    pub const fn filter_delay_s(&self) -> f64 {
+        self.filter_delay_s
     }
 
     /// Input samples rejected so far (non-finite or implausible), each replaced by the
@@ -357,7 +387,8 @@ impl Pipeline {
             Phase::Started { run } => {
                 // The movement starts at the quiet sample before the run.
                 let start_index = self.index.saturating_sub(u32::from(run));
-                let start_time_s = time_s - f64::from(run) * f64::from(self.output_period_s);
+                let start_time_s =
+                    time_s - f64::from(run) * f64::from(self.output_period_s) - self.filter_delay_s;
                 // The rest samples still held back lead into the movement: drop them.
                 self.rest_delay.clear();
                 // The run so far is still pending: it belongs to the movement.
@@ -436,7 +467,7 @@ impl Pipeline {
             .add(raw_angle_deg - self.config.paper.misalignment_deg(duration_s));
         Some(Movement {
             start_time_s: track.start_time_s,
-            end_time_s,
+            end_time_s: end_time_s - self.filter_delay_s,
             angle_deg: self.angle_deg() - track.angle_at_start_deg,
             raw_angle_deg,
         })
