@@ -4,8 +4,15 @@
 //! last rest). A sample is *quiet* if `|rate - bias| ≤ exit_dps`.
 //!
 //! - Static → dynamic: a run of non-quiet samples lasting `min_motion_s` that reaches
-//!   `|rate - bias| > enter_dps` at least once. A run that never reaches `enter_dps` within
-//!   `min_rest_s` is a slow bias change, not motion, and is folded into the rest.
+//!   `|rate - bias| > enter_dps` at least once.
+//! - A run that returns to quiet before that is dropped; if it never reached `enter_dps` it
+//!   is folded into the rest (a small excursion of the rest level), otherwise its samples
+//!   are discarded: a knock must not move the bias reference.
+//! - A run that never reaches `enter_dps` but settles at a new level (`min_rest_s` of
+//!   samples within `2 × exit_dps` of each other) is a bias change, not motion: that level
+//!   becomes the rest. A slow movement, whose rate keeps rising by more than that per
+//!   `min_rest_s` until it passes `enter_dps`, is not mistaken for one, however long its
+//!   onset.
 //! - Dynamic → static: `min_rest_s` of consecutive quiet samples.
 //!
 //! A movement spans from the last quiet sample before its run to the first quiet sample
@@ -33,10 +40,23 @@ pub struct MotionConfig {
 }
 
 impl Default for MotionConfig {
+    /// Tuned for a CRM100 at 1 kHz, decimated to 50 Hz and low-passed at 10 Hz (the
+    /// default [`crate::Config`]; white noise of 0.05–0.1 deg/s rms per input sample leaves
+    /// at most about 0.019 deg/s rms):
+    ///
+    /// - `exit_dps` 0.08 (above 4 σ of that noise): a smooth rotation starts and ends where
+    ///   its rate crosses this level, so a lower level finds its ends closer to the truth.
+    ///   A 90° rotation in 4 s with a raised-cosine rate is still below 0.1 deg/s for
+    ///   60 ms after it started; at the former 0.3 deg/s the ends of such rotations were
+    ///   missed by up to 0.11 s (the pipeline tests now see at most 55 ms).
+    /// - `enter_dps` 2.0: above the sensor's bias (up to ±1 deg/s) with margin. At
+    ///   power-up, before a rest has measured the bias, the reference is
+    ///   `initial_bias_dps`; with the former 1.0 a bias of 1 deg/s was taken for a
+    ///   movement, and since no sample was then quiet, the movement never ended.
     fn default() -> Self {
         Self {
-            enter_dps: 1.0,
-            exit_dps: 0.3,
+            enter_dps: 2.0,
+            exit_dps: 0.08,
             min_motion_s: 0.06,
             min_rest_s: 0.2,
             initial_bias_dps: 0.0,
@@ -117,6 +137,10 @@ pub struct MotionDetector {
     run_reached_enter: bool,
     rest: Mean,
     run_mean: Mean,
+    /// The latest stretch of the run within `2 × exit_dps` (a candidate new rest level).
+    level: Mean,
+    level_min: f32,
+    level_max: f32,
     bias_dps: f32,
 }
 
@@ -156,6 +180,9 @@ impl MotionDetector {
             run_reached_enter: false,
             rest: Mean::default(),
             run_mean: Mean::default(),
+            level: Mean::default(),
+            level_min: 0.0,
+            level_max: 0.0,
             bias_dps: config.initial_bias_dps,
         })
     }
@@ -168,6 +195,19 @@ impl MotionDetector {
     /// The bias reference (deg/s) the thresholds are applied around.
     pub const fn bias_dps(&self) -> f32 {
         self.bias_dps
+    }
+
+    /// Quiet samples that end a movement (`min_rest_s` at the sample rate).
+    pub(crate) const fn min_rest_samples(&self) -> u16 {
+        self.min_rest
+    }
+
+    /// True if the state is finite (it always is for finite input).
+    pub fn is_finite(&self) -> bool {
+        self.bias_dps.is_finite()
+            && self.rest.sum.is_finite()
+            && self.run_mean.sum.is_finite()
+            && self.level.sum.is_finite()
     }
 
     /// Mean rate over the current rest (deg/s) and its sample count, while static.
@@ -186,7 +226,7 @@ impl MotionDetector {
             MotionState::Static if quiet => {
                 let aborted = self.run > 0;
                 if aborted {
-                    self.fold_run_into_rest();
+                    self.end_run();
                 }
                 self.add_rest(rate_dps);
                 if aborted {
@@ -199,15 +239,17 @@ impl MotionDetector {
                 self.run = self.run.saturating_add(1);
                 self.run_reached_enter |= deviation > self.enter_dps;
                 self.run_mean.add(rate_dps);
+                self.track_level(rate_dps);
                 if self.run >= self.min_motion && self.run_reached_enter {
                     let run = self.run;
                     self.state = MotionState::Dynamic;
-                    self.run = 0;
-                    self.run_mean = Mean::default();
+                    self.clear_run();
                     Phase::Started { run }
-                } else if self.run >= self.min_rest && !self.run_reached_enter {
-                    // A slow bias change, not a movement.
-                    self.fold_run_into_rest();
+                } else if !self.run_reached_enter && self.level.count >= u32::from(self.min_rest) {
+                    // A bias change, not a movement: the new level is the rest.
+                    self.rest = self.level;
+                    self.clear_run();
+                    self.refresh_bias();
                     Phase::Aborted
                 } else {
                     Phase::Onset
@@ -219,9 +261,8 @@ impl MotionDetector {
                 if self.run >= self.min_rest {
                     let quiet = self.run;
                     self.state = MotionState::Static;
-                    self.run = 0;
                     self.rest = self.run_mean;
-                    self.run_mean = Mean::default();
+                    self.clear_run();
                     self.refresh_bias();
                     Phase::Ended { quiet }
                 } else if self.run == 1 {
@@ -231,8 +272,7 @@ impl MotionDetector {
                 }
             }
             MotionState::Dynamic => {
-                self.run = 0;
-                self.run_mean = Mean::default();
+                self.clear_run();
                 Phase::Moving
             }
         }
@@ -243,12 +283,36 @@ impl MotionDetector {
         self.refresh_bias();
     }
 
-    fn fold_run_into_rest(&mut self) {
-        self.rest.merge(&self.run_mean);
+    /// A run returned to quiet: fold a small excursion into the rest, drop a knock.
+    fn end_run(&mut self) {
+        if !self.run_reached_enter {
+            self.rest.merge(&self.run_mean);
+        }
+        self.clear_run();
+        self.refresh_bias();
+    }
+
+    fn clear_run(&mut self) {
         self.run = 0;
         self.run_reached_enter = false;
         self.run_mean = Mean::default();
-        self.refresh_bias();
+        self.level = Mean::default();
+    }
+
+    /// Extend the current level by `rate_dps`, or start a new one if it would span more
+    /// than `2 × exit_dps`.
+    fn track_level(&mut self, rate_dps: f32) {
+        let low = self.level_min.min(rate_dps);
+        let high = self.level_max.max(rate_dps);
+        if self.level.count == 0 || high - low > 2.0 * self.exit_dps {
+            self.level = Mean::default();
+            self.level_min = rate_dps;
+            self.level_max = rate_dps;
+        } else {
+            self.level_min = low;
+            self.level_max = high;
+        }
+        self.level.add(rate_dps);
     }
 
     fn refresh_bias(&mut self) {
@@ -264,8 +328,17 @@ impl MotionDetector {
 mod tests {
     use super::*;
 
+    /// Round thresholds, so that the tests read easily (the defaults are tuned elsewhere).
+    fn config() -> MotionConfig {
+        MotionConfig {
+            enter_dps: 1.0,
+            exit_dps: 0.3,
+            ..MotionConfig::default()
+        }
+    }
+
     fn detector() -> MotionDetector {
-        MotionDetector::try_new(&MotionConfig::default(), 50.0).unwrap()
+        MotionDetector::try_new(&config(), 50.0).unwrap()
     }
 
     #[test]
@@ -314,6 +387,82 @@ mod tests {
         assert_eq!(d.update(0.5), Phase::Aborted);
         assert!((d.bias_dps() - 0.5).abs() < 1e-6);
         assert_eq!(d.update(0.5), Phase::Rest);
+    }
+
+    #[test]
+    fn a_bias_step_becomes_the_rest() {
+        let mut d = detector();
+        for _ in 0..50 {
+            assert_eq!(d.update(0.0), Phase::Rest);
+        }
+        // The bias jumps by 0.6 deg/s: between the thresholds, and steady.
+        for _ in 0..9 {
+            assert_eq!(d.update(0.6), Phase::Onset);
+        }
+        assert_eq!(d.update(0.6), Phase::Aborted);
+        // The new level replaces the old rest instead of being averaged with it.
+        assert!((d.bias_dps() - 0.6).abs() < 1e-6, "{}", d.bias_dps());
+        assert_eq!(d.update(0.6), Phase::Rest);
+    }
+
+    #[test]
+    fn a_slow_onset_is_not_taken_for_a_bias_change() {
+        let mut d = MotionDetector::try_new(
+            &MotionConfig {
+                enter_dps: 2.0,
+                ..config()
+            },
+            50.0,
+        )
+        .unwrap();
+        for _ in 0..50 {
+            assert_eq!(d.update(0.0), Phase::Rest);
+        }
+        // A slow rotation: the rate creeps up (4 deg/s², more than `2 × exit_dps` per
+        // `min_rest`) for 21 samples, twice `min_rest`, before it passes `enter_dps`; it is
+        // still one movement from its first non-quiet sample.
+        let mut started = None;
+        for k in 1..=40 {
+            let phase = d.update(0.35 + 0.08 * k as f32);
+            assert_ne!(phase, Phase::Aborted, "sample {k}");
+            if let Phase::Started { run } = phase {
+                started = Some((k, run));
+                break;
+            }
+        }
+        let (k, run) = started.expect("the slow movement starts");
+        assert_eq!(u32::from(run), k);
+        assert_eq!(d.bias_dps(), 0.0);
+    }
+
+    #[test]
+    fn a_knock_does_not_move_the_bias() {
+        let mut d = MotionDetector::try_new(
+            &MotionConfig {
+                min_motion_s: 0.2,
+                ..config()
+            },
+            50.0,
+        )
+        .unwrap();
+        for _ in 0..20 {
+            assert_eq!(d.update(0.0), Phase::Rest);
+        }
+        // Shorter than `min_motion`: not a movement, and not part of the rest either.
+        for _ in 0..5 {
+            assert_eq!(d.update(50.0), Phase::Onset);
+        }
+        assert_eq!(d.update(0.0), Phase::Aborted);
+        assert_eq!(d.bias_dps(), 0.0);
+        // So a later movement still ends.
+        for _ in 0..10 {
+            d.update(20.0);
+        }
+        assert_eq!(d.state(), MotionState::Dynamic);
+        for _ in 0..10 {
+            d.update(0.0);
+        }
+        assert_eq!(d.state(), MotionState::Static);
     }
 
     #[test]

@@ -49,18 +49,23 @@ pub struct Config {
 }
 
 impl Default for Config {
-    /// 1 kHz in, 50 Hz out, 2nd-order Butterworth at 10 Hz, paper mode with a zero model.
+    /// 1 kHz in, 50 Hz out, 1st-order Butterworth at 10 Hz, paper mode with a zero model.
     ///
-    /// The 10 Hz cutoff keeps hand motion (below ~5 Hz) and the final angle of a 90°
-    /// rotation in 0.8 s within 0.05° of the unfiltered one (a pipeline test checks it),
-    /// while removing most noise between 10 Hz and the 25 Hz Nyquist limit.
+    /// The 10 Hz cutoff keeps hand motion (below ~5 Hz): the final angle of a 90°
+    /// rotation in 0.8 s stays within 0.05° of the unfiltered one (a pipeline test checks
+    /// it; about 0.001° is seen). First order, because a 2nd-order Butterworth rings: after
+    /// a 90° rotation in 0.8 s its output undershoots by 0.4–0.5 deg/s, which keeps the rate
+    /// outside `motion.exit_dps` after the rotation has stopped (ends of fast rotations
+    /// were found up to 64 ms late, against 39 ms with order 1). The noise costs nothing:
+    /// the boxcar decimation has already removed most of it (white noise of 0.1 deg/s rms
+    /// at 1 kHz leaves about 0.019 deg/s rms after either order).
     fn default() -> Self {
         Self {
             sample_rate_hz: 1000.0,
             output_rate_hz: 50.0,
             max_abs_rate_dps: 1.0e4,
             filter: Butterworth {
-                order: 2,
+                order: 1,
                 cutoff_hz: 10.0,
             },
             motion: MotionConfig::default(),
@@ -90,11 +95,15 @@ impl Config {
 }
 
 /// A movement start or end, reported once at the sample that confirms it.
+///
+/// Movement times are on the input's time line: the time of the output sample that
+/// bounds the movement minus the low-pass filter's group delay at DC
+/// ([`Pipeline::filter_delay_s`]), by which the filtered rate lags the input.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Event {
     /// A movement was confirmed; it started at `start_time_s` (its last quiet sample).
     MovementStarted {
-        /// Time of the movement's start (s).
+        /// Time of the movement's start (s), on the input's time line.
         start_time_s: f64,
     },
     /// A rest was confirmed after a movement.
@@ -104,9 +113,9 @@ pub enum Event {
 /// One movement, from its last quiet sample before to its first quiet sample after.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Movement {
-    /// Start time (s).
+    /// Start time (s), on the input's time line (see [`Event`]).
     pub start_time_s: f64,
-    /// End time (s).
+    /// End time (s), on the input's time line (see [`Event`]).
     pub end_time_s: f64,
     /// Angle turned, with the configured compensation (deg).
     pub angle_deg: f32,
@@ -146,12 +155,82 @@ struct Track {
     settle: Option<(u32, f64)>,
 }
 
+/// Most rest samples held back from the Kalman filter (see [`RestDelay`]).
+const MAX_REST_DELAY: usize = 32;
+
+/// A delay line for rest samples on their way to the Kalman filter's zero-rate update.
+///
+/// The quiet samples just before a movement already carry the start of its rate (below
+/// `exit_dps`, but not zero); used as bias observations they pull the bias estimate
+/// towards the movement's rate, and the error is then integrated over the whole movement.
+/// Held back for `min_rest_s` (as many samples as end a movement, at most
+/// [`MAX_REST_DELAY`]), they are dropped instead when a movement starts: both ends of a
+/// movement get the same margin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct RestDelay {
+    rates_dps: [f32; MAX_REST_DELAY],
+    head: usize,
+    len: usize,
+    capacity: usize,
+}
+
+impl RestDelay {
+    fn new(capacity: usize) -> Self {
+        Self {
+            rates_dps: [0.0; MAX_REST_DELAY],
+            head: 0,
+            len: 0,
+            capacity: capacity.min(MAX_REST_DELAY),
+        }
+    }
+
+    /// Queue `rate_dps`; returns the sample it pushes out, if the line is full.
+    fn push(&mut self, rate_dps: f32) -> Option<f32> {
+        if self.capacity == 0 {
+            return Some(rate_dps);
+        }
+        if self.len < self.capacity {
+            self.rates_dps[(self.head + self.len) % self.capacity] = rate_dps;
+            self.len += 1;
+            None
+        } else {
+            let oldest = core::mem::replace(&mut self.rates_dps[self.head], rate_dps);
+            self.head = (self.head + 1) % self.capacity;
+            Some(oldest)
+        }
+    }
+
+    fn clear(&mut self) {
+        self.head = 0;
+        self.len = 0;
+    }
+}
+
+/// Group delay at DC of a cascade (output samples): for each section `B/A`,
+/// `Σ k b_k / Σ b_k − Σ k a_k / Σ a_k`. Zero if not finite (no DC gain).
+fn dc_group_delay_samples(sos: &Sos) -> f64 {
+    let delay: f64 = sos
+        .sections()
+        .iter()
+        .map(|section| {
+            let [b0, b1, b2, a1, a2] = section.ba.map(f64::from);
+            (b1 + 2.0 * b2) / (b0 + b1 + b2) - (a1 + 2.0 * a2) / (1.0 + a1 + a2)
+        })
+        .sum();
+    if delay.is_finite() {
+        delay
+    } else {
+        0.0
+    }
+}
+
 /// The pipeline. Push input samples; every `decimation_factor`-th push returns an output.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pipeline {
     config: Config,
     input_period_s: f64,
     output_period_s: f32,
+    filter_delay_s: f64,
     decimator: Decimator,
     sos: Sos,
     sos_state: SosState,
@@ -159,6 +238,7 @@ pub struct Pipeline {
     raw: Integrator,
     corrected: Integrator,
     kalman: KalmanBias,
+    rest_delay: RestDelay,
     kalman_correction: KahanSum,
     paper_total: KahanSum,
     track: Option<Track>,
@@ -184,17 +264,20 @@ impl Pipeline {
         let sos = config.filter.sos(output_rate_hz.into())?;
         config.paper.validate()?;
         let output_period_s = 1.0 / output_rate_hz;
+        let detector = MotionDetector::try_new(&config.motion, output_rate_hz)?;
         Ok(Self {
             config: *config,
             input_period_s: 1.0 / f64::from(config.sample_rate_hz),
             output_period_s,
+            filter_delay_s: dc_group_delay_samples(&sos) * f64::from(output_period_s),
             decimator: Decimator::try_new(factor)?,
             sos,
             sos_state: SosState::new(),
-            detector: MotionDetector::try_new(&config.motion, output_rate_hz)?,
+            detector,
             raw: Integrator::new(output_period_s),
             corrected: Integrator::new(output_period_s),
             kalman: KalmanBias::try_new(&config.kalman, output_period_s)?,
+            rest_delay: RestDelay::new(usize::from(detector.min_rest_samples())),
             kalman_correction: KahanSum::ZERO,
             paper_total: KahanSum::ZERO,
             track: None,
@@ -217,6 +300,12 @@ impl Pipeline {
         self.output_period_s
     }
 
+    /// Group delay of the low-pass filter at DC (s): how far the filtered rate, and the
+    /// movement boundaries found on it, lag the input. Movement times are corrected by it.
+    pub const fn filter_delay_s(&self) -> f64 {
+        self.filter_delay_s
+    }
+
     /// Input samples rejected so far (non-finite or implausible), each replaced by the
     /// last valid rate so that timing and block sizes stay intact.
     pub const fn rejected_samples(&self) -> u32 {
@@ -226,6 +315,7 @@ impl Pipeline {
     /// True if all internal state is finite (it always should be).
     pub fn is_finite(&self) -> bool {
         self.sos_state.is_finite()
+            && self.detector.is_finite()
             && self.raw.is_finite()
             && self.corrected.is_finite()
             && self.kalman.is_finite()
@@ -255,7 +345,8 @@ impl Pipeline {
         }
         self.last_time_s = time_s;
         let mean_dps = self.decimator.push(rate_dps)?;
-        let centre_s = 0.5 * (self.block_start_time_s + time_s);
+        // Halves first: the sum of two huge times would overflow.
+        let centre_s = 0.5 * self.block_start_time_s + 0.5 * time_s;
         Some(self.step(centre_s, mean_dps))
     }
 
@@ -268,7 +359,13 @@ impl Pipeline {
         let rate_dps = self.sos.process(&mut self.sos_state, mean_dps);
         let phase = self.detector.update(rate_dps);
 
-        let integrates = !matches!(phase, Phase::Rest | Phase::Aborted | Phase::Ended { .. });
+        // With `min_rest` of one sample, `Ended` comes on the first quiet sample, which is
+        // the movement's last: it is integrated like `SettleFirst`.
+        let integrates = match phase {
+            Phase::Rest | Phase::Aborted => false,
+            Phase::Ended { quiet } => quiet <= 1,
+            _ => true,
+        };
         self.kalman.predict(integrates);
         let corrected_dps = rate_dps - self.kalman.bias_dps();
         let (previous_rate, previous_corrected) =
@@ -281,8 +378,10 @@ impl Pipeline {
 
         let event = match phase {
             Phase::Rest => {
-                let correction = self.kalman.update_at_rest(rate_dps);
-                self.kalman_correction.add(correction);
+                if let Some(rest_dps) = self.rest_delay.push(rate_dps) {
+                    let correction = self.kalman.update_at_rest(rest_dps);
+                    self.kalman_correction.add(correction);
+                }
                 None
             }
             Phase::Onset | Phase::Settling => None,
@@ -293,12 +392,16 @@ impl Pipeline {
             Phase::Started { run } => {
                 // The movement starts at the quiet sample before the run.
                 let start_index = self.index.saturating_sub(u32::from(run));
-                let start_time_s = time_s - f64::from(run) * f64::from(self.output_period_s);
+                let start_time_s =
+                    time_s - f64::from(run) * f64::from(self.output_period_s) - self.filter_delay_s;
+                // The rest samples still held back lead into the movement: drop them.
+                self.rest_delay.clear();
+                // The run so far is still pending: it belongs to the movement.
                 self.track = Some(Track {
                     start_time_s,
                     start_index,
                     raw_at_start_deg: self.raw.committed_deg(),
-                    angle_at_start_deg: self.angle_deg(),
+                    angle_at_start_deg: self.committed_angle_deg(),
                     settle: None,
                 });
                 self.commit();
@@ -318,9 +421,17 @@ impl Pipeline {
                 }
                 None
             }
-            Phase::Ended { .. } => {
-                self.discard();
-                self.finish_movement().map(Event::MovementEnded)
+            Phase::Ended { quiet } => {
+                if quiet <= 1 {
+                    // This first quiet sample is the end (see `integrates`).
+                    self.commit();
+                    if let Some(track) = self.track.as_mut() {
+                        track.settle = Some((self.index, time_s));
+                    }
+                } else {
+                    self.discard();
+                }
+                self.finish_movement(time_s).map(Event::MovementEnded)
             }
         };
         let output = Output {
@@ -352,19 +463,29 @@ impl Pipeline {
     }
 
     /// Close the movement in progress, folding paper-mode compensation into the total.
-    fn finish_movement(&mut self) -> Option<Movement> {
+    fn finish_movement(&mut self, time_s: f64) -> Option<Movement> {
         let track = self.track.take()?;
-        let (end_index, end_time_s) = track.settle.unwrap_or((self.index, self.last_time_s));
+        let (end_index, end_time_s) = track.settle.unwrap_or((self.index, time_s));
         let raw_angle_deg = self.raw.committed_deg() - track.raw_at_start_deg;
         let duration_s = (end_index - track.start_index) as f32 * self.output_period_s;
         self.paper_total
             .add(raw_angle_deg - self.config.paper.misalignment_deg(duration_s));
         Some(Movement {
             start_time_s: track.start_time_s,
-            end_time_s,
+            end_time_s: end_time_s - self.filter_delay_s,
             angle_deg: self.angle_deg() - track.angle_at_start_deg,
             raw_angle_deg,
         })
+    }
+
+    /// The angle under the configured compensation, without the pending (tentative)
+    /// integration (deg). Only called while no movement is tracked.
+    fn committed_angle_deg(&self) -> f32 {
+        match self.config.compensation {
+            Compensation::None => self.raw.committed_deg(),
+            Compensation::Kalman => self.corrected.committed_deg() + self.kalman_correction.value(),
+            Compensation::Paper => self.paper_total.value(),
+        }
     }
 
     /// The angle under the configured compensation (deg).
