@@ -15,9 +15,9 @@
 //! data's correlation estimate (or 0.01 1/s), b0 = the median rest bias, o0 = 0.
 
 use crate::log::RegularLog;
-use crate::nelder_mead::{Bounds, NelderMead, Termination};
+use crate::nelder_mead::{Bounds, InitialSteps, NelderMead, Termination};
 use crate::replay::{replay, RunReport, Summary};
-use gyro_core::{Compensation, Config, GaussMarkov, MotionState};
+use gyro_core::{Compensation, Config, GaussMarkov, MotionState, Pipeline};
 use serde::Serialize;
 
 /// A bench run: a log with a reference.
@@ -40,15 +40,33 @@ pub enum Objective {
     MeanRms,
     /// Max over runs of the max abs angle error.
     WorstMaxAbs,
+    /// RMS over all completed movements of the movement's angle error (the angle a
+    /// wrench reports when the turn ends); least squares on the movement totals.
+    MovementRms,
 }
 
 impl Objective {
-    fn combine(self, per_run: impl Iterator<Item = (f64, f64)>) -> f64 {
+    /// The objective over `traces` for paper-mode parameters `gm` (deg).
+    fn evaluate(self, traces: &[Trace], gm: &GaussMarkov) -> f64 {
+        if self == Objective::MovementRms {
+            let (mut sum_sq, mut n) = (0.0, 0_usize);
+            for e in traces.iter().flat_map(|t| t.paper_movement_errors(gm)) {
+                sum_sq += e * e;
+                n += 1;
+            }
+            return if n == 0 {
+                f64::INFINITY
+            } else {
+                (sum_sq / n as f64).sqrt()
+            };
+        }
         let (mut sum, mut worst, mut n) = (0.0, 0.0_f64, 0_usize);
-        for (max_abs, rms) in per_run {
-            let v = match self {
-                Objective::MeanMaxAbs | Objective::WorstMaxAbs => max_abs,
-                Objective::MeanRms => rms,
+        for trace in traces {
+            let (max_abs, rms) = trace.paper_errors(gm);
+            let v = if self == Objective::MeanRms {
+                rms
+            } else {
+                max_abs
             };
             sum += v;
             worst = worst.max(v);
@@ -95,14 +113,25 @@ impl Trace {
             ..*config
         };
         let report = replay(log, &none)?;
-        Ok(Self::from_report(&report))
+        let delay_s = Pipeline::try_new(&report.config)?.filter_delay_s();
+        Ok(Self::from_report(&report, delay_s))
     }
 
-    fn from_report(report: &RunReport) -> Self {
+    /// `delay_s`: the pipeline's filter delay, which it subtracts from movement times.
+    fn from_report(report: &RunReport, delay_s: f64) -> Self {
         let series = &report.series;
         let output_period_s = 1.0 / f64::from(report.output_rate_hz);
+        // The output sample a movement boundary belongs to: nearest to time + delay.
         let index_of = |time_s: f64| -> usize {
-            let i = series.partition_point(|p| p.time_s < time_s - 0.25 * output_period_s);
+            let t = time_s + delay_s;
+            let i = series.partition_point(|p| p.time_s < t);
+            let i = if i > 0
+                && (i >= series.len() || (t - series[i - 1].time_s) < (series[i].time_s - t))
+            {
+                i - 1
+            } else {
+                i
+            };
             i.min(series.len().saturating_sub(1))
         };
         let spans = report
@@ -146,8 +175,12 @@ impl Trace {
             let margin = min_len / 5;
             let rest = &series[(start + margin).min(k)..k.saturating_sub(margin).max(start)];
             if rest.len() >= min_len {
-                let mean = rest.iter().map(|p| f64::from(p.rate_dps)).sum::<f64>() / rest.len() as f64;
-                sum_sq += rest.iter().map(|p| (f64::from(p.rate_dps) - mean).powi(2)).sum::<f64>();
+                let mean =
+                    rest.iter().map(|p| f64::from(p.rate_dps)).sum::<f64>() / rest.len() as f64;
+                sum_sq += rest
+                    .iter()
+                    .map(|p| (f64::from(p.rate_dps) - mean).powi(2))
+                    .sum::<f64>();
                 count += rest.len() - 1;
                 rest_means_dps.push(mean);
             }
@@ -164,7 +197,9 @@ impl Trace {
 
     /// Paper-mode angle at every output sample for parameters `gm`.
     pub fn paper_angles(&self, gm: &GaussMarkov) -> Vec<f64> {
-        let o = |samples: usize| f64::from(gm.misalignment_deg(samples as f32 * self.output_period_s as f32));
+        let o = |samples: usize| {
+            f64::from(gm.misalignment_deg(samples as f32 * self.output_period_s as f32))
+        };
         let mut angles = vec![0.0; self.raw_deg.len()];
         let mut total = 0.0;
         let mut k = 0;
@@ -193,6 +228,25 @@ impl Trace {
             k += 1;
         }
         angles
+    }
+
+    /// Paper-mode angle error of each completed movement (deg): the movement's angle
+    /// minus the reference's change over it.
+    pub fn paper_movement_errors(&self, gm: &GaussMarkov) -> Vec<f64> {
+        let o = |samples: usize| {
+            f64::from(gm.misalignment_deg(samples as f32 * self.output_period_s as f32))
+        };
+        self.spans
+            .iter()
+            .filter_map(|span| {
+                let (end, ended) = span.end?;
+                let reference = self.reference_deg.get(end)?.as_ref()?
+                    - self.reference_deg.get(span.start)?.as_ref()?;
+                let angle =
+                    self.raw_deg.get(ended)? - self.raw_deg[span.start] - o(end - span.start);
+                Some(angle - reference)
+            })
+            .collect()
     }
 
     /// Max abs and RMS of the paper-mode angle error against the reference.
@@ -230,17 +284,33 @@ pub struct RunScore {
     pub rms_deg: [f64; 3],
 }
 
+/// One parameter under leave-one-run-out refits.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ParamSpread {
+    /// Mean of the refits.
+    pub mean: f64,
+    /// Standard deviation of the refits.
+    pub sd: f64,
+    /// Smallest refit.
+    pub min: f64,
+    /// Largest refit.
+    pub max: f64,
+    /// Jackknife standard error of the full fit: `sqrt((n−1)/n · Σ(θ_i − θ̄)²)`. Refits
+    /// on n−1 of n runs barely differ, so their sd understates the uncertainty by ≈ √n.
+    pub standard_error: f64,
+}
+
 /// Spread of the parameters under leave-one-run-out refits.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Spread {
     /// Refits done (one per left-out run).
     pub refits: usize,
-    /// (mean, standard deviation, min, max) of β (1/s).
-    pub beta_per_s: [f64; 4],
-    /// Same for b0 (deg/s).
-    pub b0_dps: [f64; 4],
-    /// Same for o0 (deg).
-    pub o0_deg: [f64; 4],
+    /// β (1/s).
+    pub beta_per_s: ParamSpread,
+    /// b0 (deg/s).
+    pub b0_dps: ParamSpread,
+    /// o0 (deg).
+    pub o0_deg: ParamSpread,
 }
 
 /// The outcome of a calibration.
@@ -291,6 +361,18 @@ pub enum CalibrateError {
     Optimiser(String),
 }
 
+fn param_spread(values: &[f64]) -> ParamSpread {
+    let [mean, sd, min, max] = stats(values);
+    let n = values.len() as f64;
+    ParamSpread {
+        mean,
+        sd,
+        min,
+        max,
+        standard_error: sd * (n - 1.0) / n.sqrt(),
+    }
+}
+
 fn stats(values: &[f64]) -> [f64; 4] {
     let n = values.len().max(1) as f64;
     let mean = values.iter().sum::<f64>() / n;
@@ -321,34 +403,51 @@ fn fit_paper(
         b0_dps: x[1] as f32,
         o0_deg: x[2] as f32,
     };
-    let bounds = Bounds::new(vec![1e-4_f64.ln(), -10.0, -5.0], vec![10f64.ln(), 10.0, 5.0])
-        .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
+    let bounds = Bounds::new(
+        vec![1e-4_f64.ln(), -10.0, -5.0],
+        vec![10f64.ln(), 10.0, 5.0],
+    )
+    .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
+    // Initial steps of a size that matters for each parameter (scipy's 5 % rule would give
+    // o0 = 0 a step of 0.00025 and a flat simplex); one restart from the result guards
+    // against the simplex collapsing early.
     let optimiser = NelderMead::new()
         .with_bounds(bounds)
-        .with_x_tolerance(1e-4)
-        .and_then(|o| o.with_f_tolerance(1e-5))
-        .and_then(|o| o.with_max_evaluations(2000))
+        .with_initial_steps(InitialSteps::Absolute(vec![0.7, 0.1, 0.05]))
+        .and_then(|o| o.with_x_tolerance(1e-4))
+        .and_then(|o| o.with_f_tolerance(1e-6))
+        .and_then(|o| o.with_max_evaluations(1500))
         .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
-    let x0 = [
+    let mut x = vec![
         f64::from(start.beta_per_s).clamp(1.1e-4, 9.0).ln(),
         f64::from(start.b0_dps).clamp(-9.0, 9.0),
         f64::from(start.o0_deg).clamp(-4.0, 4.0),
     ];
     let (mut evaluations, mut best) = (0, f64::INFINITY);
-    let outcome = optimiser
-        .minimize(
-            |x| {
-                let gm = to_gm(x);
-                let value = objective.combine(traces.iter().map(|t| t.paper_errors(&gm)));
-                evaluations += 1;
-                best = best.min(value);
-                progress(evaluations, best);
-                value
-            },
-            x0,
-        )
-        .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
-    Ok((to_gm(&outcome.x), outcome.f, outcome.termination, outcome.evaluations))
+    let mut outcome = None;
+    for _ in 0..2 {
+        let result = optimiser
+            .minimize(
+                |x| {
+                    let value = objective.evaluate(traces, &to_gm(x));
+                    evaluations += 1;
+                    best = best.min(value);
+                    progress(evaluations, best);
+                    value
+                },
+                x.clone(),
+            )
+            .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
+        x.clone_from(&result.x);
+        outcome = Some(result);
+    }
+    let outcome = outcome.ok_or_else(|| CalibrateError::Optimiser("no run".into()))?;
+    Ok((
+        to_gm(&outcome.x),
+        outcome.f,
+        outcome.termination,
+        evaluations,
+    ))
 }
 
 fn score(run: &BenchRun, config: &Config) -> Result<RunScore, CalibrateError> {
@@ -364,7 +463,12 @@ fn score(run: &BenchRun, config: &Config) -> Result<RunScore, CalibrateError> {
                 source,
             })
     };
-    let [none, paper, kalman] = [Compensation::None, Compensation::Paper, Compensation::Kalman].map(summary);
+    let [none, paper, kalman] = [
+        Compensation::None,
+        Compensation::Paper,
+        Compensation::Kalman,
+    ]
+    .map(summary);
     let (none, paper, kalman) = (none?, paper?, kalman?);
     let nan = f64::NAN;
     Ok(RunScore {
@@ -423,14 +527,19 @@ pub fn calibrate(
     if traces.iter().all(|t| t.spans.is_empty()) {
         return Err(CalibrateError::NoMovement);
     }
-    let rest_means: Vec<f64> = traces.iter().flat_map(|t| t.rest_means_dps.iter().copied()).collect();
+    let rest_means: Vec<f64> = traces
+        .iter()
+        .flat_map(|t| t.rest_means_dps.iter().copied())
+        .collect();
     let start = GaussMarkov {
         beta_per_s: (1.0 / options.initial_tau_s.unwrap_or(100.0)) as f32,
         b0_dps: median(rest_means.clone()).unwrap_or(0.0) as f32,
         o0_deg: 0.0,
     };
     let (paper, objective_deg, termination, evaluations) =
-        fit_paper(&traces, options.objective, start, &mut |n, best| progress("fit", n, best))?;
+        fit_paper(&traces, options.objective, start, &mut |n, best| {
+            progress("fit", n, best)
+        })?;
 
     let spread = if options.leave_one_out && traces.len() >= 3 {
         let mut fits = Vec::with_capacity(traces.len());
@@ -442,11 +551,17 @@ pub fn calibrate(
                 .map(|(_, t)| t.clone())
                 .collect();
             let (gm, ..) = fit_paper(&others, options.objective, paper, &mut |_, best| {
-                progress(&format!("leave-one-out {}/{}", i + 1, traces.len()), i, best)
+                progress(
+                    &format!("leave-one-out {}/{}", i + 1, traces.len()),
+                    i,
+                    best,
+                )
             })?;
             fits.push(gm);
         }
-        let pick = |f: fn(&GaussMarkov) -> f32| stats(&fits.iter().map(|g| f64::from(f(g))).collect::<Vec<_>>());
+        let pick = |f: fn(&GaussMarkov) -> f32| {
+            param_spread(&fits.iter().map(|g| f64::from(f(g))).collect::<Vec<_>>())
+        };
         Some(Spread {
             refits: fits.len(),
             beta_per_s: pick(|g| g.beta_per_s),
@@ -470,9 +585,17 @@ pub fn calibrate(
     for t in &traces {
         if let [first, ..] = t.rest_means_dps.as_slice() {
             let mean = t.rest_means_dps.iter().sum::<f64>() / t.rest_means_dps.len() as f64;
-            within_sq += t.rest_means_dps.iter().map(|m| (m - mean).powi(2)).sum::<f64>();
+            within_sq += t
+                .rest_means_dps
+                .iter()
+                .map(|m| (m - mean).powi(2))
+                .sum::<f64>();
             within_n += t.rest_means_dps.len() - 1;
-            run_means.push(if t.rest_means_dps.len() == 1 { *first } else { mean });
+            run_means.push(if t.rest_means_dps.len() == 1 {
+                *first
+            } else {
+                mean
+            });
         }
     }
     if within_n > 0 {
@@ -495,7 +618,9 @@ pub fn calibrate(
         .map(|run| score(run, &config))
         .collect::<Result<Vec<_>, _>>()?;
     // Use the compensation that did best on the training runs.
-    let mean = |f: fn(&RunScore) -> f64| train_scores.iter().map(f).sum::<f64>() / train_scores.len() as f64;
+    let mean = |f: fn(&RunScore) -> f64| {
+        train_scores.iter().map(f).sum::<f64>() / train_scores.len() as f64
+    };
     config.compensation = if mean(|s| s.kalman_max_abs_deg) < mean(|s| s.paper_max_abs_deg) {
         Compensation::Kalman
     } else {

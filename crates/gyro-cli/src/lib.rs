@@ -10,10 +10,10 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod calibrate;
 pub mod log;
 pub mod model;
 pub mod nelder_mead;
 pub mod replay;
 pub mod report;
 pub mod sim;
-pub mod calibrate;

@@ -36,7 +36,11 @@ fn paper_model_run(truth: &GaussMarkov, seed: u64) -> BenchRun {
                 .find(|r| t >= r.start_s && t < r.start_s + r.duration_s)
             {
                 Some(r) => {
-                    let pulse = if t < r.start_s + pulse_s { o0 / pulse_s } else { 0.0 };
+                    let pulse = if t < r.start_s + pulse_s {
+                        o0 / pulse_s
+                    } else {
+                        0.0
+                    };
                     b0 * (-beta * (t - r.start_s)).exp() + pulse
                 }
                 None => b0,
@@ -75,9 +79,21 @@ fn fast_paper_path_equals_the_pipeline() {
     let config = Config::default();
     let trace = Trace::new(&regular, &config).unwrap();
     for gm in [
-        GaussMarkov { beta_per_s: 0.5, b0_dps: 0.3, o0_deg: 0.1 },
-        GaussMarkov { beta_per_s: 0.0, b0_dps: -0.2, o0_deg: 0.0 },
-        GaussMarkov { beta_per_s: 3.0, b0_dps: 1.5, o0_deg: -0.4 },
+        GaussMarkov {
+            beta_per_s: 0.5,
+            b0_dps: 0.3,
+            o0_deg: 0.1,
+        },
+        GaussMarkov {
+            beta_per_s: 0.0,
+            b0_dps: -0.2,
+            o0_deg: 0.0,
+        },
+        GaussMarkov {
+            beta_per_s: 3.0,
+            b0_dps: 1.5,
+            o0_deg: -0.4,
+        },
     ] {
         let paper = Config {
             compensation: Compensation::Paper,
@@ -92,7 +108,10 @@ fn fast_paper_path_equals_the_pipeline() {
             .zip(&report.series)
             .map(|(a, p)| (a - f64::from(p.angle_deg)).abs())
             .fold(0.0, f64::max);
-        assert!(worst < 1e-3, "{gm:?}: fast path differs from the pipeline by {worst} deg");
+        assert!(
+            worst < 1e-3,
+            "{gm:?}: fast path differs from the pipeline by {worst} deg"
+        );
         let (max_abs, _) = trace.paper_errors(&gm);
         let real = report.summary.max_abs_error_deg.unwrap();
         assert!((max_abs - real).abs() < 1e-3, "{max_abs} vs {real}");
@@ -108,20 +127,54 @@ fn fit_recovers_the_paper_model_and_halves_holdout_error() {
     };
     let runs: Vec<BenchRun> = (1..=20).map(|seed| paper_model_run(&truth, seed)).collect();
     let (train, holdout) = runs.split_at(10);
+    // Least squares on the movement totals: the estimator for parameter recovery (the
+    // paper's max-abs objective weighs transients inside movements, see the next test).
     let options = CalibrateOptions {
-        objective: Objective::MeanMaxAbs,
+        objective: Objective::MovementRms,
         leave_one_out: true,
         initial_tau_s: None,
     };
-    let result = calibrate(train, holdout, &Config::default(), &options, &mut |_, _, _| {}).unwrap();
+    let result = calibrate(
+        train,
+        holdout,
+        &Config::default(),
+        &options,
+        &mut |_, _, _| {},
+    )
+    .unwrap();
     let fit = result.paper;
     println!("truth {truth:?}\nfit   {fit:?}\nspread {:?}", result.spread);
-    assert!((fit.beta_per_s - truth.beta_per_s).abs() < 0.15 * truth.beta_per_s, "{fit:?}");
-    assert!((fit.b0_dps - truth.b0_dps).abs() < 0.1 * truth.b0_dps, "{fit:?}");
-    assert!((fit.o0_deg - truth.o0_deg).abs() < 0.05, "{fit:?}");
+    // Each parameter within two jackknife standard errors of the truth. (β, b0, o0) trade
+    // off against each other over movements of 0.8-4 s, so the curve o(t) is pinned much
+    // more tightly than the parameters: within 0.04 deg of the truth over that range. The
+    // model is applied over the *detected* movement, whose ends differ from the generated
+    // rotation's by up to ~50 ms, during which the 0.4 deg/s bias adds 0.02 deg per end.
     let spread = result.spread.unwrap();
     assert_eq!(spread.refits, 10);
-    assert!(spread.b0_dps[1] < 0.05, "{spread:?}");
+    // The standard errors themselves must be small enough to mean something.
+    for (name, got, want, p, max_se) in [
+        (
+            "beta",
+            fit.beta_per_s,
+            truth.beta_per_s,
+            spread.beta_per_s,
+            0.2,
+        ),
+        ("b0", fit.b0_dps, truth.b0_dps, spread.b0_dps, 0.1),
+        ("o0", fit.o0_deg, truth.o0_deg, spread.o0_deg, 0.1),
+    ] {
+        let miss = f64::from(got - want).abs();
+        assert!(
+            miss <= 2.0 * p.standard_error,
+            "{name}: {got} vs {want}, se {}",
+            p.standard_error
+        );
+        assert!(p.standard_error < max_se, "{name}: se {}", p.standard_error);
+    }
+    for t in [0.8_f32, 1.5, 2.5, 4.0] {
+        let miss = (fit.misalignment_deg(t) - truth.misalignment_deg(t)).abs();
+        assert!(miss < 0.04, "o({t}) misses by {miss} deg");
+    }
 
     let max = |f: fn(&gyro_host::calibrate::RunScore) -> f64| {
         result.holdout.iter().map(f).fold(0.0, f64::max)
@@ -129,6 +182,36 @@ fn fit_recovers_the_paper_model_and_halves_holdout_error() {
     let (none, paper) = (max(|s| s.none_max_abs_deg), max(|s| s.paper_max_abs_deg));
     println!("hold-out worst max abs error: none {none:.3} deg, paper {paper:.3} deg");
     assert!(paper <= 0.5 * none, "paper {paper} vs none {none}");
+    for s in &result.holdout {
+        assert!(s.paper_max_abs_deg <= 0.5 * s.none_max_abs_deg, "{s:?}");
+    }
+}
+
+#[test]
+fn paper_objective_also_halves_holdout_error() {
+    let truth = GaussMarkov {
+        beta_per_s: 0.5,
+        b0_dps: 0.4,
+        o0_deg: 0.1,
+    };
+    let runs: Vec<BenchRun> = (21..=30)
+        .map(|seed| paper_model_run(&truth, seed))
+        .collect();
+    let (train, holdout) = runs.split_at(5);
+    let options = CalibrateOptions {
+        objective: Objective::MeanMaxAbs,
+        leave_one_out: false,
+        initial_tau_s: None,
+    };
+    let result = calibrate(
+        train,
+        holdout,
+        &Config::default(),
+        &options,
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    println!("paper objective fit {:?}", result.paper);
     for s in &result.holdout {
         assert!(s.paper_max_abs_deg <= 0.5 * s.none_max_abs_deg, "{s:?}");
     }

@@ -1,6 +1,6 @@
 //! The real-time pipeline: decimate → low-pass → detect motion → integrate → compensate.
 
-use crate::butterworth::Butterworth;
+use crate::butterworth::{Butterworth, SosDesign};
 use crate::decimator::Decimator;
 use crate::error::{check_range, Error};
 use crate::gauss_markov::GaussMarkov;
@@ -18,9 +18,9 @@ pub enum Compensation {
     /// The integrated rate as it is.
     None,
     /// The paper's error model: subtract the modelled misalignment o(t_m) per movement.
-    #[default]
     Paper,
     /// The Kalman form: Gauss-Markov bias with zero-rate updates at rest.
+    #[default]
     Kalman,
 }
 
@@ -49,27 +49,30 @@ pub struct Config {
 }
 
 impl Default for Config {
-    /// 1 kHz in, 50 Hz out, 1st-order Butterworth at 10 Hz, paper mode with a zero model.
+    /// 1 kHz in, 50 Hz out, 2nd-order Butterworth at 12.5 Hz, Kalman compensation.
     ///
-    /// The 10 Hz cutoff keeps hand motion (below ~5 Hz): the final angle of a 90°
-    /// rotation in 0.8 s stays within 0.05° of the unfiltered one (a pipeline test checks
-    /// it; about 0.001° is seen). First order, because a 2nd-order Butterworth rings: after
-    /// a 90° rotation in 0.8 s its output undershoots by 0.4–0.5 deg/s, which keeps the rate
-    /// outside `motion.exit_dps` after the rotation has stopped (ends of fast rotations
-    /// were found up to 64 ms late, against 39 ms with order 1). The noise costs nothing:
-    /// the boxcar decimation has already removed most of it (white noise of 0.1 deg/s rms
-    /// at 1 kHz leaves about 0.019 deg/s rms after either order).
+    /// The cutoff keeps hand motion (below ~5 Hz): the final angle of a 90° rotation in
+    /// 0.8 s stays within 0.05° of the unfiltered one (a pipeline test checks it; about
+    /// 0.001° is seen). 12.5 Hz rather than lower because a 2nd-order Butterworth rings:
+    /// at 10 Hz its undershoot after a fast stop (0.4–0.5 deg/s) kept the rate outside
+    /// `motion.exit_dps` long enough to find ends of fast rotations up to 64 ms late; at
+    /// 12.5 Hz starts and ends stay within 55 ms on bench-like runs (a test checks 60 ms).
+    /// Noise costs little: the boxcar decimation has already removed most of it.
+    ///
+    /// Kalman compensation by default: it needs no calibration (the bias comes from the
+    /// rests), whereas the paper's model is only as good as its fitted parameters and
+    /// with the default zero model equals no compensation.
     fn default() -> Self {
         Self {
             sample_rate_hz: 1000.0,
             output_rate_hz: 50.0,
             max_abs_rate_dps: 1.0e4,
             filter: Butterworth {
-                order: 1,
-                cutoff_hz: 10.0,
+                order: 2,
+                cutoff_hz: 12.5,
             },
             motion: MotionConfig::default(),
-            compensation: Compensation::Paper,
+            compensation: Compensation::Kalman,
             paper: GaussMarkov::default(),
             kalman: KalmanConfig::default(),
         }
@@ -208,13 +211,12 @@ impl RestDelay {
 
 /// Group delay at DC of a cascade (output samples): for each section `B/A`,
 /// `Σ k b_k / Σ b_k − Σ k a_k / Σ a_k`. Zero if not finite (no DC gain).
-fn dc_group_delay_samples(sos: &Sos) -> f64 {
-    let delay: f64 = sos
+fn dc_group_delay_samples(design: &SosDesign) -> f64 {
+    let delay: f64 = design
         .sections()
         .iter()
-        .map(|section| {
-            let [b0, b1, b2, a1, a2] = section.ba.map(f64::from);
-            (b1 + 2.0 * b2) / (b0 + b1 + b2) - (a1 + 2.0 * a2) / (1.0 + a1 + a2)
+        .map(|&[b0, b1, b2, a0, a1, a2]| {
+            (b1 + 2.0 * b2) / (b0 + b1 + b2) - (a1 + 2.0 * a2) / (a0 + a1 + a2)
         })
         .sum();
     if delay.is_finite() {
@@ -261,7 +263,8 @@ impl Pipeline {
             1e30,
         )?;
         let output_rate_hz = config.effective_output_rate_hz()?;
-        let sos = config.filter.sos(output_rate_hz.into())?;
+        let design = config.filter.design(output_rate_hz.into())?;
+        let sos = design.to_sos();
         config.paper.validate()?;
         let output_period_s = 1.0 / output_rate_hz;
         let detector = MotionDetector::try_new(&config.motion, output_rate_hz)?;
@@ -269,7 +272,7 @@ impl Pipeline {
             config: *config,
             input_period_s: 1.0 / f64::from(config.sample_rate_hz),
             output_period_s,
-            filter_delay_s: dc_group_delay_samples(&sos) * f64::from(output_period_s),
+            filter_delay_s: dc_group_delay_samples(&design) * f64::from(output_period_s),
             decimator: Decimator::try_new(factor)?,
             sos,
             sos_state: SosState::new(),

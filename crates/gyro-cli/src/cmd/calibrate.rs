@@ -2,7 +2,9 @@
 
 use anyhow::{Context, Result};
 use gyro_core::Config;
-use gyro_host::calibrate::{calibrate, BenchRun, CalibrateOptions, Calibration, Objective, RunScore};
+use gyro_host::calibrate::{
+    calibrate, BenchRun, CalibrateOptions, Calibration, Objective, RunScore,
+};
 use gyro_host::{log, model};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -57,9 +59,17 @@ fn score_table(title: &str, scores: &[RunScore]) -> String {
         return s;
     }
     let _ = writeln!(s, "{title}: max abs angle error per run (deg)");
-    let _ = writeln!(s, "  {:<40} {:>9} {:>9} {:>9}", "run", "none", "paper", "kalman");
+    let _ = writeln!(
+        s,
+        "  {:<40} {:>9} {:>9} {:>9}",
+        "run", "none", "paper", "kalman"
+    );
     for r in scores {
-        let name = if r.name.len() > 40 { &r.name[r.name.len() - 40..] } else { &r.name };
+        let name = if r.name.len() > 40 {
+            &r.name[r.name.len() - 40..]
+        } else {
+            &r.name
+        };
         let _ = writeln!(
             s,
             "  {:<40} {:>9.4} {:>9.4} {:>9.4}",
@@ -96,12 +106,19 @@ fn table(c: &Calibration) -> String {
     );
     if let Some(sp) = &c.spread {
         s += &format!(
-            "  leave-one-run-out ({} refits), mean ± sd [min, max]:\n    beta {:.5} ± {:.5} [{:.5}, {:.5}]\n    b0   {:.5} ± {:.5} [{:.5}, {:.5}]\n    o0   {:.5} ± {:.5} [{:.5}, {:.5}]\n",
-            sp.refits,
-            sp.beta_per_s[0], sp.beta_per_s[1], sp.beta_per_s[2], sp.beta_per_s[3],
-            sp.b0_dps[0], sp.b0_dps[1], sp.b0_dps[2], sp.b0_dps[3],
-            sp.o0_deg[0], sp.o0_deg[1], sp.o0_deg[2], sp.o0_deg[3],
+            "  leave-one-run-out ({} refits): mean ± sd [min, max], jackknife standard error\n",
+            sp.refits
         );
+        for (name, p) in [
+            ("beta", &sp.beta_per_s),
+            ("b0  ", &sp.b0_dps),
+            ("o0  ", &sp.o0_deg),
+        ] {
+            s += &format!(
+                "    {name} {:.5} ± {:.5} [{:.5}, {:.5}]  se {:.5}\n",
+                p.mean, p.sd, p.min, p.max, p.standard_error
+            );
+        }
     }
     let k = &c.config.kalman;
     s += &format!(
@@ -110,7 +127,10 @@ fn table(c: &Calibration) -> String {
     );
     s += &score_table("training runs", &c.train);
     s += &score_table("hold-out runs", &c.holdout);
-    s += &format!("model compensation: {:?} (best on the training runs)\n", c.config.compensation);
+    s += &format!(
+        "model compensation: {:?} (best on the training runs)\n",
+        c.config.compensation
+    );
     s
 }
 
@@ -124,19 +144,26 @@ pub fn run(args: &Args) -> Result<()> {
     let holdout = load_runs(&args.holdout)?;
     let bar = ProgressBar::new_spinner();
     bar.set_style(
-        ProgressStyle::with_template("{spinner} {elapsed} {msg}").unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        ProgressStyle::with_template("{spinner} {elapsed} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
     );
     let options = CalibrateOptions {
         objective: args.objective,
         leave_one_out: !args.no_leave_one_out,
         initial_tau_s: args.tau_s,
     };
-    let result = calibrate(&train, &holdout, &base.config, &options, &mut |stage, n, best| {
-        if n % 10 == 0 {
-            bar.set_message(format!("{stage}: {n} evaluations, best {best:.4} deg"));
-            bar.tick();
-        }
-    });
+    let result = calibrate(
+        &train,
+        &holdout,
+        &base.config,
+        &options,
+        &mut |stage, n, best| {
+            if n % 10 == 0 {
+                bar.set_message(format!("{stage}: {n} evaluations, best {best:.4} deg"));
+                bar.tick();
+            }
+        },
+    );
     bar.finish_and_clear();
     let result = result?;
     let mut out = base.clone();
