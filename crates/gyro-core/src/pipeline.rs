@@ -511,3 +511,29 @@ impl Pipeline {
         }
     }
 }
+
+#[cfg(test)]
+mod size_tests {
+    use super::Pipeline;
+
+    /// The firmware budget: the whole pipeline state in under 512 bytes.
+    #[test]
+    fn pipeline_state_fits_in_512_bytes() {
+        use core::mem::size_of;
+        std::println!(
+            "config {} sos {} sos_state {} detector {} integrator {} kalman {} rest_delay {} track {} decimator {}",
+            size_of::<super::Config>(),
+            size_of::<super::Sos>(),
+            size_of::<super::SosState>(),
+            size_of::<super::MotionDetector>(),
+            size_of::<super::Integrator>(),
+            size_of::<super::KalmanBias>(),
+            size_of::<super::RestDelay>(),
+            size_of::<Option<super::Track>>(),
+            size_of::<super::Decimator>(),
+        );
+        let size = core::mem::size_of::<Pipeline>();
+        std::println!("size_of::<Pipeline>() = {size} bytes");
+        assert!(size <= 512, "{size} bytes");
+    }
+}
