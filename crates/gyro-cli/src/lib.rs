@@ -12,6 +12,7 @@
 
 pub mod log;
 pub mod model;
+pub mod noise;
 pub mod replay;
 pub mod report;
 pub mod sim;
