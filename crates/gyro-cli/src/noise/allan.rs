@@ -23,7 +23,7 @@
 //! for the power-law noise that dominates at that τ ([`NoiseType`]), summed over
 //! segments. The interval at confidence `c` (default 68.27%, 1σ) is
 //! `σ̂ √(edf / χ²_{(1+c)/2}) … σ̂ √(edf / χ²_{(1−c)/2})` (SP 1065 eq. 45). The noise type
-//! is white FM (angle random walk) until a fit says otherwise: [`super::fit`] sets it per τ
+//! is white FM (angle random walk) until a fit says otherwise: [`mod@super::fit`] sets it per τ
 //! from the local slope of the fitted model.
 
 use super::chi2::chi2_quantile;

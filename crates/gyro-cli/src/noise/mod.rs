@@ -14,11 +14,12 @@
 //!
 //! - [`allan`]: the overlapping Allan deviation (as `allantools.oadev` on rate data),
 //!   pooled over segments, with chi-squared bounds from NIST SP 1065 degrees of freedom.
-//! - [`fit`]: Q, N, B, K and a Gauss-Markov (σ, T) by weighted non-negative least squares
+//! - [`mod@fit`]: Q, N, B, K and a Gauss-Markov (σ, T) by weighted non-negative least squares
 //!   on the Allan variance, with backward elimination of insignificant terms; the Allan
 //!   bounds then use the noise type the fitted model has at each τ.
 //! - [`psd`]: Welch PSD (Hann, 50% overlap, one-sided) and the white density.
 //! - [`rest`]: rest stretches found by the gyro-core motion detector (`--static-only`).
+//! - [`report`]: the human-readable table.
 //!
 //! Data comes in *segments* (contiguous runs of samples at one rate): a whole static log
 //! is one segment; rest stretches of a log with motion, or several logs, are several.
@@ -29,6 +30,7 @@ mod chi2;
 mod fft;
 pub mod fit;
 pub mod psd;
+pub mod report;
 pub mod rest;
 
 pub use allan::{AllanDeviation, AllanPoint, NoiseType, TauGrid, ONE_SIGMA};
@@ -123,8 +125,11 @@ pub struct Characterization {
     pub suggested_effects: Vec<Effect>,
 }
 
-/// The step of the grid all `values` lie on (within 1e-6 of a step), if there is one and
-/// it is coarse (fewer distinct values than half the samples).
+/// The step of the grid all `values` lie on (a multiple of it, within 5% of a step), if
+/// there is one and it is coarse (fewer distinct values than half the samples). The
+/// tolerance admits values written with a few decimals (a log's 1/24 deg/s step as
+/// `0.04167`): the step is the least-squares fit through the origin of the values within
+/// 50 steps of zero, starting from the smallest difference between distinct values.
 pub fn rate_step(values: &[f64]) -> Option<f64> {
     let mut sorted: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
     sorted.sort_by(f64::total_cmp);
@@ -132,15 +137,27 @@ pub fn rate_step(values: &[f64]) -> Option<f64> {
     if sorted.len() < 2 || sorted.len() * 2 > values.len() {
         return None;
     }
-    let step = sorted
+    let first = sorted
         .windows(2)
         .map(|w| w[1] - w[0])
         .fold(f64::INFINITY, f64::min);
+    if first <= 0.0 || !first.is_finite() {
+        return None;
+    }
+    let (mut vk, mut kk) = (0.0, 0.0);
+    for v in &sorted {
+        let k = (v / first).round();
+        if k.abs() <= 50.0 {
+            vk += v * k;
+            kk += k * k;
+        }
+    }
+    let step = if kk > 0.0 { vk / kk } else { first };
     let on_grid = sorted.iter().all(|v| {
         let k = v / step;
-        (k - k.round()).abs() < 1e-6
+        (k - k.round()).abs() < 0.05
     });
-    (step > 0.0 && on_grid).then_some(step)
+    on_grid.then_some(step)
 }
 
 /// The simulator's `bias_instability` σ (deg/s) whose Allan floor matches a bias
