@@ -14,6 +14,7 @@ pub mod calibrate;
 pub mod log;
 pub mod model;
 pub mod nelder_mead;
+pub mod noise;
 pub mod replay;
 pub mod report;
 pub mod sim;

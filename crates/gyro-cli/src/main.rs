@@ -25,6 +25,9 @@ enum Command {
     /// Simulate a sensor log: the nominal model plus optional effects, on bench-like
     /// motion or on the motion recorded in a log's reference.
     Simulate(cmd::simulate::Args),
+    /// Noise characterisation of static logs: Allan deviation with bounds, fitted noise
+    /// terms (ARW, bias instability, rate random walk, Gauss-Markov), Welch PSD.
+    Noise(cmd::noise::Args),
 }
 
 fn main() -> ExitCode {
@@ -33,6 +36,7 @@ fn main() -> ExitCode {
         Command::Run(args) => cmd::run::run(args),
         Command::Simulate(args) => cmd::simulate::run(args),
         Command::Calibrate(args) => cmd::calibrate::run(args),
+        Command::Noise(args) => cmd::noise::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

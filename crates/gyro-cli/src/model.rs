@@ -48,12 +48,12 @@ impl ModelFile {
 #[derive(Debug, thiserror::Error)]
 pub enum ModelError {
     /// Not readable.
-    #[error("{path}: {source}")]
+    #[error("{path}: {cause}")]
     Io {
         /// File.
         path: PathBuf,
-        /// Cause.
-        source: std::io::Error,
+        /// Cause (in the message, not chained: it would print twice).
+        cause: std::io::Error,
     },
     /// Not valid JSON for a model file.
     #[error("{path}:{line}:{column}: {message}")]
@@ -99,9 +99,9 @@ pub enum ModelError {
 
 /// Read and validate a model file.
 pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
+    let text = std::fs::read_to_string(path).map_err(|cause| ModelError::Io {
         path: path.to_path_buf(),
-        source,
+        cause,
     })?;
     let model: ModelFile = serde_json::from_str(&text).map_err(|e| ModelError::Json {
         path: path.to_path_buf(),
@@ -132,9 +132,9 @@ pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
 
 /// Write a model file (pretty JSON).
 pub fn save(path: &Path, model: &ModelFile) -> Result<(), ModelError> {
-    let io = |source| ModelError::Io {
+    let io = |cause| ModelError::Io {
         path: path.to_path_buf(),
-        source,
+        cause,
     };
     let text = serde_json::to_string_pretty(model).map_err(|e| io(std::io::Error::other(e)))?;
     std::fs::write(path, text + "\n").map_err(io)

@@ -126,10 +126,13 @@ impl KalmanBias {
         self.bias_dps = self.bias_mean_dps + self.phi * (self.bias_dps - self.bias_mean_dps);
     }
 
-    /// Zero-rate update with the rate measured at rest. Returns the angle correction (deg).
-    pub fn update_at_rest(&mut self, rate_dps: f32) -> f32 {
+    /// Zero-rate update with the mean of `samples` rates measured at rest (its noise
+    /// variance is R/samples). Returns the angle correction (deg).
+    pub fn update_at_rest(&mut self, mean_rate_dps: f32, samples: u32) -> f32 {
+        let rate_dps = mean_rate_dps;
+        let r = self.r_rate / samples.max(1) as f32;
         let h = RowVector2::new(0.0, 1.0);
-        let s = self.p[(1, 1)] + self.r_rate;
+        let s = self.p[(1, 1)] + r;
         if s.is_nan() || s <= 0.0 {
             return 0.0;
         }
@@ -138,7 +141,7 @@ impl KalmanBias {
         self.bias_dps += gain[1] * innovation;
         // Joseph form keeps P symmetric and positive in f32.
         let i_kh = Matrix2::identity() - gain * h;
-        self.p = i_kh * self.p * i_kh.transpose() + gain * gain.transpose() * self.r_rate;
+        self.p = i_kh * self.p * i_kh.transpose() + gain * gain.transpose() * r;
         gain[0] * innovation
     }
 
@@ -157,7 +160,7 @@ mod tests {
         let mut kf = KalmanBias::try_new(&KalmanConfig::default(), 0.02).unwrap();
         for _ in 0..500 {
             kf.predict(false);
-            kf.update_at_rest(0.7);
+            kf.update_at_rest(0.7, 1);
         }
         assert!((kf.bias_dps() - 0.7).abs() < 1e-3);
         // Steady state of a random walk observed directly: P ≈ √(q R), so the standard
@@ -184,7 +187,7 @@ mod tests {
         let mut correction = 0.0;
         for _ in 0..200 {
             kf.predict(false);
-            correction += kf.update_at_rest(0.4);
+            correction += kf.update_at_rest(0.4, 1);
         }
         assert!(kf.angle_std_deg() < std_after_motion);
         assert!(correction < -1.5 && correction > -2.5, "{correction}");

@@ -158,54 +158,53 @@ struct Track {
     settle: Option<(u32, f64)>,
 }
 
-/// Most rest samples held back from the Kalman filter (see [`RestDelay`]).
-const MAX_REST_DELAY: usize = 32;
-
-/// A delay line for rest samples on their way to the Kalman filter's zero-rate update.
+/// Rest samples on their way to the Kalman filter's zero-rate update, held back in blocks.
 ///
 /// The quiet samples just before a movement already carry the start of its rate (below
 /// `exit_dps`, but not zero); used as bias observations they pull the bias estimate
 /// towards the movement's rate, and the error is then integrated over the whole movement.
-/// Held back for `min_rest_s` (as many samples as end a movement, at most
-/// [`MAX_REST_DELAY`]), they are dropped instead when a movement starts: both ends of a
-/// movement get the same margin.
+/// So rest samples are collected in blocks of `min_rest_s` (as many samples as end a
+/// movement): a block is released only when the next one is complete, so every sample has
+/// waited at least `min_rest_s`, and both pending blocks are dropped when a movement
+/// starts. A released block is one update with its mean and R/n, which is what n updates
+/// of a constant bias amount to. Two running means instead of a delay line keep the
+/// pipeline's state small.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct RestDelay {
-    rates_dps: [f32; MAX_REST_DELAY],
-    head: usize,
-    len: usize,
-    capacity: usize,
+struct RestBlocks {
+    block: u16,
+    fresh: (KahanSum, u16),
+    aged: (KahanSum, u16),
 }
 
-impl RestDelay {
-    fn new(capacity: usize) -> Self {
+impl RestBlocks {
+    fn new(block: u16) -> Self {
         Self {
-            rates_dps: [0.0; MAX_REST_DELAY],
-            head: 0,
-            len: 0,
-            capacity: capacity.min(MAX_REST_DELAY),
+            block,
+            fresh: (KahanSum::ZERO, 0),
+            aged: (KahanSum::ZERO, 0),
         }
     }
 
-    /// Queue `rate_dps`; returns the sample it pushes out, if the line is full.
-    fn push(&mut self, rate_dps: f32) -> Option<f32> {
-        if self.capacity == 0 {
-            return Some(rate_dps);
+    /// Add a rest sample; returns a released block's (mean, count).
+    fn push(&mut self, rate_dps: f32) -> Option<(f32, u16)> {
+        self.fresh.0.add(rate_dps);
+        self.fresh.1 += 1;
+        if self.fresh.1 < self.block.max(1) {
+            return None;
         }
-        if self.len < self.capacity {
-            self.rates_dps[(self.head + self.len) % self.capacity] = rate_dps;
-            self.len += 1;
-            None
-        } else {
-            let oldest = core::mem::replace(&mut self.rates_dps[self.head], rate_dps);
-            self.head = (self.head + 1) % self.capacity;
-            Some(oldest)
-        }
+        let (sum, count) = core::mem::replace(&mut self.aged, self.fresh);
+        self.fresh = (KahanSum::ZERO, 0);
+        (count > 0).then(|| (sum.value() / f32::from(count), count))
     }
 
+    /// Drop the pending blocks (a movement starts).
     fn clear(&mut self) {
-        self.head = 0;
-        self.len = 0;
+        self.fresh = (KahanSum::ZERO, 0);
+        self.aged = (KahanSum::ZERO, 0);
+    }
+
+    fn is_finite(&self) -> bool {
+        self.fresh.0.is_finite() && self.aged.0.is_finite()
     }
 }
 
@@ -229,7 +228,9 @@ fn dc_group_delay_samples(design: &SosDesign) -> f64 {
 /// The pipeline. Push input samples; every `decimation_factor`-th push returns an output.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pipeline {
-    config: Config,
+    max_abs_rate_dps: f32,
+    compensation: Compensation,
+    paper: GaussMarkov,
     input_period_s: f64,
     output_period_s: f32,
     filter_delay_s: f64,
@@ -240,7 +241,7 @@ pub struct Pipeline {
     raw: Integrator,
     corrected: Integrator,
     kalman: KalmanBias,
-    rest_delay: RestDelay,
+    rest_blocks: RestBlocks,
     kalman_correction: KahanSum,
     paper_total: KahanSum,
     track: Option<Track>,
@@ -269,7 +270,9 @@ impl Pipeline {
         let output_period_s = 1.0 / output_rate_hz;
         let detector = MotionDetector::try_new(&config.motion, output_rate_hz)?;
         Ok(Self {
-            config: *config,
+            max_abs_rate_dps: config.max_abs_rate_dps,
+            compensation: config.compensation,
+            paper: config.paper,
             input_period_s: 1.0 / f64::from(config.sample_rate_hz),
             output_period_s,
             filter_delay_s: dc_group_delay_samples(&design) * f64::from(output_period_s),
@@ -280,7 +283,7 @@ impl Pipeline {
             raw: Integrator::new(output_period_s),
             corrected: Integrator::new(output_period_s),
             kalman: KalmanBias::try_new(&config.kalman, output_period_s)?,
-            rest_delay: RestDelay::new(usize::from(detector.min_rest_samples())),
+            rest_blocks: RestBlocks::new(detector.min_rest_samples()),
             kalman_correction: KahanSum::ZERO,
             paper_total: KahanSum::ZERO,
             track: None,
@@ -293,9 +296,9 @@ impl Pipeline {
         })
     }
 
-    /// The configuration.
-    pub const fn config(&self) -> &Config {
-        &self.config
+    /// The compensation producing [`Output::angle_deg`].
+    pub const fn compensation(&self) -> Compensation {
+        self.compensation
     }
 
     /// Output sample period (s).
@@ -324,6 +327,7 @@ impl Pipeline {
             && self.kalman.is_finite()
             && self.kalman_correction.is_finite()
             && self.paper_total.is_finite()
+            && self.rest_blocks.is_finite()
     }
 
     /// Push one input sample: `time_s` (s) and `rate_dps` (deg/s).
@@ -335,14 +339,13 @@ impl Pipeline {
         } else {
             0.0
         };
-        let rate_dps =
-            if rate_dps.is_finite() && libm::fabsf(rate_dps) <= self.config.max_abs_rate_dps {
-                self.last_valid_rate_dps = rate_dps;
-                rate_dps
-            } else {
-                self.rejected = self.rejected.saturating_add(1);
-                self.last_valid_rate_dps
-            };
+        let rate_dps = if rate_dps.is_finite() && libm::fabsf(rate_dps) <= self.max_abs_rate_dps {
+            self.last_valid_rate_dps = rate_dps;
+            rate_dps
+        } else {
+            self.rejected = self.rejected.saturating_add(1);
+            self.last_valid_rate_dps
+        };
         if self.decimator.pending() == 0 {
             self.block_start_time_s = time_s;
         }
@@ -381,8 +384,8 @@ impl Pipeline {
 
         let event = match phase {
             Phase::Rest => {
-                if let Some(rest_dps) = self.rest_delay.push(rate_dps) {
-                    let correction = self.kalman.update_at_rest(rest_dps);
+                if let Some((mean_dps, samples)) = self.rest_blocks.push(rate_dps) {
+                    let correction = self.kalman.update_at_rest(mean_dps, u32::from(samples));
                     self.kalman_correction.add(correction);
                 }
                 None
@@ -398,7 +401,7 @@ impl Pipeline {
                 let start_time_s =
                     time_s - f64::from(run) * f64::from(self.output_period_s) - self.filter_delay_s;
                 // The rest samples still held back lead into the movement: drop them.
-                self.rest_delay.clear();
+                self.rest_blocks.clear();
                 // The run so far is still pending: it belongs to the movement.
                 self.track = Some(Track {
                     start_time_s,
@@ -444,9 +447,9 @@ impl Pipeline {
             event,
             angle_deg: self.angle_deg(),
             raw_angle_deg: self.raw.angle_deg(),
-            angle_std_deg: (self.config.compensation == Compensation::Kalman)
+            angle_std_deg: (self.compensation == Compensation::Kalman)
                 .then(|| self.kalman.angle_std_deg()),
-            bias_dps: match self.config.compensation {
+            bias_dps: match self.compensation {
                 Compensation::Kalman => self.kalman.bias_dps(),
                 _ => self.detector.bias_dps(),
             },
@@ -472,7 +475,7 @@ impl Pipeline {
         let raw_angle_deg = self.raw.committed_deg() - track.raw_at_start_deg;
         let duration_s = (end_index - track.start_index) as f32 * self.output_period_s;
         self.paper_total
-            .add(raw_angle_deg - self.config.paper.misalignment_deg(duration_s));
+            .add(raw_angle_deg - self.paper.misalignment_deg(duration_s));
         Some(Movement {
             start_time_s: track.start_time_s,
             end_time_s: end_time_s - self.filter_delay_s,
@@ -484,7 +487,7 @@ impl Pipeline {
     /// The angle under the configured compensation, without the pending (tentative)
     /// integration (deg). Only called while no movement is tracked.
     fn committed_angle_deg(&self) -> f32 {
-        match self.config.compensation {
+        match self.compensation {
             Compensation::None => self.raw.committed_deg(),
             Compensation::Kalman => self.corrected.committed_deg() + self.kalman_correction.value(),
             Compensation::Paper => self.paper_total.value(),
@@ -493,7 +496,7 @@ impl Pipeline {
 
     /// The angle under the configured compensation (deg).
     fn angle_deg(&self) -> f32 {
-        match self.config.compensation {
+        match self.compensation {
             Compensation::None => self.raw.angle_deg(),
             Compensation::Kalman => self.corrected.angle_deg() + self.kalman_correction.value(),
             Compensation::Paper => {
@@ -504,7 +507,7 @@ impl Pipeline {
                         let elapsed = self.index.saturating_sub(track.start_index);
                         let moved = self.raw.angle_deg() - track.raw_at_start_deg;
                         let duration_s = elapsed as f32 * self.output_period_s;
-                        total + moved - self.config.paper.misalignment_deg(duration_s)
+                        total + moved - self.paper.misalignment_deg(duration_s)
                     }
                 }
             }
@@ -521,14 +524,14 @@ mod size_tests {
     fn pipeline_state_fits_in_512_bytes() {
         use core::mem::size_of;
         std::println!(
-            "config {} sos {} sos_state {} detector {} integrator {} kalman {} rest_delay {} track {} decimator {}",
+            "config {} sos {} sos_state {} detector {} integrator {} kalman {} rest_blocks {} track {} decimator {}",
             size_of::<super::Config>(),
             size_of::<super::Sos>(),
             size_of::<super::SosState>(),
             size_of::<super::MotionDetector>(),
             size_of::<super::Integrator>(),
             size_of::<super::KalmanBias>(),
-            size_of::<super::RestDelay>(),
+            size_of::<super::RestBlocks>(),
             size_of::<Option<super::Track>>(),
             size_of::<super::Decimator>(),
         );

@@ -1,5 +1,6 @@
 //! One module per `gyro-cli` subcommand: its arguments (`Args`) and `run`.
 
 pub mod calibrate;
+pub mod noise;
 pub mod run;
 pub mod simulate;

@@ -90,9 +90,9 @@ fn parse_field(field: &[u8]) -> Result<Option<f64>, ()> {
 
 /// Read a CSV log whole.
 pub fn read_csv(path: &Path, columns: &ColumnOptions) -> Result<Log, LogError> {
-    let io_err = |source| LogError::Io {
+    let io_err = |cause| LogError::Io {
         path: path.to_path_buf(),
-        source,
+        cause,
     };
     let file = File::open(path).map_err(io_err)?;
     let mut reader = BufReader::with_capacity(1 << 20, file);

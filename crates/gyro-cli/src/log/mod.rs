@@ -54,12 +54,12 @@ impl Log {
 #[derive(Debug, thiserror::Error)]
 pub enum LogError {
     /// The file could not be opened or read.
-    #[error("{path}: {source}")]
+    #[error("{path}: {cause}")]
     Io {
         /// File.
         path: PathBuf,
-        /// Cause.
-        source: std::io::Error,
+        /// Cause (in the message, not chained: it would print twice).
+        cause: std::io::Error,
     },
     /// The CSV structure is broken (e.g. a row with the wrong number of fields).
     #[error("{path}:{line}: {message}")]

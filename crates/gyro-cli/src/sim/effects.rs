@@ -132,7 +132,7 @@ pub const EFFECTS: &[EffectInfo] = &[
     EffectInfo {
         id: "quantization",
         params: &[("lsb_dps", "deg/s")],
-        signature: "raw values on a grid; Allan slope -1 at short tau",
+        signature: "raw values on a grid (rounding each rate sample adds white rate noise of lsb^2/12: a higher -1/2 Allan slope, not -1)",
         typical: Effect::Quantization { lsb_dps: 0.2 },
     },
     EffectInfo {

@@ -1,0 +1,312 @@
+//! `gyro-cli noise`: Allan deviation / PSD characterisation of static logs.
+
+use anyhow::{bail, Context, Result};
+use clap::ValueEnum;
+use gyro_host::noise::{self, Characterization, NoiseOptions, PsdOptions, TauGrid};
+use gyro_host::{log, model};
+use serde::Serialize;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// Human-readable.
+    Table,
+    /// JSON.
+    Json,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Grid {
+    /// About `--per-decade` factors per decade (allantools "log10"-like).
+    Log,
+    /// 1, 2, 4, 8, ... (allantools "octave").
+    Octave,
+    /// 1, 2, 4, 10, 20, 40, ... (allantools "decade").
+    Decade,
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Static logs (CSV: `time_s,rate_dps,...`). Several: each, then all pooled.
+    #[arg(required = true)]
+    logs: Vec<PathBuf>,
+    /// Output format on stdout.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+    /// Write a model file whose `sensor` section comes from the fit (of all logs pooled
+    /// if several): ARW, Gauss-Markov σ/T, bias = mean rate, output step.
+    #[arg(long)]
+    model_out: Option<PathBuf>,
+    /// Keep only the rest stretches found by the gyro-core motion detector (default: the
+    /// logs are taken whole, as static).
+    #[arg(long)]
+    static_only: bool,
+    /// With --static-only: margin cut on both sides of each movement (s).
+    #[arg(long, default_value_t = 0.5)]
+    margin_s: f64,
+    /// With --static-only: shortest rest stretch kept (s).
+    #[arg(long, default_value_t = 1.0)]
+    min_rest_s: f64,
+    /// Model file: its pipeline configuration drives --static-only's motion detector, and
+    /// --model-out starts from it (its sensor section replaced, its range kept).
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Averaging times: log-spaced, octaves or decades of the sample period, up to a
+    /// quarter of the longest stretch.
+    #[arg(long, value_enum, default_value_t = Grid::Log)]
+    tau_grid: Grid,
+    /// Averaging times per decade with `--tau-grid log`.
+    #[arg(long, default_value_t = 10)]
+    per_decade: u32,
+    /// Confidence of the Allan bounds (default 1σ).
+    #[arg(long, default_value_t = noise::ONE_SIGMA)]
+    confidence: f64,
+    /// Welch segment length (a power of two); default: a quarter of the longest stretch,
+    /// 16 to 16384.
+    #[arg(long)]
+    psd_segment: Option<usize>,
+    /// Write the full PSD as CSV (`log,frequency_hz,psd_dps2_per_hz`) here.
+    #[arg(long)]
+    psd_out: Option<PathBuf>,
+    /// Sample rate of the logs (Hz); default: their `sample_rate_hz` metadata, else the
+    /// median time step.
+    #[arg(long)]
+    sample_rate_hz: Option<f64>,
+    /// Longest stretch of missing data (s) bridged by interpolation; longer is an error.
+    #[arg(long, default_value_t = 0.5)]
+    max_gap_s: f64,
+    #[command(flatten)]
+    columns: log::ColumnOptions,
+}
+
+/// One log's data, ready to characterise.
+struct Loaded {
+    file: String,
+    rate: Vec<f64>,
+    sample_rate_hz: f64,
+    segments: Vec<std::ops::Range<usize>>,
+    input: log::Quality,
+}
+
+impl Loaded {
+    fn parts(&self) -> Vec<&[f64]> {
+        self.segments
+            .iter()
+            .map(|r| &self.rate[r.clone()])
+            .collect()
+    }
+}
+
+#[derive(Serialize)]
+struct LogResult<'a> {
+    file: &'a str,
+    /// Rest stretches used (s from the log's start), with --static-only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rest_stretches_s: Option<Vec<(f64, f64)>>,
+    input: &'a log::Quality,
+    #[serde(flatten)]
+    result: &'a Characterization,
+}
+
+#[derive(Serialize)]
+struct Output<'a> {
+    logs: Vec<LogResult<'a>>,
+    combined: Option<&'a Characterization>,
+    model_out: Option<String>,
+}
+
+fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<Loaded> {
+    let raw = log::read_csv(path, &args.columns)?;
+    let regular = log::regularize(
+        &raw,
+        &log::GridOptions {
+            sample_rate_hz: args.sample_rate_hz,
+            max_gap_s: args.max_gap_s,
+        },
+    )?;
+    let rate: Vec<f64> = regular.slots.iter().map(|s| s.rate_dps).collect();
+    let segments = if args.static_only {
+        let segments = noise::rest_segments(&regular, config, args.margin_s, args.min_rest_s)
+            .with_context(|| {
+                format!(
+                    "{}: cannot configure the pipeline for this log",
+                    path.display()
+                )
+            })?;
+        if segments.is_empty() {
+            bail!(
+                "{}: no rest stretch of at least {} s found (--static-only)",
+                path.display(),
+                args.min_rest_s
+            );
+        }
+        segments
+    } else {
+        std::iter::once(0..rate.len()).collect()
+    };
+    Ok(Loaded {
+        file: path.display().to_string(),
+        rate,
+        sample_rate_hz: regular.sample_rate_hz,
+        segments,
+        input: regular.quality,
+    })
+}
+
+/// Run the command.
+pub fn run(args: &Args) -> Result<()> {
+    if !(args.confidence > 0.0 && args.confidence < 1.0) {
+        bail!("--confidence must be in (0, 1)");
+    }
+    if !(args.margin_s >= 0.0 && args.min_rest_s >= 0.0) {
+        bail!("--margin-s and --min-rest-s must be >= 0");
+    }
+    if let Some(len) = args.psd_segment {
+        if len < 2 || !len.is_power_of_two() {
+            bail!("--psd-segment must be a power of two >= 2");
+        }
+    }
+    let base = match &args.model {
+        Some(path) => Some(model::load(path)?),
+        None => None,
+    };
+    let config = base
+        .as_ref()
+        .map_or_else(gyro_core::Config::default, |m| m.config);
+    let options = NoiseOptions {
+        taus: match args.tau_grid {
+            Grid::Log => TauGrid::PerDecade(args.per_decade.max(1)),
+            Grid::Octave => TauGrid::Octave,
+            Grid::Decade => TauGrid::Decade,
+        },
+        confidence: args.confidence,
+        psd: PsdOptions {
+            segment_len: args.psd_segment,
+            ..PsdOptions::default()
+        },
+        ..NoiseOptions::default()
+    };
+
+    let loaded = args
+        .logs
+        .iter()
+        .map(|path| load(path, args, &config))
+        .collect::<Result<Vec<_>>>()?;
+    let results = loaded
+        .iter()
+        .map(|l| {
+            noise::characterize(&l.parts(), l.sample_rate_hz, &options)
+                .with_context(|| l.file.clone())
+        })
+        .collect::<Result<Vec<_>>>()?;
+
+    let combined = if loaded.len() > 1 {
+        let rate = loaded[0].sample_rate_hz;
+        if loaded
+            .iter()
+            .all(|l| (l.sample_rate_hz / rate - 1.0).abs() < 1e-9)
+        {
+            let parts: Vec<&[f64]> = loaded.iter().flat_map(|l| l.parts()).collect();
+            Some(noise::characterize(&parts, rate, &options).context("all logs pooled")?)
+        } else {
+            eprintln!("note: the logs differ in sample rate; no pooled result");
+            None
+        }
+    } else {
+        None
+    };
+
+    if let Some(out) = &args.model_out {
+        let source = match (&combined, results.as_slice()) {
+            (Some(c), _) => c,
+            (None, [only]) => only,
+            (None, _) => bail!("--model-out needs one log, or logs of one sample rate to pool"),
+        };
+        let file = match base {
+            Some(base) => model::ModelFile {
+                sensor: gyro_host::sim::SensorModel {
+                    range_dps: base.sensor.range_dps,
+                    ..source.sensor_model()
+                },
+                ..base
+            },
+            None => source.model_file(),
+        };
+        model::save(out, &file)?;
+        let s = &file.sensor;
+        eprintln!(
+            "wrote {}: sensor at {} Hz, bias {:.5} deg/s, ARW {:.4} deg/√h, Gauss-Markov σ {:.4e} deg/s T {:.4} s, step {} deg/s",
+            out.display(),
+            s.sample_rate_hz,
+            s.bias_dps,
+            s.arw_deg_per_rt_h,
+            s.gm_sigma_dps,
+            s.gm_tau_s,
+            s.lsb_dps
+        );
+    }
+
+    if let Some(out) = &args.psd_out {
+        let write = || -> std::io::Result<()> {
+            let mut w = std::io::BufWriter::new(std::fs::File::create(out)?);
+            writeln!(w, "log,frequency_hz,psd_dps2_per_hz")?;
+            for (l, r) in loaded.iter().zip(&results) {
+                noise::report::psd_csv(&mut w, &l.file, r)?;
+            }
+            if let Some(c) = &combined {
+                noise::report::psd_csv(&mut w, "combined", c)?;
+            }
+            w.flush()
+        };
+        write().with_context(|| format!("cannot write {}", out.display()))?;
+    }
+
+    let mut stdout = std::io::stdout().lock();
+    match args.format {
+        Format::Table => {
+            for (l, r) in loaded.iter().zip(&results) {
+                let irregular = l.input.filled_slots + l.input.duplicate_rows;
+                let label = if irregular > 0 {
+                    format!(
+                        "{} ({} samples interpolated, {} duplicates dropped)",
+                        l.file, l.input.filled_slots, l.input.duplicate_rows
+                    )
+                } else {
+                    l.file.clone()
+                };
+                writeln!(stdout, "{}", noise::report::table(&label, r))?;
+            }
+            if let Some(c) = &combined {
+                let label = format!("all {} logs pooled", loaded.len());
+                writeln!(stdout, "{}", noise::report::table(&label, c))?;
+            }
+        }
+        Format::Json => {
+            let output = Output {
+                logs: loaded
+                    .iter()
+                    .zip(&results)
+                    .map(|(l, r)| LogResult {
+                        file: &l.file,
+                        rest_stretches_s: args.static_only.then(|| {
+                            l.segments
+                                .iter()
+                                .map(|s| {
+                                    let dt = 1.0 / l.sample_rate_hz;
+                                    (s.start as f64 * dt, s.end as f64 * dt)
+                                })
+                                .collect()
+                        }),
+                        input: &l.input,
+                        result: r,
+                    })
+                    .collect(),
+                combined: combined.as_ref(),
+                model_out: args.model_out.as_ref().map(|p| p.display().to_string()),
+            };
+            writeln!(stdout, "{}", serde_json::to_string_pretty(&output)?)?;
+        }
+    }
+    Ok(())
+}
