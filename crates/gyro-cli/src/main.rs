@@ -23,6 +23,8 @@ enum Command {
     /// Simulate a sensor log: the nominal model plus optional effects, on bench-like
     /// motion or on the motion recorded in a log's reference.
     Simulate(cmd::simulate::Args),
+    /// Convert a log between CSV and MCAP (also from a ROS 2 bag in MCAP).
+    Convert(cmd::convert::Args),
 }
 
 fn main() -> ExitCode {
@@ -30,6 +32,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Run(args) => cmd::run::run(args),
         Command::Simulate(args) => cmd::simulate::run(args),
+        Command::Convert(args) => cmd::convert::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

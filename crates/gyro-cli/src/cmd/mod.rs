@@ -1,4 +1,5 @@
 //! One module per `gyro-cli` subcommand: its arguments (`Args`) and `run`.
 
+pub mod convert;
 pub mod run;
 pub mod simulate;
