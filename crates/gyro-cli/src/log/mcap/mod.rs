@@ -23,7 +23,7 @@ mod read;
 mod ros2;
 mod write;
 
-pub use read::{read_mcap, McapOptions, McapRead, REFERENCE_MAX_SPAN_S};
+pub use read::{read_mcap, McapOptions, McapRead, REFERENCE_MAX_SPAN_S, TIME_ORIGIN_KEY};
 pub use ros2::{Axis, TimeSource, IMU_SCHEMA_NAME};
 pub use write::{write_mcap, JsonChannel, McapLogWriter, McapWriteOptions};
 

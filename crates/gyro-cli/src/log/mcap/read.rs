@@ -8,6 +8,12 @@
 //! channels carry messages, reading fails and asks for `--topic`. Other channels are
 //! skipped without being decoded.
 //!
+//! # Time
+//! `time_s` is the log time (JSON channels) or the chosen ROS 2 stamp, in seconds. ROS 2
+//! stamps count from the Unix epoch, where an `f64` second resolves only about 0.24 µs; so
+//! for an Imu channel `time_s` counts from the whole second at or before the earliest
+//! sample, and the metadata key [`TIME_ORIGIN_KEY`] holds that second.
+//!
 //! # Reference attachment
 //! Reference samples (`/reference`, `{"angle_deg": f64|null}`) are attached to rate rows by
 //! log time, after the whole file is read (so neither channel needs to be sorted):
@@ -43,6 +49,10 @@ use std::path::Path;
 /// Longest time (s) between two reference samples across which a rate row's reference is
 /// interpolated.
 pub const REFERENCE_MAX_SPAN_S: f64 = 0.5;
+
+/// Metadata key set for ROS 2 logs: the source-clock time (whole seconds; ROS time counts
+/// from the Unix epoch) at which the log's `time_s` is 0.
+pub const TIME_ORIGIN_KEY: &str = "time_origin_s";
 
 /// Records (and chunks) larger than this are treated as corrupt rather than allocated.
 const RECORD_LENGTH_LIMIT: usize = 1 << 30;
@@ -203,7 +213,8 @@ pub fn read_mcap(path: &Path, options: &McapOptions) -> Result<McapRead, LogErro
         has_temperature: false,
         messages: 0,
     };
-    let mut damage: Option<String> = None;
+    // What stopped the reading early, and whether it was the end of the file.
+    let mut damage: Option<(String, bool)> = None;
     while let Some(event) = reader.next_event() {
         match event {
             Ok(LinearReadEvent::ReadRequest(need)) => {
@@ -218,21 +229,25 @@ pub fn read_mcap(path: &Path, options: &McapOptions) -> Result<McapRead, LogErro
             }
             Ok(LinearReadEvent::Record { opcode, data }) => {
                 if let Err(e) = state.record(opcode, data)? {
-                    damage = Some(e);
+                    damage = Some((e, false));
                     break;
                 }
             }
             Err(e) => {
-                damage = Some(describe(&e));
+                damage = Some((describe(&e), matches!(e, McapError::UnexpectedEof)));
                 break;
             }
         }
     }
 
     let mut warnings = Vec::new();
-    if let Some(what) = damage {
+    if let Some((what, eof)) = damage {
         if !state.saw_header {
-            return Err(mcap_err(format!("not an MCAP file ({what})")));
+            return Err(mcap_err(if eof {
+                format!("cut short ({len} bytes) before the end of the MCAP header")
+            } else {
+                format!("not an MCAP file ({what})")
+            }));
         }
         if finished {
             return Err(mcap_err(format!("corrupt MCAP file: {what}")));
@@ -300,32 +315,29 @@ impl State<'_> {
                     },
                 );
             }
-            Record::Channel(channel) => {
-                if !self.channels.contains_key(&channel.id) {
-                    let kind = self.classify(&channel)?;
-                    let schema = self
-                        .schemas
-                        .get(&channel.schema_id)
-                        .map_or(String::new(), |s| s.name.clone());
-                    if kind == Kind::Reference {
-                        self.has_reference = true;
-                    }
-                    self.channels.insert(
-                        channel.id,
-                        ChannelInfo {
-                            topic: channel.topic,
-                            schema,
-                            kind,
-                            count: 0,
-                        },
-                    );
+            // Channels repeat in the summary section: the first record counts.
+            Record::Channel(channel) if !self.channels.contains_key(&channel.id) => {
+                let kind = self.classify(&channel)?;
+                let schema = self
+                    .schemas
+                    .get(&channel.schema_id)
+                    .map_or(String::new(), |s| s.name.clone());
+                if kind == Kind::Reference {
+                    self.has_reference = true;
                 }
+                self.channels.insert(
+                    channel.id,
+                    ChannelInfo {
+                        topic: channel.topic,
+                        schema,
+                        kind,
+                        count: 0,
+                    },
+                );
             }
             Record::Message { header, data } => self.message(&header, &data)?,
-            Record::Metadata(metadata) => {
-                if metadata.name == METADATA_NAME {
-                    self.metadata.extend(metadata.metadata);
-                }
+            Record::Metadata(metadata) if metadata.name == METADATA_NAME => {
+                self.metadata.extend(metadata.metadata);
             }
             _ => {}
         }
@@ -468,6 +480,17 @@ impl State<'_> {
             return Err(self.no_rate_channel(&warnings));
         };
         attach_reference(&mut self.rows, &self.row_ns, &mut self.reference);
+        if kind == Kind::Imu {
+            // ROS time is epoch-scale, where an f64 resolves only ~0.24 us: count from the
+            // whole second before the first sample instead, and say so in the metadata.
+            let origin_s = self.row_ns.iter().min().map_or(0, |t| t / 1_000_000_000);
+            let origin_ns = origin_s * 1_000_000_000;
+            for (row, &t) in self.rows.iter_mut().zip(&self.row_ns) {
+                row.time_s = ns_to_seconds(t - origin_ns);
+            }
+            self.metadata
+                .insert(TIME_ORIGIN_KEY.to_string(), origin_s.to_string());
+        }
         Ok(McapRead {
             log: Log {
                 path: self.path.to_path_buf(),
