@@ -15,6 +15,10 @@
 //! CSV field); `temperature_c` is left out of every message if the log has no temperature.
 //! The log's `# key: value` metadata is one MCAP metadata record named `gyro`.
 //!
+//! Chunks are zstd-compressed and closed every 0.5 s of log time (see [`McapWriteOptions`]),
+//! with message indexes (Foxglove's indexed reader needs them; they are most of the size:
+//! about 52 bytes per 1 kHz sample with a reference, 187 MB per hour, against 134 MB of CSV).
+//!
 //! Times are whole nanoseconds (u64): a CSV time with up to 9 decimals survives the trip
 //! exactly, values are JSON numbers in their shortest round-trip form and come back
 //! bit for bit.

@@ -596,6 +596,7 @@ fn attach_reference(rows: &mut [Row], row_ns: &[u64], reference: &mut [(u64, Opt
     let max_span_ns = (REFERENCE_MAX_SPAN_S * 1e9) as u64;
     let mut previous: Option<u64> = None;
     let mut same_time = 0_usize;
+    let mut lo = 0_usize;
     for (row, &t) in rows.iter_mut().zip(row_ns) {
         same_time = if previous == Some(t) {
             same_time + 1
@@ -603,8 +604,14 @@ fn attach_reference(rows: &mut [Row], row_ns: &[u64], reference: &mut [(u64, Opt
             0
         };
         previous = Some(t);
-        let lo = reference.partition_point(|&(r, _)| r < t);
-        let hi = reference.partition_point(|&(r, _)| r <= t);
+        // First reference at or after t: walk forward from the last row's (rows are
+        // usually in time order), search again when time goes back.
+        lo = if lo > 0 && reference[lo - 1].0 >= t {
+            reference.partition_point(|&(r, _)| r < t)
+        } else {
+            lo + reference[lo..].iter().take_while(|&&(r, _)| r < t).count()
+        };
+        let hi = lo + reference[lo..].iter().take_while(|&&(r, _)| r == t).count();
         row.reference_deg = if hi > lo {
             reference[lo + same_time.min(hi - lo - 1)].1
         } else if lo > 0 && lo < reference.len() {

@@ -156,6 +156,8 @@ impl McapLogWriter {
             .compression_threads(0)
             // Chunks are closed by `roll_chunk`, by time and by size.
             .chunk_size(None)
+            // Message indexes cost 16 uncompressed bytes per message (more than the
+            // compressed message), but Foxglove's indexed reader rejects chunks without them.
             .library(concat!("gyro-cli ", env!("CARGO_PKG_VERSION")))
             .create(BufWriter::with_capacity(1 << 16, file))
             .map_err(err)?;
