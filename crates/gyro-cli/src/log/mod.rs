@@ -60,10 +60,10 @@ impl LogFormat {
 #[derive(Clone, Debug, Default, PartialEq, Eq, clap::Args)]
 pub struct LogOptions {
     /// CSV columns and units.
-    #[command(flatten)]
+    #[command(flatten, next_help_heading = "CSV input")]
     pub columns: ColumnOptions,
     /// MCAP channels and ROS 2 options.
-    #[command(flatten)]
+    #[command(flatten, next_help_heading = "MCAP / ROS 2 input")]
     pub mcap: McapOptions,
 }
 
