@@ -28,6 +28,8 @@ enum Command {
     /// Noise characterisation of static logs: Allan deviation with bounds, fitted noise
     /// terms (ARW, bias instability, rate random walk, Gauss-Markov), Welch PSD.
     Noise(cmd::noise::Args),
+    /// Convert a log between CSV and MCAP (also from a ROS 2 bag in MCAP).
+    Convert(cmd::convert::Args),
 }
 
 fn main() -> ExitCode {
@@ -37,6 +39,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => cmd::simulate::run(args),
         Command::Calibrate(args) => cmd::calibrate::run(args),
         Command::Noise(args) => cmd::noise::run(args),
+        Command::Convert(args) => cmd::convert::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

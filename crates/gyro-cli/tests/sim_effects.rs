@@ -210,7 +210,8 @@ fn clock_error_scales_the_angle_with_a_clean_rate_shape() {
         .map(|(((a, b), row), t)| (a - b) - (t - motion.rate_dps(row.time_s)))
         .collect();
     let worst = residual.iter().map(|x| x.abs()).fold(0.0, f64::max);
-    assert!(worst < 1e-9, "{worst}");
+    // Up to two roundings of the output to 1e-6 deg/s.
+    assert!(worst < 1.1e-6, "{worst}");
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! One module per `gyro-cli` subcommand: its arguments (`Args`) and `run`.
 
 pub mod calibrate;
+pub mod convert;
 pub mod noise;
 pub mod run;
 pub mod simulate;

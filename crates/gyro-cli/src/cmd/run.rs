@@ -26,7 +26,8 @@ pub enum CompensationArg {
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The log (CSV: `time_s,rate_dps[,temperature_c][,reference_deg]`).
+    /// The log: CSV (`time_s,rate_dps[,temperature_c][,reference_deg]`), MCAP (`/gyro`,
+    /// `/reference`) or a ROS 2 bag in MCAP (`sensor_msgs/msg/Imu`).
     log: PathBuf,
     /// Model file (JSON, from `calibrate`); default: the built-in configuration.
     #[arg(long)]
@@ -48,7 +49,7 @@ pub struct Args {
     #[arg(long, default_value_t = 0.5)]
     max_gap_s: f64,
     #[command(flatten)]
-    columns: log::ColumnOptions,
+    input: log::LogOptions,
 }
 
 /// Run the command.
@@ -64,7 +65,10 @@ pub fn run(args: &Args) -> Result<()> {
             CompensationArg::Kalman => Compensation::Kalman,
         };
     }
-    let raw = log::read_csv(&args.log, &args.columns)?;
+    let (raw, warnings) = log::read_log_with_warnings(&args.log, &args.input)?;
+    for warning in &warnings {
+        eprintln!("warning: {warning}");
+    }
     let regular = log::regularize(
         &raw,
         &log::GridOptions {

@@ -231,15 +231,16 @@ pub fn write_csv(out: &mut impl std::io::Write, log: &Log) -> std::io::Result<()
         header.push_str(",reference_deg");
     }
     writeln!(out, "{header}")?;
-    let field =
-        |v: Option<f64>, decimals: usize| v.map_or_else(String::new, |v| format!("{v:.decimals$}"));
+    // Shortest round-trip formatting: every f64 reads back exactly (CSV → MCAP → CSV is
+    // lossless), and values written with few digits keep them.
+    let field = |v: Option<f64>| v.map_or_else(String::new, |v| format!("{v}"));
     for row in &log.rows {
-        write!(out, "{:.6},{}", row.time_s, field(row.rate_dps, 5))?;
+        write!(out, "{},{}", row.time_s, field(row.rate_dps))?;
         if log.has_temperature {
-            write!(out, ",{}", field(row.temperature_c, 3))?;
+            write!(out, ",{}", field(row.temperature_c))?;
         }
         if log.has_reference {
-            write!(out, ",{}", field(row.reference_deg, 5))?;
+            write!(out, ",{}", field(row.reference_deg))?;
         }
         writeln!(out)?;
     }

@@ -1,14 +1,114 @@
-//! Gyro logs: the shared CSV contract (DESIGN.md "Log formats"), read into rows, then put
-//! on a regular time grid with every irregularity counted.
+//! Gyro logs: the shared CSV and MCAP contract (DESIGN.md "Log formats"), read into rows,
+//! then put on a regular time grid with every irregularity counted.
+//!
+//! [`read_log`] reads either format (by content, else by extension); [`write_log`] writes
+//! either by extension.
 
 mod csv_log;
+pub mod mcap;
 mod regular;
 
 pub use csv_log::{read_csv, write_csv, ColumnOptions, RateUnit, TimeUnit};
+pub use mcap::{
+    read_mcap, write_mcap, Axis, JsonChannel, McapLogWriter, McapOptions, McapRead,
+    McapWriteOptions, TimeSource,
+};
 pub use regular::{regularize, GridOptions, Quality, RegularLog, Slot};
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// A log file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum LogFormat {
+    /// CSV with `# key: value` metadata lines and a header.
+    Csv,
+    /// MCAP (JSON channels `/gyro`, `/reference`; or a ROS 2 bag with an Imu channel).
+    Mcap,
+}
+
+impl LogFormat {
+    /// The format a file name asks for: `.csv` or `.mcap` (any case), else `None`.
+    pub fn from_extension(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "csv" => Some(Self::Csv),
+            "mcap" => Some(Self::Mcap),
+            _ => None,
+        }
+    }
+
+    /// The format of an existing file: MCAP if it starts with the MCAP magic, else by
+    /// extension, else CSV. A file that cannot be opened is judged by its extension (the
+    /// reader then reports the error).
+    pub fn detect(path: &Path) -> Self {
+        use std::io::Read;
+        let mut head = [0_u8; 5];
+        let starts_mcap = std::fs::File::open(path)
+            .and_then(|mut f| f.read_exact(&mut head))
+            .is_ok()
+            && head == mcap::MAGIC[..5];
+        if starts_mcap {
+            Self::Mcap
+        } else {
+            Self::from_extension(path).unwrap_or(Self::Csv)
+        }
+    }
+}
+
+/// How to read a log of either format.
+#[derive(Clone, Debug, Default, PartialEq, Eq, clap::Args)]
+pub struct LogOptions {
+    /// CSV columns and units.
+    #[command(flatten, next_help_heading = "CSV input")]
+    pub columns: ColumnOptions,
+    /// MCAP channels and ROS 2 options.
+    #[command(flatten, next_help_heading = "MCAP / ROS 2 input")]
+    pub mcap: McapOptions,
+}
+
+/// Read a CSV or MCAP log (format from [`LogFormat::detect`]). MCAP damage that did not
+/// stop reading (an interrupted recording) is returned as warnings, one line each.
+pub fn read_log_with_warnings(
+    path: &Path,
+    options: &LogOptions,
+) -> Result<(Log, Vec<String>), LogError> {
+    match LogFormat::detect(path) {
+        LogFormat::Csv => Ok((read_csv(path, &options.columns)?, Vec::new())),
+        LogFormat::Mcap => {
+            let read = read_mcap(path, &options.mcap)?;
+            Ok((read.log, read.warnings))
+        }
+    }
+}
+
+/// Read a CSV or MCAP log (format from [`LogFormat::detect`]); warnings are dropped (see
+/// [`read_log_with_warnings`]).
+pub fn read_log(path: &Path, options: &LogOptions) -> Result<Log, LogError> {
+    read_log_with_warnings(path, options).map(|(log, _)| log)
+}
+
+/// Write `log` to `path` as `format`, or by the path's extension (`.csv`, `.mcap`).
+pub fn write_log(path: &Path, log: &Log, format: Option<LogFormat>) -> Result<(), LogError> {
+    let format = format
+        .or_else(|| LogFormat::from_extension(path))
+        .ok_or_else(|| LogError::Format {
+            path: path.to_path_buf(),
+            message: "unknown output format: name it .csv or .mcap".into(),
+        })?;
+    match format {
+        LogFormat::Mcap => write_mcap(path, log),
+        LogFormat::Csv => {
+            let io_err = |cause| LogError::Io {
+                path: path.to_path_buf(),
+                cause,
+            };
+            let mut out = std::io::BufWriter::new(std::fs::File::create(path).map_err(io_err)?);
+            write_csv(&mut out, log).map_err(io_err)?;
+            std::io::Write::flush(&mut out).map_err(io_err)
+        }
+    }
+}
 
 /// One row of a log as recorded (units converted to s, deg/s, deg, °C).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -160,5 +260,43 @@ pub enum LogError {
         gap_s: f64,
         /// The limit (s).
         max_gap_s: f64,
+    },
+    /// An MCAP file that cannot be read (not MCAP, empty, corrupt) or written.
+    #[error("{path}: {message}")]
+    Mcap {
+        /// File.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// An MCAP channel the log needs has the wrong schema or encoding.
+    #[error("{path}: channel `{channel}`: {message}")]
+    McapChannel {
+        /// File.
+        path: PathBuf,
+        /// Topic.
+        channel: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// An MCAP message cannot be decoded.
+    #[error("{path}: channel `{channel}` message {index}: {message}")]
+    McapMessage {
+        /// File.
+        path: PathBuf,
+        /// Topic.
+        channel: String,
+        /// 1-based index of the message on its channel.
+        index: u64,
+        /// What is wrong.
+        message: String,
+    },
+    /// The file format is unknown or unsupported.
+    #[error("{path}: {message}")]
+    Format {
+        /// File.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
     },
 }

@@ -278,12 +278,14 @@ pub fn simulate(
             let per_count = 360.0 / f64::from(counts.max(1));
             reference_deg = (reference_deg / per_count).round() * per_count;
         }
+        // Rounded to what a logger would keep (and what reads back short from CSV).
+        let round = |x: f64, step: f64| (x / step).round() * step;
         rows.push(Row {
             line: 0,
-            time_s: label_s,
-            rate_dps: Some(measured),
-            reference_deg: Some(reference_deg),
-            temperature_c: Some(temperature_c + 0.02 * temp_noise),
+            time_s: k as f64 / fs,
+            rate_dps: Some(round(measured, 1e-6)),
+            reference_deg: Some(round(reference_deg, 1e-6)),
+            temperature_c: Some(round(temperature_c + 0.02 * temp_noise, 1e-3)),
         });
     }
     let mut metadata = BTreeMap::new();

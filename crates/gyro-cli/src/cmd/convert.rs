@@ -1,0 +1,43 @@
+//! `gyro-cli convert`: a log from one format to another (CSV, MCAP, ROS 2 bag in MCAP).
+
+use anyhow::{bail, Result};
+use gyro_host::log;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Input log: CSV, MCAP (`/gyro`, `/reference`) or a ROS 2 bag in MCAP.
+    input: PathBuf,
+    /// Output log, CSV or MCAP by its extension (`.csv`, `.mcap`) unless `--to` says.
+    output: PathBuf,
+    /// Output format, overriding the extension.
+    #[arg(long, value_enum)]
+    to: Option<log::LogFormat>,
+    #[command(flatten)]
+    input_options: log::LogOptions,
+}
+
+/// Run the command.
+pub fn run(args: &Args) -> Result<()> {
+    if args.input == args.output {
+        bail!(
+            "{}: input and output are the same file",
+            args.input.display()
+        );
+    }
+    let (log, warnings) = log::read_log_with_warnings(&args.input, &args.input_options)?;
+    for warning in &warnings {
+        eprintln!("warning: {warning}");
+    }
+    log::write_log(&args.output, &log, args.to)?;
+    let yes_no = |b: bool| if b { "yes" } else { "no" };
+    eprintln!(
+        "{} -> {}: {} rows, reference: {}, temperature: {}",
+        args.input.display(),
+        args.output.display(),
+        log.rows.len(),
+        yes_no(log.has_reference),
+        yes_no(log.has_temperature)
+    );
+    Ok(())
+}
