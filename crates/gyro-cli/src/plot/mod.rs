@@ -11,11 +11,15 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Each plot is a [`Figure`], e.g. [`RunPlot`]. [`save`]
+//! Each plot is a [`Figure`]: [`RunPlot`], [`NoisePlot`], [`CalibrationPlot`]. [`save`]
 //! writes one to a file, [`render`] returns the file's bytes (e.g. for an HTML report).
 
+mod calibrate_plot;
+mod noise_plot;
 mod run_plot;
 
+pub use calibrate_plot::{calibrate_plot, CalibrationPlot};
+pub use noise_plot::{noise_plot, NoisePlot};
 pub use run_plot::{run_plot, RunPlot};
 
 use plotters::coord::Shift;
