@@ -405,6 +405,30 @@ pub(crate) fn thin(points: &[(f64, f64)], max_points: usize) -> Vec<(f64, f64)> 
     out
 }
 
+/// Thin `points` (sorted by x) to at most `max_points`: the largest value of each
+/// bucket, at the bucket's middle point; an upper envelope without notches.
+pub(crate) fn envelope(points: &[(f64, f64)], max_points: usize) -> Vec<(f64, f64)> {
+    if points.len() <= max_points.max(2) {
+        return points.to_vec();
+    }
+    let per = points.len().div_ceil(max_points.max(2));
+    let mut out: Vec<(f64, f64)> = points
+        .chunks(per)
+        .map(|chunk| {
+            let hi = chunk.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+            (chunk[chunk.len() / 2].0, hi)
+        })
+        .collect();
+    // Keep the ends where they were.
+    if let (Some(first), Some(o)) = (points.first(), out.first_mut()) {
+        o.0 = first.0;
+    }
+    if let (Some(last), Some(o)) = (points.last(), out.last_mut()) {
+        o.0 = last.0;
+    }
+    out
+}
+
 /// `(lo, hi)` widened by `pad` of its span on both sides (and to a non-zero span).
 pub(crate) fn padded(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
     let (lo, hi) = if lo.is_finite() && hi.is_finite() && lo <= hi {

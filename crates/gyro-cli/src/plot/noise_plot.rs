@@ -2,13 +2,14 @@
 //! model and each significant term; below it the Welch PSD with the white-noise density.
 
 use super::{
-    colour, draw_err, legend_corner, legend_size, log_tick, save, sig, titled, DrawResult, Figure,
-    PlotError, RenderError, LABEL_PX, TICK_PX,
+    colour, draw_err, legend_corner, legend_size, log_tick, save, sig, tick, titled, DrawResult,
+    Figure, PlotError, RenderError, LABEL_PX, TICK_PX,
 };
 use crate::noise::{Characterization, FitTerm, GaussMarkovFit, NoiseFit, Psd};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::cell::Cell;
 use std::path::Path;
 
@@ -244,6 +245,16 @@ fn log_legend<'a, DB: DrawingBackend + 'a>(
         .map_err(draw_err)
 }
 
+/// A message in the middle of `area`, in place of a panel.
+fn note<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, text: &str) -> DrawResult {
+    let (w, h) = area.dim_in_pixel();
+    let style = TextStyle::from(("sans-serif", LABEL_PX).into_font())
+        .color(&colour::GREY)
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    area.draw_text(text, &style, ((w / 2) as i32, (h / 2) as i32))
+        .map_err(draw_err)
+}
+
 fn line_swatch(c: RGBColor, width: u32) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
     move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(width))
 }
@@ -261,6 +272,12 @@ impl NoisePlot<'_> {
         let points = &r.allan.points;
         let fit = &r.fit;
         let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !points.iter().any(|p| positive(p.adev_dps)) {
+            return note(
+                area,
+                "The Allan deviation is zero at every τ: the rate is constant.",
+            );
+        }
         let tau_lo = points.iter().map(|p| p.tau_s).fold(f64::INFINITY, f64::min);
         let tau_hi = points.iter().map(|p| p.tau_s).fold(0.0, f64::max);
         let x = log_range(tau_lo, tau_hi, 1.4);
@@ -372,7 +389,10 @@ impl NoisePlot<'_> {
             .map(|(f, p)| (*f, *p))
             .collect();
         let (Some(first), Some(last)) = (bins.first(), bins.last()) else {
-            return Ok(());
+            return note(
+                area,
+                "The PSD is zero at every frequency: the rate is constant.",
+            );
         };
         let x = (first.0, last.0 * 1.05);
         let white = 2.0 * psd.white_density_dps_per_rt_hz.powi(2);
@@ -483,7 +503,7 @@ impl Figure for NoisePlot<'_> {
         let subtitle = format!(
             "{} samples at {} Hz ({} s in {} segment{}), mean rate {} deg/s\nARW {} deg/√h   ·   Allan floor {} deg/s at τ = {} s{}",
             r.samples,
-            sig(r.sample_rate_hz, 4),
+            tick(&r.sample_rate_hz),
             sig(r.duration_s, 3),
             r.segments,
             if r.segments == 1 { "" } else { "s" },

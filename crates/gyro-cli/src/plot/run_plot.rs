@@ -2,8 +2,8 @@
 //! angle error (with the Kalman ±1σ band), the motion state and the filtered rate.
 
 use super::{
-    colour, draw_err, legend_corner, legend_size, padded, save, thin, tick, titled, DrawResult,
-    Figure, PlotError, RenderError, LABEL_PX, TICK_PX,
+    colour, draw_err, envelope, legend_corner, legend_size, padded, save, thin, tick, titled,
+    DrawResult, Figure, PlotError, RenderError, LABEL_PX, TICK_PX,
 };
 use crate::replay::{RunReport, SeriesPoint};
 use gyro_core::{Compensation, MotionState};
@@ -187,12 +187,12 @@ impl Figure for RunPlot<'_> {
         };
         let errors = match (s.max_abs_error_deg, s.rms_error_deg, s.final_error_deg) {
             (Some(max), Some(rms), Some(fin)) => {
-                format!("max |error| {max:.3}°   RMS {rms:.3}°   final {fin:+.3}°")
+                format!("max |error| {max:.3}°, RMS {rms:.3}°, final {fin:+.3}°")
             }
             _ => "no reference in the log: errors not available".to_string(),
         };
         let subtitle = format!(
-            "{mode}   ·   {errors}   ·   {} movement{}, {:.1} s",
+            "{mode}  ·  {errors}  ·  {} movement{} in {:.1} s",
             s.movements,
             if s.movements == 1 { "" } else { "s" },
             s.duration_s
@@ -213,9 +213,20 @@ impl Figure for RunPlot<'_> {
         let angle = thin_all(segments(series, |p| Some(f64::from(p.angle_deg))));
         let reference = thin_all(segments(series, |p| p.reference_deg));
         let error = thin_all(segments(series, SeriesPoint::error_deg));
-        let sigma = thin_all(segments(series, |p| p.angle_std_deg.map(f64::from)));
+        // The band's edge: the largest σ per bucket (min/max thinning would notch it).
+        let sigma: Vec<Vec<(f64, f64)>> = segments(series, |p| p.angle_std_deg.map(f64::from))
+            .iter()
+            .map(|l| envelope(l, MAX_POINTS / 2))
+            .collect();
         let rate = thin_all(segments(series, |p| Some(f64::from(p.rate_dps))));
         let has_error = !error.is_empty();
+        // Thinned lines are drawn thin: plotters' bitmap backend leaves gaps in thick,
+        // near-vertical segments.
+        let (width, wide) = if series.len() > MAX_POINTS {
+            (1, 3)
+        } else {
+            (2, 5)
+        };
 
         // Panel heights (px) of the body.
         let (_, h) = body.dim_in_pixel();
@@ -240,20 +251,20 @@ impl Figure for RunPlot<'_> {
                 let drawn = chart
                     .draw_series(LineSeries::new(
                         line.iter().copied(),
-                        colour::GREY.mix(0.55).stroke_width(5),
+                        colour::GREY.mix(0.55).stroke_width(wide),
                     ))
                     .map_err(draw_err)?;
                 if i == 0 {
                     drawn
                         .label(REFERENCE_LABEL)
-                        .legend(line_legend(RGBColor(180, 180, 180), 5));
+                        .legend(line_legend(RGBColor(180, 180, 180), wide));
                 }
             }
             for (i, line) in angle.iter().enumerate() {
                 let drawn = chart
                     .draw_series(LineSeries::new(
                         line.iter().copied(),
-                        colour::BLUE.stroke_width(2),
+                        colour::BLUE.stroke_width(width),
                     ))
                     .map_err(draw_err)?;
                 if i == 0 {
@@ -320,7 +331,7 @@ impl Figure for RunPlot<'_> {
                 let drawn = chart
                     .draw_series(LineSeries::new(
                         line.iter().copied(),
-                        colour::VERMILLION.stroke_width(2),
+                        colour::VERMILLION.stroke_width(width),
                     ))
                     .map_err(draw_err)?;
                 if i == 0 {
@@ -403,7 +414,7 @@ impl Figure for RunPlot<'_> {
                 let drawn = chart
                     .draw_series(LineSeries::new(
                         line.iter().copied(),
-                        colour::GREEN.stroke_width(2),
+                        colour::GREEN.stroke_width(width),
                     ))
                     .map_err(draw_err)?;
                 if i == 0 {
