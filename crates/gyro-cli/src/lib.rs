@@ -15,6 +15,7 @@ pub mod log;
 pub mod model;
 pub mod nelder_mead;
 pub mod noise;
+pub mod plot;
 pub mod replay;
 pub mod report;
 pub mod sim;

@@ -36,6 +36,10 @@ pub struct Args {
     /// Output format on stdout.
     #[arg(long, value_enum, default_value_t = super::run::Format::Table)]
     format: super::run::Format,
+    /// Plot each run's max abs error without compensation, with the paper model and the
+    /// Kalman form (training and hold-out runs) to this file: .svg or .png.
+    #[arg(long, value_parser = gyro_host::plot::parse_plot_path)]
+    plot: Option<PathBuf>,
 }
 
 fn load_runs(paths: &[PathBuf]) -> Result<Vec<BenchRun>> {
@@ -174,5 +178,9 @@ pub fn run(args: &Args) -> Result<()> {
         _ => print!("{}", table(&result)),
     }
     eprintln!("wrote {}", args.out.display());
+    if let Some(path) = &args.plot {
+        gyro_host::plot::calibrate_plot(path, &result)?;
+        eprintln!("wrote {}", path.display());
+    }
     Ok(())
 }

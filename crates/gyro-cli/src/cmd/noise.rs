@@ -69,6 +69,10 @@ pub struct Args {
     /// Write the full PSD as CSV (`log,frequency_hz,psd_dps2_per_hz`) here.
     #[arg(long)]
     psd_out: Option<PathBuf>,
+    /// Plot the Allan deviation with bounds, the fitted model and its terms, and the PSD
+    /// to this file: .svg or .png (of all logs pooled, if several).
+    #[arg(long, value_parser = gyro_host::plot::parse_plot_path)]
+    plot: Option<PathBuf>,
     /// Sample rate of the logs (Hz); default: their `sample_rate_hz` metadata, else the
     /// median time step.
     #[arg(long)]
@@ -260,6 +264,15 @@ pub fn run(args: &Args) -> Result<()> {
             w.flush()
         };
         write().with_context(|| format!("cannot write {}", out.display()))?;
+    }
+
+    if let Some(path) = &args.plot {
+        let (title, result) = match (&combined, loaded.as_slice(), results.as_slice()) {
+            (Some(c), ..) => (format!("all {} logs pooled", loaded.len()), c),
+            (None, [l, ..], [r, ..]) => (l.file.clone(), r),
+            _ => bail!("no result to plot"),
+        };
+        gyro_host::plot::noise_plot(path, &title, result)?;
     }
 
     let mut stdout = std::io::stdout().lock();

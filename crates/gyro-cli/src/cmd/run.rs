@@ -41,6 +41,10 @@ pub struct Args {
     /// Write the output-rate series (angle, reference, error, state) as CSV here.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Plot angle vs reference, error (±1σ in Kalman mode), motion state and rate to this
+    /// file: .svg or .png.
+    #[arg(long, value_parser = gyro_host::plot::parse_plot_path)]
+    plot: Option<PathBuf>,
     /// Sample rate of the log (Hz); default: its `sample_rate_hz` metadata, else the
     /// median time step.
     #[arg(long)]
@@ -96,6 +100,13 @@ pub fn run(args: &Args) -> Result<()> {
             w.flush()
         };
         write().with_context(|| format!("cannot write {}", out.display()))?;
+    }
+    if let Some(path) = &args.plot {
+        let name = args
+            .log
+            .file_name()
+            .map_or(file.clone(), |n| n.to_string_lossy().into());
+        gyro_host::plot::run_plot(path, &name, &result)?;
     }
     Ok(())
 }
