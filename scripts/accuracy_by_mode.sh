@@ -7,15 +7,18 @@
 # with no compensation, the paper's error model and the Kalman form with rest updates).
 #
 # Usage: scripts/accuracy_by_mode.sh [OUTDIR]   (default: a temporary folder)
+#        EFFECTS="" scripts/accuracy_by_mode.sh   (the paper's assumption: the same bias
+#        every run; EFFECTS holds --effect options for every run)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-$(mktemp -d)}"
 mkdir -p "$out"
+effects="${EFFECTS-"--effect turn_on_bias:sigma_dps=0.3"}"
 cargo build --release -q -p gyro-cli
 gyro=target/release/gyro-cli
 for seed in $(seq 101 120); do
-    "$gyro" simulate -o "$out/run$seed.csv" --seed "$seed" --duration-s 90 \
-        --effect turn_on_bias:sigma_dps=0.3 2>/dev/null
+    # shellcheck disable=SC2086
+    "$gyro" simulate -o "$out/run$seed.csv" --seed "$seed" --duration-s 90 $effects 2>/dev/null
 done
 train=$(for s in $(seq 101 110); do echo "$out/run$s.csv"; done)
 holdout=$(for s in $(seq 111 120); do echo "$out/run$s.csv"; done)

@@ -126,6 +126,18 @@ impl KalmanBias {
         self.bias_dps = self.bias_mean_dps + self.phi * (self.bias_dps - self.bias_mean_dps);
     }
 
+    /// Add the angle uncertainty of `samples` steps that were integrated while the motion
+    /// was unconfirmed (propagated as static until then). Covariance only: the bias
+    /// estimate already evolved the same way in both cases.
+    pub fn add_motion(&mut self, samples: u32) {
+        if samples == 0 {
+            return;
+        }
+        let n = samples as f32;
+        let g = Matrix2::new(1.0, -self.dt_s * n, 0.0, 1.0);
+        self.p = g * self.p * g.transpose() + Matrix2::new(self.q_angle * n, 0.0, 0.0, 0.0);
+    }
+
     /// Zero-rate update with the mean of `samples` rates measured at rest (its noise
     /// variance is R/samples). Returns the angle correction (deg).
     pub fn update_at_rest(&mut self, mean_rate_dps: f32, samples: u32) -> f32 {

@@ -372,7 +372,12 @@ impl Pipeline {
             Phase::Ended { quiet } => quiet <= 1,
             _ => true,
         };
-        self.kalman.predict(integrates);
+        // An onset may still turn out not to be a movement: its samples are propagated as
+        // static, and their share of the angle's uncertainty is added once the movement is
+        // confirmed. Propagating them as moving coupled angle and bias for samples that
+        // were then discarded, and the next rest updates "corrected" an angle that had not
+        // moved (0.08 deg at power-up with an unknown bias).
+        self.kalman.predict(integrates && phase != Phase::Onset);
         let corrected_dps = rate_dps - self.kalman.bias_dps();
         let (previous_rate, previous_corrected) =
             self.previous.unwrap_or((rate_dps, corrected_dps));
@@ -396,6 +401,7 @@ impl Pipeline {
                 None
             }
             Phase::Started { run } => {
+                self.kalman.add_motion(u32::from(run).saturating_sub(1));
                 // The movement starts at the quiet sample before the run.
                 let start_index = self.index.saturating_sub(u32::from(run));
                 let start_time_s =
