@@ -44,7 +44,7 @@ pub const DEFAULT_READ_BUFFER: usize = 4096;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ReadEvent {
     /// A frame whose CRC is good, with its place in the sequence. A
-    /// [`SeqEvent::Gap`] means frames were lost just before it ([`Received::lost_before`]).
+    /// [`SeqEvent::Gap`](crate::SeqEvent::Gap) means frames were lost just before it ([`Received::lost_before`]).
     Frame(Received),
     /// A candidate frame (sync and format matched) failed its CRC: a frame was damaged.
     /// Its bytes are reported in a following [`ReadEvent::Skipped`].

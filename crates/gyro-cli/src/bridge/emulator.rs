@@ -474,7 +474,8 @@ const BATCH_FRAMES: usize = 512;
 /// Writes that time out or are interrupted (a serial port or pseudo-terminal whose reader
 /// is slow) are retried; `stop` (e.g. set by a signal handler) ends streaming early, and
 /// `sent` (if given) is updated with the number of frames handed to `out` so far, for a
-/// test or a progress display.
+/// test or a progress display. When `stop` ends a blocked write, the frames of that last
+/// batch are counted in the report but may be partly unsent.
 pub fn stream<W: Write + ?Sized>(
     frames: impl IntoIterator<Item = PlannedFrame>,
     out: &mut W,

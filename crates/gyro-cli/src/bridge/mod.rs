@@ -1,5 +1,5 @@
 //! The CRM100 serial bridge on the host: an [`emulator`] that plays samples as a bridge
-//! would send them (with seeded faults), and [`record`] that reads a bridge into an MCAP or
+//! would send them (with seeded faults), and [`record`](mod@record) that reads a bridge into an MCAP or
 //! CSV log with every loss counted. Both sit on `crm100-driver`'s framing
 //! ([`crm100_driver::bridge`]) and its host reader ([`crm100_driver::BridgeReader`]).
 
