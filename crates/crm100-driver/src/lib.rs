@@ -11,6 +11,10 @@
 //! - [`bridge`] and [`sequence`]: the framing a bridge MCU uses to forward raw responses over
 //!   UART/USB ([`encode`]), and the host's resynchronising [`BridgeDecoder`], loss-counting
 //!   [`SequenceTracker`] and the [`BridgeReceiver`] that combines them.
+//! - `reader` (feature `std`): `BridgeReader`, the host reader over any `std::io::Read`
+//!   that reports every frame, sequence gap, CRC error, run of skipped bytes and read
+//!   timeout as a `ReadEvent`; `serial` (feature `serial`): opening a serial port by name
+//!   with a read timeout (the `serialport` crate, re-exported).
 //!
 //! The CRM100 datasheet was not available. Protocol facts come from public working code;
 //! what could not be confirmed is a setting, not a constant: the poll command
@@ -54,7 +58,11 @@ mod crc16;
 pub mod driver;
 mod error;
 pub mod frame;
+#[cfg(feature = "std")]
+pub mod reader;
 pub mod sequence;
+#[cfg(feature = "serial")]
+pub mod serial;
 mod types;
 
 pub use bridge::{
@@ -67,6 +75,8 @@ pub use error::{Error, FrameError};
 pub use frame::{
     checksum, command_frame, decode, decode_slice, verify_checksum, Response, FRAME_LEN,
 };
+#[cfg(feature = "std")]
+pub use reader::{BridgeReader, ReadEvent, ReaderStats, DEFAULT_READ_BUFFER};
 pub use sequence::{
     BridgeReceiver, Gap, Received, ReceiverFeed, ReceiverStats, SeqEvent, SequenceStats,
     SequenceTracker, MAX_FORWARD_STEP,

@@ -149,6 +149,17 @@ pub struct Received {
     pub sequence: SeqEvent,
 }
 
+impl Received {
+    /// Frames lost right before this one, as its sequence number says (0 unless the
+    /// verdict is a [`SeqEvent::Gap`]).
+    pub const fn lost_before(&self) -> u32 {
+        match self.sequence {
+            SeqEvent::Gap(gap) => gap.lost,
+            _ => 0,
+        }
+    }
+}
+
 /// Counters of a [`BridgeReceiver`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct ReceiverStats {
@@ -190,6 +201,12 @@ impl BridgeReceiver {
     /// The sequence tracker.
     pub const fn tracker(&self) -> &SequenceTracker {
         &self.tracker
+    }
+
+    /// Drops a partial frame held in the decoder (counted as skipped bytes), e.g. at the
+    /// end of a stream or after reopening the port. The sequence tracker is kept.
+    pub fn clear(&mut self) {
+        self.decoder.clear();
     }
 
     /// Takes one byte; see [`BridgeDecoder::push`].

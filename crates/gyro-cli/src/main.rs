@@ -30,6 +30,12 @@ enum Command {
     Noise(cmd::noise::Args),
     /// Convert a log between CSV and MCAP (also from a ROS 2 bag in MCAP).
     Convert(cmd::convert::Args),
+    /// Record the CRM100 serial bridge to MCAP (or CSV) as it comes: every loss counted,
+    /// a live status line, a clean finish on Ctrl-C.
+    Record(cmd::record::Args),
+    /// Play a log or a simulated run as a CRM100 serial bridge on a port, with seeded
+    /// faults (byte loss, bit flips, bad checksums, status faults, dropped frames, stalls).
+    Emulate(cmd::emulate::Args),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +46,8 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => cmd::calibrate::run(args),
         Command::Noise(args) => cmd::noise::run(args),
         Command::Convert(args) => cmd::convert::run(args),
+        Command::Record(args) => cmd::record::run(args),
+        Command::Emulate(args) => cmd::emulate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

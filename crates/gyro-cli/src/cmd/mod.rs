@@ -2,6 +2,8 @@
 
 pub mod calibrate;
 pub mod convert;
+pub mod emulate;
 pub mod noise;
+pub mod record;
 pub mod run;
 pub mod simulate;

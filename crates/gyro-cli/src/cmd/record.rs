@@ -1,0 +1,132 @@
+//! `gyro-cli record`: read the CRM100 serial bridge into an MCAP (or CSV) log as it comes,
+//! with a live status line, every loss counted, and a clean finish on Ctrl-C.
+
+use anyhow::{Context, Result};
+use crm100_driver::{serial, Range};
+use gyro_host::bridge::{self, CsvSink, LiveStatus, McapSink, RecordOptions, RecordSink};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::Duration;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Serial port of the bridge (e.g. /dev/ttyACM0, COM3, a pseudo-terminal).
+    #[arg(long)]
+    port: String,
+    /// Baud rate (24-byte frames at 1 kHz need at least 460800).
+    #[arg(long, default_value_t = serial::DEFAULT_BAUD)]
+    baud: u32,
+    /// Output log: MCAP (default) or, with --csv, CSV.
+    #[arg(short, long)]
+    out: PathBuf,
+    /// Stop after this many seconds (default: until Ctrl-C or the port closes).
+    #[arg(long)]
+    duration: Option<f64>,
+    /// Stop when no byte arrived for this many seconds.
+    #[arg(long)]
+    idle_stop: Option<f64>,
+    /// Range the sensor runs in (°/s): 75, 150, 300 or 900; scales the rate word.
+    #[arg(long, default_value = "300", value_parser = bridge::parse_range)]
+    range: Range,
+    /// Nominal frame rate of the bridge (Hz), for the metadata.
+    #[arg(long, default_value_t = 1000.0)]
+    sample_rate_hz: f64,
+    /// Write CSV (time_s, rate_dps, temperature_c, status, sequence, raw) instead of MCAP.
+    #[arg(long)]
+    csv: bool,
+    /// Do not verify the CRM100 response checksum (the rule is assumed, not documented).
+    #[arg(long)]
+    no_checksum: bool,
+    /// Read timeout of the port (ms): how often the status line, flushes and Ctrl-C are
+    /// looked at when the line is quiet.
+    #[arg(long, default_value_t = 100)]
+    timeout_ms: u64,
+}
+
+fn seconds(value: Option<f64>, name: &str) -> Result<Option<Duration>> {
+    value
+        .map(|s| {
+            Duration::try_from_secs_f64(s)
+                .ok()
+                .filter(|d| !d.is_zero())
+                .with_context(|| format!("--{name} must be a positive number of seconds"))
+        })
+        .transpose()
+}
+
+fn status_line(s: &LiveStatus) -> String {
+    let value = |v: Option<f64>, width: usize, unit: &str| {
+        v.map_or_else(
+            || format!("{:>width$} {unit}", "-"),
+            |v| format!("{v:>+width$.2} {unit}"),
+        )
+    };
+    let st = &s.stats;
+    format!(
+        "{:>7.1} s  rate {}  temp {}  {:>6.0} frames/s  frames {}  lost {}  crc {}  skipped {} B  chk {}  status {}",
+        s.elapsed_s,
+        value(s.rate_dps, 8, "°/s"),
+        value(s.temperature_c, 6, "°C"),
+        s.frames_per_s,
+        st.frames,
+        st.frames_lost,
+        st.crc_errors,
+        st.bytes_skipped,
+        st.checksum_errors,
+        st.status_faults,
+    )
+}
+
+/// Run the command.
+pub fn run(args: &Args) -> Result<()> {
+    // SIGINT/SIGTERM set a flag the loop polls (signal-hook: an atomic store in the
+    // handler, no extra thread); a second one while the first is being handled exits at
+    // once with status 1.
+    let stop = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(signal, 1, Arc::clone(&stop))
+            .context("cannot install the signal handler")?;
+        signal_hook::flag::register(signal, Arc::clone(&stop))
+            .context("cannot install the signal handler")?;
+    }
+    let options = RecordOptions {
+        range: args.range,
+        verify_checksum: !args.no_checksum,
+        sample_rate_hz: args.sample_rate_hz,
+        duration: seconds(args.duration, "duration")?,
+        idle_stop: seconds(args.idle_stop, "idle-stop")?,
+        source: format!("{} at {} Bd", args.port, args.baud),
+        ..RecordOptions::default()
+    };
+    let mut reader = serial::open_reader(
+        &args.port,
+        args.baud,
+        Duration::from_millis(args.timeout_ms.max(1)),
+    )
+    .with_context(|| format!("cannot open {}", args.port))?;
+    let sink: Box<dyn RecordSink> = if args.csv {
+        Box::new(CsvSink::create(&args.out, &options)?)
+    } else {
+        Box::new(McapSink::create(&args.out, &options)?)
+    };
+    eprintln!(
+        "recording {} ({} Bd, range {}) to {}; Ctrl-C to stop",
+        args.port,
+        args.baud,
+        args.range,
+        args.out.display()
+    );
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr_with_hz(4));
+    bar.set_style(
+        ProgressStyle::with_template("{msg}").unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    let mut show = |s: &LiveStatus| bar.set_message(status_line(s));
+    let summary = bridge::record(&mut reader, sink, &options, &stop, &mut show);
+    bar.finish_and_clear();
+    let summary = summary?;
+    eprintln!("{summary}");
+    eprintln!("wrote {}", args.out.display());
+    Ok(())
+}
