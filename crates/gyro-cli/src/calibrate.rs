@@ -173,7 +173,8 @@ impl Trace {
             // Skip 0.2 s at both ends of each static stretch: the filter's tail of the last
             // movement, and the onset of the next one (static until it is confirmed).
             let margin = min_len / 5;
-            let rest = &series[(start + margin).min(k)..k.saturating_sub(margin).max(start)];
+            let (lo, hi) = (start + margin, k.saturating_sub(margin));
+            let rest = if lo < hi { &series[lo..hi] } else { &[][..] };
             if rest.len() >= min_len {
                 let mean =
                     rest.iter().map(|p| f64::from(p.rate_dps)).sum::<f64>() / rest.len() as f64;
@@ -322,6 +323,9 @@ pub struct Calibration {
     pub objective: Objective,
     /// Its value at the fit (deg).
     pub objective_deg: f64,
+    /// Starting correlation time of the fit (s) and where it came from (`option`,
+    /// `rest_allan` or `default`).
+    pub initial_tau: (f64, &'static str),
     /// Why the optimiser stopped.
     pub termination: String,
     /// Objective evaluations.
@@ -491,8 +495,94 @@ pub struct CalibrateOptions {
     pub objective: Objective,
     /// Refit leaving each run out, for the parameters' spread.
     pub leave_one_out: bool,
-    /// Initial correlation time of the bias (s), e.g. from `noise`; default 100 s.
+    /// Initial correlation time of the bias (s), e.g. from `noise`; default: the
+    /// Gauss-Markov term fitted to the rest segments' Allan deviation, else 100 s.
     pub initial_tau_s: Option<f64>,
+    /// Also fit the motion detector's thresholds (`enter_dps`, `exit_dps`).
+    pub fit_motion: bool,
+}
+
+/// The correlation time of the bias from the rest segments of `runs` (Allan deviation
+/// with a significant Gauss-Markov term), if they show one. Runs at another sample rate
+/// than the first are left out.
+fn rest_correlation_time(runs: &[BenchRun], base: &Config) -> Option<f64> {
+    let rate_hz = runs.first()?.log.sample_rate_hz;
+    let mut segments: Vec<Vec<f64>> = Vec::new();
+    for run in runs.iter().filter(|r| r.log.sample_rate_hz == rate_hz) {
+        let ranges = crate::noise::rest_segments(&run.log, base, 0.5, 1.0).ok()?;
+        for range in ranges {
+            segments.push(run.log.slots[range].iter().map(|s| s.rate_dps).collect());
+        }
+    }
+    let views: Vec<&[f64]> = segments.iter().map(Vec::as_slice).collect();
+    let c =
+        crate::noise::characterize(&views, rate_hz, &crate::noise::NoiseOptions::default()).ok()?;
+    let gm = c.fit.gauss_markov;
+    if gm.significant {
+        gm.corr_time_s
+    } else {
+        None
+    }
+}
+
+fn traces_for(runs: &[BenchRun], base: &Config) -> Result<Vec<Trace>, CalibrateError> {
+    runs.iter()
+        .map(|run| {
+            Trace::new(&run.log, base).map_err(|source| CalibrateError::Config {
+                name: run.name.clone(),
+                source,
+            })
+        })
+        .collect()
+}
+
+/// Fit the detector thresholds around the paper fit: an outer Nelder-Mead over
+/// (ln exit_dps, ln(enter_dps − exit_dps)), each point scored by the best paper fit on
+/// traces replayed with those thresholds.
+fn fit_motion(
+    train: &[BenchRun],
+    base: &Config,
+    objective: Objective,
+    start: GaussMarkov,
+    progress: &mut dyn FnMut(&str, usize, f64),
+) -> Result<Config, CalibrateError> {
+    let with = |x: &[f64]| {
+        let mut config = *base;
+        config.motion.exit_dps = x[0].exp() as f32;
+        config.motion.enter_dps = (x[0].exp() + x[1].exp()) as f32;
+        config
+    };
+    let bounds = Bounds::new(
+        vec![0.01_f64.ln(), 0.05_f64.ln()],
+        vec![2f64.ln(), 10f64.ln()],
+    )
+    .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
+    let optimiser = NelderMead::new()
+        .with_bounds(bounds)
+        .with_initial_steps(InitialSteps::Absolute(vec![0.4, 0.4]))
+        .and_then(|o| o.with_x_tolerance(0.02))
+        .and_then(|o| o.with_f_tolerance(1e-4))
+        .and_then(|o| o.with_max_evaluations(60))
+        .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
+    let exit = f64::from(base.motion.exit_dps).clamp(0.011, 1.9);
+    let gap = (f64::from(base.motion.enter_dps) - exit).clamp(0.051, 9.9);
+    let mut evaluations = 0;
+    let outcome = optimiser
+        .try_minimize(
+            |x| -> Result<f64, CalibrateError> {
+                let traces = traces_for(train, &with(x))?;
+                let (_, value, ..) = fit_paper(&traces, objective, start, &mut |_, _| {})?;
+                evaluations += 1;
+                progress("motion thresholds", evaluations, value);
+                Ok(value)
+            },
+            vec![exit.ln(), gap.ln()],
+        )
+        .map_err(|e| match e {
+            crate::nelder_mead::Error::Objective(e) => e,
+            other => CalibrateError::Optimiser(other.to_string()),
+        })?;
+    Ok(with(&outcome.x))
 }
 
 /// Calibrate `base` on `train`; score on `train` and `holdout`.
@@ -511,19 +601,15 @@ pub fn calibrate(
             return Err(CalibrateError::NoReference(run.name.clone()));
         }
     }
-    let traces = train
-        .iter()
-        .map(|run| {
-            let config = Config {
-                sample_rate_hz: run.log.sample_rate_hz as f32,
-                ..*base
-            };
-            Trace::new(&run.log, &config).map_err(|source| CalibrateError::Config {
-                name: run.name.clone(),
-                source,
-            })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let initial_tau = match options.initial_tau_s {
+        Some(tau_s) => (tau_s, "option"),
+        None => match rest_correlation_time(train, base) {
+            Some(tau_s) => (tau_s, "rest_allan"),
+            None => (100.0, "default"),
+        },
+    };
+    let mut base = *base;
+    let mut traces = traces_for(train, &base)?;
     if traces.iter().all(|t| t.spans.is_empty()) {
         return Err(CalibrateError::NoMovement);
     }
@@ -532,10 +618,14 @@ pub fn calibrate(
         .flat_map(|t| t.rest_means_dps.iter().copied())
         .collect();
     let start = GaussMarkov {
-        beta_per_s: (1.0 / options.initial_tau_s.unwrap_or(100.0)) as f32,
+        beta_per_s: (1.0 / initial_tau.0) as f32,
         b0_dps: median(rest_means.clone()).unwrap_or(0.0) as f32,
         o0_deg: 0.0,
     };
+    if options.fit_motion {
+        base = fit_motion(train, &base, options.objective, start, progress)?;
+        traces = traces_for(train, &base)?;
+    }
     let (paper, objective_deg, termination, evaluations) =
         fit_paper(&traces, options.objective, start, &mut |n, best| {
             progress("fit", n, best)
@@ -576,7 +666,7 @@ pub fn calibrate(
     // of a run's rest means about their mean: the Gauss-Markov sigma) and differs between
     // runs (turn-on: the initial uncertainty). Mixing the two would make the filter chase
     // noise. White noise: of the filtered rate at rest.
-    let mut config = *base;
+    let mut config = base;
     config.paper = paper;
     if let Some(mean) = median(rest_means.clone()) {
         config.kalman.bias_mean_dps = mean as f32;
@@ -630,6 +720,7 @@ pub fn calibrate(
         paper,
         objective: options.objective,
         objective_deg,
+        initial_tau,
         termination: format!("{termination:?}"),
         evaluations,
         config,

@@ -133,6 +133,7 @@ fn fit_recovers_the_paper_model_and_halves_holdout_error() {
         objective: Objective::MovementRms,
         leave_one_out: true,
         initial_tau_s: None,
+        fit_motion: false,
     };
     let result = calibrate(
         train,
@@ -202,6 +203,7 @@ fn paper_objective_also_halves_holdout_error() {
         objective: Objective::MeanMaxAbs,
         leave_one_out: false,
         initial_tau_s: None,
+        fit_motion: false,
     };
     let result = calibrate(
         train,
@@ -225,7 +227,54 @@ fn runs_without_reference_are_refused() {
         objective: Objective::MeanMaxAbs,
         leave_one_out: false,
         initial_tau_s: None,
+        fit_motion: false,
     };
     let err = calibrate(&[run], &[], &Config::default(), &options, &mut |_, _, _| {}).unwrap_err();
     assert!(err.to_string().contains("no reference_deg column"), "{err}");
+}
+
+#[test]
+fn motion_thresholds_fit_never_worsens_the_objective() {
+    let truth = GaussMarkov {
+        beta_per_s: 0.5,
+        b0_dps: 0.4,
+        o0_deg: 0.1,
+    };
+    let runs: Vec<BenchRun> = (31..=33)
+        .map(|seed| paper_model_run(&truth, seed))
+        .collect();
+    let options = |fit_motion| CalibrateOptions {
+        objective: Objective::MeanMaxAbs,
+        leave_one_out: false,
+        initial_tau_s: Some(2.0),
+        fit_motion,
+    };
+    let fixed = calibrate(
+        &runs,
+        &[],
+        &Config::default(),
+        &options(false),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    let fitted = calibrate(
+        &runs,
+        &[],
+        &Config::default(),
+        &options(true),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    assert!(
+        fitted.objective_deg <= fixed.objective_deg + 1e-9,
+        "{} vs {}",
+        fitted.objective_deg,
+        fixed.objective_deg
+    );
+    let m = fitted.config.motion;
+    assert!(
+        m.exit_dps >= 0.01 && m.exit_dps <= 2.0 && m.enter_dps > m.exit_dps,
+        "{m:?}"
+    );
+    assert_eq!(fitted.initial_tau, (2.0, "option"));
 }

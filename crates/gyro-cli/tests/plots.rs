@@ -132,6 +132,7 @@ fn small_calibration() -> Calibration {
             objective: Default::default(),
             leave_one_out: false,
             initial_tau_s: None,
+            fit_motion: false,
         },
         &mut |_, _, _| {},
     )

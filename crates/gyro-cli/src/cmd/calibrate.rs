@@ -30,6 +30,9 @@ pub struct Args {
     /// Initial bias correlation time (s), e.g. from `gyro-cli noise`.
     #[arg(long)]
     tau_s: Option<f64>,
+    /// Also fit the motion detector's thresholds (slower: runs are replayed per trial).
+    #[arg(long)]
+    fit_motion: bool,
     /// Skip the leave-one-run-out refits.
     #[arg(long)]
     no_leave_one_out: bool,
@@ -98,6 +101,16 @@ fn score_table(title: &str, scores: &[RunScore]) -> String {
 
 fn table(c: &Calibration) -> String {
     let mut s = format!(
+        "start: correlation time {:.1} s ({})\n",
+        c.initial_tau.0, c.initial_tau.1
+    );
+    if c.config.motion != Config::default().motion {
+        s += &format!(
+            "motion thresholds: enter {:.3} deg/s, exit {:.3} deg/s\n",
+            c.config.motion.enter_dps, c.config.motion.exit_dps
+        );
+    }
+    s += &format!(
         "paper error model: beta {:.5} 1/s (T {:.1} s), b0 {:.5} deg/s, o0 {:.5} deg\n  objective {:?} = {:.4} deg after {} evaluations ({})\n",
         c.paper.beta_per_s,
         1.0 / c.paper.beta_per_s,
@@ -155,6 +168,7 @@ pub fn run(args: &Args) -> Result<()> {
         objective: args.objective,
         leave_one_out: !args.no_leave_one_out,
         initial_tau_s: args.tau_s,
+        fit_motion: args.fit_motion,
     };
     let result = calibrate(
         &train,
