@@ -247,3 +247,56 @@ fn model_file_is_used_and_bad_models_are_refused() {
     let out = gyro(&["run", log, "--model", &broken]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("broken.json:1:"));
 }
+
+#[test]
+fn calibrate_and_noise_take_mcap_and_refuse_logs_without_reference() {
+    let dir = temp_dir("mcap-commands");
+    let log = bench_log();
+    let mcap = dir.join("bench.mcap");
+    let out = gyro(&["convert", log.to_str().unwrap(), mcap.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    let model = dir.join("model.json");
+    let out = gyro(&[
+        "calibrate",
+        mcap.to_str().unwrap(),
+        "-o",
+        model.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    let report = json_of(&out);
+    assert_eq!(report["train"].as_array().unwrap().len(), 1);
+    assert!(report["train"][0]["kalman_max_abs_deg"].as_f64().unwrap() < 0.15);
+    assert!(model.exists());
+
+    let out = gyro(&[
+        "noise",
+        mcap.to_str().unwrap(),
+        "--static-only",
+        "--format",
+        "json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    let no_reference = write(
+        &dir,
+        "noref.csv",
+        "time_s,rate_dps\n0.000,0.1\n0.001,0.1\n0.002,0.1\n",
+    );
+    let out = gyro(&["calibrate", &no_reference, "-o", model.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("noref.csv: no reference_deg column"),
+        "{stderr}"
+    );
+}

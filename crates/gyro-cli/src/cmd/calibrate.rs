@@ -36,6 +36,8 @@ pub struct Args {
     /// Skip the leave-one-run-out refits.
     #[arg(long)]
     no_leave_one_out: bool,
+    #[command(flatten)]
+    input: log::LogOptions,
     /// Output format on stdout.
     #[arg(long, value_enum, default_value_t = super::run::Format::Table)]
     format: super::run::Format,
@@ -45,11 +47,14 @@ pub struct Args {
     plot: Option<PathBuf>,
 }
 
-fn load_runs(paths: &[PathBuf]) -> Result<Vec<BenchRun>> {
+fn load_runs(paths: &[PathBuf], input: &log::LogOptions) -> Result<Vec<BenchRun>> {
     paths
         .iter()
         .map(|path| {
-            let raw = log::read_csv(path, &log::ColumnOptions::default())?;
+            let (raw, warnings) = log::read_log_with_warnings(path, input)?;
+            for warning in &warnings {
+                eprintln!("warning: {warning}");
+            }
             let regular = log::regularize(&raw, &log::GridOptions::default())?;
             Ok(BenchRun {
                 name: path.display().to_string(),
@@ -157,8 +162,8 @@ pub fn run(args: &Args) -> Result<()> {
         Some(path) => model::load(path)?,
         None => model::ModelFile::new(Config::default()),
     };
-    let train = load_runs(&args.logs)?;
-    let holdout = load_runs(&args.holdout)?;
+    let train = load_runs(&args.logs, &args.input)?;
+    let holdout = load_runs(&args.holdout, &args.input)?;
     let bar = ProgressBar::new_spinner();
     bar.set_style(
         ProgressStyle::with_template("{spinner} {elapsed} {msg}")

@@ -81,7 +81,7 @@ pub struct Args {
     #[arg(long, default_value_t = 0.5)]
     max_gap_s: f64,
     #[command(flatten)]
-    columns: log::ColumnOptions,
+    input: log::LogOptions,
 }
 
 /// One log's data, ready to characterise.
@@ -121,7 +121,10 @@ struct Output<'a> {
 }
 
 fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<Loaded> {
-    let raw = log::read_csv(path, &args.columns)?;
+    let (raw, warnings) = log::read_log_with_warnings(path, &args.input)?;
+    for warning in &warnings {
+        eprintln!("warning: {warning}");
+    }
     let regular = log::regularize(
         &raw,
         &log::GridOptions {

@@ -81,7 +81,10 @@ pub fn run(args: &Args) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let motion = match &args.motion_from {
         Some(path) => {
-            let raw = log::read_csv(path, &log::ColumnOptions::default())?;
+            let (raw, warnings) = log::read_log_with_warnings(path, &log::LogOptions::default())?;
+            for warning in &warnings {
+                eprintln!("warning: {warning}");
+            }
             if !raw.has_reference {
                 anyhow::bail!(
                     "{}: no reference_deg column to take the motion from",
