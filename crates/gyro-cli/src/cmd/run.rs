@@ -80,6 +80,7 @@ pub fn run(args: &Args) -> Result<()> {
             max_gap_s: args.max_gap_s,
         },
     )?;
+    drop(raw); // the rows are on the grid now; free them before the replay
     let result = replay::replay(&regular, &config).with_context(|| {
         format!(
             "{}: cannot configure the pipeline for this log",

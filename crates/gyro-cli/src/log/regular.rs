@@ -175,8 +175,8 @@ pub fn regularize(log: &Log, options: &GridOptions) -> Result<RegularLog, LogErr
         ..Quality::default()
     };
 
-    // Pass 1: assign slots; rates may be missing (None) for now.
-    let mut slots: Vec<(Slot, Option<f64>)> = Vec::with_capacity(log.rows.len() + 16);
+    // Pass 1: assign slots; a missing rate is NaN (and `filled`) for now.
+    let mut slots: Vec<Slot> = Vec::with_capacity(log.rows.len() + 16);
     let mut previous: Option<&Row> = None;
     for row in &log.rows {
         if let Some(prev) = previous {
@@ -223,17 +223,14 @@ pub fn regularize(log: &Log, options: &GridOptions) -> Result<RegularLog, LogErr
                 quality.note("gap filled by interpolation", row.line);
                 for j in 1..steps {
                     let time_s = prev.time_s + dt * j as f64 / steps as f64;
-                    slots.push((
-                        Slot {
-                            time_s,
-                            rate_dps: f64::NAN,
-                            reference_deg: None,
-                            temperature_c: None,
-                            line: 0,
-                            filled: true,
-                        },
-                        None,
-                    ));
+                    slots.push(Slot {
+                        time_s,
+                        rate_dps: f64::NAN,
+                        reference_deg: None,
+                        temperature_c: None,
+                        line: 0,
+                        filled: true,
+                    });
                 }
             } else if dt > 0.0 && (dt - period_s).abs() > 0.05 * period_s {
                 quality.jittered_steps += 1;
@@ -243,23 +240,20 @@ pub fn regularize(log: &Log, options: &GridOptions) -> Result<RegularLog, LogErr
             quality.missing_rate_rows += 1;
             quality.note("missing rate interpolated", row.line);
         }
-        slots.push((
-            Slot {
-                time_s: row.time_s,
-                rate_dps: row.rate_dps.unwrap_or(f64::NAN),
-                reference_deg: row.reference_deg,
-                temperature_c: row.temperature_c,
-                line: row.line,
-                filled: row.rate_dps.is_none(),
-            },
-            row.rate_dps,
-        ));
+        slots.push(Slot {
+            time_s: row.time_s,
+            rate_dps: row.rate_dps.unwrap_or(f64::NAN),
+            reference_deg: row.reference_deg,
+            temperature_c: row.temperature_c,
+            line: row.line,
+            filled: row.rate_dps.is_none(),
+        });
         previous = Some(row);
     }
 
     // Trim slots without a rate at both ends.
-    let first = slots.iter().position(|(_, r)| r.is_some());
-    let last = slots.iter().rposition(|(_, r)| r.is_some());
+    let first = slots.iter().position(|s| !s.rate_dps.is_nan());
+    let last = slots.iter().rposition(|s| !s.rate_dps.is_nan());
     let (Some(first), Some(last)) = (first, last) else {
         return Err(LogError::NoData {
             path: log.path.clone(),
@@ -267,7 +261,8 @@ pub fn regularize(log: &Log, options: &GridOptions) -> Result<RegularLog, LogErr
         });
     };
     quality.trimmed_slots = (slots.len() - 1 - last + first) as u64;
-    let mut slots: Vec<Slot> = slots.drain(first..=last).map(|(s, _)| s).collect();
+    slots.truncate(last + 1);
+    slots.drain(..first);
 
     // Pass 2: interpolate the rate across missing slots (runs bounded by max_gap_s).
     let max_run = ((options.max_gap_s / period_s).floor() as usize).max(1);
