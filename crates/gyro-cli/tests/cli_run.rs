@@ -1,44 +1,8 @@
 //! Integration tests of `gyro-cli run` on fixture logs and on deliberately broken logs.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn bench_log() -> PathBuf {
-    workspace_root().join("fixtures/logs/bench_run.csv")
-}
-
-fn gyro(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
-        .args(args)
-        .output()
-        .expect("gyro-cli runs")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gyro-cli-test-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> String {
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
-    path.to_string_lossy().into_owned()
-}
-
-fn json_of(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("valid JSON on stdout")
-}
+mod common;
+use common::{bench_log, gyro, json_of, temp_dir, write};
 
 #[test]
 fn bench_fixture_json_contract_and_accuracy_by_mode() {

@@ -1,35 +1,12 @@
 //! `gyro-cli convert` and MCAP input to `gyro-cli run`; a writer killed mid-recording.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+mod common;
+use common::{gyro, ok, temp_dir, workspace_root};
+
 use gyro_host::log::{self, McapLogWriter, McapOptions, Row};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gyro-mcap-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn gyro(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
-        .args(args)
-        .output()
-        .expect("gyro-cli runs")
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout.clone()).unwrap()
-}
+use std::path::Path;
+use std::process::Command;
 
 fn summary_without_file(json: &str) -> serde_json::Value {
     let mut value: serde_json::Value = serde_json::from_str(json).unwrap();

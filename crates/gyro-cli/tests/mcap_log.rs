@@ -2,22 +2,15 @@
 //! files, wrong schemas, ROS 2 bags.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+mod common;
+use common::{temp_dir, workspace_root};
+
 use gyro_host::log::{
     self, Axis, Log, LogError, LogOptions, McapLogWriter, McapOptions, Row, TimeSource,
 };
 use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
-
-fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gyro-mcap-test-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn bench() -> Log {
     log::read_csv(

@@ -1,29 +1,13 @@
 //! Integration tests of `gyro-cli noise` on simulated static logs and on bad input.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+mod common;
+use common::{gyro, json_of, temp_dir, write};
+
 use gyro_host::log;
 use gyro_host::sim::{simulate, Motion, Rotation, SensorModel, SimOptions};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn gyro(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
-        .args(args)
-        .output()
-        .expect("gyro-cli runs")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gyro-noise-test-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> String {
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
-    path.to_string_lossy().into_owned()
-}
+use std::path::Path;
+use std::process::Output;
 
 /// A simulated log written as CSV.
 fn simulated(dir: &Path, name: &str, model: &SensorModel, motion: &Motion, seed: u64) -> String {
@@ -54,15 +38,6 @@ fn model() -> SensorModel {
         lsb_dps: 0.0,
         range_dps: 300.0,
     }
-}
-
-fn json_of(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("valid JSON on stdout")
 }
 
 fn f(v: &serde_json::Value) -> f64 {

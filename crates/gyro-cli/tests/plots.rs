@@ -5,6 +5,9 @@
 //! Set `GYRO_PLOT_DIR` to keep the files for a look.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+mod common;
+use common::{bench_log, gyro};
+
 use gyro_core::{Compensation, Config};
 use gyro_host::calibrate::{calibrate, BenchRun, CalibrateOptions, Calibration};
 use gyro_host::log::{self, GridOptions};
@@ -13,15 +16,6 @@ use gyro_host::plot::{self, CalibrationPlot, Figure, ImageFormat, NoisePlot, Run
 use gyro_host::replay::{replay, RunReport};
 use gyro_host::sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn bench_log() -> PathBuf {
-    workspace_root().join("fixtures/logs/bench_run.csv")
-}
 
 /// Where plots go: `GYRO_PLOT_DIR` if set, else a fresh temporary directory.
 fn out_dir(name: &str) -> PathBuf {
@@ -329,13 +323,6 @@ fn calibrate_plot_svg_and_png() {
     );
     // One connecting line per run.
     assert!(lines(&svg) >= 4, "{} lines", lines(&svg));
-}
-
-fn gyro(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
-        .args(args)
-        .output()
-        .expect("gyro-cli runs")
 }
 
 #[test]

@@ -37,6 +37,8 @@ pub struct Args {
     #[arg(long)]
     no_leave_one_out: bool,
     #[command(flatten)]
+    grid: log::GridOptions,
+    #[command(flatten)]
     input: log::LogOptions,
     /// Output format on stdout.
     #[arg(long, value_enum, default_value_t = super::run::Format::Table)]
@@ -47,15 +49,15 @@ pub struct Args {
     plot: Option<PathBuf>,
 }
 
-fn load_runs(paths: &[PathBuf], input: &log::LogOptions) -> Result<Vec<BenchRun>> {
+fn load_runs(paths: &[PathBuf], args: &Args) -> Result<Vec<BenchRun>> {
     paths
         .iter()
         .map(|path| {
-            let (raw, warnings) = log::read_log_with_warnings(path, input)?;
+            let (raw, warnings) = log::read_log_with_warnings(path, &args.input)?;
             for warning in &warnings {
                 eprintln!("warning: {warning}");
             }
-            let regular = log::regularize(&raw, &log::GridOptions::default())?;
+            let regular = log::regularize(&raw, &args.grid)?;
             Ok(BenchRun {
                 name: path.display().to_string(),
                 log: regular,
@@ -162,8 +164,8 @@ pub fn run(args: &Args) -> Result<()> {
         Some(path) => model::load(path)?,
         None => model::ModelFile::new(Config::default()),
     };
-    let train = load_runs(&args.logs, &args.input)?;
-    let holdout = load_runs(&args.holdout, &args.input)?;
+    let train = load_runs(&args.logs, args)?;
+    let holdout = load_runs(&args.holdout, args)?;
     let bar = ProgressBar::new_spinner();
     bar.set_style(
         ProgressStyle::with_template("{spinner} {elapsed} {msg}")

@@ -73,13 +73,8 @@ pub struct Args {
     /// to this file: .svg or .png (of all logs pooled, if several).
     #[arg(long, value_parser = gyro_host::plot::parse_plot_path)]
     plot: Option<PathBuf>,
-    /// Sample rate of the logs (Hz); default: their `sample_rate_hz` metadata, else the
-    /// median time step.
-    #[arg(long)]
-    sample_rate_hz: Option<f64>,
-    /// Longest stretch of missing data (s) bridged by interpolation; longer is an error.
-    #[arg(long, default_value_t = 0.5)]
-    max_gap_s: f64,
+    #[command(flatten)]
+    grid: log::GridOptions,
     #[command(flatten)]
     input: log::LogOptions,
 }
@@ -125,13 +120,7 @@ fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<Loaded> 
     for warning in &warnings {
         eprintln!("warning: {warning}");
     }
-    let regular = log::regularize(
-        &raw,
-        &log::GridOptions {
-            sample_rate_hz: args.sample_rate_hz,
-            max_gap_s: args.max_gap_s,
-        },
-    )?;
+    let regular = log::regularize(&raw, &args.grid)?;
     let rate: Vec<f64> = regular.slots.iter().map(|s| s.rate_dps).collect();
     let segments = if args.static_only {
         let segments = noise::rest_segments(&regular, config, args.margin_s, args.min_rest_s)

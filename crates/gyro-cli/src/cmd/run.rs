@@ -45,13 +45,8 @@ pub struct Args {
     /// file: .svg or .png.
     #[arg(long, value_parser = gyro_host::plot::parse_plot_path)]
     plot: Option<PathBuf>,
-    /// Sample rate of the log (Hz); default: its `sample_rate_hz` metadata, else the
-    /// median time step.
-    #[arg(long)]
-    sample_rate_hz: Option<f64>,
-    /// Longest stretch of missing data (s) bridged by interpolation; longer is an error.
-    #[arg(long, default_value_t = 0.5)]
-    max_gap_s: f64,
+    #[command(flatten)]
+    grid: log::GridOptions,
     #[command(flatten)]
     input: log::LogOptions,
 }
@@ -73,13 +68,7 @@ pub fn run(args: &Args) -> Result<()> {
     for warning in &warnings {
         eprintln!("warning: {warning}");
     }
-    let regular = log::regularize(
-        &raw,
-        &log::GridOptions {
-            sample_rate_hz: args.sample_rate_hz,
-            max_gap_s: args.max_gap_s,
-        },
-    )?;
+    let regular = log::regularize(&raw, &args.grid)?;
     drop(raw); // the rows are on the grid now; free them before the replay
     let result = replay::replay(&regular, &config).with_context(|| {
         format!(

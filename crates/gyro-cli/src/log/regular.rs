@@ -20,12 +20,15 @@
 use super::{Log, LogError, Row};
 use serde::Serialize;
 
-/// How to build the grid.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// How to build the grid (also the command-line options of every command reading logs).
+#[derive(Clone, Copy, Debug, PartialEq, clap::Args)]
 pub struct GridOptions {
-    /// Sample rate (Hz); `None`: the `sample_rate_hz` metadata, else the median step.
+    /// Sample rate of the log (Hz); default: its `sample_rate_hz` metadata, else the median
+    /// time step.
+    #[arg(long)]
     pub sample_rate_hz: Option<f64>,
-    /// Longest stretch of missing data (s) bridged by interpolation.
+    /// Longest stretch of missing data (s) bridged by interpolation; longer is an error.
+    #[arg(long, default_value_t = 0.5)]
     pub max_gap_s: f64,
 }
 

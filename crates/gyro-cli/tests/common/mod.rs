@@ -1,0 +1,52 @@
+//! Helpers shared by the integration tests: the workspace, the binary, temporary files.
+#![allow(dead_code, clippy::unwrap_used)] // each test file uses some; a failed unwrap fails the test
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The workspace root (fixtures live there).
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The bundled bench log.
+pub fn bench_log() -> PathBuf {
+    workspace_root().join("fixtures/logs/bench_run.csv")
+}
+
+/// Run `gyro-cli` with `args`.
+pub fn gyro(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
+        .args(args)
+        .output()
+        .expect("gyro-cli runs")
+}
+
+/// A fresh folder for one test (each test binary is its own process: the pid separates them).
+pub fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("gyro-test-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Write `text` to `dir/name`; returns the path as a string for the command line.
+pub fn write(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+/// Assert success; stdout as text.
+pub fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout.clone()).unwrap()
+}
+
+/// Assert success; stdout as JSON.
+pub fn json_of(out: &Output) -> serde_json::Value {
+    serde_json::from_str(&ok(out)).expect("valid JSON on stdout")
+}
