@@ -379,9 +379,9 @@ impl Pipeline {
         // moved (0.08 deg at power-up with an unknown bias).
         self.kalman.predict(integrates && phase != Phase::Onset);
         let corrected_dps = rate_dps - self.kalman.bias_dps();
-        let (previous_rate, previous_corrected) =
-            self.previous.unwrap_or((rate_dps, corrected_dps));
-        if integrates {
+        // The first sample has no interval before it: nothing to integrate (a log that starts
+        // in motion would otherwise gain a whole step of T × rate).
+        if let (true, Some((previous_rate, previous_corrected))) = (integrates, self.previous) {
             self.raw.step(previous_rate, rate_dps);
             self.corrected.step(previous_corrected, corrected_dps);
         }

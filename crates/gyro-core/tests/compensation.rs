@@ -161,3 +161,36 @@ fn kalman_mode_is_exact_without_bias() {
         }
     }
 }
+
+/// A log that starts in motion: the first output has no interval before it, so the angle
+/// turned equals the integral of the rate from the first output on, not one step more.
+#[test]
+fn a_log_starting_in_motion_gains_no_extra_step() {
+    let mut pipeline =
+        gyro_core::Pipeline::try_new(&gyro_core::Config::default()).expect("default config");
+    let mut first = None;
+    let mut last = None;
+    for i in 0..3000 {
+        let time_s = i as f64 * 1e-3;
+        // 50 deg/s from the very first sample for 2 s, then rest.
+        let rate_dps = if time_s < 2.0 { 50.0 } else { 0.0 };
+        if let Some(out) = pipeline.push(time_s, rate_dps) {
+            first.get_or_insert(out);
+            last = Some(out);
+        }
+    }
+    let (first, last) = (first.expect("outputs"), last.expect("outputs"));
+    assert_eq!(
+        first.raw_angle_deg, 0.0,
+        "the first output integrates nothing"
+    );
+    // From the first output's block centre (9.5 ms) to the end of the motion, plus the
+    // filter's delay: settled on the first sample, the filter acts as if the rate had been
+    // 50 deg/s forever, so its output falls that much later (one step more would be +1 deg).
+    let expected = 50.0 * (2.0 - first.time_s + pipeline.filter_delay_s());
+    assert!(
+        (f64::from(last.raw_angle_deg) - expected).abs() < 0.05,
+        "{} vs {expected}",
+        last.raw_angle_deg
+    );
+}
