@@ -13,7 +13,8 @@
 //!   [`STATIC_RATE_DPS`] lasting at least [`STATIC_MIN_S`]; `dynamic` = every other
 //!   sample that has a residual.
 //! - **Strata** of `dynamic`: by |reference rate| ([`RATE_BINS_DPS`], segment
-//!   `dynamic/rate_<lo>_<hi>`), by sign (`dynamic/positive`, `dynamic/negative`). Of both
+//!   `dynamic/rate_<lo>_<hi>`, the last `dynamic/rate_300_inf`; a bin without samples
+//!   gives no statistic), by sign (`dynamic/positive`, `dynamic/negative`). Of both
 //!   `static` and `dynamic`: by temperature tercile of the run (`<seg>/temperature_1..3`,
 //!   only if the log has temperatures) and by time since start in thirds of the run
 //!   (`<seg>/time_1..3`).
@@ -22,6 +23,9 @@
 //! - `residual_mean`, `residual_std` (deg/s): every segment and stratum with ≥ 2 samples.
 //! - `slope_vs_rate` (1): least-squares slope of residual on reference rate, with
 //!   intercept: `dynamic`, `dynamic/positive`, `dynamic/negative`.
+//! - `slope_vs_acceleration` (s): least-squares slope of residual on reference angular
+//!   acceleration (the same centred difference, applied to the reference rate), with
+//!   intercept: `dynamic`. A gyro lagging the reference by `d` gives ≈ −`d`.
 //! - `cubic_vs_rate` (1/(deg/s)²): cubic coefficient of a least-squares cubic polynomial
 //!   of residual on reference rate: `dynamic`.
 //! - `allan_log10_adev_<lo>_<hi>s` (log10 deg/s): mean log10 of the overlapping Allan
@@ -115,6 +119,8 @@ pub struct Residuals {
     pub rate_dps: Vec<f64>,
     /// Reference rate (deg/s), NaN where undefined.
     pub reference_rate_dps: Vec<f64>,
+    /// Reference angular acceleration (deg/s²), NaN where undefined.
+    pub reference_acceleration_dps2: Vec<f64>,
     /// Gyro − reference rate (deg/s), NaN where undefined.
     pub residual_dps: Vec<f64>,
     /// Temperature (°C), NaN where absent.
@@ -147,6 +153,12 @@ pub fn residuals(log: &RegularLog) -> Result<Residuals, StatsError> {
             *r = (b - a) * fs / (2 * h) as f64;
         }
     }
+    let mut reference_acceleration_dps2 = vec![f64::NAN; n];
+    for (i, a) in reference_acceleration_dps2.iter_mut().enumerate() {
+        if i >= h && i + h < n {
+            *a = (reference_rate_dps[i + h] - reference_rate_dps[i - h]) * fs / (2 * h) as f64;
+        }
+    }
     let rate_dps: Vec<f64> = log.slots.iter().map(|s| s.rate_dps).collect();
     let residual_dps: Vec<f64> = rate_dps
         .iter()
@@ -173,6 +185,7 @@ pub fn residuals(log: &RegularLog) -> Result<Residuals, StatsError> {
         time_s: log.slots.iter().map(|s| s.time_s - t0).collect(),
         rate_dps,
         reference_rate_dps,
+        reference_acceleration_dps2,
         residual_dps,
         temperature_c: log
             .slots
@@ -490,6 +503,13 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
     if let Some(s) = slope(&points(&|x| x < 0.0)) {
         out.push("dynamic/negative", "slope_vs_rate", s);
     }
+    let accel_points: Vec<(f64, f64)> = (0..n)
+        .filter(|&i| dynamic[i] && r.reference_acceleration_dps2[i].is_finite())
+        .map(|i| (r.reference_acceleration_dps2[i], r.residual_dps[i]))
+        .collect();
+    if let Some(s) = slope(&accel_points) {
+        out.push("dynamic", "slope_vs_acceleration", s);
+    }
     if let Some(c) = cubic(&all_points) {
         out.push("dynamic", "cubic_vs_rate", c);
     }
@@ -657,18 +677,27 @@ mod tests {
             let s = get(&scaled, seg, "slope_vs_rate");
             assert!((s - 0.01).abs() < 2e-3, "{seg} slope {s}");
         }
+        // Asymmetry: the sign strata see opposite slopes.
+        let asym = run(&[Effect::ScaleAsymmetry { k: 0.01 }], 1);
+        let (pos, neg) = (
+            get(&asym, "dynamic/positive", "slope_vs_rate"),
+            get(&asym, "dynamic/negative", "slope_vs_rate"),
+        );
+        assert!((pos - 0.01).abs() < 2e-3, "positive slope {pos}");
+        assert!((neg + 0.01).abs() < 2e-3, "negative slope {neg}");
     }
 
     #[test]
     fn lag_detects_latency() {
         let nominal = get(&run(&[], 1), "all", "xcorr_peak_lag_s");
         assert!(nominal.abs() < 2e-3, "nominal lag {nominal}");
-        let late = get(
-            &run(&[Effect::Latency { delay_s: 0.01 }], 1),
-            "all",
-            "xcorr_peak_lag_s",
-        );
-        assert!((late - 0.01).abs() < 3e-3, "lag {late}");
+        let nominal = get(&run(&[], 1), "dynamic", "slope_vs_acceleration");
+        assert!(nominal.abs() < 1e-3, "nominal acceleration slope {nominal}");
+        let late = run(&[Effect::Latency { delay_s: 0.01 }], 1);
+        let lag = get(&late, "all", "xcorr_peak_lag_s");
+        assert!((lag - 0.01).abs() < 3e-3, "lag {lag}");
+        let slope = get(&late, "dynamic", "slope_vs_acceleration");
+        assert!((slope + 0.01).abs() < 1e-3, "acceleration slope {slope}");
     }
 
     #[test]
