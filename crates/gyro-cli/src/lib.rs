@@ -12,6 +12,7 @@
 
 pub mod bridge;
 pub mod calibrate;
+pub mod diagnose;
 pub mod log;
 pub mod model;
 pub mod nelder_mead;
