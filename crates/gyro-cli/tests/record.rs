@@ -14,7 +14,7 @@ use gyro_host::bridge::{
     PlannedFrame, RecordOptions, RecordSink, RecordSummary, Sample, SensorFault, StopReason,
 };
 use gyro_host::log::{self, McapOptions};
-use gyro_host::sim::{self, BenchProfile, Motion, SensorModel, SimOptions};
+use gyro_host::sim::SensorModel;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -30,20 +30,7 @@ fn temp_dir(name: &str) -> PathBuf {
 
 /// A simulated bench run at 1 kHz in the ±300 °/s range.
 fn simulated(duration_s: f64, seed: u64) -> Vec<Sample> {
-    let sensor = SensorModel::default();
-    let motion = Motion::bench(
-        &BenchProfile {
-            duration_s,
-            ..BenchProfile::default()
-        },
-        seed,
-    );
-    let options = SimOptions {
-        seed,
-        ..SimOptions::default()
-    };
-    let log = sim::simulate(&sensor, &[], &motion, &options);
-    log.rows.iter().map(Sample::from).collect()
+    gyro_host::bridge::simulated_samples(&SensorModel::default(), duration_s, seed)
 }
 
 /// Streams `planned` as fast as possible into a pty pair while `record` reads it into the

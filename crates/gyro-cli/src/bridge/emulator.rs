@@ -50,6 +50,32 @@ pub struct Sample {
     pub temperature_c: Option<f64>,
 }
 
+/// Samples of a simulated bench run: bench-like rotations (seeded) seen by `sensor`, with
+/// no extra effects — what `emulate` plays when it is given no log.
+pub fn simulated_samples(
+    sensor: &crate::sim::SensorModel,
+    duration_s: f64,
+    seed: u64,
+) -> Vec<Sample> {
+    use crate::sim::{simulate, BenchProfile, Motion, SimOptions};
+    let motion = Motion::bench(
+        &BenchProfile {
+            duration_s,
+            ..BenchProfile::default()
+        },
+        seed,
+    );
+    let options = SimOptions {
+        seed,
+        ..SimOptions::default()
+    };
+    simulate(sensor, &[], &motion, &options)
+        .rows
+        .iter()
+        .map(Sample::from)
+        .collect()
+}
+
 impl From<&crate::log::Row> for Sample {
     fn from(row: &crate::log::Row) -> Self {
         Sample {

@@ -7,8 +7,8 @@ pub mod emulator;
 pub mod record;
 
 pub use emulator::{
-    stream, Emulator, EmulatorConfig, EmulatorReport, FaultSpec, Pacing, PlannedFrame, Sample,
-    SensorFault, WireFault,
+    simulated_samples, stream, Emulator, EmulatorConfig, EmulatorReport, FaultSpec, Pacing,
+    PlannedFrame, Sample, SensorFault, WireFault,
 };
 pub use record::{
     record, CsvSink, DecodedFrame, LiveStatus, McapSink, RecordEvent, RecordOptions, RecordSink,

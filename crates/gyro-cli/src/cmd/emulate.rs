@@ -6,11 +6,10 @@ use crm100_driver::serial::{self, serialport};
 use crm100_driver::Range;
 use gyro_host::bridge::{self, Emulator, EmulatorConfig, FaultSpec, Pacing, Sample};
 use gyro_host::log;
-use gyro_host::sim::{self, BenchProfile, Motion, SensorModel, SimOptions};
+use gyro_host::sim::SensorModel;
 use std::io::Write;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
-use std::sync::Arc;
 use std::time::Duration;
 
 #[derive(clap::Args)]
@@ -82,19 +81,7 @@ fn samples(args: &Args) -> Result<(Vec<Sample>, String)> {
         ..SensorModel::default()
     };
     sensor.validate().map_err(anyhow::Error::msg)?;
-    let motion = Motion::bench(
-        &BenchProfile {
-            duration_s,
-            ..BenchProfile::default()
-        },
-        seed,
-    );
-    let options = SimOptions {
-        seed,
-        ..SimOptions::default()
-    };
-    let log = sim::simulate(&sensor, &[], &motion, &options);
-    let samples = log.rows.iter().map(Sample::from).collect();
+    let samples = bridge::simulated_samples(&sensor, duration_s, seed);
     Ok((
         samples,
         format!("simulated run, seed {seed}, {duration_s} s"),
@@ -109,13 +96,7 @@ pub fn run(args: &Args) -> Result<()> {
         }
     }
     let (samples, what) = samples(args)?;
-    let stop = Arc::new(AtomicBool::new(false));
-    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-        signal_hook::flag::register_conditional_shutdown(signal, 1, Arc::clone(&stop))
-            .context("cannot install the signal handler")?;
-        signal_hook::flag::register(signal, Arc::clone(&stop))
-            .context("cannot install the signal handler")?;
-    }
+    let stop = super::stop_flag()?;
     // Keep the pair's other end open while writing, so the reader can come and go.
     let mut _pty_slave = None;
     let mut port: Box<dyn serialport::SerialPort> = match &args.port {

@@ -7,3 +7,21 @@ pub mod noise;
 pub mod record;
 pub mod run;
 pub mod simulate;
+
+use anyhow::{Context, Result};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+/// A flag set by SIGINT or SIGTERM, for loops that must finish their output cleanly
+/// (signal-hook: an atomic store in the handler, no extra thread); a second signal while
+/// the first is being handled exits at once with status 1.
+pub fn stop_flag() -> Result<Arc<AtomicBool>> {
+    let stop = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(signal, 1, Arc::clone(&stop))
+            .context("cannot install the signal handler")?;
+        signal_hook::flag::register(signal, Arc::clone(&stop))
+            .context("cannot install the signal handler")?;
+    }
+    Ok(stop)
+}

@@ -6,8 +6,6 @@ use crm100_driver::{serial, Range};
 use gyro_host::bridge::{self, CsvSink, LiveStatus, McapSink, RecordOptions, RecordSink};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
-use std::sync::Arc;
 use std::time::Duration;
 
 #[derive(clap::Args)]
@@ -81,16 +79,7 @@ fn status_line(s: &LiveStatus) -> String {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    // SIGINT/SIGTERM set a flag the loop polls (signal-hook: an atomic store in the
-    // handler, no extra thread); a second one while the first is being handled exits at
-    // once with status 1.
-    let stop = Arc::new(AtomicBool::new(false));
-    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-        signal_hook::flag::register_conditional_shutdown(signal, 1, Arc::clone(&stop))
-            .context("cannot install the signal handler")?;
-        signal_hook::flag::register(signal, Arc::clone(&stop))
-            .context("cannot install the signal handler")?;
-    }
+    let stop = super::stop_flag()?;
     let options = RecordOptions {
         range: args.range,
         verify_checksum: !args.no_checksum,
