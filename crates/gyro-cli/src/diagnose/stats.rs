@@ -137,21 +137,38 @@ pub fn residuals(log: &RegularLog) -> Result<Residuals, StatsError> {
     if !log.has_reference {
         return Err(StatsError::NoReference);
     }
-    let fs = log.sample_rate_hz;
-    let n = log.slots.len();
-    let h = ((fs * SMOOTH_WINDOW_S / 2.0).round() as usize).max(1);
     let t0 = log.slots.first().map_or(0.0, |s| s.time_s);
+    let reference: Vec<f64> = log
+        .slots
+        .iter()
+        .map(|s| s.reference_deg.unwrap_or(f64::NAN))
+        .collect();
+    let rate: Vec<f64> = log.slots.iter().map(|s| s.rate_dps).collect();
+    let temperature: Vec<f64> = log
+        .slots
+        .iter()
+        .map(|s| s.temperature_c.unwrap_or(f64::NAN))
+        .collect();
+    let time_s = log.slots.iter().map(|s| s.time_s - t0).collect();
+    residuals_of(log.sample_rate_hz, time_s, rate, &reference, temperature)
+}
+
+/// [`residuals`] of columns on a regular grid at `fs` (NaN where a reference is absent).
+pub fn residuals_of(
+    fs: f64,
+    time_s: Vec<f64>,
+    rate_dps: Vec<f64>,
+    reference_deg: &[f64],
+    temperature_c: Vec<f64>,
+) -> Result<Residuals, StatsError> {
+    let n = rate_dps.len();
+    let h = ((fs * SMOOTH_WINDOW_S / 2.0).round() as usize).max(1);
     let mut reference_rate_dps = vec![f64::NAN; n];
     for (i, r) in reference_rate_dps.iter_mut().enumerate() {
         if i < h || i + h >= n {
             continue;
         }
-        if let (Some(a), Some(b)) = (
-            log.slots[i - h].reference_deg,
-            log.slots[i + h].reference_deg,
-        ) {
-            *r = (b - a) * fs / (2 * h) as f64;
-        }
+        *r = (reference_deg[i + h] - reference_deg[i - h]) * fs / (2 * h) as f64;
     }
     let mut reference_acceleration_dps2 = vec![f64::NAN; n];
     for (i, a) in reference_acceleration_dps2.iter_mut().enumerate() {
@@ -159,7 +176,6 @@ pub fn residuals(log: &RegularLog) -> Result<Residuals, StatsError> {
             *a = (reference_rate_dps[i + h] - reference_rate_dps[i - h]) * fs / (2 * h) as f64;
         }
     }
-    let rate_dps: Vec<f64> = log.slots.iter().map(|s| s.rate_dps).collect();
     let residual_dps: Vec<f64> = rate_dps
         .iter()
         .zip(&reference_rate_dps)
@@ -182,16 +198,12 @@ pub fn residuals(log: &RegularLog) -> Result<Residuals, StatsError> {
     }
     Ok(Residuals {
         sample_rate_hz: fs,
-        time_s: log.slots.iter().map(|s| s.time_s - t0).collect(),
+        time_s,
         rate_dps,
         reference_rate_dps,
         reference_acceleration_dps2,
         residual_dps,
-        temperature_c: log
-            .slots
-            .iter()
-            .map(|s| s.temperature_c.unwrap_or(f64::NAN))
-            .collect(),
+        temperature_c,
         is_static,
     })
 }
@@ -331,52 +343,86 @@ fn lag1(x: &[f64], runs: &[std::ops::Range<usize>]) -> Option<f64> {
 }
 
 /// Cross-correlation peak lag (s) of `gyro` against `reference` within ±`max_lag` samples.
+///
+/// Samples where either is undefined count as zero after mean removal. The correlation of
+/// rates is smooth in the lag, so it is searched every few lags and then refined around
+/// the best one (the same peak as an exhaustive search unless two peaks lie within a few
+/// samples of each other).
 fn xcorr_peak_lag(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
     let n = gyro.len();
     let max_lag = ((MAX_LAG_S * fs).round() as usize).max(1);
     let both = |i: usize| gyro[i].is_finite() && reference[i].is_finite();
-    let idx: Vec<usize> = (0..n).filter(|&i| both(i)).collect();
-    if idx.len() < 3 {
+    let count = (0..n).filter(|&i| both(i)).count();
+    if count < 3 {
         return None;
     }
-    let mg = idx.iter().map(|&i| gyro[i]).sum::<f64>() / idx.len() as f64;
-    let mr = idx.iter().map(|&i| reference[i]).sum::<f64>() / idx.len() as f64;
-    let lags: Vec<i64> = (-(max_lag as i64)..=max_lag as i64).collect();
-    let c: Vec<f64> = lags
-        .iter()
-        .map(|&lag| {
-            let (mut sum, mut count) = (0.0, 0usize);
-            for (i, &rv) in reference.iter().enumerate() {
-                let j = i as i64 + lag;
-                if j < 0 || j as usize >= n {
-                    continue;
-                }
-                let j = j as usize;
-                if rv.is_finite() && gyro[j].is_finite() {
-                    sum += (gyro[j] - mg) * (rv - mr);
-                    count += 1;
-                }
-            }
-            if count == 0 {
-                f64::NEG_INFINITY
-            } else {
-                sum / count as f64
-            }
-        })
+    let mg = (0..n).filter(|&i| both(i)).map(|i| gyro[i]).sum::<f64>() / count as f64;
+    let mr = (0..n)
+        .filter(|&i| both(i))
+        .map(|i| reference[i])
+        .sum::<f64>()
+        / count as f64;
+    let g: Vec<f64> = (0..n)
+        .map(|i| if both(i) { gyro[i] - mg } else { 0.0 })
         .collect();
-    let k = (0..c.len()).max_by(|&a, &b| c[a].total_cmp(&c[b]))?;
-    if !c[k].is_finite() {
+    let r: Vec<f64> = (0..n)
+        .map(|i| if both(i) { reference[i] - mr } else { 0.0 })
+        .collect();
+    // c(lag) = Σ g[i + lag] r[i] / overlap.
+    let corr = |lag: i64| -> f64 {
+        let l = lag.unsigned_abs() as usize;
+        if l >= n {
+            return f64::NEG_INFINITY;
+        }
+        let (a, b) = if lag >= 0 {
+            (&g[l..], &r[..n - l])
+        } else {
+            (&g[..n - l], &r[l..])
+        };
+        let mut acc = [0.0f64; 4];
+        let chunks = a.len() / 4;
+        for k in 0..chunks {
+            for j in 0..4 {
+                acc[j] += a[4 * k + j] * b[4 * k + j];
+            }
+        }
+        let mut sum = acc.iter().sum::<f64>();
+        for k in 4 * chunks..a.len() {
+            sum += a[k] * b[k];
+        }
+        sum / (n - l) as f64
+    };
+    let max_lag = max_lag as i64;
+    let step = (max_lag / 10).clamp(1, 8);
+    let mut best = (0i64, f64::NEG_INFINITY);
+    let mut lag = -max_lag;
+    while lag <= max_lag {
+        let c = corr(lag);
+        if c > best.1 {
+            best = (lag, c);
+        }
+        lag += step;
+    }
+    let (lo, hi) = ((best.0 - step).max(-max_lag), (best.0 + step).min(max_lag));
+    for lag in lo..=hi {
+        let c = corr(lag);
+        if c > best.1 {
+            best = (lag, c);
+        }
+    }
+    if !best.1.is_finite() {
         return None;
     }
+    let k = best.0;
     let mut offset = 0.0;
-    if k > 0 && k + 1 < c.len() {
-        let (a, b, d) = (c[k - 1], c[k], c[k + 1]);
+    if k > -max_lag && k < max_lag {
+        let (a, b, d) = (corr(k - 1), best.1, corr(k + 1));
         let denom = a - 2.0 * b + d;
         if denom < 0.0 {
             offset = (0.5 * (a - d) / denom).clamp(-0.5, 0.5);
         }
     }
-    Some((lags[k] as f64 + offset) / fs)
+    Some((k as f64 + offset) / fs)
 }
 
 /// Averaging factors for the Allan bands at `fs`.
@@ -411,8 +457,10 @@ fn terciles(values: &[f64]) -> Option<(f64, f64)> {
     if v.len() < 3 {
         return None;
     }
-    v.sort_by(f64::total_cmp);
-    Some((v[v.len() / 3], v[2 * v.len() / 3]))
+    let (i, j) = (v.len() / 3, 2 * v.len() / 3);
+    let a = *v.select_nth_unstable_by(i, f64::total_cmp).1;
+    let b = *v.select_nth_unstable_by(j, f64::total_cmp).1;
+    Some((a, b))
 }
 
 /// The "where" statistics of `residuals` (see the module documentation).

@@ -6,4 +6,4 @@ mod sensor;
 
 pub use effects::{Effect, EffectInfo, EFFECTS};
 pub use motion::{BenchProfile, Motion, Rotation};
-pub use sensor::{simulate, SensorModel, SimOptions};
+pub use sensor::{simulate, simulate_series, SensorModel, SimOptions, SimSeries};

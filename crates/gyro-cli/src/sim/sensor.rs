@@ -91,6 +91,9 @@ pub struct SimOptions {
     pub temperature_tau_s: f64,
     /// Quantise the reference like an encoder with this many counts per revolution.
     pub encoder_counts: Option<u32>,
+    /// Quantise the reference to this step (deg); takes precedence over `encoder_counts`
+    /// (a re-simulated real log keeps its encoder's step, which need not divide 360°).
+    pub reference_step_deg: Option<f64>,
 }
 
 impl Default for SimOptions {
@@ -101,6 +104,7 @@ impl Default for SimOptions {
             temperature_rise_c: 5.0,
             temperature_tau_s: 120.0,
             encoder_counts: None,
+            reference_step_deg: None,
         }
     }
 }
@@ -147,6 +151,21 @@ impl GaussMarkovProcess {
     }
 }
 
+/// A simulated run as columns on the nominal grid (sample `k` at `k / fs`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SimSeries {
+    /// Sample rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Measured rate (deg/s), NaN where the sample was dropped.
+    pub rate_dps: Vec<f64>,
+    /// Reference angle (deg).
+    pub reference_deg: Vec<f64>,
+    /// Temperature (°C).
+    pub temperature_c: Vec<f64>,
+    /// Number of dropped samples (NaN in `rate_dps`).
+    pub dropped: usize,
+}
+
 /// Simulate a log of `motion` as seen by `model` with `effects`.
 pub fn simulate(
     model: &SensorModel,
@@ -154,6 +173,49 @@ pub fn simulate(
     motion: &Motion,
     options: &SimOptions,
 ) -> Log {
+    let series = simulate_series(model, effects, motion, options, None);
+    let fs = series.sample_rate_hz;
+    // Rounded to what a logger would keep (and what reads back short from CSV).
+    let round = |x: f64, step: f64| (x / step).round() * step;
+    let rows = (0..series.rate_dps.len())
+        .filter(|&k| series.rate_dps[k].is_finite())
+        .map(|k| Row {
+            line: 0,
+            time_s: k as f64 / fs,
+            rate_dps: Some(round(series.rate_dps[k], 1e-6)),
+            reference_deg: Some(round(series.reference_deg[k], 1e-6)),
+            temperature_c: Some(round(series.temperature_c[k], 1e-3)),
+        })
+        .collect();
+    let mut metadata = BTreeMap::new();
+    metadata.insert("sensor".into(), "simulated".into());
+    metadata.insert("sample_rate_hz".into(), format!("{fs}"));
+    metadata.insert("seed".into(), options.seed.to_string());
+    metadata.insert(
+        "effects".into(),
+        serde_json::to_string(effects).unwrap_or_default(),
+    );
+    Log {
+        path: "simulated".into(),
+        metadata,
+        has_reference: true,
+        has_temperature: true,
+        rows,
+    }
+}
+
+/// Simulate `motion` as seen by `model` with `effects`, as columns.
+///
+/// `temperature_c`, when given, is the temperature at each sample (a recorded run's, so
+/// a re-simulation sees the same temperatures; NaN entries take the previous value);
+/// otherwise the warm-up curve of `options` plus 0.02 °C of sensor noise.
+pub fn simulate_series(
+    model: &SensorModel,
+    effects: &[Effect],
+    motion: &Motion,
+    options: &SimOptions,
+    temperature_c: Option<&[f64]>,
+) -> SimSeries {
     let fs = model.sample_rate_hz;
     let dt = 1.0 / fs;
     let n = (motion.duration_s() * fs).floor() as usize + 1;
@@ -223,14 +285,39 @@ pub fn simulate(
     let mut walk = 0.0;
     let mut stages = [motion.rate_dps(-delay_s); 2];
     let mut dropout_left = false;
+    let temperature_c_is_recorded = temperature_c.is_some();
 
-    let mut rows = Vec::with_capacity(n);
+    let mut out = SimSeries {
+        sample_rate_hz: fs,
+        rate_dps: Vec::with_capacity(n),
+        reference_deg: Vec::with_capacity(n),
+        temperature_c: Vec::with_capacity(n),
+        dropped: 0,
+    };
+    let recorded_start_c = temperature_c
+        .and_then(|t| t.iter().copied().find(|v| v.is_finite()))
+        .unwrap_or(options.temperature_start_c);
+    let mut recorded_last_c = recorded_start_c;
+    let reference_step = options.reference_step_deg.filter(|s| *s > 0.0).or(options
+        .encoder_counts
+        .map(|counts| 360.0 / f64::from(counts.max(1))));
     for k in 0..n {
         let label_s = k as f64 * dt;
         let true_s = label_s / clock;
-        let temperature_c = options.temperature_start_c
-            + options.temperature_rise_c * (1.0 - (-true_s / options.temperature_tau_s).exp());
-        let delta_c = temperature_c - options.temperature_start_c;
+        let (temperature_c, delta_c) = match temperature_c {
+            Some(recorded) => {
+                if let Some(t) = recorded.get(k).copied().filter(|t| t.is_finite()) {
+                    recorded_last_c = t;
+                }
+                (recorded_last_c, recorded_last_c - recorded_start_c)
+            }
+            None => {
+                let t = options.temperature_start_c
+                    + options.temperature_rise_c
+                        * (1.0 - (-true_s / options.temperature_tau_s).exp());
+                (t, t - options.temperature_start_c)
+            }
+        };
 
         let mut rate = motion.rate_dps(true_s - delay_s);
         if let Some(alpha) = bandwidth_alpha {
@@ -262,6 +349,7 @@ pub fn simulate(
         measured = measured.clamp(-limit, limit);
 
         let temp_noise: f64 = StandardNormal.sample(&mut temp_rng);
+        let mut dropped = false;
         if let Some((start_p, continue_p)) = dropout {
             let u: f64 = dropout_rng.random();
             dropout_left = if dropout_left {
@@ -269,38 +357,23 @@ pub fn simulate(
             } else {
                 u < start_p
             };
-            if dropout_left {
-                continue;
-            }
+            dropped = dropout_left;
         }
         let mut reference_deg = motion.angle_deg(true_s);
-        if let Some(counts) = options.encoder_counts {
-            let per_count = 360.0 / f64::from(counts.max(1));
-            reference_deg = (reference_deg / per_count).round() * per_count;
+        if let Some(step) = reference_step {
+            reference_deg = (reference_deg / step).round() * step;
         }
-        // Rounded to what a logger would keep (and what reads back short from CSV).
-        let round = |x: f64, step: f64| (x / step).round() * step;
-        rows.push(Row {
-            line: 0,
-            time_s: k as f64 / fs,
-            rate_dps: Some(round(measured, 1e-6)),
-            reference_deg: Some(round(reference_deg, 1e-6)),
-            temperature_c: Some(round(temperature_c + 0.02 * temp_noise, 1e-3)),
+        if dropped {
+            out.dropped += 1;
+            measured = f64::NAN;
+        }
+        out.rate_dps.push(measured);
+        out.reference_deg.push(reference_deg);
+        out.temperature_c.push(if temperature_c_is_recorded {
+            temperature_c
+        } else {
+            temperature_c + 0.02 * temp_noise
         });
     }
-    let mut metadata = BTreeMap::new();
-    metadata.insert("sensor".into(), "simulated".into());
-    metadata.insert("sample_rate_hz".into(), format!("{fs}"));
-    metadata.insert("seed".into(), options.seed.to_string());
-    metadata.insert(
-        "effects".into(),
-        serde_json::to_string(effects).unwrap_or_default(),
-    );
-    Log {
-        path: "simulated".into(),
-        metadata,
-        has_reference: true,
-        has_temperature: true,
-        rows,
-    }
+    out
 }
