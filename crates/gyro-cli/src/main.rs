@@ -28,6 +28,9 @@ enum Command {
     /// Noise characterisation of static logs: Allan deviation with bounds, fitted noise
     /// terms (ARW, bias instability, rate random walk, Gauss-Markov), Welch PSD.
     Noise(cmd::noise::Args),
+    /// Sim-to-real diagnosis: where real runs differ from their simulation, which
+    /// unmodelled effect causes it, how far adding it closes the gap on held-out runs.
+    Diagnose(cmd::diagnose::Args),
     /// Convert a log between CSV and MCAP (also from a ROS 2 bag in MCAP).
     Convert(cmd::convert::Args),
     /// Record the CRM100 serial bridge to MCAP (or CSV) as it comes: every loss counted,
@@ -45,6 +48,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => cmd::simulate::run(args),
         Command::Calibrate(args) => cmd::calibrate::run(args),
         Command::Noise(args) => cmd::noise::run(args),
+        Command::Diagnose(args) => cmd::diagnose::run(args),
         Command::Convert(args) => cmd::convert::run(args),
         Command::Record(args) => cmd::record::run(args),
         Command::Emulate(args) => cmd::emulate::run(args),

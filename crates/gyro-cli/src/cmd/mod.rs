@@ -2,6 +2,7 @@
 
 pub mod calibrate;
 pub mod convert;
+pub mod diagnose;
 pub mod emulate;
 pub mod noise;
 pub mod record;

@@ -1,4 +1,660 @@
-//! Sim-to-real diagnosis (DESIGN.md, "Sim-to-real diagnosis").
+//! Sim-to-real diagnosis (DESIGN.md, "Sim-to-real diagnosis"): where a real sensor
+//! differs from its simulation, which unmodelled effect causes it, and how far adding the
+//! effect closes the gap on runs not used to fit it.
+//!
+//! Method, fixed before looking at any data:
+//! 1. **Baseline**: the nominal model ([`fit::nominal_model`]; or `--model`) re-simulates
+//!    every run with its own reference motion and temperatures as an ensemble of
+//!    [`Options::members`] seeds; every run, real or simulated, goes through the same
+//!    statistics ([`stats`]) and features ([`features`]).
+//! 2. **Where**: z-scores of each statistic against the run's ensemble, combined over runs
+//!    (Stouffer: Σz/√n); the gap G and its floor ([`score`]).
+//! 3. **Which**: every effect of the vocabulary is fitted on the training runs
+//!    ([`fit`]); each testable one is added to the nominal model and the held-out runs are
+//!    re-simulated with the same seeds ([`Options::candidate_members`] of them). An effect
+//!    is significant when its parameter test passes on the training runs, its held-out
+//!    ΔBIC is positive and the bootstrap over held-out runs gives P(no improvement) < 5%.
+//!    Effects are ranked by held-out gap reduction. When several are significant, each is
+//!    dropped in turn from the model holding all of them (leave-one-out); one whose
+//!    removal costs nothing significant is redundant: it is confounded with the others
+//!    (e.g. clock error and scale factor leave the same signature) and not named.
+//! 4. **How far**: the gap with the selected effects on the training and held-out runs,
+//!    and the fraction of the held-out gap closed relative to the floor.
 
+pub mod ensemble;
 pub mod features;
+pub mod fit;
+pub mod score;
 pub mod stats;
+
+use ensemble::{ensembles, Member, RealRun};
+use fit::{FitInput, Untestable};
+use score::{bootstrap_p, gap, score, RunScore};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+use crate::sim::{Effect, SensorModel};
+
+/// ΔBIC difference below which two effects count as tied (Kass & Raftery: "not worth
+/// more than a bare mention").
+pub const TIE_BIC: f64 = 2.0;
+
+/// Settings of a diagnosis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    /// Members of the baseline ensemble per run.
+    pub members: usize,
+    /// Members of each candidate's ensemble per held-out run (the baseline's first seeds).
+    pub candidate_members: usize,
+    /// Seed of every ensemble.
+    pub seed: u64,
+    /// Bootstrap resamples over runs.
+    pub bootstrap: usize,
+    /// The sensor model to start from.
+    pub prior: SensorModel,
+    /// Use the prior model as it is (`--model`), without fitting the bias and white noise.
+    pub fixed_model: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            members: 50,
+            candidate_members: 20,
+            seed: 1,
+            bootstrap: 2000,
+            prior: SensorModel::default(),
+            fixed_model: false,
+        }
+    }
+}
+
+/// Why a diagnosis cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum DiagnoseError {
+    /// A run cannot be used.
+    #[error("{name}: {message}")]
+    Run {
+        /// Run name.
+        name: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Not enough runs.
+    #[error("{0}")]
+    TooFewRuns(String),
+    /// Runs at different sample rates.
+    #[error("{0}")]
+    MismatchedRates(String),
+}
+
+/// The gap figures of the JSON contract.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GapSummary {
+    /// G of the training runs, nominal model.
+    pub train_before: f64,
+    /// G of the training runs, with the selected effects.
+    pub train_after: f64,
+    /// G of the held-out runs, nominal model.
+    pub holdout_before: f64,
+    /// G of the held-out runs, with the selected effects.
+    pub holdout_after: f64,
+    /// G between independent simulated ensembles.
+    pub floor: f64,
+}
+
+/// One "where" entry.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Where {
+    /// Segment or stratum.
+    pub segment: String,
+    /// Statistic.
+    pub statistic: String,
+    /// Combined z over all runs (Σz/√n).
+    pub z: f64,
+}
+
+/// One candidate effect's result.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EffectResult {
+    /// Effect id.
+    pub id: &'static str,
+    /// Fitted parameters by name.
+    pub params: BTreeMap<&'static str, f64>,
+    /// BIC(nominal) − BIC(nominal + effect) on the held-out runs (positive favours it).
+    pub delta_bic: f64,
+    /// G of the held-out runs, nominal (the candidate ensemble's seeds).
+    pub holdout_gap_before: f64,
+    /// G of the held-out runs with this effect added.
+    pub holdout_gap_after: f64,
+    /// (before − after) / (before − floor); 0 when before is within 10% of the floor
+    /// (no gap to close).
+    pub fraction_closed: f64,
+    /// Named in the verdict.
+    pub significant: bool,
+    /// 95% intervals of the parameters (null: unbounded).
+    pub ci95: BTreeMap<&'static str, [Option<f64>; 2]>,
+    /// Parameter test z on the training runs (null where the test is exact).
+    pub z: Option<f64>,
+    /// The parameter test and its outcome.
+    pub test: String,
+    /// Bootstrap over held-out runs: P(no likelihood improvement).
+    pub bootstrap_p: f64,
+    /// Effects it is confounded with (indistinguishable on these runs).
+    pub confounded_with: Vec<&'static str>,
+}
+
+/// The verdict.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Verdict {
+    /// Significant effects, best first.
+    pub unmodelled: Vec<&'static str>,
+    /// Fraction of the held-out gap closed by them, relative to the floor.
+    pub fraction_closed_holdout: f64,
+}
+
+/// An untestable effect.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct UntestableEntry {
+    /// Effect id.
+    pub id: &'static str,
+    /// Why.
+    pub reason: String,
+}
+
+/// The whole diagnosis (the JSON contract of DESIGN.md, plus `untestable`, `model` and
+/// `runs`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Diagnosis {
+    /// Gap figures.
+    pub gap: GapSummary,
+    /// Statistics by |z|, largest first.
+    pub r#where: Vec<Where>,
+    /// Candidate effects, best first.
+    pub effects: Vec<EffectResult>,
+    /// Verdict.
+    pub verdict: Verdict,
+    /// Effects that could not be tested, and why.
+    pub untestable: Vec<UntestableEntry>,
+    /// The nominal model used, and where its values came from.
+    pub model: ModelSummary,
+    /// Per run figures.
+    pub runs: Vec<RunSummary>,
+}
+
+/// The nominal model.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ModelSummary {
+    /// The sensor model.
+    pub sensor: SensorModel,
+    /// Provenance of its values.
+    pub notes: Vec<String>,
+    /// The selected effects with their parameters.
+    pub effects: Vec<Effect>,
+}
+
+/// One run's figures.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunSummary {
+    /// Name.
+    pub name: String,
+    /// Training or held-out.
+    pub role: &'static str,
+    /// Duration (s).
+    pub duration_s: f64,
+    /// G of this run, nominal.
+    pub gap_before: f64,
+    /// G of this run with the selected effects.
+    pub gap_after: f64,
+}
+
+/// Progress reports.
+pub trait Progress: Sync {
+    /// A new stage with `total` steps.
+    fn stage(&self, name: &str, total: u64);
+    /// One step done.
+    fn tick(&self);
+}
+
+/// No progress reporting.
+pub struct Silent;
+
+impl Progress for Silent {
+    fn stage(&self, _: &str, _: u64) {}
+    fn tick(&self) {}
+}
+
+/// Check the runs can be diagnosed together.
+pub fn check_runs(train: &[RealRun], holdout: &[RealRun]) -> Result<(), DiagnoseError> {
+    if train.len() < 2 {
+        return Err(DiagnoseError::TooFewRuns(format!(
+            "{} training run(s): at least 2 are needed (3 to test turn-on bias), each a log with reference_deg",
+            train.len()
+        )));
+    }
+    if holdout.len() < 2 {
+        return Err(DiagnoseError::TooFewRuns(format!(
+            "{} held-out run(s): at least 2 are needed to score effects on runs not used to fit them (pass --holdout, or --split-s to cut logs into windows)",
+            holdout.len()
+        )));
+    }
+    let first = &train[0];
+    for run in train.iter().chain(holdout) {
+        let ratio = run.sample_rate_hz / first.sample_rate_hz;
+        if (ratio - 1.0).abs() > 1e-3 {
+            return Err(DiagnoseError::MismatchedRates(format!(
+                "sample rates differ: {} is at {} Hz, {} at {} Hz; diagnose compares runs of one sensor setup (resample, or pass --sample-rate-hz to place all on one grid)",
+                first.name, first.sample_rate_hz, run.name, run.sample_rate_hz
+            )));
+        }
+    }
+    Ok(())
+}
+
+struct Evaluation {
+    scores: Vec<RunScore>,
+    members: Vec<Vec<Member>>,
+}
+
+fn evaluate(
+    runs: &[&RealRun],
+    ids: &[usize],
+    model: &SensorModel,
+    effects: &[Effect],
+    options: &Options,
+    members: usize,
+    progress: &dyn Progress,
+) -> Evaluation {
+    let tick = || progress.tick();
+    let ens = ensembles(runs, ids, model, effects, options.seed, members, &tick);
+    let scores = runs
+        .iter()
+        .zip(&ens)
+        .map(|(r, m)| score(&r.stats, m))
+        .collect();
+    Evaluation {
+        scores,
+        members: ens,
+    }
+}
+
+/// Baseline scores using only the first `k` members.
+fn rescore(runs: &[&RealRun], members: &[Vec<Member>], k: usize) -> Vec<RunScore> {
+    runs.iter()
+        .zip(members)
+        .map(|(r, m)| score(&r.stats, &m[..k.min(m.len())]))
+        .collect()
+}
+
+fn loglik_diffs(after: &[RunScore], before: &[RunScore]) -> Vec<f64> {
+    after
+        .iter()
+        .zip(before)
+        .map(|(a, b)| a.loglik - b.loglik)
+        .collect()
+}
+
+fn delta_bic(diffs: &[f64], params: usize, observations: usize) -> f64 {
+    2.0 * diffs.iter().sum::<f64>() - params as f64 * (observations.max(1) as f64).ln()
+}
+
+/// Diagnose `train` against `holdout`.
+pub fn diagnose(
+    train: &[RealRun],
+    holdout: &[RealRun],
+    options: &Options,
+    progress: &dyn Progress,
+) -> Result<Diagnosis, DiagnoseError> {
+    check_runs(train, holdout)?;
+    let train_refs: Vec<&RealRun> = train.iter().collect();
+    let hold_refs: Vec<&RealRun> = holdout.iter().collect();
+    let train_ids: Vec<usize> = (0..train.len()).collect();
+    let hold_ids: Vec<usize> = (train.len()..train.len() + holdout.len()).collect();
+
+    // 1. Baseline.
+    let (nominal, notes, arw_calibrated) = if options.fixed_model {
+        let mut m = options.prior;
+        m.sample_rate_hz = train[0].sample_rate_hz;
+        (
+            m,
+            vec!["the --model sensor model as given".to_string()],
+            false,
+        )
+    } else {
+        let (m, notes) = fit::nominal_model(&train_refs, &options.prior);
+        let calibrated = notes
+            .iter()
+            .any(|n| n.contains("static samples") && !n.contains("fewer"));
+        (m, notes, calibrated)
+    };
+    let m = options.members.max(4);
+    let mc = options.candidate_members.clamp(2, m);
+    progress.stage(
+        "baseline ensembles",
+        (m * (train.len() + holdout.len())) as u64,
+    );
+    let base_train = evaluate(&train_refs, &train_ids, &nominal, &[], options, m, progress);
+    let base_hold = evaluate(&hold_refs, &hold_ids, &nominal, &[], options, m, progress);
+    let floor = {
+        let all: Vec<Vec<Member>> = base_train
+            .members
+            .iter()
+            .chain(&base_hold.members)
+            .cloned()
+            .collect();
+        score::floor(&all)
+    };
+    let g_train_before = gap(&base_train.scores);
+    let g_hold_before = gap(&base_hold.scores);
+
+    // 2. Where.
+    let mut combined: BTreeMap<(String, String), (f64, usize)> = BTreeMap::new();
+    for s in base_train.scores.iter().chain(&base_hold.scores) {
+        for (stat, z) in &s.z {
+            if z.is_finite() {
+                let e = combined
+                    .entry((stat.segment.clone(), stat.statistic.clone()))
+                    .or_insert((0.0, 0));
+                e.0 += z;
+                e.1 += 1;
+            }
+        }
+    }
+    let mut r#where: Vec<Where> = combined
+        .into_iter()
+        .map(|((segment, statistic), (sum, n))| Where {
+            segment,
+            statistic,
+            z: sum / (n as f64).sqrt(),
+        })
+        .collect();
+    r#where.sort_by(|a, b| b.z.abs().total_cmp(&a.z.abs()));
+
+    // 3. Which: fit on training runs, score on held-out runs.
+    let temperature_ok = train.iter().all(|r| r.features.temperature_varies);
+    let input = FitInput {
+        train: &train_refs,
+        null: &base_train.members,
+        model: &nominal,
+        temperature_ok,
+    };
+    let (fits, untestable) = fit::fit_all(&input);
+    let before_c = rescore(&hold_refs, &base_hold.members, mc);
+    let g_before_c = gap(&before_c);
+    let observations: usize = before_c.iter().map(|s| s.count).sum();
+    progress.stage(
+        "candidate effects on held-out runs",
+        (fits.len() * mc * holdout.len()) as u64,
+    );
+    struct Candidate {
+        fit: fit::Fit,
+        eval: Evaluation,
+        gap_after: f64,
+        delta_bic: f64,
+        p: f64,
+        significant: bool,
+    }
+    let mut candidates: Vec<Candidate> = Vec::new();
+    for (i, f) in fits.into_iter().enumerate() {
+        let model = fit::model_with(&nominal, &[f.effect], arw_calibrated);
+        let eval = if fit::is_identity(&f.effect, &nominal) && model == nominal {
+            (0..mc * holdout.len()).for_each(|_| progress.tick());
+            Evaluation {
+                scores: before_c.clone(),
+                members: Vec::new(),
+            }
+        } else {
+            evaluate(
+                &hold_refs,
+                &hold_ids,
+                &model,
+                &[f.effect],
+                options,
+                mc,
+                progress,
+            )
+        };
+        let diffs = loglik_diffs(&eval.scores, &before_c);
+        let dbic = delta_bic(&diffs, f.effect.params().len(), observations);
+        let p = bootstrap_p(&diffs, options.bootstrap, options.seed ^ i as u64);
+        let significant = f.passes && dbic > 0.0 && p < 0.05;
+        candidates.push(Candidate {
+            gap_after: gap(&eval.scores),
+            fit: f,
+            eval,
+            delta_bic: dbic,
+            p,
+            significant,
+        });
+    }
+
+    // Ablation: drop effects that add nothing given the others.
+    let mut selected: Vec<usize> = (0..candidates.len())
+        .filter(|&i| candidates[i].significant)
+        .collect();
+    selected.sort_by(|&a, &b| candidates[b].delta_bic.total_cmp(&candidates[a].delta_bic));
+    // Within [`TIE_BIC`] of each other, the earlier effect of the vocabulary goes first
+    // (kept when the two are confounded): it is the simpler, more common explanation.
+    for _ in 0..selected.len() {
+        for k in 1..selected.len() {
+            let (a, b) = (selected[k - 1], selected[k]);
+            if b < a && candidates[a].delta_bic - candidates[b].delta_bic < TIE_BIC {
+                selected.swap(k - 1, k);
+            }
+        }
+    }
+    let mut confounded: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    let mut final_eval: Option<Evaluation> = None;
+    if selected.len() >= 2 {
+        progress.stage(
+            "leave-one-out ablations",
+            ((selected.len() + 1) * mc * holdout.len()) as u64,
+        );
+        let effects_of = |set: &[usize]| -> Vec<Effect> {
+            set.iter().map(|&i| candidates[i].fit.effect).collect()
+        };
+        let all_effects = effects_of(&selected);
+        let mut full = evaluate(
+            &hold_refs,
+            &hold_ids,
+            &fit::model_with(&nominal, &all_effects, arw_calibrated),
+            &all_effects,
+            options,
+            mc,
+            progress,
+        );
+        // Weakest first: an effect redundant given the rest is dropped.
+        for &i in selected.clone().iter().rev() {
+            if selected.len() < 2 {
+                break;
+            }
+            let rest: Vec<usize> = selected.iter().copied().filter(|&j| j != i).collect();
+            let rest_effects = effects_of(&rest);
+            let without = evaluate(
+                &hold_refs,
+                &hold_ids,
+                &fit::model_with(&nominal, &rest_effects, arw_calibrated),
+                &rest_effects,
+                options,
+                mc,
+                progress,
+            );
+            let diffs = loglik_diffs(&full.scores, &without.scores);
+            let dbic = delta_bic(
+                &diffs,
+                candidates[i].fit.effect.params().len(),
+                observations,
+            );
+            let p = bootstrap_p(&diffs, options.bootstrap, options.seed ^ (100 + i as u64));
+            if !(dbic > 0.0 && p < 0.05) {
+                selected.retain(|&j| j != i);
+                confounded
+                    .entry(i)
+                    .or_default()
+                    .extend(rest.iter().copied());
+                full = without;
+            }
+        }
+        final_eval = Some(full);
+    }
+    for &i in &selected {
+        candidates[i].significant = true;
+    }
+    for &i in confounded.keys() {
+        candidates[i].significant = false;
+    }
+
+    // 4. How far.
+    let selected_effects: Vec<Effect> =
+        selected.iter().map(|&i| candidates[i].fit.effect).collect();
+    let final_model = fit::model_with(&nominal, &selected_effects, arw_calibrated);
+    let (hold_after_scores, g_hold_after) = match (selected.len(), final_eval) {
+        (0, _) => (before_c.clone(), g_before_c),
+        (1, _) => {
+            let c = &candidates[selected[0]];
+            (c.eval.scores.clone(), c.gap_after)
+        }
+        (_, Some(e)) => {
+            let g = gap(&e.scores);
+            (e.scores, g)
+        }
+        (_, None) => (before_c.clone(), g_before_c),
+    };
+    let (train_after_scores, g_train_after) = if selected.is_empty() {
+        (base_train.scores.clone(), g_train_before)
+    } else {
+        progress.stage("selected model on training runs", (mc * train.len()) as u64);
+        let e = evaluate(
+            &train_refs,
+            &train_ids,
+            &final_model,
+            &selected_effects,
+            options,
+            mc,
+            progress,
+        );
+        let g = gap(&e.scores);
+        (e.scores, g)
+    };
+    // No gap above the floor (within 10% of it): nothing to close.
+    let closed = |before: f64, after: f64| -> f64 {
+        let span = before - floor;
+        if span <= 0.1 * floor {
+            0.0
+        } else {
+            (before - after) / span
+        }
+    };
+
+    // Confounded partners by name, both ways.
+    let mut partners: BTreeMap<usize, Vec<&'static str>> = BTreeMap::new();
+    for (&i, others) in &confounded {
+        for &j in others {
+            partners
+                .entry(i)
+                .or_default()
+                .push(candidates[j].fit.effect.id());
+            partners
+                .entry(j)
+                .or_default()
+                .push(candidates[i].fit.effect.id());
+        }
+    }
+    let mut effects: Vec<EffectResult> = candidates
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let info = c.fit.effect.info();
+            let values = c.fit.effect.params();
+            let params = info.params.iter().map(|p| p.0).zip(values).collect();
+            let ci95 = info
+                .params
+                .iter()
+                .map(|p| p.0)
+                .zip(c.fit.ci95.iter().map(|(a, b)| [*a, *b]))
+                .collect();
+            let mut with = partners.get(&i).cloned().unwrap_or_default();
+            with.sort_unstable();
+            with.dedup();
+            EffectResult {
+                id: info.id,
+                params,
+                delta_bic: c.delta_bic,
+                holdout_gap_before: g_before_c,
+                holdout_gap_after: c.gap_after,
+                fraction_closed: closed(g_before_c, c.gap_after),
+                significant: c.significant,
+                ci95,
+                z: c.fit.z.is_finite().then_some(c.fit.z),
+                test: format!(
+                    "{}: {}",
+                    c.fit.test,
+                    if c.fit.passes {
+                        "passes"
+                    } else {
+                        "does not pass"
+                    }
+                ),
+                bootstrap_p: c.p,
+                confounded_with: with,
+            }
+        })
+        .collect();
+    // Significant first, then by held-out gap reduction.
+    effects.sort_by(|a, b| {
+        b.significant.cmp(&a.significant).then(
+            (a.holdout_gap_after - a.holdout_gap_before)
+                .total_cmp(&(b.holdout_gap_after - b.holdout_gap_before)),
+        )
+    });
+    let unmodelled: Vec<&'static str> = effects
+        .iter()
+        .filter(|e| e.significant)
+        .map(|e| e.id)
+        .collect();
+
+    let runs = train_refs
+        .iter()
+        .zip(base_train.scores.iter().zip(&train_after_scores))
+        .map(|(r, (b, a))| (r, "train", b, a))
+        .chain(
+            hold_refs
+                .iter()
+                .zip(before_c.iter().zip(&hold_after_scores))
+                .map(|(r, (b, a))| (r, "holdout", b, a)),
+        )
+        .map(|(r, role, b, a)| RunSummary {
+            name: r.name.clone(),
+            role,
+            duration_s: r.duration_s,
+            gap_before: gap(std::slice::from_ref(b)),
+            gap_after: gap(std::slice::from_ref(a)),
+        })
+        .collect();
+
+    Ok(Diagnosis {
+        gap: GapSummary {
+            train_before: g_train_before,
+            train_after: g_train_after,
+            holdout_before: g_hold_before,
+            holdout_after: g_hold_after,
+            floor,
+        },
+        r#where,
+        effects,
+        verdict: Verdict {
+            unmodelled,
+            fraction_closed_holdout: closed(g_before_c, g_hold_after),
+        },
+        untestable: untestable
+            .into_iter()
+            .map(|Untestable { id, reason }| UntestableEntry { id, reason })
+            .collect(),
+        model: ModelSummary {
+            sensor: nominal,
+            notes,
+            effects: selected_effects,
+        },
+        runs,
+    })
+}

@@ -444,10 +444,25 @@ fn allan_factors(fs: f64) -> Vec<usize> {
 }
 
 /// Residual mean and std of `values`, pushed as `segment`.
-fn push_moments(out: &mut Out, segment: &str, values: &[f64]) {
-    if let Some((mean, std)) = mean_std(values) {
-        out.push(segment, "residual_mean", mean);
-        out.push(segment, "residual_std", std);
+/// Running mean and sum of squared deviations (Welford).
+#[derive(Clone, Copy, Default)]
+struct Welford {
+    n: usize,
+    mean: f64,
+    m2: f64,
+}
+
+impl Welford {
+    fn add(&mut self, x: f64) {
+        self.n += 1;
+        let d = x - self.mean;
+        self.mean += d / self.n as f64;
+        self.m2 += d * (x - self.mean);
+    }
+
+    /// Mean and sample standard deviation (n − 1), from 2 values on.
+    fn mean_std(&self) -> Option<(f64, f64)> {
+        (self.n >= 2).then(|| (self.mean, (self.m2 / (self.n - 1) as f64).max(0.0).sqrt()))
     }
 }
 
@@ -471,37 +486,15 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
     let dynamic: Vec<bool> = (0..n).map(|i| valid[i] && !r.is_static[i]).collect();
     let mut out = Out(Vec::new());
 
-    let pick = |keep: &dyn Fn(usize) -> bool| -> Vec<f64> {
-        (0..n)
-            .filter(|&i| valid[i] && keep(i))
-            .map(|i| r.residual_dps[i])
-            .collect()
-    };
-    push_moments(&mut out, "all", &pick(&|_| true));
-    push_moments(&mut out, "static", &pick(&|i| r.is_static[i]));
-    push_moments(&mut out, "dynamic", &pick(&|i| dynamic[i]));
-    for (lo, hi) in RATE_BINS_DPS {
-        let name = if hi.is_finite() {
-            format!("dynamic/rate_{lo}_{hi}")
-        } else {
-            format!("dynamic/rate_{lo}_inf")
-        };
-        let values = pick(&|i| {
-            let a = r.reference_rate_dps[i].abs();
-            dynamic[i] && a >= lo && a < hi
-        });
-        push_moments(&mut out, &name, &values);
-    }
-    push_moments(
-        &mut out,
-        "dynamic/positive",
-        &pick(&|i| dynamic[i] && r.reference_rate_dps[i] > 0.0),
-    );
-    push_moments(
-        &mut out,
-        "dynamic/negative",
-        &pick(&|i| dynamic[i] && r.reference_rate_dps[i] < 0.0),
-    );
+    // Moments of every segment and stratum in one pass (Welford accumulators).
+    const ALL: usize = 0;
+    const STATIC: usize = 1;
+    const DYNAMIC: usize = 2;
+    const BIN0: usize = 3; // 4 rate bins
+    const POSITIVE: usize = 7;
+    const NEGATIVE: usize = 8;
+    const SEGS: usize = 9; // [seg][k]: time at 9 + 6·seg + k, temperature at 12 + 6·seg + k
+    let mut acc = [Welford::default(); 21];
     let tercile = |x: f64, (a, b): (f64, f64)| -> usize {
         if x < a {
             0
@@ -519,17 +512,64 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
         .max(f64::MIN_POSITIVE);
     let third = |i: usize| ((3.0 * r.time_s[i] / duration).floor() as usize).min(2);
     let temp_cuts = terciles(&r.temperature_c);
-    for (seg, mask) in [("static", &r.is_static), ("dynamic", &dynamic)] {
+    for i in 0..n {
+        if !valid[i] {
+            continue;
+        }
+        let x = r.residual_dps[i];
+        acc[ALL].add(x);
+        let seg = if r.is_static[i] {
+            acc[STATIC].add(x);
+            0
+        } else {
+            acc[DYNAMIC].add(x);
+            let w = r.reference_rate_dps[i];
+            let a = w.abs();
+            if let Some(b) = RATE_BINS_DPS.iter().position(|&(lo, hi)| a >= lo && a < hi) {
+                acc[BIN0 + b].add(x);
+            }
+            if w > 0.0 {
+                acc[POSITIVE].add(x);
+            } else if w < 0.0 {
+                acc[NEGATIVE].add(x);
+            }
+            1
+        };
+        acc[SEGS + 6 * seg + third(i)].add(x);
+        if let Some(cuts) = temp_cuts {
+            let t = r.temperature_c[i];
+            if t.is_finite() {
+                acc[SEGS + 3 + 6 * seg + tercile(t, cuts)].add(x);
+            }
+        }
+    }
+    let mut moments = |segment: &str, a: &Welford| {
+        if let Some((mean, std)) = a.mean_std() {
+            out.push(segment, "residual_mean", mean);
+            out.push(segment, "residual_std", std);
+        }
+    };
+    moments("all", &acc[ALL]);
+    moments("static", &acc[STATIC]);
+    moments("dynamic", &acc[DYNAMIC]);
+    for (b, (lo, hi)) in RATE_BINS_DPS.iter().enumerate() {
+        let name = if hi.is_finite() {
+            format!("dynamic/rate_{lo}_{hi}")
+        } else {
+            format!("dynamic/rate_{lo}_inf")
+        };
+        moments(&name, &acc[BIN0 + b]);
+    }
+    moments("dynamic/positive", &acc[POSITIVE]);
+    moments("dynamic/negative", &acc[NEGATIVE]);
+    for (seg, name) in ["static", "dynamic"].iter().enumerate() {
         for k in 0..3 {
-            let values = pick(&|i| mask[i] && third(i) == k);
-            push_moments(&mut out, &format!("{seg}/time_{}", k + 1), &values);
-            if let Some(cuts) = temp_cuts {
-                let values = pick(&|i| {
-                    mask[i]
-                        && r.temperature_c[i].is_finite()
-                        && tercile(r.temperature_c[i], cuts) == k
-                });
-                push_moments(&mut out, &format!("{seg}/temperature_{}", k + 1), &values);
+            moments(&format!("{name}/time_{}", k + 1), &acc[SEGS + 6 * seg + k]);
+            if temp_cuts.is_some() {
+                moments(
+                    &format!("{name}/temperature_{}", k + 1),
+                    &acc[SEGS + 3 + 6 * seg + k],
+                );
             }
         }
     }
@@ -597,8 +637,9 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
     }
 
     // Angle error growth.
-    let bias = mean_std(&pick(&|i| r.is_static[i]))
-        .or_else(|| mean_std(&pick(&|_| true)))
+    let bias = acc[STATIC]
+        .mean_std()
+        .or_else(|| acc[ALL].mean_std())
         .map_or(0.0, |(m, _)| m);
     for h in HORIZONS_S {
         let len = (h * fs).round() as usize;

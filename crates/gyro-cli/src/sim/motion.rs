@@ -217,12 +217,23 @@ impl Motion {
                 period_s,
                 angle_deg,
             } => {
-                // Slope of the segment containing t: its integral is the angle exactly.
-                let (i, _) = locate(time_s - start_s, *period_s, angle_deg.len());
-                match (angle_deg.get(i), angle_deg.get(i + 1)) {
-                    (Some(a), Some(b)) => (b - a) / period_s,
-                    _ => 0.0,
+                // Centred slopes at the samples, linearly interpolated: the rate at a
+                // sample is centred on it (the slope of the segment after it would lead
+                // the angle by half a sample), and its sum over the samples telescopes
+                // to the angle change (up to the half segments at the ends).
+                let (i, w) = locate(time_s - start_s, *period_s, angle_deg.len());
+                let slope_at = |k: usize| -> f64 {
+                    let n = angle_deg.len();
+                    if n < 2 {
+                        return 0.0;
+                    }
+                    let (lo, hi) = (k.saturating_sub(1), (k + 1).min(n - 1));
+                    (angle_deg[hi] - angle_deg[lo]) / (period_s * (hi - lo) as f64)
+                };
+                if i + 1 >= angle_deg.len() {
+                    return slope_at(angle_deg.len().saturating_sub(1));
                 }
+                slope_at(i) + w * (slope_at(i + 1) - slope_at(i))
             }
         }
     }

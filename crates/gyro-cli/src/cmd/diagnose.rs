@@ -1,0 +1,267 @@
+//! `gyro-cli diagnose`: where a real sensor differs from its simulation, which
+//! unmodelled effect causes it, and how far the gap shrinks on held-out runs.
+
+use anyhow::{bail, Context, Result};
+use clap::ValueEnum;
+use gyro_host::diagnose::ensemble::{split, RealRun};
+use gyro_host::diagnose::{self, Diagnosis, Options, Progress};
+use gyro_host::{log, model};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Output format.
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// Human-readable.
+    Table,
+    /// The JSON contract of DESIGN.md.
+    Json,
+}
+
+/// Arguments of `diagnose`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Runs to fit the nominal model and the candidate effects on (logs with
+    /// `reference_deg`; `temperature_c` where present).
+    #[arg(long, num_args = 1.., required_unless_present = "self_test")]
+    train: Vec<PathBuf>,
+    /// Runs to score the effects on, never used in fitting.
+    #[arg(long, num_args = 1.., required_unless_present = "self_test")]
+    holdout: Vec<PathBuf>,
+    /// Cut every log into windows of this many seconds, each a run (for long recordings).
+    #[arg(long)]
+    split_s: Option<f64>,
+    /// Use this model file's sensor model as the nominal model, as it is.
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Output format on stdout.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+    /// Write an HTML report with plots into this directory.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Seed of the simulated ensembles.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Members of the baseline ensemble per run (at least 50 for the figures to mean
+    /// what the report says).
+    #[arg(long, default_value_t = 50)]
+    members: usize,
+    /// Members per held-out run for each candidate effect.
+    #[arg(long, default_value_t = 20)]
+    candidate_members: usize,
+    /// Run the injection–recovery self-check instead of diagnosing logs.
+    #[arg(long)]
+    self_test: bool,
+    #[command(flatten)]
+    grid: log::GridOptions,
+    #[command(flatten)]
+    input: log::LogOptions,
+}
+
+struct Bar(ProgressBar);
+
+impl Progress for Bar {
+    fn stage(&self, name: &str, total: u64) {
+        self.0.set_message(name.to_string());
+        self.0.set_length(total);
+        self.0.set_position(0);
+    }
+    fn tick(&self) {
+        self.0.inc(1);
+    }
+}
+
+fn progress_bar() -> Bar {
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("{msg:<36} [{bar:30}] {pos}/{len} {elapsed_precise}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    Bar(bar)
+}
+
+fn load(paths: &[PathBuf], args: &Args, role: &str) -> Result<Vec<RealRun>> {
+    let mut runs = Vec::new();
+    for path in paths {
+        let (raw, warnings) = log::read_log_with_warnings(path, &args.input)?;
+        for warning in &warnings {
+            eprintln!("warning: {warning}");
+        }
+        let regular = log::regularize(&raw, &args.grid)?;
+        drop(raw);
+        if !regular.has_reference {
+            bail!(
+                "{}: no reference_deg column; diagnose compares the gyro with an encoder reference, so every {role} run needs one",
+                path.display()
+            );
+        }
+        let pieces = match args.split_s {
+            Some(s) if !(s.is_finite() && s > 0.0) => {
+                bail!("--split-s {s}: expected a positive number of seconds")
+            }
+            Some(s) => {
+                let pieces = split(&regular, s);
+                if pieces.is_empty() {
+                    bail!(
+                        "{}: shorter than half a --split-s window ({s} s)",
+                        path.display()
+                    );
+                }
+                pieces
+            }
+            None => vec![regular],
+        };
+        let count = pieces.len();
+        for (i, piece) in pieces.into_iter().enumerate() {
+            let name = if count > 1 {
+                format!("{}#{}", path.display(), i + 1)
+            } else {
+                path.display().to_string()
+            };
+            let run = RealRun::prepare(name.clone(), piece)
+                .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+            runs.push(run);
+        }
+    }
+    Ok(runs)
+}
+
+/// Run the command.
+pub fn run(args: &Args) -> Result<()> {
+    if args.self_test {
+        bail!("--self-test is not available yet");
+    }
+    let mut options = Options {
+        seed: args.seed,
+        members: args.members,
+        candidate_members: args.candidate_members,
+        ..Options::default()
+    };
+    if args.members < 2 || args.candidate_members < 2 {
+        bail!("--members and --candidate-members must be at least 2");
+    }
+    if let Some(path) = &args.model {
+        options.prior = model::load(path)?.sensor;
+        options.fixed_model = true;
+    }
+    let train = load(&args.train, args, "training")?;
+    let holdout = load(&args.holdout, args, "held-out")?;
+    diagnose::check_runs(&train, &holdout)?;
+    let bar = progress_bar();
+    let result = diagnose::diagnose(&train, &holdout, &options, &bar);
+    bar.0.finish_and_clear();
+    let result = result?;
+    let mut stdout = std::io::stdout().lock();
+    match args.format {
+        Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
+        Format::Table => write!(stdout, "{}", table(&result))?,
+    }
+    if let Some(dir) = &args.report {
+        write_report(dir, &result, &train, &holdout)?;
+    }
+    Ok(())
+}
+
+fn write_report(
+    dir: &Path,
+    result: &Diagnosis,
+    _train: &[RealRun],
+    _holdout: &[RealRun],
+) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let path = dir.join("diagnosis.json");
+    std::fs::write(&path, serde_json::to_string_pretty(result)?)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
+}
+
+fn num(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.3}")
+    } else {
+        "-".into()
+    }
+}
+
+/// The human-readable summary.
+pub fn table(d: &Diagnosis) -> String {
+    let mut s = String::new();
+    let g = &d.gap;
+    let _ = writeln!(
+        s,
+        "gap G (RMS z of the where-statistics; floor = two simulated ensembles)"
+    );
+    let _ = writeln!(
+        s,
+        "  train    {} -> {}\n  holdout  {} -> {}\n  floor    {}",
+        num(g.train_before),
+        num(g.train_after),
+        num(g.holdout_before),
+        num(g.holdout_after),
+        num(g.floor)
+    );
+    let _ = writeln!(
+        s,
+        "verdict: {}; fraction of the held-out gap closed {}",
+        if d.verdict.unmodelled.is_empty() {
+            "nothing significant".to_string()
+        } else {
+            format!("unmodelled {}", d.verdict.unmodelled.join(", "))
+        },
+        num(d.verdict.fraction_closed_holdout)
+    );
+    let _ = writeln!(s, "\nwhere (largest |z| of real vs the nominal ensembles):");
+    for w in d.r#where.iter().take(10) {
+        let _ = writeln!(s, "  {:>8.1}  {:<28} {}", w.z, w.segment, w.statistic);
+    }
+    let _ = writeln!(
+        s,
+        "\neffects (ranked; gap on held-out runs before -> after adding the fitted effect)"
+    );
+    let _ = writeln!(
+        s,
+        "  {:<18} {:>4} {:>9} {:>9} {:>9} {:>9}  parameters [95% interval]",
+        "effect", "sig", "z", "dBIC", "gap", "closed"
+    );
+    for e in &d.effects {
+        let params: Vec<String> = e
+            .params
+            .iter()
+            .map(|(k, v)| {
+                let ci = e.ci95.get(k).map_or(String::new(), |[a, b]| {
+                    let f = |x: &Option<f64>| x.map_or("inf".to_string(), |v| format!("{v:.4e}"));
+                    format!(" [{}, {}]", f(a), f(b))
+                });
+                format!("{k}={v:.4e}{ci}")
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "  {:<18} {:>4} {:>9} {:>9.1} {:>9} {:>9}  {}{}",
+            e.id,
+            if e.significant { "yes" } else { "" },
+            e.z.map_or("exact".to_string(), |z| format!("{z:.1}")),
+            e.delta_bic,
+            num(e.holdout_gap_after),
+            num(e.fraction_closed),
+            params.join(", "),
+            if e.confounded_with.is_empty() {
+                String::new()
+            } else {
+                format!("  (confounded with {})", e.confounded_with.join(", "))
+            }
+        );
+    }
+    for u in &d.untestable {
+        let _ = writeln!(s, "  {:<18} untestable: {}", u.id, u.reason);
+    }
+    let _ = writeln!(s, "\nnominal model:");
+    for n in &d.model.notes {
+        let _ = writeln!(s, "  {n}");
+    }
+    s
+}

@@ -1,0 +1,311 @@
+//! Real runs prepared for the diagnosis, and their re-simulation with the same motion.
+//!
+//! A run is re-simulated from its own reference trajectory ([`Motion::from_reference`]),
+//! with its own temperatures and its encoder's step, on its own grid; the simulated log
+//! then goes through exactly the statistics and features the real one went through.
+//! Dropped samples are filled by linear interpolation, as the grid placement fills a
+//! real log's gaps.
+
+use super::features::{features, Features};
+use super::stats::{residuals, residuals_of, stats_of, Stat, StatsError};
+use crate::log::RegularLog;
+use crate::noise::rate_step;
+use crate::sim::{simulate_series, Effect, Motion, SensorModel, SimOptions};
+use rayon::prelude::*;
+
+/// A real run, ready to be compared with its simulations.
+#[derive(Clone, Debug)]
+pub struct RealRun {
+    /// Name (file, and window if the file was split).
+    pub name: String,
+    /// Sample rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Duration (s).
+    pub duration_s: f64,
+    /// Its "where" statistics.
+    pub stats: Vec<Stat>,
+    /// Its features.
+    pub features: Features,
+    /// The motion, from the reference.
+    pub motion: Motion,
+    /// Temperatures per sample, if the log has them.
+    pub temperature_c: Option<Vec<f64>>,
+    /// The reference's quantisation step (deg), if it is on a grid.
+    pub reference_step_deg: Option<f64>,
+    /// Rates of samples that were in the log (not filled), for the output grid.
+    pub measured_rates_dps: Vec<f64>,
+    /// Gaps in the log (dropout events) and slots filled by interpolation.
+    pub gaps: u64,
+    /// Slots filled by interpolation.
+    pub filled_slots: u64,
+    /// The regular log, for replays through the pipeline.
+    pub log: RegularLog,
+}
+
+/// Consecutive windows of `window_s` seconds of `log` (a last window shorter than half of
+/// that is dropped), each a log of its own.
+pub fn split(log: &RegularLog, window_s: f64) -> Vec<RegularLog> {
+    let per = ((window_s * log.sample_rate_hz).round() as usize).max(1);
+    log.slots
+        .chunks(per)
+        .filter(|c| c.len() * 2 >= per)
+        .map(|c| RegularLog {
+            slots: c.to_vec(),
+            sample_rate_hz: log.sample_rate_hz,
+            has_reference: log.has_reference,
+            has_temperature: log.has_temperature,
+            quality: log.quality.clone(),
+        })
+        .collect()
+}
+
+/// Smoothing of the reference trajectory when it is quantised (s): the encoder's steps
+/// would otherwise be rate spikes in the simulated gyro.
+const QUANTISED_SMOOTH_S: f64 = 0.02;
+
+impl RealRun {
+    /// Prepare `log` (named `name`).
+    pub fn prepare(name: String, log: RegularLog) -> Result<Self, StatsError> {
+        let r = residuals(&log)?;
+        let stats = stats_of(&r);
+        let features = features(&r, 1e-9);
+        let fs = log.sample_rate_hz;
+        let reference: Vec<f64> = filled_reference(&log);
+        let reference_step_deg = rate_step(&reference).filter(|s| *s >= 1e-4);
+        let smooth = if reference_step_deg.is_some() {
+            ((QUANTISED_SMOOTH_S * fs).round() as usize).max(1)
+        } else {
+            1
+        };
+        let motion = Motion::from_reference(0.0, 1.0 / fs, &reference, smooth);
+        let temperature_c = log.has_temperature.then(|| {
+            log.slots
+                .iter()
+                .map(|s| s.temperature_c.unwrap_or(f64::NAN))
+                .collect()
+        });
+        let measured_rates_dps = log
+            .slots
+            .iter()
+            .filter(|s| !s.filled)
+            .map(|s| s.rate_dps)
+            .collect();
+        Ok(Self {
+            name,
+            sample_rate_hz: fs,
+            duration_s: log.slots.len().saturating_sub(1) as f64 / fs,
+            stats,
+            features,
+            motion,
+            temperature_c,
+            reference_step_deg,
+            measured_rates_dps,
+            gaps: log
+                .slots
+                .windows(2)
+                .filter(|w| w[1].filled && !w[0].filled)
+                .count() as u64
+                + u64::from(log.slots.first().is_some_and(|s| s.filled)),
+            filled_slots: log.slots.iter().filter(|s| s.filled).count() as u64,
+            log,
+        })
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.log.slots.len()
+    }
+
+    /// True if the run has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.log.slots.is_empty()
+    }
+}
+
+/// The reference with missing values filled by the previous one (the first present one
+/// at the start).
+fn filled_reference(log: &RegularLog) -> Vec<f64> {
+    let first = log
+        .slots
+        .iter()
+        .find_map(|s| s.reference_deg)
+        .unwrap_or(0.0);
+    let mut last = first;
+    log.slots
+        .iter()
+        .map(|s| {
+            if let Some(r) = s.reference_deg.filter(|r| r.is_finite()) {
+                last = r;
+            }
+            last
+        })
+        .collect()
+}
+
+/// One simulated member of an ensemble: its statistics and features.
+#[derive(Clone, Debug)]
+pub struct Member {
+    /// "Where" statistics.
+    pub stats: Vec<Stat>,
+    /// Features.
+    pub features: Features,
+}
+
+/// Seed of member `j` of run `run` (SplitMix64 of the three).
+pub fn member_seed(base: u64, run: usize, j: usize) -> u64 {
+    let mut z = base
+        ^ (run as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ (j as u64).wrapping_mul(0xD1B5_4A32_D192_ED69);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Simulate `run` with `model` and `effects` and `seed`, and measure it.
+pub fn simulate_member(
+    run: &RealRun,
+    model: &SensorModel,
+    effects: &[Effect],
+    seed: u64,
+) -> Member {
+    let options = SimOptions {
+        seed,
+        reference_step_deg: run.reference_step_deg,
+        ..SimOptions::default()
+    };
+    let model = SensorModel {
+        sample_rate_hz: run.sample_rate_hz,
+        ..*model
+    };
+    let mut s = simulate_series(
+        &model,
+        effects,
+        &run.motion,
+        &options,
+        run.temperature_c.as_deref(),
+    );
+    let n = run.len().min(s.rate_dps.len());
+    s.rate_dps.truncate(n);
+    s.reference_deg.truncate(n);
+    s.temperature_c.truncate(n);
+    if s.dropped > 0 {
+        fill_gaps(&mut s.rate_dps);
+    }
+    let fs = run.sample_rate_hz;
+    let time: Vec<f64> = (0..n).map(|k| k as f64 / fs).collect();
+    let temperature = if run.temperature_c.is_some() {
+        s.temperature_c
+    } else {
+        vec![f64::NAN; n]
+    };
+    match residuals_of(fs, time, s.rate_dps, &s.reference_deg, temperature) {
+        Ok(r) => Member {
+            stats: stats_of(&r),
+            features: features(&r, 1e-9),
+        },
+        // The real run had enough samples; its simulation has as many.
+        Err(_) => Member {
+            stats: Vec::new(),
+            features: Features {
+                coef: [f64::NAN; 7],
+                samples: 0,
+                wander_avar: [f64::NAN; 3],
+                max_abs_rate_dps: f64::NAN,
+                plateau_samples: 0,
+                temperature_varies: false,
+                static_diff_var: (f64::NAN, 0),
+            },
+        },
+    }
+}
+
+/// Linear interpolation over NaN runs (held at the ends).
+fn fill_gaps(x: &mut [f64]) {
+    let n = x.len();
+    let mut i = 0;
+    let mut last: Option<usize> = None;
+    while i < n {
+        if x[i].is_finite() {
+            last = Some(i);
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < n && !x[i].is_finite() {
+            i += 1;
+        }
+        match (last, i < n) {
+            (Some(a), true) => {
+                let (va, vb) = (x[a], x[i]);
+                for (k, v) in x.iter_mut().enumerate().take(i).skip(start) {
+                    let w = (k - a) as f64 / (i - a) as f64;
+                    *v = va + w * (vb - va);
+                }
+            }
+            (Some(a), false) => {
+                let va = x[a];
+                x[start..].iter_mut().for_each(|v| *v = va);
+            }
+            (None, true) => {
+                let vb = x[i];
+                x[..i].iter_mut().for_each(|v| *v = vb);
+            }
+            (None, false) => {}
+        }
+    }
+}
+
+/// Ensembles of `members` members for each of `runs` (`run_ids` give each run's seed
+/// index), simulated in parallel; `tick` is called once per member done.
+pub fn ensembles(
+    runs: &[&RealRun],
+    run_ids: &[usize],
+    model: &SensorModel,
+    effects: &[Effect],
+    base_seed: u64,
+    members: usize,
+    tick: &(dyn Fn() + Sync),
+) -> Vec<Vec<Member>> {
+    let jobs: Vec<(usize, usize)> = (0..runs.len())
+        .flat_map(|r| (0..members).map(move |j| (r, j)))
+        .collect();
+    let done: Vec<(usize, Member)> = jobs
+        .par_iter()
+        .map(|&(r, j)| {
+            let m = simulate_member(
+                runs[r],
+                model,
+                effects,
+                member_seed(base_seed, run_ids[r], j),
+            );
+            tick();
+            (r, m)
+        })
+        .collect();
+    let mut out: Vec<Vec<Member>> = (0..runs.len()).map(|_| Vec::new()).collect();
+    for (r, m) in done {
+        out[r].push(m);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fill_gaps_interpolates_and_holds_ends() {
+        let mut x = [f64::NAN, 1.0, f64::NAN, f64::NAN, 4.0, f64::NAN];
+        fill_gaps(&mut x);
+        assert_eq!(x, [1.0, 1.0, 2.0, 3.0, 4.0, 4.0]);
+    }
+
+    #[test]
+    fn seeds_differ_by_run_and_member() {
+        let a = member_seed(1, 0, 0);
+        assert_ne!(a, member_seed(1, 0, 1));
+        assert_ne!(a, member_seed(1, 1, 0));
+        assert_ne!(a, member_seed(2, 0, 0));
+        assert_eq!(a, member_seed(1, 0, 0));
+    }
+}

@@ -1,0 +1,623 @@
+//! The nominal model fitted on the training runs, and a fitting procedure per effect.
+//!
+//! Every estimator is a function of the training runs' [`Features`]; applied to the
+//! baseline ensemble (member `j` of every run forms replica `j`) it gives the estimator's
+//! distribution when the effect is absent. The parameter test is the real estimate's
+//! z-score against those null replicas; the estimate is the real value minus the null
+//! mean (what the nominal sensor and the processing alone produce), rescaled by a
+//! noise-free simulation of the training runs with the effect where the feature is only
+//! proportional to the parameter to first order (the gain correction). Intervals are
+//! ±1.96 null standard deviations (deterministic effects), χ² bounds (turn-on bias) or
+//! ±1.96 null standard deviations of the variance (wander), mapped to the parameter.
+
+use super::ensemble::{simulate_member, Member, RealRun};
+use super::features::{reg, CUBIC_SCALE_DPS, WANDER_TAUS_S};
+use crate::noise::fit::gauss_markov_avar_continuous;
+use crate::noise::{chi2_quantile, rate_step};
+use crate::sim::{Effect, SensorModel, EFFECTS};
+use rayon::prelude::*;
+
+/// |z| of the parameter test above which an effect is a candidate (Bonferroni over the
+/// 14 effects at a family-wise 0.1% is 3.9).
+pub const Z_CRITICAL: f64 = 4.0;
+/// Quantisation is named when the output grid is this many times coarser than the
+/// nominal step.
+pub const QUANT_RATIO: f64 = 1.5;
+/// Fewest clipped samples over the training runs for saturation.
+pub const MIN_CLIPPED: usize = 10;
+/// Fewest gaps over the training runs for dropouts.
+pub const MIN_GAPS: u64 = 3;
+
+/// The fitted candidate of one effect.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fit {
+    /// The effect with its fitted parameters.
+    pub effect: Effect,
+    /// 95% interval of each parameter (`None` bound: unbounded).
+    pub ci95: Vec<(Option<f64>, Option<f64>)>,
+    /// z-score of the parameter test (NaN where the test is exact, see `passes`).
+    pub z: f64,
+    /// The parameter test passes.
+    pub passes: bool,
+    /// What the test was.
+    pub test: String,
+}
+
+/// An effect that cannot be tested on these runs, and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Untestable {
+    /// Effect id.
+    pub id: &'static str,
+    /// What data is missing.
+    pub reason: String,
+}
+
+/// The nominal model for these training runs, and notes on where each value came from.
+pub fn nominal_model(train: &[&RealRun], prior: &SensorModel) -> (SensorModel, Vec<String>) {
+    let mut model = *prior;
+    let mut notes = Vec::new();
+    if let Some(run) = train.first() {
+        model.sample_rate_hz = run.sample_rate_hz;
+    }
+    let intercepts: Vec<f64> = train
+        .iter()
+        .map(|r| r.features.coef[reg::INTERCEPT])
+        .filter(|c| c.is_finite())
+        .collect();
+    if !intercepts.is_empty() {
+        model.bias_dps = intercepts.iter().sum::<f64>() / intercepts.len() as f64;
+        notes.push(format!(
+            "bias {:.4} deg/s: mean regression intercept of the training runs",
+            model.bias_dps
+        ));
+    }
+    let (sum, count) = train.iter().fold((0.0, 0usize), |(s, c), r| {
+        let (v, n) = r.features.static_diff_var;
+        if n > 0 && v.is_finite() {
+            (s + v * n as f64, c + n)
+        } else {
+            (s, c)
+        }
+    });
+    let needed = (2.0 * model.sample_rate_hz) as usize;
+    if count >= needed.max(20) {
+        let white_var = (sum / count as f64 - model.lsb_dps * model.lsb_dps / 12.0).max(0.0);
+        model.arw_deg_per_rt_h = white_var.sqrt() * 60.0 / model.sample_rate_hz.sqrt();
+        notes.push(format!(
+            "angle random walk {:.4} deg/sqrt(h): first differences of {count} static samples",
+            model.arw_deg_per_rt_h
+        ));
+    } else {
+        notes.push(format!(
+            "angle random walk {:.4} deg/sqrt(h) from the prior model: fewer than 2 s of static samples",
+            model.arw_deg_per_rt_h
+        ));
+    }
+    notes.push(format!(
+        "Gauss-Markov bias sigma {} deg/s, T {} s, output step {:.5} deg/s, range {} deg/s: from the prior model",
+        model.gm_sigma_dps, model.gm_tau_s, model.lsb_dps, model.range_dps
+    ));
+    (model, notes)
+}
+
+/// The model to simulate with `effects` added: quantisation's rounding noise is taken out
+/// of the calibrated white noise (it was measured with it).
+pub fn model_with(nominal: &SensorModel, effects: &[Effect], arw_calibrated: bool) -> SensorModel {
+    let mut model = *nominal;
+    if arw_calibrated {
+        for e in effects.iter().filter(|e| !is_identity(e, nominal)) {
+            if let Effect::Quantization { lsb_dps } = *e {
+                let sigma = model.white_sigma_dps();
+                let var = (sigma * sigma - lsb_dps * lsb_dps / 12.0).max(0.0);
+                model.arw_deg_per_rt_h = var.sqrt() * 60.0 / model.sample_rate_hz.sqrt();
+            }
+        }
+    }
+    model
+}
+
+/// True if adding `effect` to `model` changes no simulated sample (a zero-size wander,
+/// no dropouts, the nominal grid again, a clip above the range): its ensemble is the
+/// baseline's, seed for seed, so it need not be simulated.
+pub fn is_identity(effect: &Effect, model: &SensorModel) -> bool {
+    match *effect {
+        Effect::BiasInstability { sigma_dps } | Effect::TurnOnBias { sigma_dps } => {
+            sigma_dps == 0.0
+        }
+        Effect::RateRandomWalk { k_dps_per_rt_s } => k_dps_per_rt_s == 0.0,
+        Effect::Dropouts { rate_per_s, .. } => rate_per_s == 0.0,
+        Effect::Quantization { lsb_dps } => {
+            lsb_dps == 0.0 || (lsb_dps - model.lsb_dps).abs() <= 1e-3 * model.lsb_dps
+        }
+        Effect::Saturation { limit_dps } => limit_dps >= model.range_dps,
+        Effect::ScaleFactor { k } | Effect::ScaleAsymmetry { k } => k == 0.0,
+        Effect::Nonlinearity { k3_per_dps2 } => k3_per_dps2 == 0.0,
+        Effect::Latency { delay_s } => delay_s == 0.0,
+        Effect::ClockError { ppm } => ppm == 0.0,
+        Effect::TemperatureBias { dps_per_c } => dps_per_c == 0.0,
+        Effect::TemperatureScale { per_c } => per_c == 0.0,
+        // The fit's stand-in for "no limit".
+        Effect::Bandwidth { cutoff_hz } => cutoff_hz >= 0.5 * model.sample_rate_hz,
+    }
+}
+
+fn mean(v: impl Iterator<Item = f64>) -> f64 {
+    let (s, n) = v
+        .filter(|x| x.is_finite())
+        .fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+    if n == 0 {
+        f64::NAN
+    } else {
+        s / n as f64
+    }
+}
+
+fn mean_sd(v: &[f64]) -> (f64, f64) {
+    let f: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if f.len() < 2 {
+        return (f64::NAN, f64::NAN);
+    }
+    let m = f.iter().sum::<f64>() / f.len() as f64;
+    let var = f.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (f.len() - 1) as f64;
+    (m, var.sqrt())
+}
+
+fn sample_var(v: &[f64]) -> f64 {
+    let (_, sd) = mean_sd(v);
+    sd * sd
+}
+
+/// Everything the estimators need.
+pub struct FitInput<'a> {
+    /// Training runs.
+    pub train: &'a [&'a RealRun],
+    /// Their baseline ensembles (same member count each).
+    pub null: &'a [Vec<Member>],
+    /// The nominal model.
+    pub model: &'a SensorModel,
+    /// Every training run's temperature varies.
+    pub temperature_ok: bool,
+}
+
+impl FitInput<'_> {
+    fn members(&self) -> usize {
+        self.null.iter().map(Vec::len).min().unwrap_or(0)
+    }
+
+    /// Pooled value of `f` over the real runs and over each null replica.
+    fn pooled(&self, f: &dyn Fn(&super::features::Features) -> f64) -> (f64, Vec<f64>) {
+        let real = mean(self.train.iter().map(|r| f(&r.features)));
+        let replicas = (0..self.members())
+            .map(|j| mean(self.null.iter().map(|m| f(&m[j].features))))
+            .collect();
+        (real, replicas)
+    }
+
+    /// Pooled regression coefficient `index` of noise-free simulations with `effects`.
+    fn noise_free(&self, effects: &[Effect], index: usize) -> f64 {
+        let quiet = SensorModel {
+            arw_deg_per_rt_h: 0.0,
+            gm_sigma_dps: 0.0,
+            lsb_dps: 0.0,
+            ..*self.model
+        };
+        let values: Vec<f64> = self
+            .train
+            .par_iter()
+            .map(|r| simulate_member(r, &quiet, effects, 1).features.coef[index])
+            .collect();
+        mean(values.into_iter())
+    }
+}
+
+/// Fit every effect of the vocabulary on the training runs.
+pub fn fit_all(input: &FitInput) -> (Vec<Fit>, Vec<Untestable>) {
+    let mut fits = Vec::new();
+    let mut untestable = Vec::new();
+    for info in EFFECTS {
+        match fit_one(input, info.typical) {
+            Ok(f) => fits.push(f),
+            Err(reason) => untestable.push(Untestable {
+                id: info.id,
+                reason,
+            }),
+        }
+    }
+    (fits, untestable)
+}
+
+/// A regression-coefficient effect: estimate, null z, gain-corrected parameter and CI.
+fn regression_fit(
+    input: &FitInput,
+    index: usize,
+    make: &dyn Fn(f64) -> Effect,
+    to_param: &dyn Fn(f64) -> f64,
+) -> (Effect, f64, (f64, f64)) {
+    let (real, replicas) = input.pooled(&|f| f.coef[index]);
+    let (m0, s0) = mean_sd(&replicas);
+    let z = (real - m0) / s0;
+    let raw = real - m0;
+    let half = 1.96 * s0 * (1.0 + 1.0 / replicas.len().max(1) as f64).sqrt();
+    // Gain: noise-free coefficient change per unit of the first-order parameter.
+    let mut gain = 1.0;
+    let param = to_param(raw);
+    if param != 0.0 && param.is_finite() {
+        let with = input.noise_free(&[make(param)], index);
+        let without = input.noise_free(&[], index);
+        let g = (with - without) / raw;
+        if g.is_finite() && g > 0.2 && g < 5.0 {
+            gain = g;
+        }
+    }
+    let est = raw / gain;
+    let (lo, hi) = ((raw - half) / gain, (raw + half) / gain);
+    (make(to_param(est)), z, (to_param(lo), to_param(hi)))
+}
+
+fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
+    let exact = f64::NAN;
+    let temperature = || -> Result<(), String> {
+        if input.temperature_ok {
+            Ok(())
+        } else {
+            Err(format!(
+                "needs a temperature column that varies by at least {} degC in every training run",
+                super::features::MIN_TEMPERATURE_RANGE_C
+            ))
+        }
+    };
+    let fit = |effect, z: f64, ci: Vec<(Option<f64>, Option<f64>)>, two_sided: bool, test: &str| {
+        let passes = if two_sided {
+            z.abs() >= Z_CRITICAL
+        } else {
+            z >= Z_CRITICAL
+        };
+        Fit {
+            effect,
+            ci95: ci,
+            z,
+            passes,
+            test: test.to_string(),
+        }
+    };
+    let some = |(a, b): (f64, f64)| vec![(Some(a.min(b)), Some(a.max(b)))];
+    Ok(match typical {
+        Effect::ScaleFactor { .. } => {
+            let (e, z, ci) =
+                regression_fit(input, reg::RATE, &|k| Effect::ScaleFactor { k }, &|x| x);
+            fit(
+                e,
+                z,
+                some(ci),
+                true,
+                "regression slope on rate vs null replicas",
+            )
+        }
+        Effect::ClockError { .. } => {
+            let (e, z, ci) =
+                regression_fit(input, reg::RATE, &|ppm| Effect::ClockError { ppm }, &|x| {
+                    x * 1e6
+                });
+            fit(
+                e,
+                z,
+                some(ci),
+                true,
+                "regression slope on rate vs null replicas (x 1e6)",
+            )
+        }
+        Effect::ScaleAsymmetry { .. } => {
+            let (e, z, ci) = regression_fit(
+                input,
+                reg::ABS_RATE,
+                &|k| Effect::ScaleAsymmetry { k },
+                &|x| x,
+            );
+            fit(
+                e,
+                z,
+                some(ci),
+                true,
+                "regression slope on |rate| vs null replicas",
+            )
+        }
+        Effect::Nonlinearity { .. } => {
+            let scale = CUBIC_SCALE_DPS.powi(3);
+            let (e, z, ci) = regression_fit(
+                input,
+                reg::RATE_CUBED,
+                &|k3_per_dps2| Effect::Nonlinearity { k3_per_dps2 },
+                &|x| x / scale,
+            );
+            fit(
+                e,
+                z,
+                some(ci),
+                true,
+                "regression on rate^3 vs null replicas",
+            )
+        }
+        Effect::Latency { .. } => {
+            let (e, z, ci) = regression_fit(
+                input,
+                reg::ACCELERATION,
+                &|d| Effect::Latency {
+                    delay_s: d.clamp(0.0, 1.0),
+                },
+                &|x| -x,
+            );
+            let ci = vec![(Some(ci.0.min(ci.1)), Some(ci.0.max(ci.1)))];
+            fit(
+                e,
+                -z,
+                ci,
+                false,
+                "regression on angular acceleration vs null replicas (one-sided)",
+            )
+        }
+        Effect::Bandwidth { .. } => {
+            // A two-pole low-pass delays slow motion by 2/(2π f_pole), f_pole = 1.554 f_c.
+            let per_delay = 1.0 / (std::f64::consts::PI * 1.5538);
+            let nyquist = 0.5 * input.model.sample_rate_hz;
+            let to_cutoff = |d: f64| -> f64 {
+                if d > 0.0 {
+                    (per_delay / d).min(nyquist)
+                } else {
+                    nyquist
+                }
+            };
+            let (real, replicas) = input.pooled(&|f| f.coef[reg::ACCELERATION]);
+            let (m0, s0) = mean_sd(&replicas);
+            let z = -(real - m0) / s0;
+            let d = -(real - m0);
+            let half = 1.96 * s0 * (1.0 + 1.0 / replicas.len().max(1) as f64).sqrt();
+            let mut cutoff = to_cutoff(d);
+            if d > 0.0 {
+                // Gain: the delay a noise-free simulation at this cutoff shows.
+                let with = input.noise_free(
+                    &[Effect::Bandwidth { cutoff_hz: cutoff }],
+                    reg::ACCELERATION,
+                );
+                let without = input.noise_free(&[], reg::ACCELERATION);
+                let d_sim = -(with - without);
+                if d_sim > 0.0 && d_sim.is_finite() {
+                    cutoff = (cutoff * d_sim / d).min(nyquist);
+                }
+            }
+            let scale = if d > 0.0 { cutoff * d } else { per_delay };
+            let bound = |dd: f64| (dd > 0.0).then(|| (scale / dd).min(nyquist));
+            let ci = vec![(bound(d + half), bound(d - half))];
+            fit(
+                Effect::Bandwidth { cutoff_hz: cutoff },
+                z,
+                ci,
+                false,
+                "delay from the acceleration regression vs null replicas (one-sided)",
+            )
+        }
+        Effect::TemperatureBias { .. } => {
+            temperature()?;
+            let (e, z, ci) = regression_fit(
+                input,
+                reg::DELTA_T,
+                &|dps_per_c| Effect::TemperatureBias { dps_per_c },
+                &|x| x,
+            );
+            fit(
+                e,
+                z,
+                some(ci),
+                true,
+                "regression on temperature change vs null replicas",
+            )
+        }
+        Effect::TemperatureScale { .. } => {
+            temperature()?;
+            let (e, z, ci) = regression_fit(
+                input,
+                reg::RATE_DELTA_T,
+                &|per_c| Effect::TemperatureScale { per_c },
+                &|x| x,
+            );
+            fit(
+                e,
+                z,
+                some(ci),
+                true,
+                "regression on rate x temperature change vs null replicas",
+            )
+        }
+        Effect::TurnOnBias { .. } => {
+            let n = input.train.len();
+            if n < 3 {
+                return Err(
+                    "needs at least 3 training runs (between-run spread of the bias)".into(),
+                );
+            }
+            let real: Vec<f64> = input
+                .train
+                .iter()
+                .map(|r| r.features.coef[reg::INTERCEPT])
+                .collect();
+            let s2 = sample_var(&real);
+            let null_vars: Vec<f64> = (0..input.members())
+                .map(|j| {
+                    let v: Vec<f64> = input
+                        .null
+                        .iter()
+                        .map(|m| m[j].features.coef[reg::INTERCEPT])
+                        .collect();
+                    sample_var(&v)
+                })
+                .collect();
+            let v0 = mean(null_vars.iter().copied());
+            let k = (n - 1) as f64;
+            // (n−1) s²/v0 ~ χ²(n−1) without the effect; Wilson–Hilferty to a z-score.
+            let x = k * s2 / v0;
+            let c = 2.0 / (9.0 * k);
+            let z = ((x / k).cbrt() - (1.0 - c)) / c.sqrt();
+            let sigma = (s2 - v0).max(0.0).sqrt();
+            let lo = (k * s2 / chi2_quantile(0.975, k) - v0).max(0.0).sqrt();
+            let hi = (k * s2 / chi2_quantile(0.025, k) - v0).max(0.0).sqrt();
+            fit(
+                Effect::TurnOnBias { sigma_dps: sigma },
+                z,
+                vec![(Some(lo), Some(hi))],
+                false,
+                "between-run variance of the bias vs null replicas (chi-square, one-sided)",
+            )
+        }
+        Effect::BiasInstability { .. } | Effect::RateRandomWalk { .. } => {
+            let shape = |tau: f64| -> f64 {
+                match typical {
+                    Effect::RateRandomWalk { .. } => tau / 3.0,
+                    _ => (0..6)
+                        .map(|i| {
+                            gauss_markov_avar_continuous(tau, 1.0, 10f64.powf(0.6 * i as f64)) / 6.0
+                        })
+                        .sum(),
+                }
+            };
+            let usable = input
+                .train
+                .iter()
+                .filter(|r| r.features.wander_avar[2].is_finite())
+                .count();
+            if usable < 2 {
+                return Err(format!(
+                    "needs at least 2 training runs longer than {} s",
+                    2.0 * WANDER_TAUS_S[2]
+                ));
+            }
+            let mut per_tau = Vec::new();
+            for (k, &tau) in WANDER_TAUS_S.iter().enumerate() {
+                let (real, replicas) = input.pooled(&|f| f.wander_avar[k]);
+                let (m0, s0) = mean_sd(&replicas);
+                per_tau.push((real, replicas, m0, s0, shape(tau)));
+            }
+            // Weighted least squares of the excess on the shape: θ = σ² or K².
+            let solve = |excess: &dyn Fn(usize) -> f64| -> f64 {
+                let (mut num, mut den) = (0.0, 0.0);
+                for (k, (_, _, _, s0, f)) in per_tau.iter().enumerate() {
+                    let w = 1.0 / (s0 * s0).max(1e-30);
+                    num += w * f * excess(k);
+                    den += w * f * f;
+                }
+                num / den
+            };
+            let theta = solve(&|k| per_tau[k].0 - per_tau[k].2);
+            let null_thetas: Vec<f64> = (0..input.members())
+                .map(|j| solve(&|k| per_tau[k].1[j] - per_tau[k].2))
+                .collect();
+            let (_, s_theta) = mean_sd(&null_thetas);
+            let z = theta / s_theta;
+            let half = 1.96 * s_theta;
+            let p = theta.max(0.0).sqrt();
+            let lo = (theta - half).max(0.0).sqrt();
+            let hi = (theta + half).max(0.0).sqrt();
+            let effect = match typical {
+                Effect::RateRandomWalk { .. } => Effect::RateRandomWalk { k_dps_per_rt_s: p },
+                _ => Effect::BiasInstability { sigma_dps: p },
+            };
+            fit(
+                effect,
+                z,
+                vec![(Some(lo), Some(hi))],
+                false,
+                "Allan variance of the regression residual at 1/4/16 s vs null replicas (one-sided)",
+            )
+        }
+        Effect::Saturation { .. } => {
+            let clipped: usize = input.train.iter().map(|r| r.features.plateau_samples).sum();
+            let limit = input
+                .train
+                .iter()
+                .map(|r| r.features.max_abs_rate_dps)
+                .fold(0.0f64, f64::max);
+            let null: Vec<f64> = (0..input.members())
+                .map(|j| {
+                    input
+                        .null
+                        .iter()
+                        .map(|m| m[j].features.plateau_samples as f64)
+                        .sum()
+                })
+                .collect();
+            let (m0, s0) = mean_sd(&null);
+            let z = (clipped as f64 - m0) / s0.max(1.0);
+            let tol = input.model.lsb_dps.max(1e-6);
+            // No plateau: no clip seen below the range.
+            let limit = if clipped >= MIN_CLIPPED {
+                limit
+            } else {
+                input.model.range_dps
+            };
+            let mut f = fit(
+                Effect::Saturation { limit_dps: limit.max(1e-3) },
+                z,
+                vec![(Some(limit - tol), Some(limit + tol))],
+                false,
+                "samples on a plateau at the largest |rate| while the reference is faster, vs null replicas",
+            );
+            f.passes = f.passes && clipped >= MIN_CLIPPED;
+            f
+        }
+        Effect::Quantization { .. } => {
+            let values: Vec<f64> = input
+                .train
+                .iter()
+                .flat_map(|r| r.measured_rates_dps.iter().copied())
+                .collect();
+            let nominal = input.model.lsb_dps;
+            match rate_step(&values) {
+                Some(step) => {
+                    let passes = step >= QUANT_RATIO * nominal && step > 0.0;
+                    Fit {
+                        effect: Effect::Quantization { lsb_dps: step },
+                        ci95: vec![(Some(step * 0.999), Some(step * 1.001))],
+                        z: exact,
+                        passes,
+                        test: format!(
+                            "output grid step {step:.6} deg/s vs nominal {nominal:.6} (named above {QUANT_RATIO}x)"
+                        ),
+                    }
+                }
+                None => Fit {
+                    effect: Effect::Quantization { lsb_dps: nominal },
+                    ci95: vec![(Some(0.0), Some(QUANT_RATIO * nominal))],
+                    z: exact,
+                    passes: false,
+                    test: "no output grid coarser than the nominal step".into(),
+                },
+            }
+        }
+        Effect::Dropouts { .. } => {
+            let gaps: u64 = input.train.iter().map(|r| r.gaps).sum();
+            let filled: u64 = input.train.iter().map(|r| r.filled_slots).sum();
+            let duration: f64 = input.train.iter().map(|r| r.duration_s).sum();
+            let g = gaps as f64;
+            let rate = g / duration.max(1e-9);
+            let mean_samples = if gaps > 0 {
+                (filled as f64 / g).max(1.0)
+            } else {
+                1.0
+            };
+            let rate_half = 1.96 * g.sqrt() / duration.max(1e-9);
+            let sd = (mean_samples * (mean_samples - 1.0)).sqrt();
+            let len_half = 1.96 * sd / g.max(1.0).sqrt();
+            Fit {
+                effect: Effect::Dropouts {
+                    rate_per_s: rate,
+                    mean_samples,
+                },
+                ci95: vec![
+                    (Some((rate - rate_half).max(0.0)), Some(rate + rate_half)),
+                    (Some((mean_samples - len_half).max(1.0)), Some(mean_samples + len_half)),
+                ],
+                z: exact,
+                passes: gaps >= MIN_GAPS,
+                test: format!("{gaps} gaps ({filled} samples filled) in the training runs; the nominal model has none (named from {MIN_GAPS})"),
+            }
+        }
+    })
+}
