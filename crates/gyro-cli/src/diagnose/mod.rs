@@ -180,6 +180,8 @@ pub struct Diagnosis {
     pub model: ModelSummary,
     /// Per run figures.
     pub runs: Vec<RunSummary>,
+    /// Angle error with the correctable effects compensated, if any were selected.
+    pub compensation: Option<CompensationSummary>,
 }
 
 /// The nominal model.
@@ -206,6 +208,31 @@ pub struct RunSummary {
     pub gap_before: f64,
     /// G of this run with the selected effects.
     pub gap_after: f64,
+    /// Its z-scores against the nominal ensemble, `(segment/statistic, z)` (for the
+    /// report's gap map; not in the JSON).
+    #[serde(skip)]
+    pub z: Vec<(String, f64)>,
+}
+
+/// The pipeline's angle error on the held-out runs without and with the correctable
+/// effects compensated (`run --model`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CompensationSummary {
+    /// The model file's corrections, as written.
+    pub corrected: Vec<&'static str>,
+    /// Per held-out run.
+    pub runs: Vec<CompensationRun>,
+}
+
+/// One run's angle error without and with compensation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CompensationRun {
+    /// Run name.
+    pub name: String,
+    /// Max abs angle error of `run` with the nominal configuration (deg).
+    pub max_abs_error_before_deg: f64,
+    /// Max abs angle error of `run --model` with the corrections (deg).
+    pub max_abs_error_after_deg: f64,
 }
 
 /// Progress reports.
@@ -629,6 +656,11 @@ pub fn diagnose(
             duration_s: r.duration_s,
             gap_before: gap(std::slice::from_ref(b)),
             gap_after: gap(std::slice::from_ref(a)),
+            z: b
+                .z
+                .iter()
+                .map(|(s, z)| (format!("{}/{}", s.segment, s.statistic), *z))
+                .collect(),
         })
         .collect();
 
@@ -656,5 +688,6 @@ pub fn diagnose(
             effects: selected_effects,
         },
         runs,
+        compensation: None,
     })
 }
