@@ -4,7 +4,7 @@
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 use gyro_host::diagnose::ensemble::{split, RealRun};
-use gyro_host::diagnose::{self, Diagnosis, Options, Progress};
+use gyro_host::diagnose::{self, selftest, Diagnosis, Options, Progress};
 use gyro_host::{log, model};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::fmt::Write as _;
@@ -133,7 +133,7 @@ fn load(paths: &[PathBuf], args: &Args, role: &str) -> Result<Vec<RealRun>> {
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
     if args.self_test {
-        bail!("--self-test is not available yet");
+        return self_test(args);
     }
     let mut options = Options {
         seed: args.seed,
@@ -164,6 +164,109 @@ pub fn run(args: &Args) -> Result<()> {
         write_report(dir, &result, &train, &holdout)?;
     }
     Ok(())
+}
+
+fn self_test(args: &Args) -> Result<()> {
+    let options = Options {
+        members: args.members,
+        candidate_members: args.candidate_members,
+        ..Options::default()
+    };
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("self-test {pos}/{len} {msg:<40} {elapsed_precise}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let result = selftest::run(args.seed, &options, &|k, total, label| {
+        bar.set_length(total as u64);
+        bar.set_position(k as u64);
+        bar.set_message(label.to_string());
+    });
+    bar.finish_and_clear();
+    let result = result?;
+    let mut stdout = std::io::stdout().lock();
+    match args.format {
+        Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
+        Format::Table => write!(stdout, "{}", self_test_table(&result))?,
+    }
+    Ok(())
+}
+
+fn pct(x: f64) -> String {
+    if x.is_finite() {
+        format!("{:.0}%", 100.0 * x)
+    } else {
+        "-".into()
+    }
+}
+
+/// The self-check's summary as text.
+pub fn self_test_table(t: &selftest::SelfTest) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "injection-recovery self-test, seed {}: {} training + {} held-out runs of {} s at 1 kHz per case",
+        t.seed,
+        selftest::TRAIN_RUNS,
+        selftest::HOLDOUT_RUNS,
+        selftest::RUN_S
+    );
+    let _ = writeln!(s, "injected magnitudes:");
+    for e in &t.magnitudes {
+        let _ = writeln!(s, "  {}", serde_json::to_string(e).unwrap_or_default());
+    }
+    let _ = writeln!(s, "
+cases:");
+    for c in &t.cases {
+        let injected: Vec<&str> = c.injected.iter().map(|e| e.id()).collect();
+        let cov: Vec<String> = c
+            .covered
+            .iter()
+            .map(|(n, ok)| format!("{n}:{}", if *ok { "in" } else { "OUT" }))
+            .collect();
+        let _ = writeln!(
+            s,
+            "  {:<6} {:<38} named {:<38} gap {:>8.2} -> {:>6.2}  closed {:>6}  {}",
+            c.kind,
+            if injected.is_empty() { "none".into() } else { injected.join("+") },
+            if c.named.is_empty() { "nothing".into() } else { c.named.join("+") },
+            c.holdout_gap.0,
+            c.holdout_gap.1,
+            pct(c.fraction_closed),
+            cov.join(" ")
+        );
+    }
+    let _ = writeln!(s, "
+confusion (single effects: injected -> top-1 named):");
+    for (truth, got, n) in &t.confusion {
+        let _ = writeln!(s, "  {truth:<18} -> {got:<18} {n}");
+    }
+    let _ = writeln!(
+        s,
+        "
+top-1 accuracy (single effects): {} strict, {} counting confounded pairs ({}) as one",
+        pct(t.top1_strict),
+        pct(t.top1_group),
+        selftest::CONFOUND_GROUPS
+            .iter()
+            .map(|(a, b)| format!("{a}~{b}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "pairs with both effects named: {} strict, {} by confound group",
+        pct(t.pairs_both_named),
+        pct(t.pairs_both_named_group)
+    );
+    let _ = writeln!(s, "null cases with nothing significant: {}", pct(t.null_clean));
+    let _ = writeln!(s, "95% intervals covering the injected value: {}", pct(t.coverage));
+    let _ = writeln!(
+        s,
+        "mean fraction of the held-out gap closed (cases with effects): {}",
+        pct(t.mean_fraction_closed)
+    );
+    s
 }
 
 fn write_report(

@@ -25,6 +25,7 @@ pub mod ensemble;
 pub mod features;
 pub mod fit;
 pub mod score;
+pub mod selftest;
 pub mod stats;
 
 use ensemble::{ensembles, Member, RealRun};
