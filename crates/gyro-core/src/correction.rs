@@ -113,6 +113,11 @@ impl Correction {
         Ok(())
     }
 
+    /// True if this is [`Self::IDENTITY`], reference temperature included.
+    pub fn is_exactly_identity(&self) -> bool {
+        *self == Self::IDENTITY
+    }
+
     /// True if this is the identity (the reference temperature aside).
     pub fn is_identity(&self) -> bool {
         self.scale_k == 0.0

@@ -48,7 +48,13 @@ pub struct Config {
     /// Parameters of the Kalman form.
     pub kalman: KalmanConfig,
     /// Correction of scale and temperature errors, applied to every accepted input sample
-    /// (identity by default, and when absent from a model file).
+    /// (identity by default, and when absent from a model file). Left out when serialized
+    /// as the identity, so that files without a correction stay readable by builds that
+    /// predate it.
+    #[cfg_attr(
+        feature = "serde",
+        serde(skip_serializing_if = "Correction::is_exactly_identity")
+    )]
     pub correction: Correction,
 }
 
