@@ -39,8 +39,13 @@ pub const TEMPERATURE_RANGE_C: (f32, f32) = (-100.0, 200.0);
 /// not miscalibrated, and the bound keeps the division far from zero.
 pub const MIN_SCALE: f32 = 0.5;
 
-/// Correction settings: the inverse of the sensor's scale and temperature errors (see the
-/// [module documentation](self)). The default is the identity.
+/// Correction settings: the inverse of the sensor's scale and temperature errors. The
+/// default is the identity.
+///
+/// The sensor reads `m = r·(1 + k + a·sign(r) + s·ΔT) + c·ΔT` for the true rate `r` (bias
+/// and noise aside; `ΔT` from `temperature_ref_c`); the correction gives back
+/// `r = (m − c·ΔT) / (1 + k + a·sign(m − c·ΔT) + s·ΔT)`, exactly, since the scale is kept
+/// positive. See [`Correction::measured_dps`] and [`Correction::corrected_dps`].
 ///
 /// In a model file (`config.correction`), every key is optional:
 ///
