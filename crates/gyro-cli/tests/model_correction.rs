@@ -37,7 +37,7 @@ fn simulated(seed: u64) -> gyro_host::log::Log {
         temperature_start_c: 22.0,
         temperature_rise_c: 10.0,
         temperature_tau_s: 60.0,
-        encoder_counts: None,
+        ..SimOptions::default()
     };
     simulate(&SensorModel::default(), &effects(), &motion, &options)
 }
