@@ -5,6 +5,20 @@
 //! ```
 //! Missing settings take the core's defaults; unknown keys are errors (a typo must not be
 //! silently ignored). `config.sample_rate_hz` is replaced by the log's rate when replaying.
+//!
+//! Fitted sensor errors (from `diagnose`) go in two places:
+//! - `config.correction` ([`gyro_core::Correction`]): scale, asymmetry and temperature
+//!   errors, which the core removes from every sample — on the wrench as in `run`;
+//! - `reference_delay_s`: the gyro's latency behind the reference, which only scoring uses
+//!   (the reference is shifted by it before comparing; see [`crate::replay::ReplayOptions`]).
+//!
+//! ```json
+//! {"format": "gyro-model", "version": 1,
+//!  "config": {"correction": {"scale_k": 0.02, "bias_dps_per_c": 0.05}},
+//!  "reference_delay_s": 0.01}
+//! ```
+//! Both are left out when written as the identity and zero, so such files stay readable by
+//! builds that predate them.
 
 use crate::sim::SensorModel;
 use gyro_core::{Config, Pipeline};
@@ -15,6 +29,9 @@ use std::path::{Path, PathBuf};
 pub const FORMAT: &str = "gyro-model";
 /// The model file version this build reads and writes.
 pub const VERSION: u32 = 1;
+/// The largest |`reference_delay_s`| accepted (s): a gyro's latency is milliseconds; a
+/// second is a wrong unit or a wrong sign convention, not a latency.
+pub const MAX_REFERENCE_DELAY_S: f64 = 1.0;
 
 /// A model file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -30,6 +47,16 @@ pub struct ModelFile {
     /// The sensor's noise and error model (for `simulate`, from `noise`/`calibrate`).
     #[serde(default)]
     pub sensor: SensorModel,
+    /// The gyro lags the reference by this much (s; negative: it leads), as fitted by
+    /// `diagnose` (effect `latency`). Applied when scoring, not by the core: `run` compares
+    /// the angle at `t` with the reference at `t − reference_delay_s` (linear between grid
+    /// slots), so that the error measures the sensor, not the logger's timing. Default 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub reference_delay_s: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 impl ModelFile {
@@ -40,6 +67,7 @@ impl ModelFile {
             version: VERSION,
             config,
             sensor: SensorModel::default(),
+            reference_delay_s: 0.0,
         }
     }
 }
@@ -87,6 +115,14 @@ pub enum ModelError {
         /// What is wrong.
         message: String,
     },
+    /// `reference_delay_s` is not finite or beyond ±[`MAX_REFERENCE_DELAY_S`].
+    #[error("{path}: reference_delay_s must be within ±{MAX_REFERENCE_DELAY_S} s, found {value}")]
+    ReferenceDelay {
+        /// File.
+        path: PathBuf,
+        /// The value found.
+        value: f64,
+    },
     /// A setting is invalid.
     #[error("{path}: {source}")]
     Invalid {
@@ -127,6 +163,15 @@ pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
             path: path.to_path_buf(),
             message,
         })?;
+    // (JSON has no NaN or infinity; the check keeps the bound honest for any caller.)
+    let delay_ok = model.reference_delay_s.is_finite()
+        && model.reference_delay_s.abs() <= MAX_REFERENCE_DELAY_S;
+    if !delay_ok {
+        return Err(ModelError::ReferenceDelay {
+            path: path.to_path_buf(),
+            value: model.reference_delay_s,
+        });
+    }
     Ok(model)
 }
 
@@ -161,6 +206,26 @@ mod tests {
         let path = temp("m.json");
         save(&path, &ModelFile::new(config)).unwrap();
         assert_eq!(load(&path).unwrap().config, config);
+    }
+
+    #[test]
+    fn correction_and_delay_round_trip() {
+        let mut config = Config::default();
+        config.correction.scale_k = 0.015;
+        config.correction.asymmetry_k = -0.004;
+        config.correction.bias_dps_per_c = 0.05;
+        config.correction.scale_per_c = 8e-4;
+        config.correction.temperature_ref_c = Some(24.5);
+        let model = ModelFile {
+            reference_delay_s: 0.0125,
+            ..ModelFile::new(config)
+        };
+        let path = temp("corrected.json");
+        save(&path, &model).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains("\"reference_delay_s\": 0.0125"), "{text}");
+        assert!(text.contains("\"temperature_ref_c\": 24.5"), "{text}");
+        assert_eq!(load(&path).unwrap(), model);
     }
 
     #[test]

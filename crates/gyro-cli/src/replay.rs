@@ -3,8 +3,15 @@
 //! The reference angle goes through the same decimator and low-pass as the rate (both
 //! linear, so filtering the angle equals integrating the filtered rate): the comparison
 //! measures sensor and integration error, not the filter's intended lag. Both start at 0.
+//!
+//! Samples go through the core exactly as on the wrench: with their temperature
+//! ([`Pipeline::push_with_temperature`]) when the log has one, so that the configured
+//! [`gyro_core::Correction`] applies in full. A known latency of the gyro behind the
+//! reference ([`ReplayOptions::reference_delay_s`], the model file's `reference_delay_s`)
+//! is a matter of scoring only: the reference is shifted by it before the comparison.
 
-use crate::log::{Quality, RegularLog};
+use crate::log::{Quality, RegularLog, Slot};
+use crate::model::ModelFile;
 use gyro_core::{Compensation, Config, Decimator, Event, MotionState, Pipeline, Sos, SosState};
 use serde::Serialize;
 
@@ -92,6 +99,25 @@ pub struct Summary {
     pub raw_final_error_deg: Option<f64>,
 }
 
+/// How a replay is scored, beyond the pipeline's configuration.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ReplayOptions {
+    /// The gyro lags the reference by this much (s; negative: it leads). The angle at `t`
+    /// is compared with the reference at `t − reference_delay_s`, interpolated linearly
+    /// between grid slots; where that time falls outside the log (or next to a slot without
+    /// reference) the sample has no reference. 0: the reference as logged.
+    pub reference_delay_s: f64,
+}
+
+impl ReplayOptions {
+    /// The options a model file asks for.
+    pub fn from_model(model: &ModelFile) -> Self {
+        Self {
+            reference_delay_s: model.reference_delay_s,
+        }
+    }
+}
+
 /// The result of replaying one log.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RunReport {
@@ -105,6 +131,12 @@ pub struct RunReport {
     pub input: Quality,
     /// The configuration used.
     pub config: Config,
+    /// The gyro's delay behind the reference the scoring allowed for (s).
+    pub reference_delay_s: f64,
+    /// The temperature (°C) from which the correction measured ΔT: the configured
+    /// reference, else the log's first valid temperature; `None` if there was neither (the
+    /// correction's temperature terms were then not applied).
+    pub temperature_reference_c: Option<f32>,
     /// Error statistics.
     pub summary: Summary,
     /// The movements.
@@ -131,8 +163,18 @@ fn error_stats(errors: impl Iterator<Item = f64>) -> (Option<f64>, Option<f64>, 
 }
 
 /// Replay `log` through a pipeline configured by `config` (its sample rate replaced by the
-/// log's).
+/// log's), scoring against the reference as logged.
 pub fn replay(log: &RegularLog, config: &Config) -> Result<RunReport, gyro_core::Error> {
+    replay_with(log, config, &ReplayOptions::default())
+}
+
+/// Replay `log` through a pipeline configured by `config` (its sample rate replaced by the
+/// log's), scoring as `options` say.
+pub fn replay_with(
+    log: &RegularLog,
+    config: &Config,
+    options: &ReplayOptions,
+) -> Result<RunReport, gyro_core::Error> {
     let config = Config {
         sample_rate_hz: log.sample_rate_hz as f32,
         ..*config
@@ -149,11 +191,21 @@ pub fn replay(log: &RegularLog, config: &Config) -> Result<RunReport, gyro_core:
     let mut ref_last = 0.0_f32;
     let mut ref_block_complete = true;
 
+    // The reference's shift in grid slots (a non-finite delay is treated as none).
+    let shift_slots = if options.reference_delay_s.is_finite() {
+        options.reference_delay_s * log.sample_rate_hz
+    } else {
+        0.0
+    };
+
     let mut series = Vec::with_capacity(log.slots.len() / usize::from(factor) + 1);
     let mut movements = Vec::new();
     let mut open: Option<(f64, usize)> = None;
-    for slot in &log.slots {
-        let reference = match (slot.reference_deg, reference_origin) {
+    for (i, slot) in log.slots.iter().enumerate() {
+        let reference = match (
+            shifted_reference(&log.slots, i, shift_slots),
+            reference_origin,
+        ) {
             (Some(r), Some(origin)) => {
                 ref_last = (r - origin) as f32;
                 Some(ref_last)
@@ -164,7 +216,15 @@ pub fn replay(log: &RegularLog, config: &Config) -> Result<RunReport, gyro_core:
             }
         };
         let ref_mean = ref_decimator.push(reference.unwrap_or(ref_last));
-        let Some(out) = pipeline.push(slot.time_s, slot.rate_dps as f32) else {
+        // A slot without temperature in a log that has them (a filled gap) keeps the last
+        // valid temperature: NaN tells the pipeline so.
+        let out = if log.has_temperature || slot.temperature_c.is_some() {
+            let temperature_c = slot.temperature_c.map_or(f32::NAN, |t| t as f32);
+            pipeline.push_with_temperature(slot.time_s, slot.rate_dps as f32, temperature_c)
+        } else {
+            pipeline.push(slot.time_s, slot.rate_dps as f32)
+        };
+        let Some(out) = out else {
             continue;
         };
         let reference_deg = match ref_mean {
@@ -253,10 +313,35 @@ pub fn replay(log: &RegularLog, config: &Config) -> Result<RunReport, gyro_core:
         output_rate_hz,
         input: log.quality.clone(),
         config,
+        reference_delay_s: options.reference_delay_s,
+        temperature_reference_c: pipeline.corrector().reference_c(),
         summary,
         movements,
         series,
     })
+}
+
+/// The reference angle at grid position `i − shift_slots`, linear between slots: `None`
+/// outside the log or next to a slot without reference. A zero shift gives the slot's own
+/// value, untouched.
+fn shifted_reference(slots: &[Slot], i: usize, shift_slots: f64) -> Option<f64> {
+    if shift_slots == 0.0 {
+        return slots.get(i)?.reference_deg;
+    }
+    let position = i as f64 - shift_slots;
+    if position.is_nan() || position < 0.0 {
+        return None;
+    }
+    let below = position.floor();
+    let fraction = position - below;
+    // Saturating: a position past `usize::MAX` is simply outside the log.
+    let below = below as usize;
+    let a = slots.get(below)?.reference_deg?;
+    if fraction == 0.0 {
+        return Some(a);
+    }
+    let b = slots.get(below.checked_add(1)?)?.reference_deg?;
+    Some(a + fraction * (b - a))
 }
 
 /// Index of the output sample nearest to `time_s`.
@@ -297,5 +382,46 @@ fn movement_result(
         reference_deg,
         error_deg: reference_deg.map(|r| f64::from(angle_deg) - r),
         raw_error_deg: reference_deg.map(|r| f64::from(raw_angle_deg) - r),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn slots(references: &[Option<f64>]) -> Vec<Slot> {
+        references
+            .iter()
+            .enumerate()
+            .map(|(i, &reference_deg)| Slot {
+                time_s: i as f64 * 1e-3,
+                rate_dps: 0.0,
+                reference_deg,
+                temperature_c: None,
+                line: i as u64 + 2,
+                filled: false,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn reference_shift_interpolates_on_the_grid() {
+        let s = slots(&[Some(0.0), Some(1.0), Some(3.0), None, Some(10.0)]);
+        // No shift: the slot's own value, missing ones included.
+        assert_eq!(shifted_reference(&s, 2, 0.0), Some(3.0));
+        assert_eq!(shifted_reference(&s, 3, 0.0), None);
+        // The gyro lags by 1.5 slots: slot 2 is compared with position 0.5.
+        assert_eq!(shifted_reference(&s, 2, 1.5), Some(0.5));
+        assert_eq!(shifted_reference(&s, 2, 1.0), Some(1.0));
+        // Before the log, past its end, or next to a missing reference: none.
+        assert_eq!(shifted_reference(&s, 0, 0.25), None);
+        assert_eq!(shifted_reference(&s, 4, -0.5), None);
+        assert_eq!(shifted_reference(&s, 2, -0.5), None);
+        assert_eq!(shifted_reference(&s, 4, 2.5), Some(2.0));
+        // Leading: slot 0 is compared with position 1.25.
+        assert_eq!(shifted_reference(&s, 0, -1.25), Some(1.5));
+        assert_eq!(shifted_reference(&s, 0, f64::MAX), None);
+        assert_eq!(shifted_reference(&s, 0, -f64::MAX), None);
+        assert_eq!(shifted_reference(&s, 0, f64::NAN), None);
     }
 }

@@ -58,6 +58,25 @@ pub fn table(file: &str, report: &RunReport) -> String {
             gyro_core::Compensation::Kalman => "kalman",
         }
     );
+    let k = &c.correction;
+    if !k.is_identity() {
+        let temperature = match report.temperature_reference_c {
+            Some(t) => format!("ΔT from {t:.2} °C"),
+            None => "no temperature: temperature terms not applied".into(),
+        };
+        let _ = writeln!(
+            s,
+            "correction: scale {:+.5}, asymmetry {:+.5}, {:+.5} deg/s/°C, scale {:+.3e} /°C ({temperature})",
+            k.scale_k, k.asymmetry_k, k.bias_dps_per_c, k.scale_per_c
+        );
+    }
+    if report.reference_delay_s != 0.0 {
+        let _ = writeln!(
+            s,
+            "reference shifted by the gyro's latency, {:.4} s",
+            report.reference_delay_s
+        );
+    }
     if report.summary.rejected_samples > 0 {
         let _ = writeln!(
             s,

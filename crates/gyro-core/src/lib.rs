@@ -4,7 +4,8 @@
 //! `#![no_std]`, allocation-free, f32 state: the pipeline an intelligent torque wrench
 //! runs on its MCU, and the one the host tools replay logs through.
 //!
-//! Input (typically 1 kHz) → [`Decimator`] (boxcar average, preserves the integral of the
+//! Input (typically 1 kHz) → [`Correction`] of scale and temperature errors (identity by
+//! default) → [`Decimator`] (boxcar average, preserves the integral of the
 //! rate) → [`Butterworth`] low-pass ([`Sos`] cascade) → [`MotionDetector`] (static/dynamic,
 //! hysteresis, dwell times) → [`Integrator`] (trapezoidal, only while moving) → error
 //! compensation: the paper's Gauss-Markov model ([`GaussMarkov`]) or its Kalman form
@@ -35,6 +36,7 @@
 #![cfg_attr(not(test), no_std)]
 
 mod butterworth;
+mod correction;
 mod decimator;
 mod error;
 mod gauss_markov;
@@ -46,6 +48,7 @@ mod pipeline;
 mod sos;
 
 pub use butterworth::{Butterworth, SosDesign, MAX_ORDER};
+pub use correction::{Correction, Corrector, MAX_DELTA_C, MIN_SCALE, TEMPERATURE_RANGE_C};
 pub use decimator::Decimator;
 pub use error::Error;
 pub use gauss_markov::GaussMarkov;

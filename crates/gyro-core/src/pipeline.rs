@@ -1,6 +1,7 @@
 //! The real-time pipeline: decimate → low-pass → detect motion → integrate → compensate.
 
 use crate::butterworth::{Butterworth, SosDesign};
+use crate::correction::{Correction, Corrector};
 use crate::decimator::Decimator;
 use crate::error::{check_range, Error};
 use crate::gauss_markov::GaussMarkov;
@@ -46,6 +47,15 @@ pub struct Config {
     pub paper: GaussMarkov,
     /// Parameters of the Kalman form.
     pub kalman: KalmanConfig,
+    /// Correction of scale and temperature errors, applied to every accepted input sample
+    /// (identity by default, and when absent from a model file). Left out when serialized
+    /// as the identity, so that files without a correction stay readable by builds that
+    /// predate it.
+    #[cfg_attr(
+        feature = "serde",
+        serde(skip_serializing_if = "Correction::is_exactly_identity")
+    )]
+    pub correction: Correction,
 }
 
 impl Default for Config {
@@ -75,6 +85,7 @@ impl Default for Config {
             compensation: Compensation::Kalman,
             paper: GaussMarkov::default(),
             kalman: KalmanConfig::default(),
+            correction: Correction::IDENTITY,
         }
     }
 }
@@ -148,14 +159,31 @@ pub struct Output {
 }
 
 /// The movement in progress.
+///
+/// The first quiet sample is kept as an index and a time in separate fields rather than an
+/// `Option<(u32, f64)>`, whose tag and padding cost 8 bytes of the state budget.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Track {
     start_time_s: f64,
+    /// Time of the first quiet sample; meaningful only with `settle_index`.
+    settle_time_s: f64,
     start_index: u32,
+    /// Output index of the first quiet sample, once settling.
+    settle_index: Option<u32>,
     raw_at_start_deg: f32,
     angle_at_start_deg: f32,
+}
+
+impl Track {
     /// Output index and time of the first quiet sample, once settling.
-    settle: Option<(u32, f64)>,
+    fn settle(&self) -> Option<(u32, f64)> {
+        self.settle_index.map(|index| (index, self.settle_time_s))
+    }
+
+    fn set_settle(&mut self, settle: Option<(u32, f64)>) {
+        self.settle_index = settle.map(|(index, _)| index);
+        self.settle_time_s = settle.map_or(0.0, |(_, time_s)| time_s);
+    }
 }
 
 /// Rest samples on their way to the Kalman filter's zero-rate update, held back in blocks.
@@ -229,6 +257,7 @@ fn dc_group_delay_samples(design: &SosDesign) -> f64 {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pipeline {
     max_abs_rate_dps: f32,
+    corrector: Corrector,
     compensation: Compensation,
     paper: GaussMarkov,
     input_period_s: f64,
@@ -271,6 +300,7 @@ impl Pipeline {
         let detector = MotionDetector::try_new(&config.motion, output_rate_hz)?;
         Ok(Self {
             max_abs_rate_dps: config.max_abs_rate_dps,
+            corrector: Corrector::try_new(&config.correction)?,
             compensation: config.compensation,
             paper: config.paper,
             input_period_s: 1.0 / f64::from(config.sample_rate_hz),
@@ -330,8 +360,45 @@ impl Pipeline {
             && self.rest_blocks.is_finite()
     }
 
+    /// The correction in use, with its temperature state.
+    pub const fn corrector(&self) -> &Corrector {
+        &self.corrector
+    }
+
     /// Push one input sample: `time_s` (s) and `rate_dps` (deg/s).
+    ///
+    /// The configured [`Correction`]'s scale and asymmetry are applied; its temperature
+    /// terms are not (as if ΔT were 0): use [`Self::push_with_temperature`] where the
+    /// sensor's temperature is known.
     pub fn push(&mut self, time_s: f64, rate_dps: f32) -> Option<Output> {
+        self.push_corrected(time_s, rate_dps, false)
+    }
+
+    /// Push one input sample with the sensor's temperature `temperature_c` (°C): the whole
+    /// [`Correction`] is applied, its temperature terms included.
+    ///
+    /// A temperature that is not finite or not plausible (outside
+    /// [`crate::TEMPERATURE_RANGE_C`]) is ignored: the last valid one stays in use, and until
+    /// one has been seen the temperature terms are 0. The first valid temperature is the
+    /// reference of ΔT unless the correction sets one (`temperature_ref_c`). With the identity
+    /// correction this gives exactly what [`Self::push`] gives.
+    pub fn push_with_temperature(
+        &mut self,
+        time_s: f64,
+        rate_dps: f32,
+        temperature_c: f32,
+    ) -> Option<Output> {
+        self.corrector.observe_temperature(temperature_c);
+        self.push_corrected(time_s, rate_dps, true)
+    }
+
+    /// Accept or reject the sample, correct it, decimate it.
+    fn push_corrected(
+        &mut self,
+        time_s: f64,
+        rate_dps: f32,
+        with_temperature: bool,
+    ) -> Option<Output> {
         let time_s = if time_s.is_finite() {
             time_s
         } else if self.last_time_s.is_finite() {
@@ -339,9 +406,16 @@ impl Pipeline {
         } else {
             0.0
         };
+        // Plausibility is judged on the reading; a rejected sample is replaced by the last
+        // valid one, corrected as it was then.
         let rate_dps = if rate_dps.is_finite() && libm::fabsf(rate_dps) <= self.max_abs_rate_dps {
-            self.last_valid_rate_dps = rate_dps;
-            rate_dps
+            let corrected = if with_temperature {
+                self.corrector.correct_at_temperature(rate_dps)
+            } else {
+                self.corrector.correct(rate_dps)
+            };
+            self.last_valid_rate_dps = corrected;
+            corrected
         } else {
             self.rejected = self.rejected.saturating_add(1);
             self.last_valid_rate_dps
@@ -414,7 +488,8 @@ impl Pipeline {
                     start_index,
                     raw_at_start_deg: self.raw.committed_deg(),
                     angle_at_start_deg: self.committed_angle_deg(),
-                    settle: None,
+                    settle_time_s: 0.0,
+                    settle_index: None,
                 });
                 self.commit();
                 Some(Event::MovementStarted { start_time_s })
@@ -422,14 +497,14 @@ impl Pipeline {
             Phase::Moving => {
                 self.commit();
                 if let Some(track) = self.track.as_mut() {
-                    track.settle = None;
+                    track.set_settle(None);
                 }
                 None
             }
             Phase::SettleFirst => {
                 self.commit();
                 if let Some(track) = self.track.as_mut() {
-                    track.settle = Some((self.index, time_s));
+                    track.set_settle(Some((self.index, time_s)));
                 }
                 None
             }
@@ -438,7 +513,7 @@ impl Pipeline {
                     // This first quiet sample is the end (see `integrates`).
                     self.commit();
                     if let Some(track) = self.track.as_mut() {
-                        track.settle = Some((self.index, time_s));
+                        track.set_settle(Some((self.index, time_s)));
                     }
                 } else {
                     self.discard();
@@ -477,7 +552,7 @@ impl Pipeline {
     /// Close the movement in progress, folding paper-mode compensation into the total.
     fn finish_movement(&mut self, time_s: f64) -> Option<Movement> {
         let track = self.track.take()?;
-        let (end_index, end_time_s) = track.settle.unwrap_or((self.index, time_s));
+        let (end_index, end_time_s) = track.settle().unwrap_or((self.index, time_s));
         let raw_angle_deg = self.raw.committed_deg() - track.raw_at_start_deg;
         let duration_s = (end_index - track.start_index) as f32 * self.output_period_s;
         self.paper_total
@@ -525,13 +600,16 @@ impl Pipeline {
 mod size_tests {
     use super::Pipeline;
 
-    /// The firmware budget: the whole pipeline state in under 512 bytes.
+    /// The firmware budget: the whole pipeline state in 512 bytes at most. With the
+    /// corrector (24 bytes) it is exactly 512: `Track` gave up 8 bytes of `Option` padding
+    /// to make room (see its documentation).
     #[test]
     fn pipeline_state_fits_in_512_bytes() {
         use core::mem::size_of;
         std::println!(
-            "config {} sos {} sos_state {} detector {} integrator {} kalman {} rest_blocks {} track {} decimator {}",
+            "config {} corrector {} sos {} sos_state {} detector {} integrator {} kalman {} rest_blocks {} track {} decimator {}",
             size_of::<super::Config>(),
+            size_of::<super::Corrector>(),
             size_of::<super::Sos>(),
             size_of::<super::SosState>(),
             size_of::<super::MotionDetector>(),

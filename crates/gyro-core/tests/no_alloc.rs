@@ -6,7 +6,7 @@
 mod common;
 
 use common::{BenchSpec, Profile, Rng};
-use gyro_core::{Compensation, Config, Event, Pipeline};
+use gyro_core::{Compensation, Config, Correction, Event, Pipeline};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::hint::black_box;
@@ -84,13 +84,23 @@ fn pipeline_allocates_nothing() {
     }
     assert_eq!(samples.len(), 90_000);
 
-    for compensation in [
-        Compensation::None,
-        Compensation::Paper,
-        Compensation::Kalman,
+    let correction = Correction {
+        scale_k: 0.02,
+        asymmetry_k: 0.005,
+        bias_dps_per_c: 0.05,
+        scale_per_c: 1e-3,
+        temperature_ref_c: None,
+    };
+    for (compensation, correction, with_temperature) in [
+        (Compensation::None, Correction::IDENTITY, false),
+        (Compensation::Paper, Correction::IDENTITY, false),
+        (Compensation::Kalman, Correction::IDENTITY, false),
+        (Compensation::Kalman, correction, false),
+        (Compensation::Kalman, correction, true),
     ] {
         let config = Config {
             compensation,
+            correction,
             ..Config::default()
         };
         let ((outputs, movements, angle_deg), n) = allocations_during(|| {
@@ -99,7 +109,14 @@ fn pipeline_allocates_nothing() {
             let mut movements = 0_usize;
             let mut angle_deg = 0.0;
             for (i, &rate) in samples.iter().enumerate() {
-                if let Some(out) = pipeline.push(i as f64 * 1e-3, black_box(rate)) {
+                let time_s = i as f64 * 1e-3;
+                let out = if with_temperature {
+                    let temperature_c = 25.0 + 1e-4 * i as f32;
+                    pipeline.push_with_temperature(time_s, black_box(rate), temperature_c)
+                } else {
+                    pipeline.push(time_s, black_box(rate))
+                };
+                if let Some(out) = out {
                     outputs += 1;
                     angle_deg = out.angle_deg;
                     if let Some(Event::MovementEnded(_)) = out.event {
@@ -110,7 +127,7 @@ fn pipeline_allocates_nothing() {
             black_box(&pipeline);
             (outputs, movements, angle_deg)
         });
-        assert_eq!(n, 0, "{compensation:?}: {n} allocations");
+        assert_eq!(n, 0, "{compensation:?} {correction:?}: {n} allocations");
         // The run did real work.
         assert_eq!(outputs, 4500);
         assert_eq!(movements, profile.swings.len());

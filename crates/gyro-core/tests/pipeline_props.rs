@@ -5,8 +5,8 @@ mod common;
 
 use common::{BenchSpec, Profile, Rng};
 use gyro_core::{
-    Butterworth, Compensation, Config, Event, GaussMarkov, KalmanConfig, MotionConfig, Output,
-    Pipeline,
+    Butterworth, Compensation, Config, Correction, Event, GaussMarkov, KalmanConfig, MotionConfig,
+    Output, Pipeline,
 };
 use proptest::prelude::*;
 
@@ -46,6 +46,41 @@ fn any_time_step() -> impl Strategy<Value = Option<f64>> {
         ]
         .prop_map(Some),
     ]
+}
+
+/// Temperatures (°C): mostly plausible, sometimes garbage.
+fn any_temperature() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        6 => 0.0..60.0_f32,
+        1 => prop::num::f32::ANY,
+        1 => prop_oneof![
+            Just(f32::NAN),
+            Just(f32::INFINITY),
+            Just(f32::NEG_INFINITY),
+            Just(-273.15_f32),
+            Just(8000.0_f32),
+        ],
+    ]
+}
+
+/// A valid correction: scale errors up to 15%, 1e-3/°C, 1 deg/s/°C.
+fn any_valid_correction() -> impl Strategy<Value = Correction> {
+    (
+        -0.15..0.15_f32,
+        -0.15..0.15_f32,
+        -1.0..1.0_f32,
+        -1e-3..1e-3_f32,
+        prop::option::of(-20.0..60.0_f32),
+    )
+        .prop_map(
+            |(scale_k, asymmetry_k, bias_dps_per_c, scale_per_c, temperature_ref_c)| Correction {
+                scale_k,
+                asymmetry_k,
+                bias_dps_per_c,
+                scale_per_c,
+                temperature_ref_c,
+            },
+        )
 }
 
 fn any_compensation() -> impl Strategy<Value = Compensation> {
@@ -94,8 +129,47 @@ fn push_all(pipeline: &mut Pipeline, input: impl IntoIterator<Item = (f64, f32)>
     outputs
 }
 
+/// As [`push_all`], with a temperature per sample.
+fn push_all_with_temperature(
+    pipeline: &mut Pipeline,
+    input: impl IntoIterator<Item = (f64, f32, f32)>,
+) -> usize {
+    let mut outputs = 0;
+    for (time_s, rate_dps, temperature_c) in input {
+        if let Some(out) = pipeline.push_with_temperature(time_s, rate_dps, temperature_c) {
+            assert_output_finite(&out);
+            outputs += 1;
+        }
+        assert!(pipeline.is_finite());
+        assert!(pipeline.corrector().delta_c().is_finite());
+    }
+    outputs
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// Any rate, time and temperature through any valid correction: no panic, finite state
+    /// and outputs, rejected samples counted as without temperatures.
+    #[test]
+    fn any_input_with_temperature_keeps_the_state_finite(
+        input in prop::collection::vec((any_rate(), any_time_step(), any_temperature()), 0..1500),
+        compensation in any_compensation(),
+        correction in any_valid_correction(),
+    ) {
+        let config = Config { compensation, correction, ..Config::default() };
+        let mut pipeline = Pipeline::try_new(&config).expect("valid config");
+        let samples = input.iter().enumerate().map(|(i, &(rate, time, temperature))| {
+            (time.unwrap_or(i as f64 * 1e-3), rate, temperature)
+        });
+        let outputs = push_all_with_temperature(&mut pipeline, samples);
+        prop_assert_eq!(outputs, input.len() / 20);
+        let bad = input
+            .iter()
+            .filter(|(r, _, _)| !r.is_finite() || r.abs() > config.max_abs_rate_dps)
+            .count();
+        prop_assert_eq!(pipeline.rejected_samples() as usize, bad);
+    }
 
     /// Any f32 input with any times: no panic, finite state and outputs, and every
     /// non-finite or implausible rate counted as rejected.
@@ -149,6 +223,7 @@ fn any_valid_config() -> impl Strategy<Value = Config> {
         paper,
         kalman,
         10.0..1e6_f32,
+        any_valid_correction(),
     )
         .prop_map(
             |(
@@ -159,6 +234,7 @@ fn any_valid_config() -> impl Strategy<Value = Config> {
                 (paper_beta, b0_dps, o0_deg),
                 (kalman_beta, bias_sigma_dps, bias_mean_dps, rate_noise_dps, initial_sigma),
                 max_abs_rate_dps,
+                correction,
             )| {
                 let factor = factor.min(sample_rate_hz as u16);
                 let output_rate_hz = sample_rate_hz / f32::from(factor);
@@ -190,6 +266,7 @@ fn any_valid_config() -> impl Strategy<Value = Config> {
                         rate_noise_dps,
                         initial_bias_sigma_dps: initial_sigma,
                     },
+                    correction,
                 }
             },
         )
@@ -224,8 +301,13 @@ proptest! {
             let i = rng.next_u64() as usize % samples.len();
             samples[i] = [f32::NAN, f32::INFINITY, -3e38][i % 3];
         }
-        let input = samples.iter().enumerate().map(|(i, &r)| (i as f64 / sample_rate_hz, r));
-        let outputs = push_all(&mut pipeline, input);
+        // A warm-up of 10 °C with a few bad readings.
+        let input = samples.iter().enumerate().map(|(i, &r)| {
+            let time_s = i as f64 / sample_rate_hz;
+            let temperature_c = if i % 997 == 5 { f32::NAN } else { 25.0 + 0.5 * time_s as f32 };
+            (time_s, r, temperature_c)
+        });
+        let outputs = push_all_with_temperature(&mut pipeline, input);
         let factor = usize::from(config.decimation_factor().expect("valid"));
         prop_assert_eq!(outputs, samples.len() / factor);
     }

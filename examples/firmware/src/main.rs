@@ -5,7 +5,9 @@
 //! answers the driver's frames with the rate words of the first 20 s of
 //! `fixtures/logs/bench_run.csv` (three 90° turns); everything after the SPI device is the
 //! code a wrench runs: the driver's `read()` (framing, checksum, scaling by range) and the
-//! pipeline's `push()`. Results go to the host console over semihosting, and the exit
+//! pipeline's `push_with_temperature()` (the sensor's temperature drives the temperature
+//! terms of the model's correction; the default correction is the identity, which gives
+//! exactly what `push()` gives). Results go to the host console over semihosting, and the exit
 //! status says whether the run was clean. `run-qemu.sh` checks the printed angles against
 //! `gyro-cli run` on the host: they must be the same f32 values, bit for bit.
 //!
@@ -63,10 +65,15 @@ struct Channel {
 }
 
 impl Channel {
-    /// Feeds one input sample; prints movement events as they are confirmed.
-    fn push(&mut self, time_s: f64, rate_dps: f32) {
-        // Returns `Some` once per decimation block (every 20th sample: 50 Hz).
-        let Some(output) = self.pipeline.push(time_s, rate_dps) else {
+    /// Feeds one input sample with the sensor's temperature; prints movement events as they
+    /// are confirmed.
+    fn push(&mut self, time_s: f64, rate_dps: f32, temperature_c: f32) {
+        // Returns `Some` once per decimation block (every 20th sample: 50 Hz). A NaN
+        // temperature (none read yet) leaves the temperature terms as they were.
+        let Some(output) = self
+            .pipeline
+            .push_with_temperature(time_s, rate_dps, temperature_c)
+        else {
             return;
         };
         self.outputs += 1;
@@ -197,7 +204,7 @@ fn run() -> bool {
             }
         };
         for channel in channels.iter_mut().flatten() {
-            channel.push(time_s, rate_dps);
+            channel.push(time_s, rate_dps, temperature_c);
         }
     }
 

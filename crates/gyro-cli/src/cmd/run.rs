@@ -29,7 +29,9 @@ pub struct Args {
     /// The log: CSV (`time_s,rate_dps[,temperature_c][,reference_deg]`), MCAP (`/gyro`,
     /// `/reference`) or a ROS 2 bag in MCAP (`sensor_msgs/msg/Imu`).
     log: PathBuf,
-    /// Model file (JSON, from `calibrate`); default: the built-in configuration.
+    /// Model file (JSON, from `calibrate`); default: the built-in configuration. Its
+    /// `config.correction` is applied to every sample (with the log's temperatures), its
+    /// `reference_delay_s` shifts the reference before scoring.
     #[arg(long)]
     model: Option<PathBuf>,
     /// Override the model's compensation.
@@ -53,9 +55,12 @@ pub struct Args {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    let mut config = match &args.model {
-        Some(path) => model::load(path)?.config,
-        None => Config::default(),
+    let (mut config, options) = match &args.model {
+        Some(path) => {
+            let model = model::load(path)?;
+            (model.config, replay::ReplayOptions::from_model(&model))
+        }
+        None => (Config::default(), replay::ReplayOptions::default()),
     };
     if let Some(c) = args.compensation {
         config.compensation = match c {
@@ -70,7 +75,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let regular = log::regularize(&raw, &args.grid)?;
     drop(raw); // the rows are on the grid now; free them before the replay
-    let result = replay::replay(&regular, &config).with_context(|| {
+    let result = replay::replay_with(&regular, &config, &options).with_context(|| {
         format!(
             "{}: cannot configure the pipeline for this log",
             args.log.display()
