@@ -33,9 +33,14 @@ pub struct Args {
     /// Cut every log into windows of this many seconds, each a run (for long recordings).
     #[arg(long)]
     split_s: Option<f64>,
-    /// Use this model file's sensor model as the nominal model, as it is.
+    /// Use this model file's sensor model as the nominal model, as it is (and its
+    /// pipeline configuration for the compensated replays).
     #[arg(long)]
     model: Option<PathBuf>,
+    /// Write a model file with the corrections of the selected correctable effects
+    /// (scale, asymmetry, temperature, latency, turn-on bias), for `run --model`.
+    #[arg(short, long)]
+    out: Option<PathBuf>,
     /// Output format on stdout.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -145,7 +150,9 @@ pub fn run(args: &Args) -> Result<()> {
         bail!("--members and --candidate-members must be at least 2");
     }
     if let Some(path) = &args.model {
-        options.prior = model::load(path)?.sensor;
+        let file = model::load(path)?;
+        options.prior = file.sensor;
+        options.base_model = file;
         options.fixed_model = true;
     }
     let train = load(&args.train, args, "training")?;
@@ -162,6 +169,21 @@ pub fn run(args: &Args) -> Result<()> {
     }
     if let Some(dir) = &args.report {
         write_report(dir, &result, &train, &holdout)?;
+    }
+    if let Some(out) = &args.out {
+        let file = result
+            .corrected_model
+            .clone()
+            .unwrap_or_else(|| options.base_model.clone());
+        model::save(out, &file)?;
+        eprintln!(
+            "wrote {} ({})",
+            out.display(),
+            match &result.compensation {
+                Some(c) => format!("corrections for {}", c.corrected.join(", ")),
+                None => "no correctable effect selected: the base model unchanged".into(),
+            }
+        );
     }
     Ok(())
 }
@@ -215,8 +237,11 @@ pub fn self_test_table(t: &selftest::SelfTest) -> String {
     for e in &t.magnitudes {
         let _ = writeln!(s, "  {}", serde_json::to_string(e).unwrap_or_default());
     }
-    let _ = writeln!(s, "
-cases:");
+    let _ = writeln!(
+        s,
+        "
+cases:"
+    );
     for c in &t.cases {
         let injected: Vec<&str> = c.injected.iter().map(|e| e.id()).collect();
         let cov: Vec<String> = c
@@ -228,16 +253,27 @@ cases:");
             s,
             "  {:<6} {:<38} named {:<38} gap {:>8.2} -> {:>6.2}  closed {:>6}  {}",
             c.kind,
-            if injected.is_empty() { "none".into() } else { injected.join("+") },
-            if c.named.is_empty() { "nothing".into() } else { c.named.join("+") },
+            if injected.is_empty() {
+                "none".into()
+            } else {
+                injected.join("+")
+            },
+            if c.named.is_empty() {
+                "nothing".into()
+            } else {
+                c.named.join("+")
+            },
             c.holdout_gap.0,
             c.holdout_gap.1,
             pct(c.fraction_closed),
             cov.join(" ")
         );
     }
-    let _ = writeln!(s, "
-confusion (single effects: injected -> top-1 named):");
+    let _ = writeln!(
+        s,
+        "
+confusion (single effects: injected -> top-1 named):"
+    );
     for (truth, got, n) in &t.confusion {
         let _ = writeln!(s, "  {truth:<18} -> {got:<18} {n}");
     }
@@ -259,8 +295,16 @@ top-1 accuracy (single effects): {} strict, {} counting confounded pairs ({}) as
         pct(t.pairs_both_named),
         pct(t.pairs_both_named_group)
     );
-    let _ = writeln!(s, "null cases with nothing significant: {}", pct(t.null_clean));
-    let _ = writeln!(s, "95% intervals covering the injected value: {}", pct(t.coverage));
+    let _ = writeln!(
+        s,
+        "null cases with nothing significant: {}",
+        pct(t.null_clean)
+    );
+    let _ = writeln!(
+        s,
+        "95% intervals covering the injected value: {}",
+        pct(t.coverage)
+    );
     let _ = writeln!(
         s,
         "mean fraction of the held-out gap closed (cases with effects): {}",
@@ -361,6 +405,20 @@ pub fn table(d: &Diagnosis) -> String {
     }
     for u in &d.untestable {
         let _ = writeln!(s, "  {:<18} untestable: {}", u.id, u.reason);
+    }
+    if let Some(c) = &d.compensation {
+        let _ = writeln!(
+            s,
+            "\nrun --model with corrections for {}: max abs angle error per held-out run (deg)",
+            c.corrected.join(", ")
+        );
+        for r in &c.runs {
+            let _ = writeln!(
+                s,
+                "  {:<40} {:>9.4} -> {:>9.4}",
+                r.name, r.max_abs_error_before_deg, r.max_abs_error_after_deg
+            );
+        }
     }
     let _ = writeln!(s, "\nnominal model:");
     for n in &d.model.notes {

@@ -6,7 +6,7 @@
 //! Dropped samples are filled by linear interpolation, as the grid placement fills a
 //! real log's gaps.
 
-use super::features::{features, Features};
+use super::features::{features, Features, REGRESSORS, WANDER_TAUS_S};
 use super::stats::{residuals, residuals_of, stats_of, Stat, StatsError};
 use crate::log::RegularLog;
 use crate::noise::rate_step;
@@ -67,8 +67,9 @@ impl RealRun {
     /// Prepare `log` (named `name`).
     pub fn prepare(name: String, log: RegularLog) -> Result<Self, StatsError> {
         let r = residuals(&log)?;
-        let stats = stats_of(&r);
         let features = features(&r, 1e-9);
+        let mut stats = stats_of(&r);
+        stats.extend(feature_stats(&features));
         let fs = log.sample_rate_hz;
         let reference: Vec<f64> = filled_reference(&log);
         let reference_step_deg = rate_step(&reference).filter(|s| *s >= 1e-4);
@@ -142,6 +143,32 @@ fn filled_reference(log: &RegularLog) -> Vec<f64> {
         .collect()
 }
 
+/// "Where" statistics from the features: the joint regression's coefficients (segment
+/// `dynamic`, statistic `regression_<regressor>`) and the wander Allan variances
+/// (`all`, `wander_log10_avar_<τ>s`).
+pub fn feature_stats(f: &Features) -> Vec<Stat> {
+    let mut out = Vec::new();
+    for (k, name) in REGRESSORS.iter().enumerate().skip(1) {
+        if f.coef[k].is_finite() {
+            out.push(Stat {
+                segment: "dynamic".into(),
+                statistic: format!("regression_{name}"),
+                value: f.coef[k],
+            });
+        }
+    }
+    for (k, tau) in WANDER_TAUS_S.iter().enumerate() {
+        if f.wander_avar[k] > 0.0 {
+            out.push(Stat {
+                segment: "all".into(),
+                statistic: format!("wander_log10_avar_{tau}s"),
+                value: f.wander_avar[k].log10(),
+            });
+        }
+    }
+    out
+}
+
 /// One simulated member of an ensemble: its statistics and features.
 #[derive(Clone, Debug)]
 pub struct Member {
@@ -199,15 +226,17 @@ pub fn simulate_member(
         vec![f64::NAN; n]
     };
     match residuals_of(fs, time, s.rate_dps, &s.reference_deg, temperature) {
-        Ok(r) => Member {
-            stats: stats_of(&r),
-            features: features(&r, 1e-9),
-        },
+        Ok(r) => {
+            let features = features(&r, 1e-9);
+            let mut stats = stats_of(&r);
+            stats.extend(feature_stats(&features));
+            Member { stats, features }
+        }
         // The real run had enough samples; its simulation has as many.
         Err(_) => Member {
             stats: Vec::new(),
             features: Features {
-                coef: [f64::NAN; 7],
+                coef: [f64::NAN; 8],
                 samples: 0,
                 wander_avar: [f64::NAN; 3],
                 max_abs_rate_dps: f64::NAN,

@@ -8,11 +8,12 @@
 //! - **Joint regression** (one per run): the gyro averaged over the reference
 //!   derivative's window (trapezoid over ±h samples, so both sides see the same
 //!   smoothing and no lag is introduced) minus the reference rate ω, regressed on
-//!   `[1, ω, |ω|, (ω/100)³, α, ΔT, ω·ΔT]` (α: reference angular acceleration, ΔT:
+//!   `[1, ω, |ω|, (ω/100)³, α, dα/dt, ΔT, ω·ΔT]` (α: reference angular acceleration, ΔT:
 //!   temperature change since the run's first sample; the last two only when the run's
 //!   temperature varies). One regression separates effects that act together:
 //!   `scale_factor` (and `clock_error`) → ω, `scale_asymmetry` → |ω|, `nonlinearity` →
-//!   ω³, `latency` and `bandwidth` → −α (a delay d gives −d·α to first order),
+//!   ω³, `latency` and `bandwidth` → −α (a delay d gives −d·α + d²/2·dα/dt; a two-pole
+//!   low-pass of time constant τ gives −2τ·α + 3τ²·dα/dt, which is how they differ),
 //!   `temperature_bias` → ΔT, `temperature_scale` → ω·ΔT; the intercept is the run's
 //!   bias (`turn_on_bias` spreads it between runs). Samples on a clipped plateau are
 //!   left out (saturation is its own feature).
@@ -28,12 +29,13 @@ use super::stats::{Residuals, SMOOTH_WINDOW_S};
 use crate::noise::AllanDeviation;
 
 /// Regressor names, in coefficient order.
-pub const REGRESSORS: [&str; 7] = [
+pub const REGRESSORS: [&str; 8] = [
     "intercept",
     "rate",
     "abs_rate",
     "rate_cubed",
     "acceleration",
+    "jerk",
     "delta_temperature",
     "rate_delta_temperature",
 ];
@@ -49,10 +51,12 @@ pub mod reg {
     pub const RATE_CUBED: usize = 3;
     /// α (s).
     pub const ACCELERATION: usize = 4;
+    /// dα/dt (s²).
+    pub const JERK: usize = 5;
     /// ΔT (deg/s/°C).
-    pub const DELTA_T: usize = 5;
+    pub const DELTA_T: usize = 6;
     /// ω·ΔT (1/°C).
-    pub const RATE_DELTA_T: usize = 6;
+    pub const RATE_DELTA_T: usize = 7;
 }
 /// Scale of ω inside the cubic regressor (deg/s), for conditioning.
 pub const CUBIC_SCALE_DPS: f64 = 100.0;
@@ -65,7 +69,7 @@ pub const MIN_TEMPERATURE_RANGE_C: f64 = 0.5;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Features {
     /// Regression coefficients ([`REGRESSORS`] order); NaN where the regressor was not used.
-    pub coef: [f64; 7],
+    pub coef: [f64; 8],
     /// Samples in the regression.
     pub samples: usize,
     /// Allan variance of the regression residual at [`WANDER_TAUS_S`] ((deg/s)²); NaN
@@ -126,15 +130,23 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
             (a.min(t), b.max(t))
         });
     let temperature_varies = t_first.is_some() && t_max - t_min >= MIN_TEMPERATURE_RANGE_C;
-    let used: usize = if temperature_varies { 7 } else { 5 };
+    let used: usize = if temperature_varies { 8 } else { 6 };
 
-    let row = |i: usize| -> Option<([f64; 7], f64)> {
-        let (g, w, a) = (
+    // Jerk: the centred difference of the acceleration, like the acceleration of the rate.
+    let mut jerk = vec![f64::NAN; n];
+    for i in h..n.saturating_sub(h) {
+        jerk[i] = (r.reference_acceleration_dps2[i + h] - r.reference_acceleration_dps2[i - h])
+            * fs
+            / (2 * h) as f64;
+    }
+    let row = |i: usize| -> Option<([f64; 8], f64)> {
+        let (g, w, a, j) = (
             smooth[i],
             r.reference_rate_dps[i],
             r.reference_acceleration_dps2[i],
+            jerk[i],
         );
-        if !(g.is_finite() && w.is_finite() && a.is_finite()) {
+        if !(g.is_finite() && w.is_finite() && a.is_finite() && j.is_finite()) {
             return None;
         }
         if clipped && on_plateau(i) {
@@ -151,10 +163,10 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
             _ => 0.0,
         };
         let u = w / CUBIC_SCALE_DPS;
-        Some(([1.0, w, w.abs(), u * u * u, a, dt, w * dt], g - w))
+        Some(([1.0, w, w.abs(), u * u * u, a, j, dt, w * dt], g - w))
     };
-    let mut xtx = [[0.0f64; 7]; 7];
-    let mut xty = [0.0f64; 7];
+    let mut xtx = [[0.0f64; 8]; 8];
+    let mut xty = [0.0f64; 8];
     let mut samples = 0usize;
     for i in 0..n {
         if let Some((x, y)) = row(i) {
@@ -172,7 +184,7 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
             xtx[a][b] = xtx[b][a];
         }
     }
-    let mut coef = [f64::NAN; 7];
+    let mut coef = [f64::NAN; 8];
     if samples > used + 2 {
         if let Some(c) = solve_spd(&xtx, &xty, used) {
             coef[..used].copy_from_slice(&c[..used]);
@@ -254,15 +266,15 @@ fn finite_runs(x: &[f64]) -> Vec<std::ops::Range<usize>> {
 
 /// Solve the leading `n`×`n` block of a symmetric positive definite system by Cholesky
 /// with the regressors scaled to unit diagonal; `None` if it is singular.
-fn solve_spd(a: &[[f64; 7]; 7], b: &[f64; 7], n: usize) -> Option<[f64; 7]> {
-    let mut d = [1.0f64; 7];
+fn solve_spd(a: &[[f64; 8]; 8], b: &[f64; 8], n: usize) -> Option<[f64; 8]> {
+    let mut d = [1.0f64; 8];
     for i in 0..n {
         if a[i][i] <= 0.0 || !a[i][i].is_finite() {
             return None;
         }
         d[i] = a[i][i].sqrt();
     }
-    let mut l = [[0.0f64; 7]; 7];
+    let mut l = [[0.0f64; 8]; 8];
     for i in 0..n {
         for j in 0..=i {
             let mut s = a[i][j] / (d[i] * d[j]);
@@ -279,7 +291,7 @@ fn solve_spd(a: &[[f64; 7]; 7], b: &[f64; 7], n: usize) -> Option<[f64; 7]> {
             }
         }
     }
-    let mut y = [0.0f64; 7];
+    let mut y = [0.0f64; 8];
     for i in 0..n {
         let mut s = b[i] / d[i];
         for k in 0..i {
@@ -287,7 +299,7 @@ fn solve_spd(a: &[[f64; 7]; 7], b: &[f64; 7], n: usize) -> Option<[f64; 7]> {
         }
         y[i] = s / l[i][i];
     }
-    let mut x = [0.0f64; 7];
+    let mut x = [0.0f64; 8];
     for i in (0..n).rev() {
         let mut s = y[i];
         for k in i + 1..n {

@@ -41,6 +41,45 @@ pub struct Fit {
     pub passes: bool,
     /// What the test was.
     pub test: String,
+    /// The effect is seen directly in the raw data (a grid, a plateau, gaps): it is
+    /// significant when the same direct test also passes on the held-out runs.
+    pub direct: bool,
+}
+
+/// The direct test of saturation, quantisation or dropouts on `runs` (false for the
+/// other effects).
+pub fn direct_evidence(effect: &Effect, runs: &[&RealRun], model: &SensorModel) -> bool {
+    match effect {
+        Effect::Saturation { .. } => {
+            runs.iter()
+                .map(|r| r.features.plateau_samples)
+                .sum::<usize>()
+                >= MIN_CLIPPED
+        }
+        Effect::Quantization { .. } => {
+            let values: Vec<f64> = runs
+                .iter()
+                .flat_map(|r| r.measured_rates_dps.iter().copied())
+                .collect();
+            rate_step(&values).is_some_and(|s| s >= QUANT_RATIO * model.lsb_dps && s > 0.0)
+        }
+        Effect::Dropouts { .. } => runs.iter().map(|r| r.gaps).sum::<u64>() >= MIN_GAPS,
+        _ => false,
+    }
+}
+
+/// Two-sided 95% quantile of Student's t with `dof` degrees of freedom.
+pub fn t95(dof: usize) -> f64 {
+    const T: [f64; 30] = [
+        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
+        2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
+        2.052, 2.048, 2.045, 2.042,
+    ];
+    match dof {
+        0 => f64::INFINITY,
+        d if d <= 30 => T[d - 1],
+        _ => 1.96,
+    }
 }
 
 /// An effect that cannot be tested on these runs, and why.
@@ -52,8 +91,12 @@ pub struct Untestable {
     pub reason: String,
 }
 
-/// The nominal model for these training runs, and notes on where each value came from.
-pub fn nominal_model(train: &[&RealRun], prior: &SensorModel) -> (SensorModel, Vec<String>) {
+/// The nominal model for these training runs, notes on where each value came from, and
+/// the static first-difference variance the white noise was matched to (if measured).
+pub fn nominal_model(
+    train: &[&RealRun],
+    prior: &SensorModel,
+) -> (SensorModel, Vec<String>, Option<f64>) {
     let mut model = *prior;
     let mut notes = Vec::new();
     if let Some(run) = train.first() {
@@ -80,11 +123,14 @@ pub fn nominal_model(train: &[&RealRun], prior: &SensorModel) -> (SensorModel, V
         }
     });
     let needed = (2.0 * model.sample_rate_hz) as usize;
+    let mut target = None;
     if count >= needed.max(20) {
-        let white_var = (sum / count as f64 - model.lsb_dps * model.lsb_dps / 12.0).max(0.0);
-        model.arw_deg_per_rt_h = white_var.sqrt() * 60.0 / model.sample_rate_hz.sqrt();
+        let v = sum / count as f64;
+        let sigma = solve_white_sigma(v, &model, &[model.lsb_dps]);
+        model.arw_deg_per_rt_h = sigma * 60.0 / model.sample_rate_hz.sqrt();
+        target = Some(v);
         notes.push(format!(
-            "angle random walk {:.4} deg/sqrt(h): first differences of {count} static samples",
+            "angle random walk {:.4} deg/sqrt(h): matched to the first differences of {count} static samples (output rounding included)",
             model.arw_deg_per_rt_h
         ));
     } else {
@@ -97,19 +143,81 @@ pub fn nominal_model(train: &[&RealRun], prior: &SensorModel) -> (SensorModel, V
         "Gauss-Markov bias sigma {} deg/s, T {} s, output step {:.5} deg/s, range {} deg/s: from the prior model",
         model.gm_sigma_dps, model.gm_tau_s, model.lsb_dps, model.range_dps
     ));
-    (model, notes)
+    (model, notes, target)
 }
 
-/// The model to simulate with `effects` added: quantisation's rounding noise is taken out
-/// of the calibrated white noise (it was measured with it).
-pub fn model_with(nominal: &SensorModel, effects: &[Effect], arw_calibrated: bool) -> SensorModel {
+/// The white-noise σ (deg/s per sample) whose simulated static output — bias, the
+/// Gauss-Markov wander, white noise, rounded to each of `lsbs` in turn — has half the
+/// mean squared first difference `target`. Rounding a signal that barely moves is not
+/// the textbook lsb²/12, so the match is by simulation (40 000 samples, fixed seed,
+/// bisection).
+pub fn solve_white_sigma(target: f64, model: &SensorModel, lsbs: &[f64]) -> f64 {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+    const N: usize = 40_000;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x000A_11A4);
+    let white: Vec<f64> = (0..N).map(|_| StandardNormal.sample(&mut rng)).collect();
+    let dt = 1.0 / model.sample_rate_hz;
+    let phi = (-dt / model.gm_tau_s).exp();
+    let drive = model.gm_sigma_dps * (1.0 - phi * phi).sqrt();
+    let mut g = model.gm_sigma_dps * {
+        let x: f64 = StandardNormal.sample(&mut rng);
+        x
+    };
+    let wander: Vec<f64> = (0..N)
+        .map(|_| {
+            let x: f64 = StandardNormal.sample(&mut rng);
+            g = phi * g + drive * x;
+            g
+        })
+        .collect();
+    let diff_var = |sigma: f64| -> f64 {
+        let mut prev = f64::NAN;
+        let (mut sum, mut n) = (0.0, 0usize);
+        for k in 0..N {
+            let mut x = model.bias_dps + wander[k] + sigma * white[k];
+            for &q in lsbs {
+                if q > 0.0 {
+                    x = (x / q).round() * q;
+                }
+            }
+            if prev.is_finite() {
+                sum += (x - prev) * (x - prev);
+                n += 1;
+            }
+            prev = x;
+        }
+        sum / n.max(1) as f64 / 2.0
+    };
+    let (mut lo, mut hi) = (0.0, (2.0 * target).sqrt().max(1e-6) * 2.0);
+    if diff_var(lo) >= target {
+        return 0.0;
+    }
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if diff_var(mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The model to simulate with `effects` added. With quantisation, the white noise is
+/// matched again to the measured static differences `white_target` (it was measured
+/// with the rounding in it).
+pub fn model_with(
+    nominal: &SensorModel,
+    effects: &[Effect],
+    white_target: Option<f64>,
+) -> SensorModel {
     let mut model = *nominal;
-    if arw_calibrated {
+    if let Some(target) = white_target {
         for e in effects.iter().filter(|e| !is_identity(e, nominal)) {
             if let Effect::Quantization { lsb_dps } = *e {
-                let sigma = model.white_sigma_dps();
-                let var = (sigma * sigma - lsb_dps * lsb_dps / 12.0).max(0.0);
-                model.arw_deg_per_rt_h = var.sqrt() * 60.0 / model.sample_rate_hz.sqrt();
+                let sigma = solve_white_sigma(target, nominal, &[nominal.lsb_dps, lsb_dps]);
+                model.arw_deg_per_rt_h = sigma * 60.0 / model.sample_rate_hz.sqrt();
             }
         }
     }
@@ -177,6 +285,8 @@ pub struct FitInput<'a> {
     pub model: &'a SensorModel,
     /// Every training run's temperature varies.
     pub temperature_ok: bool,
+    /// Seed of the ensembles (training run `i` has seed index `i`).
+    pub seed: u64,
 }
 
 impl FitInput<'_> {
@@ -278,6 +388,7 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
             z,
             passes,
             test: test.to_string(),
+            direct: false,
         }
     };
     let some = |(a, b): (f64, f64)| vec![(Some(a.min(b)), Some(a.max(b)))];
@@ -505,22 +616,84 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
                 }
                 num / den
             };
-            let theta = solve(&|k| per_tau[k].0 - per_tau[k].2);
             let null_thetas: Vec<f64> = (0..input.members())
                 .map(|j| solve(&|k| per_tau[k].1[j] - per_tau[k].2))
                 .collect();
             let (_, s_theta) = mean_sd(&null_thetas);
+            // Per run: the excess over that run's own ensemble mean.
+            let per_run = |f: &dyn Fn(usize, usize) -> f64, r: usize, members: &[Member]| {
+                solve(&|k| f(r, k) - mean(members.iter().map(|m| m.features.wander_avar[k])))
+            };
+            let thetas: Vec<f64> = (0..input.train.len())
+                .map(|r| {
+                    per_run(
+                        &|r, k| input.train[r].features.wander_avar[k],
+                        r,
+                        &input.null[r],
+                    )
+                })
+                .filter(|t| t.is_finite())
+                .collect();
+            let (mut theta, sd) = mean_sd(&thetas);
             let z = theta / s_theta;
-            let half = 1.96 * s_theta;
-            let p = theta.max(0.0).sqrt();
+            let mut half = t95(thetas.len().saturating_sub(1)) * sd / (thetas.len() as f64).sqrt();
+            let make = |theta: f64| match typical {
+                Effect::RateRandomWalk { .. } => Effect::RateRandomWalk {
+                    k_dps_per_rt_s: theta.max(0.0).sqrt(),
+                },
+                _ => Effect::BiasInstability {
+                    sigma_dps: theta.max(0.0).sqrt(),
+                },
+            };
+            if z >= Z_CRITICAL && theta > 0.0 {
+                // Gain: the same estimator on the training runs simulated with the
+                // effect, against the same seeds without it.
+                const GAIN_MEMBERS: usize = 8;
+                let effect = [make(theta)];
+                let sims: Vec<Vec<Member>> = (0..input.train.len())
+                    .into_par_iter()
+                    .map(|r| {
+                        (0..GAIN_MEMBERS.min(input.null[r].len()))
+                            .map(|j| {
+                                simulate_member(
+                                    input.train[r],
+                                    input.model,
+                                    &effect,
+                                    super::ensemble::member_seed(input.seed, r, j),
+                                )
+                            })
+                            .collect()
+                    })
+                    .collect();
+                let gains: Vec<f64> = (0..input.train.len())
+                    .flat_map(|r| {
+                        let sims = &sims[r];
+                        (0..sims.len()).map(move |j| (r, j))
+                    })
+                    .map(|(r, j)| {
+                        let k_sim = per_run(
+                            &|r, k| sims[r][j].features.wander_avar[k],
+                            r,
+                            &input.null[r],
+                        );
+                        let k_null = per_run(
+                            &|r, k| input.null[r][j].features.wander_avar[k],
+                            r,
+                            &input.null[r],
+                        );
+                        k_sim - k_null
+                    })
+                    .collect();
+                let gain = mean(gains.into_iter()) / theta;
+                if gain.is_finite() && gain > 0.1 && gain < 10.0 {
+                    theta /= gain;
+                    half /= gain;
+                }
+            }
             let lo = (theta - half).max(0.0).sqrt();
             let hi = (theta + half).max(0.0).sqrt();
-            let effect = match typical {
-                Effect::RateRandomWalk { .. } => Effect::RateRandomWalk { k_dps_per_rt_s: p },
-                _ => Effect::BiasInstability { sigma_dps: p },
-            };
             fit(
-                effect,
+                make(theta),
                 z,
                 vec![(Some(lo), Some(hi))],
                 false,
@@ -560,6 +733,7 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
                 "samples on a plateau at the largest |rate| while the reference is faster, vs null replicas",
             );
             f.passes = f.passes && clipped >= MIN_CLIPPED;
+            f.direct = true;
             f
         }
         Effect::Quantization { .. } => {
@@ -577,6 +751,7 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
                         ci95: vec![(Some(step * 0.999), Some(step * 1.001))],
                         z: exact,
                         passes,
+                        direct: true,
                         test: format!(
                             "output grid step {step:.6} deg/s vs nominal {nominal:.6} (named above {QUANT_RATIO}x)"
                         ),
@@ -587,6 +762,7 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
                     ci95: vec![(Some(0.0), Some(QUANT_RATIO * nominal))],
                     z: exact,
                     passes: false,
+                    direct: true,
                     test: "no output grid coarser than the nominal step".into(),
                 },
             }
@@ -616,6 +792,7 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
                 ],
                 z: exact,
                 passes: gaps >= MIN_GAPS,
+                direct: true,
                 test: format!("{gaps} gaps ({filled} samples filled) in the training runs; the nominal model has none (named from {MIN_GAPS})"),
             }
         }

@@ -21,6 +21,7 @@
 //! 4. **How far**: the gap with the selected effects on the training and held-out runs,
 //!    and the fraction of the held-out gap closed relative to the floor.
 
+pub mod compensate;
 pub mod ensemble;
 pub mod features;
 pub mod fit;
@@ -34,6 +35,7 @@ use score::{bootstrap_p, gap, score, RunScore};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
+use crate::model::ModelFile;
 use crate::sim::{Effect, SensorModel};
 
 /// ΔBIC difference below which two effects count as tied (Kass & Raftery: "not worth
@@ -55,6 +57,9 @@ pub struct Options {
     pub prior: SensorModel,
     /// Use the prior model as it is (`--model`), without fitting the bias and white noise.
     pub fixed_model: bool,
+    /// The model file whose pipeline configuration replays the held-out runs, and to
+    /// which the corrections are added.
+    pub base_model: ModelFile,
 }
 
 impl Default for Options {
@@ -66,6 +71,7 @@ impl Default for Options {
             bootstrap: 2000,
             prior: SensorModel::default(),
             fixed_model: false,
+            base_model: ModelFile::new(gyro_core::Config::default()),
         }
     }
 }
@@ -183,6 +189,9 @@ pub struct Diagnosis {
     pub runs: Vec<RunSummary>,
     /// Angle error with the correctable effects compensated, if any were selected.
     pub compensation: Option<CompensationSummary>,
+    /// The model file with those corrections (`--out`).
+    #[serde(skip)]
+    pub corrected_model: Option<ModelFile>,
 }
 
 /// The nominal model.
@@ -340,20 +349,16 @@ pub fn diagnose(
     let hold_ids: Vec<usize> = (train.len()..train.len() + holdout.len()).collect();
 
     // 1. Baseline.
-    let (nominal, notes, arw_calibrated) = if options.fixed_model {
+    let (nominal, notes, white_target) = if options.fixed_model {
         let mut m = options.prior;
         m.sample_rate_hz = train[0].sample_rate_hz;
         (
             m,
             vec!["the --model sensor model as given".to_string()],
-            false,
+            None,
         )
     } else {
-        let (m, notes) = fit::nominal_model(&train_refs, &options.prior);
-        let calibrated = notes
-            .iter()
-            .any(|n| n.contains("static samples") && !n.contains("fewer"));
-        (m, notes, calibrated)
+        fit::nominal_model(&train_refs, &options.prior)
     };
     let m = options.members.max(4);
     let mc = options.candidate_members.clamp(2, m);
@@ -405,6 +410,7 @@ pub fn diagnose(
         null: &base_train.members,
         model: &nominal,
         temperature_ok,
+        seed: options.seed,
     };
     let (fits, untestable) = fit::fit_all(&input);
     let before_c = rescore(&hold_refs, &base_hold.members, mc);
@@ -424,7 +430,7 @@ pub fn diagnose(
     }
     let mut candidates: Vec<Candidate> = Vec::new();
     for (i, f) in fits.into_iter().enumerate() {
-        let model = fit::model_with(&nominal, &[f.effect], arw_calibrated);
+        let model = fit::model_with(&nominal, &[f.effect], white_target);
         let eval = if fit::is_identity(&f.effect, &nominal) && model == nominal {
             (0..mc * holdout.len()).for_each(|_| progress.tick());
             Evaluation {
@@ -445,7 +451,11 @@ pub fn diagnose(
         let diffs = loglik_diffs(&eval.scores, &before_c);
         let dbic = delta_bic(&diffs, f.effect.params().len(), observations);
         let p = bootstrap_p(&diffs, options.bootstrap, options.seed ^ i as u64);
-        let significant = f.passes && dbic > 0.0 && p < 0.05;
+        let significant = if f.direct {
+            f.passes && fit::direct_evidence(&f.effect, &hold_refs, &nominal)
+        } else {
+            f.passes && dbic > 0.0 && p < 0.05
+        };
         candidates.push(Candidate {
             gap_after: gap(&eval.scores),
             fit: f,
@@ -485,7 +495,7 @@ pub fn diagnose(
         let mut full = evaluate(
             &hold_refs,
             &hold_ids,
-            &fit::model_with(&nominal, &all_effects, arw_calibrated),
+            &fit::model_with(&nominal, &all_effects, white_target),
             &all_effects,
             options,
             mc,
@@ -501,7 +511,7 @@ pub fn diagnose(
             let without = evaluate(
                 &hold_refs,
                 &hold_ids,
-                &fit::model_with(&nominal, &rest_effects, arw_calibrated),
+                &fit::model_with(&nominal, &rest_effects, white_target),
                 &rest_effects,
                 options,
                 mc,
@@ -535,7 +545,7 @@ pub fn diagnose(
     // 4. How far.
     let selected_effects: Vec<Effect> =
         selected.iter().map(|&i| candidates[i].fit.effect).collect();
-    let final_model = fit::model_with(&nominal, &selected_effects, arw_calibrated);
+    let final_model = fit::model_with(&nominal, &selected_effects, white_target);
     let (hold_after_scores, g_hold_after) = match (selected.len(), final_eval) {
         (0, _) => (before_c.clone(), g_before_c),
         (1, _) => {
@@ -657,13 +667,21 @@ pub fn diagnose(
             duration_s: r.duration_s,
             gap_before: gap(std::slice::from_ref(b)),
             gap_after: gap(std::slice::from_ref(a)),
-            z: b
-                .z
+            z: b.z
                 .iter()
                 .map(|(s, z)| (format!("{}/{}", s.segment, s.statistic), *z))
                 .collect(),
         })
         .collect();
+
+    let (corrected, ids) = compensate::corrected_model(&options.base_model, &selected_effects);
+    let (compensation, corrected_model) = if ids.is_empty() {
+        (None, None)
+    } else {
+        progress.stage("compensated replays of held-out runs", 0);
+        let summary = compensate::score(holdout, &options.base_model, &corrected, ids);
+        (Some(summary), Some(corrected))
+    };
 
     Ok(Diagnosis {
         gap: GapSummary {
@@ -689,6 +707,7 @@ pub fn diagnose(
             effects: selected_effects,
         },
         runs,
-        compensation: None,
+        compensation,
+        corrected_model,
     })
 }

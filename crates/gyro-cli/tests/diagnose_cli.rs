@@ -1,0 +1,243 @@
+//! Integration tests of `gyro-cli diagnose`: an injected effect named blind and
+//! compensated by `run --model`, the JSON contract, and bad input.
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+mod common;
+use common::{gyro, json_of, ok, temp_dir, write};
+
+use gyro_host::log;
+use gyro_host::sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+use std::path::Path;
+
+/// A simulated bench run of `duration_s` at `fs`, written as CSV.
+fn run_csv(
+    dir: &Path,
+    name: &str,
+    fs: f64,
+    duration_s: f64,
+    effects: &[Effect],
+    seed: u64,
+) -> String {
+    let model = SensorModel {
+        sample_rate_hz: fs,
+        ..SensorModel::default()
+    };
+    let profile = BenchProfile {
+        duration_s,
+        ..BenchProfile::default()
+    };
+    let log = simulate(
+        &model,
+        effects,
+        &Motion::bench(&profile, seed),
+        &SimOptions {
+            seed: seed + 100,
+            ..SimOptions::default()
+        },
+    );
+    let path = dir.join(name);
+    let mut file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+    log::write_csv(&mut file, &log).unwrap();
+    drop(file);
+    path.to_string_lossy().into_owned()
+}
+
+fn runs(dir: &Path, prefix: &str, count: usize, effects: &[Effect], seed: u64) -> Vec<String> {
+    (0..count)
+        .map(|i| {
+            run_csv(
+                dir,
+                &format!("{prefix}{i}.csv"),
+                250.0,
+                45.0,
+                effects,
+                seed + i as u64,
+            )
+        })
+        .collect()
+}
+
+fn fails_with(args: &[&str], needle: &str) {
+    let out = gyro(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert!(
+        stderr.contains(needle),
+        "{args:?}: expected `{needle}` in: {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "one-line error: {stderr}");
+}
+
+#[test]
+fn names_an_injected_scale_factor_and_compensates_it() {
+    let dir = temp_dir("diagnose_scale");
+    let effect = [Effect::ScaleFactor { k: 0.02 }];
+    let train = runs(&dir, "train", 4, &effect, 10);
+    let holdout = runs(&dir, "hold", 3, &effect, 50);
+    let model = dir.join("model.json");
+    let mut args = vec![
+        "diagnose",
+        "--format",
+        "json",
+        "--members",
+        "20",
+        "--candidate-members",
+        "8",
+        "-o",
+    ];
+    let model_s = model.to_string_lossy().into_owned();
+    args.push(&model_s);
+    args.push("--train");
+    args.extend(train.iter().map(String::as_str));
+    args.push("--holdout");
+    args.extend(holdout.iter().map(String::as_str));
+    let out = gyro(&args);
+    let d = json_of(&out);
+    // The contract's keys.
+    for key in [
+        "train_before",
+        "train_after",
+        "holdout_before",
+        "holdout_after",
+        "floor",
+    ] {
+        assert!(d["gap"][key].is_number(), "gap.{key}: {}", d["gap"]);
+    }
+    assert!(d["where"][0]["segment"].is_string() && d["where"][0]["z"].is_number());
+    let first = &d["effects"][0];
+    for key in [
+        "delta_bic",
+        "holdout_gap_before",
+        "holdout_gap_after",
+        "fraction_closed",
+    ] {
+        assert!(first[key].is_number(), "effects[0].{key}: {first}");
+    }
+    assert_eq!(first["id"], "scale_factor", "{}", d["effects"]);
+    assert_eq!(first["significant"], true);
+    let k = first["params"]["k"].as_f64().unwrap();
+    assert!((k - 0.02).abs() < 2e-3, "k = {k}");
+    assert_eq!(d["verdict"]["unmodelled"][0], "scale_factor");
+    assert!(d["verdict"]["fraction_closed_holdout"].as_f64().unwrap() > 0.8);
+    let g = &d["gap"];
+    assert!(g["holdout_after"].as_f64().unwrap() < 0.2 * g["holdout_before"].as_f64().unwrap());
+
+    // The model file carries the correction; `run --model` uses it.
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let scale = file["config"]["correction"]["scale_k"].as_f64().unwrap();
+    assert!((scale - 0.02).abs() < 2e-3, "{file}");
+    let comp = &d["compensation"]["runs"];
+    for r in comp.as_array().unwrap() {
+        let (before, after) = (
+            r["max_abs_error_before_deg"].as_f64().unwrap(),
+            r["max_abs_error_after_deg"].as_f64().unwrap(),
+        );
+        assert!(after < 0.5 * before, "{r}");
+    }
+    let with = json_of(&gyro(&[
+        "run",
+        &holdout[0],
+        "--format",
+        "json",
+        "--model",
+        &model_s,
+    ]));
+    let without = json_of(&gyro(&["run", &holdout[0], "--format", "json"]));
+    let e = |v: &serde_json::Value| v["summary"]["max_abs_error_deg"].as_f64().unwrap();
+    assert!(
+        e(&with) < 0.5 * e(&without),
+        "{} vs {}",
+        e(&with),
+        e(&without)
+    );
+}
+
+#[test]
+fn nothing_significant_without_an_effect() {
+    let dir = temp_dir("diagnose_null");
+    let train = runs(&dir, "train", 4, &[], 200);
+    let holdout = runs(&dir, "hold", 3, &[], 300);
+    let mut args = vec![
+        "diagnose",
+        "--members",
+        "20",
+        "--candidate-members",
+        "8",
+        "--train",
+    ];
+    args.extend(train.iter().map(String::as_str));
+    args.push("--holdout");
+    args.extend(holdout.iter().map(String::as_str));
+    let table = ok(&gyro(&args));
+    assert!(table.contains("verdict: nothing significant"), "{table}");
+    assert!(
+        table.contains("temperature_bias"),
+        "every effect is listed: {table}"
+    );
+}
+
+#[test]
+fn bad_input_is_refused_with_a_clear_message() {
+    let dir = temp_dir("diagnose_bad");
+    let a = run_csv(&dir, "a.csv", 250.0, 20.0, &[], 1);
+    let b = run_csv(&dir, "b.csv", 250.0, 20.0, &[], 2);
+    let c = run_csv(&dir, "c.csv", 250.0, 20.0, &[], 3);
+    let fast = run_csv(&dir, "fast.csv", 500.0, 20.0, &[], 4);
+    let no_reference = write(
+        &dir,
+        "noref.csv",
+        "time_s,rate_dps\n0.0,0.1\n0.004,0.1\n0.008,0.2\n0.012,0.1\n",
+    );
+    fails_with(
+        &[
+            "diagnose",
+            "--train",
+            &a,
+            &no_reference,
+            "--holdout",
+            &b,
+            &c,
+        ],
+        "no reference_deg column",
+    );
+    fails_with(
+        &["diagnose", "--train", &a, &b, "--holdout", &c],
+        "held-out run(s): at least 2 are needed",
+    );
+    fails_with(
+        &["diagnose", "--train", &a, "--holdout", &b, &c],
+        "training run(s): at least 2 are needed",
+    );
+    fails_with(
+        &["diagnose", "--train", &a, &b, "--holdout", &c, &fast],
+        "sample rates differ",
+    );
+    fails_with(
+        &[
+            "diagnose",
+            "--train",
+            &a,
+            &b,
+            "--holdout",
+            &c,
+            &c,
+            "--split-s",
+            "-3",
+        ],
+        "--split-s",
+    );
+    fails_with(
+        &[
+            "diagnose",
+            "--train",
+            &a,
+            "missing.csv",
+            "--holdout",
+            &b,
+            &c,
+        ],
+        "missing.csv",
+    );
+}
