@@ -9,7 +9,6 @@
 use super::features::{features, Features, REGRESSORS, WANDER_TAUS_S};
 use super::stats::{residuals, residuals_of, stats_of, Stat, StatsError};
 use crate::log::RegularLog;
-use crate::noise::rate_step;
 use crate::sim::{simulate_series, Effect, Motion, SensorModel, SimOptions};
 use rayon::prelude::*;
 
@@ -72,7 +71,7 @@ impl RealRun {
         stats.extend(feature_stats(&features));
         let fs = log.sample_rate_hz;
         let reference: Vec<f64> = filled_reference(&log);
-        let reference_step_deg = rate_step(&reference).filter(|s| *s >= 1e-4);
+        let reference_step_deg = reference_step(&reference);
         let smooth = if reference_step_deg.is_some() {
             ((QUANTISED_SMOOTH_S * fs).round() as usize).max(1)
         } else {
@@ -121,6 +120,58 @@ impl RealRun {
     pub fn is_empty(&self) -> bool {
         self.log.slots.is_empty()
     }
+}
+
+/// The step of an encoder reference (deg), if its values lie on a grid coarser than
+/// 1e-4°: the median gap between distinct values, refined by least squares over the
+/// grid indices; accepted when 90% of the values lie within 15% of a step of the grid
+/// (an encoder angle printed with fewer decimals than its step is only near its grid).
+pub fn reference_step(values: &[f64]) -> Option<f64> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    if v.len() < 3 || v.len() * 2 > values.len() {
+        return None;
+    }
+    let mut gaps: Vec<f64> = v.windows(2).map(|w| w[1] - w[0]).collect();
+    let mid = gaps.len() / 2;
+    let g0 = *gaps.select_nth_unstable_by(mid, f64::total_cmp).1;
+    if g0.is_nan() || g0 < 1e-4 {
+        return None;
+    }
+    let origin = v[0];
+    // Refine on a growing span, so that the grid index stays right as it grows.
+    let (mut step, mut a) = (g0, 0.0);
+    for span_steps in [10.0, 100.0, 1000.0, f64::INFINITY] {
+        let (mut kk, mut kv, mut sk, mut sv, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for x in v.iter().map(|x| x - origin) {
+            let k = ((x - a) / step).round();
+            if k > span_steps {
+                break;
+            }
+            kk += k * k;
+            kv += k * x;
+            sk += k;
+            sv += x;
+            n += 1.0;
+        }
+        // Least squares x − origin = a + step · k.
+        let s = (n * kv - sk * sv) / (n * kk - sk * sk);
+        if !(s.is_finite() && s >= 1e-4) {
+            return None;
+        }
+        step = s;
+        a = (sv - step * sk) / n;
+    }
+    let near = values
+        .iter()
+        .filter(|x| x.is_finite())
+        .filter(|x| {
+            let k = (*x - origin - a) / step;
+            (k - k.round()).abs() < 0.15
+        })
+        .count();
+    (near as f64 >= 0.9 * values.len() as f64).then_some(step)
 }
 
 /// The reference with missing values filled by the previous one (the first present one
@@ -327,6 +378,22 @@ mod tests {
         let mut x = [f64::NAN, 1.0, f64::NAN, f64::NAN, 4.0, f64::NAN];
         fill_gaps(&mut x);
         assert_eq!(x, [1.0, 1.0, 2.0, 3.0, 4.0, 4.0]);
+    }
+
+    #[test]
+    fn encoder_step_is_found_through_printing() {
+        // 0.08775° counts printed with two decimals, a sweep back and forth.
+        let values: Vec<f64> = (0..4000)
+            .map(|i| {
+                let count = (i % 2000) as f64 * 0.7;
+                ((count.round() * 0.08775) * 100.0).round() / 100.0
+            })
+            .collect();
+        let step = reference_step(&values).unwrap();
+        assert!((step - 0.08775).abs() < 2e-4, "{step}");
+        // A smooth reference has no step.
+        let smooth: Vec<f64> = (0..4000).map(|i| (i as f64 * 0.001).sin() * 90.0).collect();
+        assert_eq!(reference_step(&smooth), None);
     }
 
     #[test]

@@ -25,6 +25,11 @@ pub const Z_CRITICAL: f64 = 4.0;
 pub const QUANT_RATIO: f64 = 1.5;
 /// Fewest clipped samples over the training runs for saturation.
 pub const MIN_CLIPPED: usize = 10;
+/// Relative systematic uncertainty added (in quadrature) to the intervals of the
+/// regression-based parameters: re-simulating a run from its sampled reference, and the
+/// gain calibrated by simulation, leave errors of about 1% (measured by the self-test on
+/// large effects, where the statistical interval is far narrower).
+pub const SYSTEMATIC_REL: f64 = 0.02;
 /// Fewest gaps over the training runs for dropouts.
 pub const MIN_GAPS: u64 = 3;
 
@@ -360,6 +365,8 @@ fn regression_fit(
         }
     }
     let est = raw / gain;
+    // Plus the systematic allowance of the simulation-calibrated gain.
+    let half = (half * half + (SYSTEMATIC_REL * raw).powi(2)).sqrt();
     let (lo, hi) = ((raw - half) / gain, (raw + half) / gain);
     (make(to_param(est)), z, (to_param(lo), to_param(hi)))
 }
@@ -482,6 +489,7 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
             let z = -(real - m0) / s0;
             let d = -(real - m0);
             let half = 1.96 * s0 * (1.0 + 1.0 / replicas.len().max(1) as f64).sqrt();
+            let half = (half * half + (SYSTEMATIC_REL * d).powi(2)).sqrt();
             let mut cutoff = to_cutoff(d);
             if d > 0.0 {
                 // Gain: the delay a noise-free simulation at this cutoff shows.

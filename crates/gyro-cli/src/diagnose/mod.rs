@@ -38,6 +38,12 @@ use std::collections::BTreeMap;
 use crate::model::ModelFile;
 use crate::sim::{Effect, SensorModel};
 
+/// Most effects the forward selection adds.
+pub const MAX_EFFECTS: usize = 6;
+/// Cosine similarity of two effects' shifts of the held-out z-scores above which one
+/// that is not selected is reported as confounded with the selected one.
+pub const CONFOUND_COSINE: f64 = 0.8;
+
 /// ΔBIC difference below which two effects count as tied (Kass & Raftery: "not worth
 /// more than a bare mention").
 pub const TIE_BIC: f64 = 2.0;
@@ -420,144 +426,284 @@ pub fn diagnose(
         "candidate effects on held-out runs",
         (fits.len() * mc * holdout.len()) as u64,
     );
-    struct Candidate {
-        fit: fit::Fit,
-        eval: Evaluation,
+    struct Step {
+        gap_before: f64,
         gap_after: f64,
         delta_bic: f64,
         p: f64,
-        significant: bool,
     }
-    let mut candidates: Vec<Candidate> = Vec::new();
-    for (i, f) in fits.into_iter().enumerate() {
-        let model = fit::model_with(&nominal, &[f.effect], white_target);
-        let eval = if fit::is_identity(&f.effect, &nominal) && model == nominal {
-            (0..mc * holdout.len()).for_each(|_| progress.tick());
-            Evaluation {
-                scores: before_c.clone(),
-                members: Vec::new(),
-            }
-        } else {
-            evaluate(
-                &hold_refs,
-                &hold_ids,
-                &model,
-                &[f.effect],
-                options,
-                mc,
-                progress,
-            )
-        };
-        let diffs = loglik_diffs(&eval.scores, &before_c);
-        let dbic = delta_bic(&diffs, f.effect.params().len(), observations);
-        let p = bootstrap_p(&diffs, options.bootstrap, options.seed ^ i as u64);
-        let significant = if f.direct {
+    struct Candidate {
+        fit: fit::Fit,
+        /// Added alone to the nominal model.
+        alone: Step,
+        alone_scores: Vec<RunScore>,
+        /// Qualified when added alone.
+        alone_ok: bool,
+        /// Added on top of the effects selected before it (selected effects only).
+        added: Option<Step>,
+    }
+    let step_of = |after: &[RunScore], before: &[RunScore], params: usize, salt: u64| -> Step {
+        let diffs = loglik_diffs(after, before);
+        Step {
+            gap_before: gap(before),
+            gap_after: gap(after),
+            delta_bic: delta_bic(&diffs, params, observations),
+            p: bootstrap_p(&diffs, options.bootstrap, options.seed ^ salt),
+        }
+    };
+    let qualifies = |f: &fit::Fit, st: &Step| -> bool {
+        if f.direct {
             f.passes && fit::direct_evidence(&f.effect, &hold_refs, &nominal)
         } else {
-            f.passes && dbic > 0.0 && p < 0.05
-        };
+            f.passes && st.delta_bic > 0.0 && st.p < 0.05
+        }
+    };
+    let eval_set = |set: &[Effect]| -> Vec<RunScore> {
+        let model = fit::model_with(&nominal, set, white_target);
+        if set.iter().all(|e| fit::is_identity(e, &nominal)) && model == nominal {
+            (0..mc * holdout.len()).for_each(|_| progress.tick());
+            return before_c.clone();
+        }
+        evaluate(&hold_refs, &hold_ids, &model, set, options, mc, progress).scores
+    };
+    let mut candidates: Vec<Candidate> = Vec::new();
+    for (i, f) in fits.into_iter().enumerate() {
+        let scores = eval_set(&[f.effect]);
+        let alone = step_of(&scores, &before_c, f.effect.params().len(), i as u64);
+        let alone_ok = qualifies(&f, &alone);
         candidates.push(Candidate {
-            gap_after: gap(&eval.scores),
             fit: f,
-            eval,
-            delta_bic: dbic,
-            p,
-            significant,
+            alone,
+            alone_scores: scores,
+            alone_ok,
+            added: None,
         });
     }
 
-    // Ablation: drop effects that add nothing given the others.
-    let mut selected: Vec<usize> = (0..candidates.len())
-        .filter(|&i| candidates[i].significant)
-        .collect();
-    selected.sort_by(|&a, &b| candidates[b].delta_bic.total_cmp(&candidates[a].delta_bic));
-    // Within [`TIE_BIC`] of each other, the earlier effect of the vocabulary goes first
-    // (kept when the two are confounded): it is the simpler, more common explanation.
-    for _ in 0..selected.len() {
-        for k in 1..selected.len() {
-            let (a, b) = (selected[k - 1], selected[k]);
-            if b < a && candidates[a].delta_bic - candidates[b].delta_bic < TIE_BIC {
-                selected.swap(k - 1, k);
+    // Forward selection: add the best qualifying effect on top of those already chosen,
+    // until none qualifies.
+    let mut selected: Vec<usize> = Vec::new();
+    let mut current = before_c.clone();
+    for step in 0..MAX_EFFECTS {
+        let pool: Vec<usize> = (0..candidates.len())
+            .filter(|i| !selected.contains(i) && candidates[*i].fit.passes)
+            .collect();
+        if pool.is_empty() {
+            break;
+        }
+        let mut tried: Vec<(usize, Step, Vec<RunScore>)> = Vec::new();
+        if step == 0 {
+            for &i in &pool {
+                let c = &candidates[i];
+                let st = step_of(
+                    &c.alone_scores,
+                    &current,
+                    c.fit.effect.params().len(),
+                    i as u64,
+                );
+                tried.push((i, st, c.alone_scores.clone()));
+            }
+        } else {
+            progress.stage(
+                &format!("effects on top of {} selected", selected.len()),
+                (pool.len() * mc * holdout.len()) as u64,
+            );
+            for &i in &pool {
+                let mut set: Vec<Effect> =
+                    selected.iter().map(|&j| candidates[j].fit.effect).collect();
+                set.push(candidates[i].fit.effect);
+                let scores = eval_set(&set);
+                let st = step_of(
+                    &scores,
+                    &current,
+                    candidates[i].fit.effect.params().len(),
+                    (1000 * step + i) as u64,
+                );
+                tried.push((i, st, scores));
+            }
+        }
+        let mut ok: Vec<(usize, Step, Vec<RunScore>)> = tried
+            .into_iter()
+            .filter(|(i, st, _)| qualifies(&candidates[*i].fit, st))
+            .collect();
+        // Best ΔBIC; an earlier effect of the vocabulary (the simpler, more common
+        // explanation of a shared signature) is preferred unless the best one is
+        // significantly better on the held-out runs (bootstrap of the per-run difference).
+        ok.sort_by(|a, b| b.1.delta_bic.total_cmp(&a.1.delta_bic));
+        if ok.is_empty() {
+            break;
+        }
+        let lead = ok[0].0;
+        let lead_ll = loglik_diffs(&ok[0].2, &current);
+        let best = ok
+            .iter()
+            .filter(|t| {
+                let ll = loglik_diffs(&t.2, &current);
+                let d: Vec<f64> = lead_ll.iter().zip(&ll).map(|(a, b)| a - b).collect();
+                t.0 == lead
+                    || ok[0].1.delta_bic - t.1.delta_bic < TIE_BIC
+                    || bootstrap_p(&d, options.bootstrap, options.seed ^ 77) > 0.05
+            })
+            .map(|t| t.0)
+            .min()
+            .unwrap_or(lead);
+        let Some(pos) = ok.iter().position(|t| t.0 == best) else {
+            break;
+        };
+        let (i, st, scores) = ok.swap_remove(pos);
+        candidates[i].added = Some(st);
+        selected.push(i);
+        current = scores;
+    }
+
+    // Swaps: a selected effect replaced by another that passed its parameter test, kept
+    // when the held-out likelihood improves significantly (greedy selection can take a
+    // look-alike first, e.g. a bandwidth for a latency while a scale error is unmodelled).
+    if !selected.is_empty() {
+        let alternatives: Vec<usize> = (0..candidates.len())
+            .filter(|i| {
+                !selected.contains(i) && candidates[*i].fit.passes && !candidates[*i].fit.direct
+            })
+            .collect();
+        progress.stage(
+            "swaps",
+            (selected.len() * alternatives.len() * mc * holdout.len()) as u64,
+        );
+        for slot in 0..selected.len() {
+            for &a in &alternatives {
+                if selected.contains(&a) || candidates[selected[slot]].fit.direct {
+                    continue;
+                }
+                let set: Vec<Effect> = selected
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &j)| {
+                        if k == slot {
+                            candidates[a].fit.effect
+                        } else {
+                            candidates[j].fit.effect
+                        }
+                    })
+                    .collect();
+                let scores = eval_set(&set);
+                let diffs = loglik_diffs(&scores, &current);
+                let better = diffs.iter().sum::<f64>() > 0.0
+                    && bootstrap_p(
+                        &diffs,
+                        options.bootstrap,
+                        options.seed ^ (200_000 + a) as u64,
+                    ) < 0.05;
+                if better {
+                    let out = selected[slot];
+                    let st = step_of(
+                        &scores,
+                        &current,
+                        candidates[a].fit.effect.params().len(),
+                        (300_000 + a) as u64,
+                    );
+                    candidates[a].added = Some(st);
+                    candidates[out].added = None;
+                    selected[slot] = a;
+                    current = scores;
+                }
             }
         }
     }
-    let mut confounded: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
-    let mut final_eval: Option<Evaluation> = None;
+
+    // Leave-one-out: an effect whose removal from the selected set costs nothing
+    // significant is redundant given the others.
+    let mut dropped: Vec<usize> = Vec::new();
     if selected.len() >= 2 {
         progress.stage(
             "leave-one-out ablations",
-            ((selected.len() + 1) * mc * holdout.len()) as u64,
+            (selected.len() * mc * holdout.len()) as u64,
         );
-        let effects_of = |set: &[usize]| -> Vec<Effect> {
-            set.iter().map(|&i| candidates[i].fit.effect).collect()
-        };
-        let all_effects = effects_of(&selected);
-        let mut full = evaluate(
-            &hold_refs,
-            &hold_ids,
-            &fit::model_with(&nominal, &all_effects, white_target),
-            &all_effects,
-            options,
-            mc,
-            progress,
-        );
-        // Weakest first: an effect redundant given the rest is dropped.
         for &i in selected.clone().iter().rev() {
-            if selected.len() < 2 {
-                break;
+            if selected.len() < 2 || candidates[i].fit.direct {
+                continue;
             }
-            let rest: Vec<usize> = selected.iter().copied().filter(|&j| j != i).collect();
-            let rest_effects = effects_of(&rest);
-            let without = evaluate(
-                &hold_refs,
-                &hold_ids,
-                &fit::model_with(&nominal, &rest_effects, white_target),
-                &rest_effects,
-                options,
-                mc,
-                progress,
-            );
-            let diffs = loglik_diffs(&full.scores, &without.scores);
-            let dbic = delta_bic(
-                &diffs,
+            let rest: Vec<Effect> = selected
+                .iter()
+                .filter(|&&j| j != i)
+                .map(|&j| candidates[j].fit.effect)
+                .collect();
+            let without = eval_set(&rest);
+            let st = step_of(
+                &current,
+                &without,
                 candidates[i].fit.effect.params().len(),
-                observations,
+                (100_000 + i) as u64,
             );
-            let p = bootstrap_p(&diffs, options.bootstrap, options.seed ^ (100 + i as u64));
-            if !(dbic > 0.0 && p < 0.05) {
+            if !(st.delta_bic > 0.0 && st.p < 0.05) {
                 selected.retain(|&j| j != i);
-                confounded
-                    .entry(i)
-                    .or_default()
-                    .extend(rest.iter().copied());
-                full = without;
+                candidates[i].added = None;
+                dropped.push(i);
+                current = without;
             }
         }
-        final_eval = Some(full);
     }
-    for &i in &selected {
-        candidates[i].significant = true;
+
+    // Confounds: an effect that qualified alone but is not selected, and the selected
+    // effect whose signature (the shift it gives the held-out z-scores) is most alike.
+    let shift = |scores: &[RunScore]| -> Vec<f64> {
+        scores
+            .iter()
+            .zip(&before_c)
+            .flat_map(|(a, b)| {
+                a.z.iter().zip(&b.z).map(|((_, za), (_, zb))| {
+                    if za.is_finite() && zb.is_finite() {
+                        za - zb
+                    } else {
+                        0.0
+                    }
+                })
+            })
+            .collect()
+    };
+    let cosine = |a: &[f64], b: &[f64]| -> f64 {
+        let (mut ab, mut aa, mut bb) = (0.0, 0.0, 0.0);
+        for (x, y) in a.iter().zip(b) {
+            ab += x * y;
+            aa += x * x;
+            bb += y * y;
+        }
+        if aa > 0.0 && bb > 0.0 {
+            ab / (aa * bb).sqrt()
+        } else {
+            0.0
+        }
+    };
+    let mut partners: BTreeMap<usize, Vec<&'static str>> = BTreeMap::new();
+    for i in 0..candidates.len() {
+        if selected.contains(&i) || !candidates[i].alone_ok {
+            continue;
+        }
+        let si = shift(&candidates[i].alone_scores);
+        let best = selected
+            .iter()
+            .map(|&j| (j, cosine(&si, &shift(&candidates[j].alone_scores))))
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((j, c)) = best {
+            if c > CONFOUND_COSINE || dropped.contains(&i) {
+                partners
+                    .entry(i)
+                    .or_default()
+                    .push(candidates[j].fit.effect.id());
+                partners
+                    .entry(j)
+                    .or_default()
+                    .push(candidates[i].fit.effect.id());
+            }
+        }
     }
-    for &i in confounded.keys() {
-        candidates[i].significant = false;
-    }
+    let final_scores = current;
 
     // 4. How far.
     let selected_effects: Vec<Effect> =
         selected.iter().map(|&i| candidates[i].fit.effect).collect();
     let final_model = fit::model_with(&nominal, &selected_effects, white_target);
-    let (hold_after_scores, g_hold_after) = match (selected.len(), final_eval) {
-        (0, _) => (before_c.clone(), g_before_c),
-        (1, _) => {
-            let c = &candidates[selected[0]];
-            (c.eval.scores.clone(), c.gap_after)
-        }
-        (_, Some(e)) => {
-            let g = gap(&e.scores);
-            (e.scores, g)
-        }
-        (_, None) => (before_c.clone(), g_before_c),
-    };
+    let g_hold_after = gap(&final_scores);
+    let hold_after_scores = final_scores;
     let (train_after_scores, g_train_after) = if selected.is_empty() {
         (base_train.scores.clone(), g_train_before)
     } else {
@@ -584,21 +730,7 @@ pub fn diagnose(
         }
     };
 
-    // Confounded partners by name, both ways.
-    let mut partners: BTreeMap<usize, Vec<&'static str>> = BTreeMap::new();
-    for (&i, others) in &confounded {
-        for &j in others {
-            partners
-                .entry(i)
-                .or_default()
-                .push(candidates[j].fit.effect.id());
-            partners
-                .entry(j)
-                .or_default()
-                .push(candidates[i].fit.effect.id());
-        }
-    }
-    let mut effects: Vec<EffectResult> = candidates
+    let mut effects: Vec<(Option<usize>, EffectResult)> = candidates
         .iter()
         .enumerate()
         .map(|(i, c)| {
@@ -614,37 +746,45 @@ pub fn diagnose(
             let mut with = partners.get(&i).cloned().unwrap_or_default();
             with.sort_unstable();
             with.dedup();
-            EffectResult {
-                id: info.id,
-                params,
-                delta_bic: c.delta_bic,
-                holdout_gap_before: g_before_c,
-                holdout_gap_after: c.gap_after,
-                fraction_closed: closed(g_before_c, c.gap_after),
-                significant: c.significant,
-                ci95,
-                z: c.fit.z.is_finite().then_some(c.fit.z),
-                test: format!(
-                    "{}: {}",
-                    c.fit.test,
-                    if c.fit.passes {
-                        "passes"
-                    } else {
-                        "does not pass"
-                    }
-                ),
-                bootstrap_p: c.p,
-                confounded_with: with,
-            }
+            let st = c.added.as_ref().unwrap_or(&c.alone);
+            let order = selected.iter().position(|&j| j == i);
+            (
+                order,
+                EffectResult {
+                    id: info.id,
+                    params,
+                    delta_bic: st.delta_bic,
+                    holdout_gap_before: st.gap_before,
+                    holdout_gap_after: st.gap_after,
+                    fraction_closed: closed(st.gap_before, st.gap_after),
+                    significant: order.is_some(),
+                    ci95,
+                    z: c.fit.z.is_finite().then_some(c.fit.z),
+                    test: format!(
+                        "{}: {}",
+                        c.fit.test,
+                        if c.fit.passes {
+                            "passes"
+                        } else {
+                            "does not pass"
+                        }
+                    ),
+                    bootstrap_p: st.p,
+                    confounded_with: with,
+                },
+            )
         })
         .collect();
-    // Significant first, then by held-out gap reduction.
-    effects.sort_by(|a, b| {
-        b.significant.cmp(&a.significant).then(
-            (a.holdout_gap_after - a.holdout_gap_before)
-                .total_cmp(&(b.holdout_gap_after - b.holdout_gap_before)),
-        )
+    // Selected effects in the order they were added, then the rest by held-out gap
+    // reduction when added alone.
+    effects.sort_by(|(oa, a), (ob, b)| match (oa, ob) {
+        (Some(x), Some(y)) => x.cmp(y),
+        (Some(_), None) => std::cmp::Ordering::Less,
+        (None, Some(_)) => std::cmp::Ordering::Greater,
+        (None, None) => (a.holdout_gap_after - a.holdout_gap_before)
+            .total_cmp(&(b.holdout_gap_after - b.holdout_gap_before)),
     });
+    let effects: Vec<EffectResult> = effects.into_iter().map(|(_, e)| e).collect();
     let unmodelled: Vec<&'static str> = effects
         .iter()
         .filter(|e| e.significant)
