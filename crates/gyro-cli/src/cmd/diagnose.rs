@@ -1,7 +1,7 @@
 //! `gyro-cli diagnose`: where a real sensor differs from its simulation, which
 //! unmodelled effect causes it, and how far the gap shrinks on held-out runs.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::ValueEnum;
 use gyro_host::diagnose::ensemble::{split, RealRun};
 use gyro_host::diagnose::{self, selftest, Diagnosis, Options, Progress};
@@ -168,7 +168,7 @@ pub fn run(args: &Args) -> Result<()> {
         Format::Table => write!(stdout, "{}", table(&result))?,
     }
     if let Some(dir) = &args.report {
-        write_report(dir, &result, &train, &holdout)?;
+        write_report(dir, &result, &train, &holdout, &options)?;
     }
     if let Some(out) = &args.out {
         let file = result
@@ -316,13 +316,12 @@ top-1 accuracy (single effects): {} strict, {} counting confounded pairs ({}) as
 fn write_report(
     dir: &Path,
     result: &Diagnosis,
-    _train: &[RealRun],
-    _holdout: &[RealRun],
+    train: &[RealRun],
+    holdout: &[RealRun],
+    options: &Options,
 ) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let path = dir.join("diagnosis.json");
-    std::fs::write(&path, serde_json::to_string_pretty(result)?)
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    diagnose::report::write_report(dir, result, train, holdout, options)?;
+    eprintln!("wrote {}", dir.join("index.html").display());
     Ok(())
 }
 

@@ -7,7 +7,7 @@
 //! real log's gaps.
 
 use super::features::{features, Features, REGRESSORS, WANDER_TAUS_S};
-use super::stats::{residuals, residuals_of, stats_of, Stat, StatsError};
+use super::stats::{residuals, residuals_of, stats_of, Residuals, Stat, StatsError};
 use crate::log::RegularLog;
 use crate::sim::{simulate_series, Effect, Motion, SensorModel, SimOptions};
 use rayon::prelude::*;
@@ -239,13 +239,15 @@ pub fn member_seed(base: u64, run: usize, j: usize) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Simulate `run` with `model` and `effects` and `seed`, and measure it.
-pub fn simulate_member(
+/// Simulate `run` with `model` and `effects` and `seed` (its motion, temperatures and
+/// encoder step, on its grid; dropped samples filled as the grid fills a real log's gaps)
+/// and take the residuals exactly as a real run's ([`residuals`]).
+pub fn simulate_residuals(
     run: &RealRun,
     model: &SensorModel,
     effects: &[Effect],
     seed: u64,
-) -> Member {
+) -> Result<Residuals, StatsError> {
     let options = SimOptions {
         seed,
         reference_step_deg: run.reference_step_deg,
@@ -276,7 +278,17 @@ pub fn simulate_member(
     } else {
         vec![f64::NAN; n]
     };
-    match residuals_of(fs, time, s.rate_dps, &s.reference_deg, temperature) {
+    residuals_of(fs, time, s.rate_dps, &s.reference_deg, temperature)
+}
+
+/// Simulate `run` with `model` and `effects` and `seed`, and measure it.
+pub fn simulate_member(
+    run: &RealRun,
+    model: &SensorModel,
+    effects: &[Effect],
+    seed: u64,
+) -> Member {
+    match simulate_residuals(run, model, effects, seed) {
         Ok(r) => {
             let features = features(&r, 1e-9);
             let mut stats = stats_of(&r);

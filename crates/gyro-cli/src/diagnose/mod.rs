@@ -25,6 +25,7 @@ pub mod compensate;
 pub mod ensemble;
 pub mod features;
 pub mod fit;
+pub mod report;
 pub mod score;
 pub mod selftest;
 pub mod stats;

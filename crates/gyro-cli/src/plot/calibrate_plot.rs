@@ -35,7 +35,7 @@ const PAPER_LABEL: &str = "paper error model";
 const KALMAN_LABEL: &str = "Kalman form";
 
 /// The run's name as shown: its file name, shortened from the left.
-fn short_name(name: &str) -> String {
+pub(super) fn short_name(name: &str) -> String {
     let file = Path::new(name)
         .file_name()
         .and_then(|f| f.to_str())

@@ -11,10 +11,12 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Each plot is a [`Figure`]: [`RunPlot`], [`NoisePlot`], [`CalibrationPlot`]. [`save`]
-//! writes one to a file, [`render`] returns the file's bytes (e.g. for an HTML report).
+//! Each plot is a [`Figure`]: [`RunPlot`], [`NoisePlot`], [`CalibrationPlot`], and the
+//! diagnosis report's figures in [`diagnose_plot`]. [`save`] writes one to a file,
+//! [`render`] returns the file's bytes (e.g. for an HTML report).
 
 mod calibrate_plot;
+pub mod diagnose_plot;
 mod noise_plot;
 mod run_plot;
 

@@ -27,7 +27,7 @@ pub fn noise_plot(path: &Path, title: &str, result: &Characterization) -> Result
     save(path, &NoisePlot { title, result })
 }
 
-type LogChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+pub(super) type LogChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
 
 /// Points of model curves per decade of τ.
 const CURVE_PER_DECADE: f64 = 40.0;
@@ -133,7 +133,7 @@ fn curve(x: (f64, f64), y: (f64, f64), f: impl Fn(f64) -> f64) -> Vec<Vec<(f64, 
 }
 
 /// Log range covering `lo..hi` with a margin of `factor` on both sides.
-fn log_range(lo: f64, hi: f64, factor: f64) -> (f64, f64) {
+pub(super) fn log_range(lo: f64, hi: f64, factor: f64) -> (f64, f64) {
     if !(lo > 0.0 && hi >= lo && hi.is_finite()) {
         return (1e-3, 1.0);
     }
@@ -153,7 +153,7 @@ fn log_range(lo: f64, hi: f64, factor: f64) -> (f64, f64) {
     }
 }
 
-fn log_chart<'a, DB: DrawingBackend>(
+pub(super) fn log_chart<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
     x: (f64, f64),
     y: (f64, f64),
@@ -246,7 +246,7 @@ fn log_legend<'a, DB: DrawingBackend + 'a>(
 }
 
 /// A message in the middle of `area`, in place of a panel.
-fn note<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, text: &str) -> DrawResult {
+pub(super) fn note<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, text: &str) -> DrawResult {
     let (w, h) = area.dim_in_pixel();
     let style = TextStyle::from(("sans-serif", LABEL_PX).into_font())
         .color(&colour::GREY)
@@ -255,7 +255,10 @@ fn note<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, text: &str) -> DrawRe
         .map_err(draw_err)
 }
 
-fn line_swatch(c: RGBColor, width: u32) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+pub(super) fn line_swatch(
+    c: RGBColor,
+    width: u32,
+) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
     move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(width))
 }
 
