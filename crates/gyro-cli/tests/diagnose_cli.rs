@@ -224,7 +224,7 @@ fn bad_input_is_refused_with_a_clear_message() {
             &c,
             &c,
             "--split-s",
-            "-3",
+            "0",
         ],
         "--split-s",
     );
