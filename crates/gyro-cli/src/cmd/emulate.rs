@@ -167,21 +167,32 @@ fn drain(
     pty_slave: Option<&PtySlave>,
     stop: &AtomicBool,
 ) -> u64 {
-    let pending = |port: &mut dyn serialport::SerialPort| {
-        let queued = match pty_slave {
-            Some(slave) => pty_unread(slave),
-            None => port.bytes_to_write(),
-        };
-        queued.map_or(0, u64::from)
+    // Bytes still on their way: in the reader's input queue and, for a pseudo-terminal,
+    // still in the master's output queue (moved to the slave in chunks).
+    let pending = |port: &mut dyn serialport::SerialPort| match pty_slave {
+        Some(slave) => pty_unread(slave)
+            .map(u64::from)
+            .unwrap_or(0)
+            .saturating_add(port.bytes_to_write().map_or(0, u64::from)),
+        None => port.bytes_to_write().map_or(0, u64::from),
     };
+    // Done when nothing has been pending for QUIET consecutive polls (a momentarily
+    // empty slave queue can still be refilled from the master).
+    const QUIET: u32 = 10;
     let mut last = pending(port);
     let mut since = std::time::Instant::now();
-    while last > 0 && !stop.load(std::sync::atomic::Ordering::Relaxed) {
+    let mut quiet = 0;
+    while quiet < QUIET && !stop.load(std::sync::atomic::Ordering::Relaxed) {
         std::thread::sleep(Duration::from_millis(20));
         let now = pending(port);
+        if now == 0 {
+            quiet += 1;
+        } else {
+            quiet = 0;
+        }
         if now < last {
             since = std::time::Instant::now();
-        } else if since.elapsed() > Duration::from_secs(5) {
+        } else if now > 0 && since.elapsed() > Duration::from_secs(5) {
             return now;
         }
         last = now;
