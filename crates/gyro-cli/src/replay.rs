@@ -11,8 +11,8 @@
 //! is a matter of scoring only: the reference is shifted by it before the comparison.
 
 use crate::log::{
-    metadata_rate_hz, place, read_log_with_warnings, read_mcap, regularize, CsvRows, GridOptions,
-    LogError, LogFormat, LogInfo, LogOptions, Quality, RegularLog, Slot, SlotSink,
+    metadata_rate_hz, place, read_ahead, read_log_with_warnings, read_mcap, regularize, CsvRows,
+    GridOptions, LogError, LogFormat, LogInfo, LogOptions, Quality, RegularLog, Slot, SlotSink,
 };
 use crate::model::ModelFile;
 use gyro_core::{Compensation, Config, Decimator, Event, MotionState, Pipeline, Sos, SosState};
@@ -262,7 +262,8 @@ pub fn replay_file(
                 has_temperature: rows.has_temperature(),
             };
             sink.has_temperature = info.has_temperature;
-            place(&info, rows, grid, &mut sink)?
+            // Parsing on a second thread, the grid and the pipeline on this one.
+            read_ahead(rows, |rows| place(&info, rows, grid, &mut sink))?
         }
         LogFormat::Mcap => {
             let read = read_mcap(path, &options.mcap)?;

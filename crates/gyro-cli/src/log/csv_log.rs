@@ -3,7 +3,7 @@
 use super::{Log, LogError, Row};
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 /// Unit of the time column.
@@ -131,44 +131,94 @@ fn parse_plain_decimal(field: &[u8]) -> Option<f64> {
 
 /// A CSV log opened for reading row by row: metadata and header read, rows on demand.
 ///
-/// [`read_csv`] collects every row; `gyro-cli run` streams them
-/// ([`super::place`]) so that memory stays bounded however long the log.
+/// [`read_csv`] collects every row; `gyro-cli run` streams them ([`super::place`]) so
+/// that memory stays bounded however long the log.
+///
+/// The data lines of a regular file are split here, for speed, as long as they are
+/// plain: no quote, no carriage return but one before the line feed, a line feed at the
+/// end. From the first line that is not, the `csv` crate reads the rest. Either way the rows, their line numbers
+/// and the errors are the `csv` crate's, quirks included: a row is numbered from where
+/// the reader stood after the previous row, that is before any blank or comment lines
+/// in between, and after a `\r\n` row still on that row's line.
 pub struct CsvRows {
-    path: PathBuf,
+    columns: Columns,
     metadata: BTreeMap<String, String>,
-    csv: csv::Reader<BufReader<File>>,
-    record: csv::ByteRecord,
-    prelude_lines: u64,
-    time_idx: usize,
-    rate_idx: usize,
-    reference_idx: Option<usize>,
-    temperature_idx: Option<usize>,
+    data: Data,
+    done: bool,
+}
+
+/// Which fields hold what: everything needed to turn fields into a [`Row`].
+struct Columns {
+    path: PathBuf,
+    names: ColumnOptions,
+    /// Fields in the header (every row must have as many).
+    len: usize,
+    time: usize,
+    rate: usize,
+    reference: Option<usize>,
+    temperature: Option<usize>,
     time_scale: f64,
     rate_scale: f64,
-    columns: ColumnOptions,
-    done: bool,
+    /// Metadata lines before the header.
+    prelude_lines: u64,
+}
+
+/// Where the data rows come from.
+enum Data {
+    /// Plain lines split here.
+    Lines(Lines),
+    /// The `csv` crate.
+    Csv(CsvData),
+}
+
+/// The `csv` crate reading data rows; its line numbers are shifted by `line_offset`.
+struct CsvData {
+    reader: csv::Reader<Box<dyn Read + Send>>,
+    record: csv::ByteRecord,
+    line_offset: u64,
+    /// The line of the first row, if not the reader's own (it starts mid-file).
+    first_line: Option<u64>,
+    /// True if this reader checks the field count (it read the header itself).
+    checks_lengths: bool,
 }
 
 impl CsvRows {
     /// Open `path`, read its metadata lines and header, and find the columns.
     pub fn open(path: &Path, columns: &ColumnOptions) -> Result<Self, LogError> {
+        Self::open_with(path, columns, true)
+    }
+
+    /// [`Self::open`]; `split_lines: false` leaves every row to the `csv` crate.
+    fn open_with(
+        path: &Path,
+        columns: &ColumnOptions,
+        split_lines: bool,
+    ) -> Result<Self, LogError> {
         let io_err = |cause| LogError::Io {
             path: path.to_path_buf(),
             cause,
         };
         let file = File::open(path).map_err(io_err)?;
+        // Lines are split here only in a regular file: the data is read again from the
+        // header's end.
+        let lines_file = if split_lines && file.metadata().is_ok_and(|m| m.is_file()) {
+            file.try_clone().ok()
+        } else {
+            None
+        };
         let mut reader = BufReader::with_capacity(1 << 20, file);
 
         // Metadata: `# key: value` lines before the header.
         let mut metadata = BTreeMap::new();
         let mut prelude_lines = 0_u64;
+        let mut prelude_bytes = 0_u64;
         loop {
             let buf = reader.fill_buf().map_err(io_err)?;
             if buf.first() != Some(&b'#') {
                 break;
             }
             let mut line = String::new();
-            reader.read_line(&mut line).map_err(io_err)?;
+            prelude_bytes += reader.read_line(&mut line).map_err(io_err)? as u64;
             prelude_lines += 1;
             if let Some((key, value)) = line.trim_start_matches('#').split_once(':') {
                 metadata.insert(key.trim().to_string(), value.trim().to_string());
@@ -178,7 +228,7 @@ impl CsvRows {
         let mut csv = csv::ReaderBuilder::new()
             .has_headers(true)
             .comment(Some(b'#'))
-            .from_reader(reader);
+            .from_reader(Box::new(reader) as Box<dyn Read + Send>);
         let header_line = prelude_lines + 1;
         let headers = csv
             .byte_headers()
@@ -202,35 +252,54 @@ impl CsvRows {
                 available: names.join(", "),
             })
         };
-        let time_idx = required(&columns.time_column)?;
-        let rate_idx = required(&columns.rate_column)?;
-        let reference_idx = find(&columns.reference_column);
-        let temperature_idx = find(&columns.temperature_column);
-        let time_scale = columns.time_unit.to_seconds();
-        let rate_scale = match columns.rate_unit {
-            RateUnit::Dps => 1.0,
-            RateUnit::Rads => 180.0 / std::f64::consts::PI,
+        let time = required(&columns.time_column)?;
+        let rate = required(&columns.rate_column)?;
+        let columns = Columns {
+            path: path.to_path_buf(),
+            names: columns.clone(),
+            len: headers.len(),
+            time,
+            rate,
+            reference: find(&columns.reference_column),
+            temperature: find(&columns.temperature_column),
+            time_scale: columns.time_unit.to_seconds(),
+            rate_scale: match columns.rate_unit {
+                RateUnit::Dps => 1.0,
+                RateUnit::Rads => 180.0 / std::f64::consts::PI,
+            },
+            prelude_lines,
+        };
+
+        // Where the reader stands after the header: the data's first byte, and the line
+        // its first row is numbered with.
+        let after_header = csv.position().clone();
+        let start = prelude_bytes + after_header.byte();
+        let line = prelude_lines + after_header.line();
+        let lines = lines_file.and_then(|mut file| {
+            file.seek(SeekFrom::Start(start)).ok()?;
+            Some(Lines::new(file, line))
+        });
+        let data = match lines {
+            Some(lines) => Data::Lines(lines),
+            None => Data::Csv(CsvData {
+                reader: csv,
+                record: csv::ByteRecord::new(),
+                line_offset: prelude_lines,
+                first_line: None,
+                checks_lengths: true,
+            }),
         };
         Ok(Self {
-            path: path.to_path_buf(),
+            columns,
             metadata,
-            csv,
-            record: csv::ByteRecord::new(),
-            prelude_lines,
-            time_idx,
-            rate_idx,
-            reference_idx,
-            temperature_idx,
-            time_scale,
-            rate_scale,
-            columns: columns.clone(),
+            data,
             done: false,
         })
     }
 
     /// The file.
     pub fn path(&self) -> &Path {
-        &self.path
+        &self.columns.path
     }
 
     /// The `# key: value` metadata lines before the header.
@@ -240,12 +309,12 @@ impl CsvRows {
 
     /// True if the header has the reference column.
     pub fn has_reference(&self) -> bool {
-        self.reference_idx.is_some()
+        self.columns.reference.is_some()
     }
 
     /// True if the header has the temperature column.
     pub fn has_temperature(&self) -> bool {
-        self.temperature_idx.is_some()
+        self.columns.temperature.is_some()
     }
 
     /// The next row; `Ok(None)` at the end of the file. After an error, the end.
@@ -261,47 +330,258 @@ impl CsvRows {
     }
 
     fn read_row(&mut self) -> Result<Option<Row>, LogError> {
-        let path = self.path.as_path();
-        match self.csv.read_byte_record(&mut self.record) {
-            Ok(false) => return Ok(None),
-            Ok(true) => {}
-            Err(e) => return Err(csv_error(path, self.prelude_lines, e)),
+        let columns = &self.columns;
+        if let Data::Lines(lines) = &mut self.data {
+            match lines.next_record(columns)? {
+                Record::Row(row) => return Ok(Some(row)),
+                Record::End => return Ok(None),
+                Record::NotPlain {
+                    rest,
+                    line_offset,
+                    first_line,
+                } => {
+                    let reader = csv::ReaderBuilder::new()
+                        .has_headers(false)
+                        .flexible(true)
+                        .comment(Some(b'#'))
+                        .from_reader(rest);
+                    self.data = Data::Csv(CsvData {
+                        reader,
+                        record: csv::ByteRecord::new(),
+                        line_offset,
+                        first_line: Some(first_line),
+                        checks_lengths: false,
+                    });
+                }
+            }
         }
-        let record = &self.record;
-        let line = self.prelude_lines + record.position().map_or(0, |p| p.line());
-        let field = |idx: usize, column: &str| -> Result<Option<f64>, LogError> {
-            let raw = record.get(idx).unwrap_or_default();
+        match &mut self.data {
+            Data::Csv(data) => data.next_row(columns),
+            Data::Lines(_) => Ok(None), // replaced above
+        }
+    }
+}
+
+impl Columns {
+    /// The row of the fields `field(i)` (as many as the header has), at `line`.
+    fn row<'a>(&self, line: u64, field: impl Fn(usize) -> &'a [u8]) -> Result<Row, LogError> {
+        let value = |idx: usize, column: &str| -> Result<Option<f64>, LogError> {
+            let raw = field(idx);
             parse_field(raw).map_err(|()| LogError::NotANumber {
-                path: path.to_path_buf(),
+                path: self.path.clone(),
                 line,
                 column: column.to_string(),
                 value: String::from_utf8_lossy(raw).into_owned(),
             })
         };
-        let columns = &self.columns;
-        let time_s = field(self.time_idx, &columns.time_column)?
+        let names = &self.names;
+        let time_s = value(self.time, &names.time_column)?
             .map(|t| t * self.time_scale)
             .ok_or_else(|| LogError::BadTime {
-                path: path.to_path_buf(),
+                path: self.path.clone(),
                 line,
-                column: columns.time_column.clone(),
+                column: names.time_column.clone(),
             })?;
-        let rate_dps = field(self.rate_idx, &columns.rate_column)?.map(|r| r * self.rate_scale);
-        let reference_deg = match self.reference_idx {
-            Some(idx) => field(idx, &columns.reference_column)?,
+        let rate_dps = value(self.rate, &names.rate_column)?.map(|r| r * self.rate_scale);
+        let reference_deg = match self.reference {
+            Some(idx) => value(idx, &names.reference_column)?,
             None => None,
         };
-        let temperature_c = match self.temperature_idx {
-            Some(idx) => field(idx, &columns.temperature_column)?,
+        let temperature_c = match self.temperature {
+            Some(idx) => value(idx, &names.temperature_column)?,
             None => None,
         };
-        Ok(Some(Row {
+        Ok(Row {
             line,
             time_s,
             rate_dps,
             reference_deg,
             temperature_c,
-        }))
+        })
+    }
+
+    /// The error of a row with `len` fields, as the `csv` crate words it.
+    fn length_error(&self, line: u64, len: usize) -> LogError {
+        LogError::Csv {
+            path: self.path.clone(),
+            line,
+            message: format!("row has {len} fields, the header has {}", self.len),
+        }
+    }
+}
+
+impl CsvData {
+    fn next_row(&mut self, columns: &Columns) -> Result<Option<Row>, LogError> {
+        let result = self.reader.read_byte_record(&mut self.record);
+        let first_line = self.first_line.take();
+        match result {
+            Ok(false) => return Ok(None),
+            Ok(true) => {}
+            // An error without a position (I/O) is numbered as if from the start.
+            Err(e) if e.position().is_none() => {
+                return Err(csv_error(&columns.path, columns.prelude_lines, e))
+            }
+            Err(e) => return Err(csv_error(&columns.path, self.line_offset, e)),
+        }
+        let record = &self.record;
+        let line = first_line
+            .unwrap_or_else(|| self.line_offset + record.position().map_or(0, |p| p.line()));
+        if !self.checks_lengths && record.len() != columns.len {
+            return Err(columns.length_error(line, record.len()));
+        }
+        columns
+            .row(line, |idx| record.get(idx).unwrap_or_default())
+            .map(Some)
+    }
+}
+
+/// What [`Lines::next_record`] found.
+enum Record {
+    Row(Row),
+    End,
+    /// A line that is not plain: the `csv` crate reads on from there (`rest`), its lines
+    /// shifted by `line_offset`, its first row numbered `first_line`.
+    NotPlain {
+        rest: Box<dyn Read + Send>,
+        line_offset: u64,
+        first_line: u64,
+    },
+}
+
+/// The data lines of a regular file, split on line feeds and commas.
+struct Lines {
+    file: Option<File>,
+    buf: Vec<u8>,
+    /// The unread bytes are `buf[start..end]`.
+    start: usize,
+    end: usize,
+    /// The line number of the next line read.
+    line: u64,
+    /// The line number the next row gets (see [`CsvRows`]).
+    row_line: u64,
+    /// Where the commas are in the current line.
+    commas: Vec<usize>,
+}
+
+impl Lines {
+    fn new(file: File, line: u64) -> Self {
+        Self {
+            file: Some(file),
+            buf: vec![0; 1 << 20],
+            start: 0,
+            end: 0,
+            line,
+            row_line: line,
+            commas: Vec::new(),
+        }
+    }
+
+    /// Read more bytes into the buffer (keeping the unread ones); false at the end.
+    fn fill(&mut self, columns: &Columns) -> Result<bool, LogError> {
+        let Some(file) = self.file.as_mut() else {
+            return Ok(false);
+        };
+        if self.start > 0 {
+            self.buf.copy_within(self.start..self.end, 0);
+            self.end -= self.start;
+            self.start = 0;
+        }
+        if self.end == self.buf.len() {
+            self.buf.resize(self.buf.len() * 2, 0);
+        }
+        loop {
+            match file.read(&mut self.buf[self.end..]) {
+                Ok(0) => {
+                    self.file = None;
+                    return Ok(false);
+                }
+                Ok(n) => {
+                    self.end += n;
+                    return Ok(true);
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => {
+                    return Err(LogError::Csv {
+                        path: columns.path.clone(),
+                        line: columns.prelude_lines,
+                        message: format!("read error: {e}"),
+                    })
+                }
+            }
+        }
+    }
+
+    /// The next row, the end, or the first line that is not plain.
+    fn next_record(&mut self, columns: &Columns) -> Result<Record, LogError> {
+        loop {
+            // The next line, without its line feed; `terminated`: it has one.
+            let (line_start, line_end, terminated) = loop {
+                let unread = &self.buf[self.start..self.end];
+                if let Some(i) = memchr::memchr(b'\n', unread) {
+                    break (self.start, self.start + i, true);
+                }
+                if !self.fill(columns)? {
+                    if self.start == self.end {
+                        return Ok(Record::End);
+                    }
+                    break (self.start, self.end, false);
+                }
+            };
+            let line = self.line;
+            let mut text = &self.buf[line_start..line_end];
+            let crlf = text.last() == Some(&b'\r');
+            if crlf {
+                text = &text[..text.len() - 1];
+            }
+            // The last line without a line feed also goes to the `csv` crate (which reads
+            // a comment there as a row of one field).
+            if !terminated || memchr::memchr2(b'"', b'\r', text).is_some() {
+                // A line feed first: the `csv` crate reads on as from a line start, and
+                // does not take a byte-order mark there for the file's.
+                let mut rest = Vec::with_capacity(self.end - line_start + 1);
+                rest.push(b'\n');
+                rest.extend_from_slice(&self.buf[line_start..self.end]);
+                let reader: Box<dyn Read + Send> = match self.file.take() {
+                    Some(file) => Box::new(std::io::Cursor::new(rest).chain(file)),
+                    None => Box::new(std::io::Cursor::new(rest)),
+                };
+                return Ok(Record::NotPlain {
+                    rest: reader,
+                    line_offset: line.saturating_sub(2),
+                    first_line: self.row_line,
+                });
+            }
+            self.start = line_end + 1;
+            self.line += 1;
+            // Blank lines and comments are skipped.
+            if text.is_empty() || text[0] == b'#' {
+                continue;
+            }
+            let row_line = self.row_line;
+            // The `csv` crate ends a row at `\r` and reads the `\n` with the next row.
+            self.row_line = if crlf { line } else { line + 1 };
+            // Short lines: a plain loop beats a vectorised search.
+            self.commas.clear();
+            for (i, &b) in text.iter().enumerate() {
+                if b == b',' {
+                    self.commas.push(i);
+                }
+            }
+            if self.commas.len() + 1 != columns.len {
+                return Err(columns.length_error(row_line, self.commas.len() + 1));
+            }
+            let commas = &self.commas;
+            // Field `i` lies between comma `i - 1` and comma `i`.
+            let field = |i: usize| {
+                let from = match i.checked_sub(1) {
+                    Some(before) => commas.get(before).map_or(text.len(), |c| c + 1),
+                    None => 0,
+                };
+                let to = commas.get(i).copied().unwrap_or(text.len());
+                text.get(from..to).unwrap_or_default()
+            };
+            return columns.row(row_line, field).map(Record::Row);
+        }
     }
 }
 
@@ -321,9 +601,9 @@ pub fn read_csv(path: &Path, columns: &ColumnOptions) -> Result<Log, LogError> {
         rows.push(row);
     }
     Ok(Log {
-        path: reader.path,
-        has_reference: reader.reference_idx.is_some(),
-        has_temperature: reader.temperature_idx.is_some(),
+        has_reference: reader.has_reference(),
+        has_temperature: reader.has_temperature(),
+        path: reader.columns.path,
         metadata: reader.metadata,
         rows,
     })
@@ -480,6 +760,156 @@ mod tests {
                 proptest::prop_assert_eq!(fast.to_bits(), std.to_bits(), "{}", text);
             }
         }
+    }
+
+    /// Every row, then the error if any, as text.
+    fn read_all(path: &Path, split_lines: bool) -> String {
+        let mut out = String::new();
+        match CsvRows::open_with(path, &ColumnOptions::default(), split_lines) {
+            Err(e) => out.push_str(&format!("open error: {e}")),
+            Ok(mut rows) => loop {
+                match rows.next_row() {
+                    Ok(Some(row)) => out.push_str(&format!("{row:?}\n")),
+                    Ok(None) => break,
+                    Err(e) => {
+                        out.push_str(&format!("error: {e}"));
+                        break;
+                    }
+                }
+            },
+        }
+        out
+    }
+
+    /// One generated data line (without its terminator).
+    fn data_line() -> impl proptest::strategy::Strategy<Value = String> {
+        use proptest::prelude::*;
+        let number = prop_oneof![
+            8 => (-1000.0..1000.0_f64).prop_map(|v| format!("{v}")),
+            4 => (-100_000_i64..100_000).prop_map(|v| format!("{:.3}", v as f64 / 1000.0)),
+            1 => Just(String::new()),
+            1 => Just("nan".to_string()),
+            1 => Just(" 1.5 ".to_string()),
+            1 => Just("1e-3".to_string()),
+            1 => Just("x1".to_string()),
+            1 => Just("\"2.5\"".to_string()),
+        ];
+        prop_oneof![
+            20 => proptest::collection::vec(number, 3).prop_map(|f| f.join(",")),
+            2 => proptest::collection::vec(-5.0..5.0_f64, 2..5).prop_map(|f| {
+                f.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>().join(",")
+            }),
+            2 => Just(String::new()),
+            2 => Just("# a comment, with a comma".to_string()),
+            1 => Just("#\"quoted\" comment".to_string()),
+            1 => Just("0.5,1.0\r,2.0".to_string()),
+            1 => Just("\"0.25\",\"1,0\",3".to_string()),
+            1 => Just("\"0.25\n0.5\",1,2".to_string()),
+            1 => Just("\u{feff}0.1,2,3".to_string()),
+            1 => Just(" ".to_string()),
+        ]
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
+        /// Lines split here give what the `csv` crate gives: rows, line numbers, errors.
+        #[test]
+        fn split_lines_read_like_the_csv_crate(
+            prelude in proptest::collection::vec(proptest::bool::ANY, 0..3),
+            bom: bool,
+            header_crlf: bool,
+            lines in proptest::collection::vec((data_line(), 0_u8..10), 0..40),
+            final_newline: bool,
+        ) {
+            let mut text = String::new();
+            if bom {
+                text.push('\u{feff}');
+            }
+            for with_rate in prelude {
+                text.push_str(if with_rate { "# sample_rate_hz: 100\n" } else { "# sensor: x\n" });
+            }
+            text.push_str("time_s,rate_dps,reference_deg");
+            text.push_str(if header_crlf { "\r\n" } else { "\n" });
+            let count = lines.len();
+            for (i, (line, terminator)) in lines.into_iter().enumerate() {
+                text.push_str(&line);
+                if i + 1 < count || final_newline {
+                    text.push_str(match terminator {
+                        0..=5 => "\n",
+                        6..=8 => "\r\n",
+                        _ => "\r",
+                    });
+                }
+            }
+            let path = write_temp("split.csv", &text);
+            let fast = read_all(&path, true);
+            let slow = read_all(&path, false);
+            proptest::prop_assert_eq!(fast, slow, "{:?}", text);
+        }
+    }
+
+    /// Line numbers and errors as the `csv` crate gives them, quirks included (what
+    /// `gyro-cli run` always printed).
+    #[test]
+    fn csv_crate_quirks_are_kept() {
+        let cases = [
+            // Numbered from the line after the previous row, before blank and comment lines.
+            (
+                "blank.csv",
+                "time_s,rate_dps\n0.0,1\n\n# c\n0.01,x\n",
+                "blank.csv:3: column",
+            ),
+            // After a `\r\n` row, still on that row's line.
+            (
+                "crlf.csv",
+                "time_s,rate_dps\r\n0.0,1\r\n0.01,1\r\n0.02,x\r\n",
+                "crlf.csv:3: column",
+            ),
+            (
+                "crlf2.csv",
+                "time_s,rate_dps\r\n0.0,1\r\n0.01,1\r\n0.02,1,3\r\n",
+                "crlf2.csv:3: row has 3 fields, the header has 2",
+            ),
+            // A comment on the last line without a line feed is a row of one field.
+            (
+                "eof_comment.csv",
+                "time_s,rate_dps\n0.0,1\n0.01,1\n# trailing comment",
+                "eof_comment.csv:4: row has 1 fields, the header has 2",
+            ),
+        ];
+        for (name, text, expected) in cases {
+            let path = write_temp(name, text);
+            for split_lines in [true, false] {
+                let all = read_all(&path, split_lines);
+                assert!(all.contains(expected), "{name} {split_lines}: {all}");
+            }
+        }
+    }
+
+    /// Lines across buffer refills, a line longer than the buffer, and a switch to the
+    /// `csv` crate with most of the file still unread.
+    #[test]
+    fn split_lines_across_buffers_read_like_the_csv_crate() {
+        let mut text = String::from("# sample_rate_hz: 1000\ntime_s,rate_dps,reference_deg\n");
+        for k in 0..60_000 {
+            let pad = " ".repeat(k % 13);
+            text.push_str(&format!("{}{pad},{},{}\n", k as f64 * 0.001, k % 7, k % 3));
+            if k == 20_000 {
+                text.push_str(&format!("20.0005,{}1.0,0\n", " ".repeat(3 << 20)));
+            }
+            if k == 40_000 {
+                text.push_str("40.0005,\"1.0\",0\r\n");
+            }
+        }
+        let path = write_temp("big.csv", &text);
+        let fast = read_all(&path, true);
+        assert!(
+            !fast.contains("error"),
+            "{}",
+            &fast[fast.len().saturating_sub(300)..]
+        );
+        assert_eq!(fast.lines().count(), 60_002);
+        assert_eq!(fast, read_all(&path, false));
     }
 
     #[test]

@@ -4,10 +4,12 @@
 //! [`read_log`] reads either format (by content, else by extension); [`write_log`] writes
 //! either by extension.
 
+mod ahead;
 mod csv_log;
 pub mod mcap;
 mod regular;
 
+pub use ahead::read_ahead;
 pub use csv_log::{read_csv, write_csv, ColumnOptions, CsvRows, RateUnit, TimeUnit};
 pub use mcap::{
     read_mcap, write_mcap, Axis, JsonChannel, McapLogWriter, McapOptions, McapRead,
