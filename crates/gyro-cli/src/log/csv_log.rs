@@ -106,26 +106,27 @@ fn parse_plain_decimal(field: &[u8]) -> Option<f64> {
         Some((b'-', rest)) => (true, rest),
         _ => (false, field),
     };
-    let mut mantissa = 0_u64;
-    let mut count = 0_usize;
-    let mut decimals: Option<usize> = None;
-    for (i, &b) in digits.iter().enumerate() {
-        match b {
-            b'0'..=b'9' => {
-                count += 1;
-                if count > 19 {
-                    return None;
-                }
-                mantissa = mantissa * 10 + u64::from(b - b'0');
-            }
-            b'.' if decimals.is_none() => decimals = Some(digits.len() - i - 1),
-            _ => return None,
-        }
-    }
-    if count == 0 || mantissa > 1 << 53 {
+    // At most 19 digits: the mantissa fits in a u64.
+    if digits.len() > 19 {
         return None;
     }
-    let value = mantissa as f64 / *POW10.get(decimals.unwrap_or(0))?;
+    let mut mantissa = 0_u64;
+    let mut dot: Option<usize> = None;
+    for (i, &b) in digits.iter().enumerate() {
+        let digit = b.wrapping_sub(b'0');
+        if digit < 10 {
+            mantissa = mantissa * 10 + u64::from(digit);
+        } else if b == b'.' && dot.is_none() {
+            dot = Some(i);
+        } else {
+            return None;
+        }
+    }
+    let decimals = dot.map_or(0, |i| digits.len() - i - 1);
+    if digits.len() == usize::from(dot.is_some()) || mantissa > 1 << 53 {
+        return None; // no digit, or too many for an exact double
+    }
+    let value = mantissa as f64 / *POW10.get(decimals)?;
     Some(if negative { -value } else { value })
 }
 
@@ -514,12 +515,30 @@ impl Lines {
     /// The next row, the end, or the first line that is not plain.
     fn next_record(&mut self, columns: &Columns) -> Result<Record, LogError> {
         loop {
-            // The next line, without its line feed; `terminated`: it has one.
+            // The next line, without its line feed (`terminated`: it has one), in one pass:
+            // where its commas are, whether it has quotes or carriage returns.
+            self.commas.clear();
+            let (mut quotes, mut returns) = (false, 0_usize);
+            let mut scanned = 0;
             let (line_start, line_end, terminated) = loop {
-                let unread = &self.buf[self.start..self.end];
-                if let Some(i) = memchr::memchr(b'\n', unread) {
+                let line = &self.buf[self.start..self.end];
+                let mut feed = None;
+                for (i, &b) in line.iter().enumerate().skip(scanned) {
+                    match b {
+                        b',' => self.commas.push(i),
+                        b'\n' => {
+                            feed = Some(i);
+                            break;
+                        }
+                        b'"' => quotes = true,
+                        b'\r' => returns += 1,
+                        _ => {}
+                    }
+                }
+                if let Some(i) = feed {
                     break (self.start, self.start + i, true);
                 }
+                scanned = line.len();
                 if !self.fill(columns)? {
                     if self.start == self.end {
                         return Ok(Record::End);
@@ -535,7 +554,7 @@ impl Lines {
             }
             // The last line without a line feed also goes to the `csv` crate (which reads
             // a comment there as a row of one field).
-            if !terminated || memchr::memchr2(b'"', b'\r', text).is_some() {
+            if !terminated || quotes || returns > usize::from(crlf) {
                 // A line feed first: the `csv` crate reads on as from a line start, and
                 // does not take a byte-order mark there for the file's.
                 let mut rest = Vec::with_capacity(self.end - line_start + 1);
@@ -560,13 +579,6 @@ impl Lines {
             let row_line = self.row_line;
             // The `csv` crate ends a row at `\r` and reads the `\n` with the next row.
             self.row_line = if crlf { line } else { line + 1 };
-            // Short lines: a plain loop beats a vectorised search.
-            self.commas.clear();
-            for (i, &b) in text.iter().enumerate() {
-                if b == b',' {
-                    self.commas.push(i);
-                }
-            }
             if self.commas.len() + 1 != columns.len {
                 return Err(columns.length_error(row_line, self.commas.len() + 1));
             }
