@@ -10,10 +10,14 @@
 //! reference ([`ReplayOptions::reference_delay_s`], the model file's `reference_delay_s`)
 //! is a matter of scoring only: the reference is shifted by it before the comparison.
 
-use crate::log::{Quality, RegularLog, Slot};
+use crate::log::{
+    metadata_rate_hz, place, read_ahead, read_log_with_warnings, read_mcap, regularize, CsvRows,
+    GridOptions, LogError, LogFormat, LogInfo, LogOptions, Quality, RegularLog, Slot, SlotSink,
+};
 use crate::model::ModelFile;
 use gyro_core::{Compensation, Config, Decimator, Event, MotionState, Pipeline, Sos, SosState};
 use serde::Serialize;
+use std::path::{Path, PathBuf};
 
 /// One output sample of the run, with the reference where present.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -175,70 +179,259 @@ pub fn replay_with(
     config: &Config,
     options: &ReplayOptions,
 ) -> Result<RunReport, gyro_core::Error> {
-    let config = Config {
-        sample_rate_hz: log.sample_rate_hz as f32,
-        ..*config
-    };
-    let mut pipeline = Pipeline::try_new(&config)?;
-    let factor = config.decimation_factor()?;
-    let output_rate_hz = config.effective_output_rate_hz()?;
-
-    // The reference path: same decimation and low-pass, on the angle relative to its start.
-    let reference_origin = log.slots.iter().find_map(|s| s.reference_deg);
-    let mut ref_decimator = Decimator::try_new(factor)?;
-    let ref_sos: Sos = config.filter.sos(output_rate_hz.into())?;
-    let mut ref_state = SosState::new();
-    let mut ref_last = 0.0_f32;
-    let mut ref_block_complete = true;
-
+    let mut replayer = Replayer::new(log.sample_rate_hz, config, options, log.has_temperature)?;
     // The reference's shift in grid slots (a non-finite delay is treated as none).
     let shift_slots = if options.reference_delay_s.is_finite() {
         options.reference_delay_s * log.sample_rate_hz
     } else {
         0.0
     };
+    if shift_slots == 0.0 {
+        for slot in &log.slots {
+            replayer.push(slot);
+        }
+    } else {
+        // The reference at other slots, ahead or behind: the whole log is at hand.
+        replayer.reference_origin = log.slots.iter().find_map(|s| s.reference_deg);
+        for (i, slot) in log.slots.iter().enumerate() {
+            replayer.push_scored(slot, shifted_reference(&log.slots, i, shift_slots));
+        }
+    }
+    Ok(replayer.finish(log.quality.clone()))
+}
 
-    let mut series = Vec::with_capacity(log.slots.len() / usize::from(factor) + 1);
-    let mut movements = Vec::new();
-    let mut open: Option<(f64, usize)> = None;
-    for (i, slot) in log.slots.iter().enumerate() {
-        let reference = match (
-            shifted_reference(&log.slots, i, shift_slots),
-            reference_origin,
-        ) {
+/// Why [`replay_file`] failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayFileError {
+    /// The log cannot be read or placed on the grid.
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// The pipeline cannot be configured for the log's sample rate.
+    #[error("{path}: cannot configure the pipeline for this log")]
+    Config {
+        /// The log.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        cause: gyro_core::Error,
+    },
+}
+
+/// Read, place on the grid and replay a log: what [`read_log_with_warnings`],
+/// [`regularize`] and [`replay_with`] do, with the same result and the same errors, in
+/// one pass without holding the log: a CSV log is streamed row by row (memory: the rate
+/// look-ahead, the output series); an MCAP log is read whole, then streamed from its rows.
+/// Scoring against a reference shifted by a delay needs the reference ahead: then the log
+/// is placed whole and replayed by [`replay_with`]. MCAP warnings go to `warn` before
+/// anything else is reported.
+pub fn replay_file(
+    path: &Path,
+    options: &LogOptions,
+    grid: &GridOptions,
+    config: &Config,
+    replay_options: &ReplayOptions,
+    warn: &mut dyn FnMut(&str),
+) -> Result<RunReport, ReplayFileError> {
+    let config_error = |cause| ReplayFileError::Config {
+        path: path.to_path_buf(),
+        cause,
+    };
+    let delay = replay_options.reference_delay_s;
+    if delay.is_finite() && delay != 0.0 {
+        let (raw, warnings) = read_log_with_warnings(path, options)?;
+        for warning in &warnings {
+            warn(warning);
+        }
+        let regular = regularize(&raw, grid)?;
+        drop(raw);
+        return replay_with(&regular, config, replay_options).map_err(config_error);
+    }
+    let mut sink = ReplaySink {
+        config,
+        options: replay_options,
+        has_temperature: false,
+        replayer: None,
+    };
+    let quality = match LogFormat::detect(path) {
+        LogFormat::Csv => {
+            let rows = CsvRows::open(path, &options.columns)?;
+            let info = LogInfo {
+                path,
+                metadata_rate_hz: metadata_rate_hz(rows.metadata()),
+                has_reference: rows.has_reference(),
+                has_temperature: rows.has_temperature(),
+            };
+            sink.has_temperature = info.has_temperature;
+            // Parsing on a second thread, the grid and the pipeline on this one.
+            read_ahead(rows, |rows| place(&info, rows, grid, &mut sink))?
+        }
+        LogFormat::Mcap => {
+            let read = read_mcap(path, &options.mcap)?;
+            for warning in &read.warnings {
+                warn(warning);
+            }
+            sink.has_temperature = read.log.has_temperature;
+            place(
+                &LogInfo::of(&read.log),
+                read.log.rows.iter().copied().map(Ok),
+                grid,
+                &mut sink,
+            )?
+        }
+    };
+    match sink.replayer {
+        Some(Ok(replayer)) => Ok(replayer.finish(quality)),
+        Some(Err(cause)) => Err(config_error(cause)),
+        // `place` succeeded, so it gave the rate: not reached.
+        None => Replayer::new(
+            quality.sample_rate_hz,
+            config,
+            replay_options,
+            sink.has_temperature,
+        )
+        .map(|replayer| replayer.finish(quality))
+        .map_err(config_error),
+    }
+}
+
+/// The sink of [`replay_file`]: a replayer built once the rate is known. If the pipeline
+/// cannot be configured, the error waits until the log has been read (its errors first).
+struct ReplaySink<'c> {
+    config: &'c Config,
+    options: &'c ReplayOptions,
+    has_temperature: bool,
+    replayer: Option<Result<Replayer, gyro_core::Error>>,
+}
+
+impl SlotSink for ReplaySink<'_> {
+    fn start(&mut self, sample_rate_hz: f64) {
+        self.replayer = Some(Replayer::new(
+            sample_rate_hz,
+            self.config,
+            self.options,
+            self.has_temperature,
+        ));
+    }
+
+    fn slot(&mut self, slot: &Slot) {
+        if let Some(Ok(replayer)) = &mut self.replayer {
+            replayer.push(slot);
+        }
+    }
+}
+
+/// Replays slots one at a time: the state of [`replay_with`] between two slots. Holds the
+/// output series (decimated), not the input.
+pub struct Replayer {
+    sample_rate_hz: f64,
+    config: Config,
+    reference_delay_s: f64,
+    /// The log has a temperature column: every sample goes in with its temperature.
+    has_temperature: bool,
+    pipeline: Pipeline,
+    factor: u16,
+    output_rate_hz: f32,
+    // The reference path: same decimation and low-pass, on the angle relative to its start.
+    reference_origin: Option<f64>,
+    ref_decimator: Decimator,
+    ref_sos: Sos,
+    ref_state: SosState,
+    ref_last: f32,
+    ref_block_complete: bool,
+    series: Vec<SeriesPoint>,
+    movements: Vec<MovementResult>,
+    open: Option<(f64, usize)>,
+}
+
+impl Replayer {
+    /// A replayer for slots at `sample_rate_hz`, with a pipeline configured by `config`
+    /// (its sample rate replaced); `options.reference_delay_s` is reported (the shift
+    /// itself is [`replay_with`]'s); `has_temperature`: the log has a temperature column.
+    pub fn new(
+        sample_rate_hz: f64,
+        config: &Config,
+        options: &ReplayOptions,
+        has_temperature: bool,
+    ) -> Result<Self, gyro_core::Error> {
+        let config = Config {
+            sample_rate_hz: sample_rate_hz as f32,
+            ..*config
+        };
+        let pipeline = Pipeline::try_new(&config)?;
+        let factor = config.decimation_factor()?;
+        let output_rate_hz = config.effective_output_rate_hz()?;
+        let ref_decimator = Decimator::try_new(factor)?;
+        let ref_sos: Sos = config.filter.sos(output_rate_hz.into())?;
+        Ok(Self {
+            sample_rate_hz,
+            config,
+            reference_delay_s: options.reference_delay_s,
+            has_temperature,
+            pipeline,
+            factor,
+            output_rate_hz,
+            reference_origin: None,
+            ref_decimator,
+            ref_sos,
+            ref_state: SosState::new(),
+            ref_last: 0.0,
+            ref_block_complete: true,
+            series: Vec::new(),
+            movements: Vec::new(),
+            open: None,
+        })
+    }
+
+    /// One slot of the grid, scored against its own reference.
+    ///
+    /// The reference origin is the first reference value. Until it comes, every block is
+    /// incomplete (no reference) and the reference filter sees zeros: running it then is
+    /// the same as not running it when the log has no reference at all.
+    pub fn push(&mut self, slot: &Slot) {
+        if self.reference_origin.is_none() {
+            self.reference_origin = slot.reference_deg;
+        }
+        self.push_scored(slot, slot.reference_deg);
+    }
+
+    /// One slot, scored against `reference` (deg; the origin is set).
+    fn push_scored(&mut self, slot: &Slot, reference: Option<f64>) {
+        let reference = match (reference, self.reference_origin) {
             (Some(r), Some(origin)) => {
-                ref_last = (r - origin) as f32;
-                Some(ref_last)
+                self.ref_last = (r - origin) as f32;
+                Some(self.ref_last)
             }
             _ => {
-                ref_block_complete = false;
+                self.ref_block_complete = false;
                 None
             }
         };
-        let ref_mean = ref_decimator.push(reference.unwrap_or(ref_last));
+        let ref_mean = self.ref_decimator.push(reference.unwrap_or(self.ref_last));
         // A slot without temperature in a log that has them (a filled gap) keeps the last
         // valid temperature: NaN tells the pipeline so.
-        let out = if log.has_temperature || slot.temperature_c.is_some() {
+        let out = if self.has_temperature || slot.temperature_c.is_some() {
             let temperature_c = slot.temperature_c.map_or(f32::NAN, |t| t as f32);
-            pipeline.push_with_temperature(slot.time_s, slot.rate_dps as f32, temperature_c)
+            self.pipeline
+                .push_with_temperature(slot.time_s, slot.rate_dps as f32, temperature_c)
         } else {
-            pipeline.push(slot.time_s, slot.rate_dps as f32)
+            self.pipeline.push(slot.time_s, slot.rate_dps as f32)
         };
         let Some(out) = out else {
-            continue;
+            return;
         };
         let reference_deg = match ref_mean {
-            Some(mean) if reference_origin.is_some() => {
-                if series.is_empty() {
-                    ref_sos.settle(&mut ref_state, mean);
+            Some(mean) => {
+                if self.series.is_empty() {
+                    self.ref_sos.settle(&mut self.ref_state, mean);
                 }
-                let filtered = ref_sos.process(&mut ref_state, mean);
-                let complete = ref_block_complete;
-                ref_block_complete = true;
+                let filtered = self.ref_sos.process(&mut self.ref_state, mean);
+                let complete = self.ref_block_complete;
+                self.ref_block_complete = true;
                 complete.then_some(f64::from(filtered))
             }
-            _ => None,
+            None => None,
         };
+        let series = &mut self.series;
         series.push(SeriesPoint {
             time_s: out.time_s,
             rate_dps: out.rate_dps,
@@ -251,74 +444,91 @@ pub fn replay_with(
         });
         match out.event {
             Some(Event::MovementStarted { start_time_s }) => {
-                open = Some((start_time_s, index_at(&series, start_time_s)));
+                self.open = Some((start_time_s, index_at(series, start_time_s)));
             }
             Some(Event::MovementEnded(m)) => {
-                let start = open
+                let start = self
+                    .open
                     .take()
-                    .map_or(index_at(&series, m.start_time_s), |o| o.1);
-                let end = index_at(&series, m.end_time_s);
-                movements.push(movement_result(
-                    movements.len() + 1,
+                    .map_or(index_at(series, m.start_time_s), |o| o.1);
+                let end = index_at(series, m.end_time_s);
+                self.movements.push(movement_result(
+                    self.movements.len() + 1,
                     (m.start_time_s, m.end_time_s),
                     true,
                     (m.angle_deg, m.raw_angle_deg),
-                    reference_change(&series, start, end),
+                    reference_change(series, start, end),
                 ));
             }
             None => {}
         }
     }
-    if let (Some((start_time_s, start)), Some(last)) = (open, series.last()) {
-        let first = &series[start];
-        movements.push(movement_result(
-            movements.len() + 1,
-            (start_time_s, last.time_s),
-            false,
-            (
-                last.angle_deg - first.angle_deg,
-                last.raw_angle_deg - first.raw_angle_deg,
-            ),
-            reference_change(&series, start, series.len() - 1),
-        ));
-    }
 
-    let (max_abs, rms, final_e) = error_stats(series.iter().filter_map(SeriesPoint::error_deg));
-    let (raw_max_abs, raw_rms, raw_final) = error_stats(
-        series
-            .iter()
-            .filter_map(|p| p.reference_deg.map(|r| f64::from(p.raw_angle_deg) - r)),
-    );
-    let summary = Summary {
-        compensation: config.compensation,
-        outputs: series.len(),
-        duration_s: match (series.first(), series.last()) {
-            (Some(a), Some(b)) => b.time_s - a.time_s,
-            _ => 0.0,
-        },
-        movements: movements.len(),
-        rejected_samples: pipeline.rejected_samples(),
-        final_angle_deg: series.last().map_or(0.0, |p| p.angle_deg),
-        final_raw_angle_deg: series.last().map_or(0.0, |p| p.raw_angle_deg),
-        max_abs_error_deg: max_abs,
-        rms_error_deg: rms,
-        final_error_deg: final_e,
-        raw_max_abs_error_deg: raw_max_abs,
-        raw_rms_error_deg: raw_rms,
-        raw_final_error_deg: raw_final,
-    };
-    Ok(RunReport {
-        sample_rate_hz: log.sample_rate_hz,
-        decimation_factor: factor,
-        output_rate_hz,
-        input: log.quality.clone(),
-        config,
-        reference_delay_s: options.reference_delay_s,
-        temperature_reference_c: pipeline.corrector().reference_c(),
-        summary,
-        movements,
-        series,
-    })
+    /// The report, with `input` the quality of the grid the slots came from.
+    pub fn finish(self, input: Quality) -> RunReport {
+        let Self {
+            sample_rate_hz,
+            config,
+            reference_delay_s,
+            pipeline,
+            factor,
+            output_rate_hz,
+            series,
+            mut movements,
+            open,
+            ..
+        } = self;
+        if let (Some((start_time_s, start)), Some(last)) = (open, series.last()) {
+            let first = &series[start];
+            movements.push(movement_result(
+                movements.len() + 1,
+                (start_time_s, last.time_s),
+                false,
+                (
+                    last.angle_deg - first.angle_deg,
+                    last.raw_angle_deg - first.raw_angle_deg,
+                ),
+                reference_change(&series, start, series.len() - 1),
+            ));
+        }
+
+        let (max_abs, rms, final_e) = error_stats(series.iter().filter_map(SeriesPoint::error_deg));
+        let (raw_max_abs, raw_rms, raw_final) = error_stats(
+            series
+                .iter()
+                .filter_map(|p| p.reference_deg.map(|r| f64::from(p.raw_angle_deg) - r)),
+        );
+        let summary = Summary {
+            compensation: config.compensation,
+            outputs: series.len(),
+            duration_s: match (series.first(), series.last()) {
+                (Some(a), Some(b)) => b.time_s - a.time_s,
+                _ => 0.0,
+            },
+            movements: movements.len(),
+            rejected_samples: pipeline.rejected_samples(),
+            final_angle_deg: series.last().map_or(0.0, |p| p.angle_deg),
+            final_raw_angle_deg: series.last().map_or(0.0, |p| p.raw_angle_deg),
+            max_abs_error_deg: max_abs,
+            rms_error_deg: rms,
+            final_error_deg: final_e,
+            raw_max_abs_error_deg: raw_max_abs,
+            raw_rms_error_deg: raw_rms,
+            raw_final_error_deg: raw_final,
+        };
+        RunReport {
+            sample_rate_hz,
+            decimation_factor: factor,
+            output_rate_hz,
+            input,
+            config,
+            reference_delay_s,
+            temperature_reference_c: pipeline.corrector().reference_c(),
+            summary,
+            movements,
+            series,
+        }
+    }
 }
 
 /// The reference angle at grid position `i − shift_slots`, linear between slots: `None`

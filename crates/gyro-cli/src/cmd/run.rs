@@ -69,17 +69,24 @@ pub fn run(args: &Args) -> Result<()> {
             CompensationArg::Kalman => Compensation::Kalman,
         };
     }
-    let (raw, warnings) = log::read_log_with_warnings(&args.log, &args.input)?;
-    for warning in &warnings {
-        eprintln!("warning: {warning}");
-    }
-    let regular = log::regularize(&raw, &args.grid)?;
-    drop(raw); // the rows are on the grid now; free them before the replay
-    let result = replay::replay_with(&regular, &config, &options).with_context(|| {
-        format!(
-            "{}: cannot configure the pipeline for this log",
-            args.log.display()
-        )
+    // One pass: rows are read, placed on the grid and replayed as they come; only the
+    // output series is kept.
+    let result = replay::replay_file(
+        &args.log,
+        &args.input,
+        &args.grid,
+        &config,
+        &options,
+        &mut |warning| eprintln!("warning: {warning}"),
+    )
+    .map_err(|e| match e {
+        replay::ReplayFileError::Log(e) => anyhow::Error::new(e),
+        replay::ReplayFileError::Config { path, cause } => {
+            anyhow::Error::new(cause).context(format!(
+                "{}: cannot configure the pipeline for this log",
+                path.display()
+            ))
+        }
     })?;
     let file = args.log.display().to_string();
     let mut stdout = std::io::stdout().lock();

@@ -4,16 +4,20 @@
 //! [`read_log`] reads either format (by content, else by extension); [`write_log`] writes
 //! either by extension.
 
+mod ahead;
 mod csv_log;
 pub mod mcap;
 mod regular;
 
-pub use csv_log::{read_csv, write_csv, ColumnOptions, RateUnit, TimeUnit};
+pub use ahead::read_ahead;
+pub use csv_log::{read_csv, write_csv, ColumnOptions, CsvRows, RateUnit, TimeUnit};
 pub use mcap::{
     read_mcap, write_mcap, Axis, JsonChannel, McapLogWriter, McapOptions, McapRead,
     McapWriteOptions, TimeSource,
 };
-pub use regular::{regularize, GridOptions, Quality, RegularLog, Slot};
+pub use regular::{
+    place, regularize, GridOptions, LogInfo, Quality, RegularLog, Slot, SlotSink, RATE_WINDOW_STEPS,
+};
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -143,11 +147,16 @@ pub struct Log {
 impl Log {
     /// The `sample_rate_hz` metadata value, if present and a positive number.
     pub fn metadata_rate_hz(&self) -> Option<f64> {
-        self.metadata
-            .get("sample_rate_hz")
-            .and_then(|v| v.trim().parse::<f64>().ok())
-            .filter(|v| v.is_finite() && *v > 0.0)
+        metadata_rate_hz(&self.metadata)
     }
+}
+
+/// The `sample_rate_hz` value of a log's metadata, if present and a positive number.
+pub fn metadata_rate_hz(metadata: &BTreeMap<String, String>) -> Option<f64> {
+    metadata
+        .get("sample_rate_hz")
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .filter(|v| v.is_finite() && *v > 0.0)
 }
 
 /// Why a log could not be read. Every variant names the file; row-level ones the line.
