@@ -25,7 +25,7 @@
 // Small dense linear algebra reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
-use super::stats::{Residuals, SMOOTH_WINDOW_S};
+use super::stats::{stretches, Residuals, SMOOTH_WINDOW_S};
 use crate::noise::AllanDeviation;
 
 /// Regressor names, in coefficient order.
@@ -200,7 +200,7 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
                 None => f64::NAN,
             })
             .collect();
-        let segments: Vec<&[f64]> = finite_runs(&residual)
+        let segments: Vec<&[f64]> = stretches(residual.len(), |i| residual[i].is_finite())
             .into_iter()
             .map(|run| &residual[run])
             .collect();
@@ -242,26 +242,6 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
         temperature_varies,
         static_diff_var,
     }
-}
-
-/// Ranges of consecutive finite values.
-fn finite_runs(x: &[f64]) -> Vec<std::ops::Range<usize>> {
-    let mut out = Vec::new();
-    let mut start = None;
-    for (i, v) in x.iter().enumerate() {
-        match (v.is_finite(), start) {
-            (true, None) => start = Some(i),
-            (false, Some(s)) => {
-                out.push(s..i);
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    if let Some(s) = start {
-        out.push(s..x.len());
-    }
-    out
 }
 
 /// Solve the leading `n`×`n` block of a symmetric positive definite system by Cholesky

@@ -21,7 +21,7 @@
 use super::ensemble::{member_seed, simulate_residuals, RealRun};
 use super::features::MIN_TEMPERATURE_RANGE_C;
 use super::fit::{model_with, nominal_model};
-use super::stats::{residuals, Residuals, MAX_LAG_S};
+use super::stats::{residuals, stretches, Residuals, MAX_LAG_S};
 use super::{Diagnosis, EffectResult, Options};
 use crate::noise::{welch, AllanDeviation, PsdOptions, TauGrid, ONE_SIGMA};
 use crate::plot::diagnose_plot::{
@@ -253,26 +253,6 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
         }
     }
     acc.iter().sum::<f64>() + tail
-}
-
-/// Maximal runs of consecutive indices for which `ok` holds.
-fn stretches(n: usize, ok: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
-    let mut out = Vec::new();
-    let mut start = None;
-    for i in 0..n {
-        match (ok(i), start) {
-            (true, None) => start = Some(i),
-            (false, Some(s)) => {
-                out.push(s..i);
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    if let Some(s) = start {
-        out.push(s..n);
-    }
-    out
 }
 
 impl Measures {

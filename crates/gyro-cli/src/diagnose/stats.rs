@@ -210,10 +210,15 @@ pub fn residuals_of(
 
 /// Maximal runs of consecutive `true`.
 fn runs(mask: &[bool]) -> Vec<std::ops::Range<usize>> {
+    stretches(mask.len(), |i| mask[i])
+}
+
+/// Maximal runs of consecutive indices below `n` for which `ok` holds.
+pub(crate) fn stretches(n: usize, ok: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
     let mut out = Vec::new();
     let mut start = None;
-    for (i, &m) in mask.iter().enumerate() {
-        match (m, start) {
+    for i in 0..n {
+        match (ok(i), start) {
             (true, None) => start = Some(i),
             (false, Some(s)) => {
                 out.push(s..i);
@@ -223,7 +228,7 @@ fn runs(mask: &[bool]) -> Vec<std::ops::Range<usize>> {
         }
     }
     if let Some(s) = start {
-        out.push(s..mask.len());
+        out.push(s..n);
     }
     out
 }

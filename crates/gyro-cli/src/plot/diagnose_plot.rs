@@ -14,6 +14,7 @@ use super::{
     colour, draw_err, legend_corner, legend_size, padded, sig, tick, titled, DrawResult, Figure,
     RenderError, LABEL_PX, TICK_PX,
 };
+use crate::diagnose::stats::stretches;
 use plotters::coord::combinators::BindKeyPoints;
 use plotters::coord::ranged1d::Ranged;
 use plotters::coord::types::RangedCoordf64;
@@ -196,26 +197,6 @@ fn linear_chart<'a, DB: DrawingBackend>(
         .draw()
         .map_err(draw_err)?;
     Ok(chart)
-}
-
-/// Maximal runs of consecutive indices for which `ok` holds.
-fn stretches(n: usize, ok: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
-    let mut out = Vec::new();
-    let mut start = None;
-    for i in 0..n {
-        match (ok(i), start) {
-            (true, None) => start = Some(i),
-            (false, Some(s)) => {
-                out.push(s..i);
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    if let Some(s) = start {
-        out.push(s..n);
-    }
-    out
 }
 
 /// Draw the bands, the real data and the legend on `chart`; `norm` maps a data point to
