@@ -154,6 +154,74 @@ fn names_an_injected_scale_factor_and_compensates_it() {
     );
 }
 
+/// Diagnose `train` against `holdout` (small ensembles) and return the JSON.
+fn diagnose_json(train: &[String], holdout: &[String]) -> serde_json::Value {
+    let mut args = vec![
+        "diagnose",
+        "--format",
+        "json",
+        "--members",
+        "20",
+        "--candidate-members",
+        "8",
+        "--train",
+    ];
+    args.extend(train.iter().map(String::as_str));
+    args.push("--holdout");
+    args.extend(holdout.iter().map(String::as_str));
+    json_of(&gyro(&args))
+}
+
+#[test]
+fn a_clock_error_is_named_from_the_time_stamps_not_as_a_scale_factor() {
+    let dir = temp_dir("diagnose_clock");
+    let effect = [Effect::ClockError { ppm: 5000.0 }];
+    let train = runs(&dir, "train", 4, &effect, 20);
+    let holdout = runs(&dir, "hold", 3, &effect, 60);
+    let d = diagnose_json(&train, &holdout);
+    let first = &d["effects"][0];
+    assert_eq!(first["id"], "clock_error", "{}", d["effects"]);
+    assert_eq!(first["significant"], true);
+    let ppm = first["params"]["ppm"].as_f64().unwrap();
+    assert!((ppm - 5000.0).abs() < 1.0, "ppm = {ppm}");
+    assert_eq!(
+        d["verdict"]["unmodelled"],
+        serde_json::json!(["clock_error"])
+    );
+
+    // Without the nominal rate in the logs, the grid takes the stamps' own rate: the
+    // rate is right on that time base, so nothing is named and the clock error is
+    // listed as untestable, with what it needs.
+    let strip = |paths: &[String], prefix: &str| -> Vec<String> {
+        paths
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let text = std::fs::read_to_string(p).unwrap();
+                let kept: String = text
+                    .lines()
+                    .filter(|l| !l.starts_with("# sample_rate_hz"))
+                    .map(|l| format!("{l}\n"))
+                    .collect();
+                write(&dir, &format!("{prefix}{i}.csv"), &kept)
+            })
+            .collect()
+    };
+    let d = diagnose_json(&strip(&train, "bare_train"), &strip(&holdout, "bare_hold"));
+    assert_eq!(
+        d["verdict"]["unmodelled"],
+        serde_json::json!([]),
+        "{}",
+        d["effects"]
+    );
+    let untestable = d["untestable"].as_array().unwrap();
+    assert!(
+        untestable.iter().any(|u| u["id"] == "clock_error"
+            && u["reason"].as_str().unwrap().contains("sample_rate_hz")),
+        "{untestable:?}"
+    );
+}
+
 #[test]
 fn nothing_significant_without_an_effect() {
     let dir = temp_dir("diagnose_null");

@@ -195,12 +195,15 @@ fn clock_error_scales_the_angle_with_a_clean_rate_shape() {
         "{gained} vs {}",
         eps * total_angle
     );
-    // The measured rate is the true rate sampled at slightly shifted times: its shape
-    // still matches the truth closely (no scale error in the rate itself at a given time).
+    // The stamps are the true sample times, 1/(fs(1+ε)) apart.
+    let last = with.rows.last().unwrap();
+    let period = last.time_s / (with.rows.len() - 1) as f64;
+    assert!((period * FS * (1.0 + eps) - 1.0).abs() < 1e-9, "{period}");
+    // The measured rate is the true rate at its stamp (no scale error in the rate itself).
     let true_at_sample: Vec<f64> = with
         .rows
         .iter()
-        .map(|r| motion.rate_dps(r.time_s / (1.0 + eps)))
+        .map(|r| motion.rate_dps(r.time_s))
         .collect();
     let residual: Vec<f64> = rates(&with)
         .iter()

@@ -3,8 +3,8 @@
 //! without and with it).
 //!
 //! What the core corrects, per effect: `scale_factor` → `correction.scale_k`;
-//! `clock_error` → `correction.scale_k` too (with one time base a fast clock scales the
-//! integrated angle exactly like a scale factor); `scale_asymmetry` →
+//! `clock_error` → `correction.scale_k` too (integrated over nominal periods, the samples
+//! of a clock fast by ε give 1 + ε times the angle, exactly like a scale factor); `scale_asymmetry` →
 //! `correction.asymmetry_k`; `temperature_bias` → `correction.bias_dps_per_c` and
 //! `temperature_scale` → `correction.scale_per_c` (ΔT from the first temperature of the
 //! run, as the simulator defines them); `latency` → `reference_delay_s`; `bandwidth` →

@@ -11,7 +11,7 @@
 //!   `[1, ω, |ω|, (ω/100)³, α, dα/dt, ΔT, ω·ΔT]` (α: reference angular acceleration, ΔT:
 //!   temperature change since the run's first sample; the last two only when the run's
 //!   temperature varies). One regression separates effects that act together:
-//!   `scale_factor` (and `clock_error`) → ω, `scale_asymmetry` → |ω|, `nonlinearity` →
+//!   `scale_factor` (and, on the nominal grid, `clock_error`) → ω, `scale_asymmetry` → |ω|, `nonlinearity` →
 //!   ω³, `latency` and `bandwidth` → −α (a delay d gives −d·α + d²/2·dα/dt; a two-pole
 //!   low-pass of time constant τ gives −2τ·α + 3τ²·dα/dt, which is how they differ),
 //!   `temperature_bias` → ΔT, `temperature_scale` → ω·ΔT; the intercept is the run's

@@ -10,7 +10,7 @@
 //! ±1.96 null standard deviations (deterministic effects), χ² bounds (turn-on bias) or
 //! ±1.96 null standard deviations of the variance (wander), mapped to the parameter.
 
-use super::ensemble::{simulate_member, Member, RealRun};
+use super::ensemble::{simulate_features, simulate_member, Member, RealRun, StampedClock};
 use super::features::{reg, CUBIC_SCALE_DPS, WANDER_TAUS_S};
 use crate::noise::fit::gauss_markov_avar_continuous;
 use crate::noise::{chi2_quantile, rate_step};
@@ -308,29 +308,154 @@ impl FitInput<'_> {
         (real, replicas)
     }
 
-    /// Pooled regression coefficient `index` of noise-free simulations with `effects`.
-    fn noise_free(&self, effects: &[Effect], index: usize) -> f64 {
+    /// Pooled regression coefficients of noise-free simulations with `effects`.
+    fn noise_free(&self, effects: &[Effect]) -> [f64; 8] {
         let quiet = SensorModel {
             arw_deg_per_rt_h: 0.0,
             gm_sigma_dps: 0.0,
             lsb_dps: 0.0,
             ..*self.model
         };
-        let values: Vec<f64> = self
+        let coefs: Vec<[f64; 8]> = self
             .train
             .par_iter()
-            .map(|r| simulate_member(r, &quiet, effects, 1).features.coef[index])
+            .map(|r| simulate_features(r, &quiet, effects, 1))
             .collect();
-        mean(values.into_iter())
+        std::array::from_fn(|i| mean(coefs.iter().map(|c| c[i])))
     }
 }
 
-/// Fit every effect of the vocabulary on the training runs.
-pub fn fit_all(input: &FitInput) -> (Vec<Fit>, Vec<Untestable>) {
+/// What the regression fits share: the noise-free coefficients without any effect, and
+/// the effects already established from direct evidence (a clock error from the time
+/// stamps), on top of which the others are fitted.
+struct Known {
+    quiet: [f64; 8],
+    effects: Vec<Effect>,
+    /// Noise-free coefficients with `effects`.
+    with_effects: [f64; 8],
+}
+
+impl Known {
+    fn new(input: &FitInput, quiet: [f64; 8], effects: Vec<Effect>) -> Self {
+        let with_effects = if effects.is_empty() {
+            quiet
+        } else {
+            input.noise_free(&effects)
+        };
+        Self {
+            quiet,
+            effects,
+            with_effects,
+        }
+    }
+}
+
+/// Effects fitted from the joint regression, which [`Joint`] refits given the others.
+fn conditional(effect: &Effect) -> bool {
+    matches!(
+        effect,
+        Effect::ScaleFactor { .. }
+            | Effect::ScaleAsymmetry { .. }
+            | Effect::Nonlinearity { .. }
+            | Effect::Latency { .. }
+            | Effect::Bandwidth { .. }
+            | Effect::TemperatureBias { .. }
+            | Effect::TemperatureScale { .. }
+    )
+}
+
+/// Deterministic effects, which a noise-free calibration can hold as known.
+fn deterministic(effect: &Effect) -> bool {
+    conditional(effect)
+        || matches!(
+            effect,
+            Effect::ClockError { .. } | Effect::Saturation { .. }
+        )
+}
+
+/// Joint fits of a set of effects: each regression-based effect refitted with the others
+/// of the set (and the stamped clock) held as known, one pass in the set's order. Each
+/// effect alone is fitted against the nominal model, which misses products of effects
+/// (a 1% scale factor makes a latency look 1% longer); held-out statistics resolve such
+/// differences, so sets are scored with their joint fits. Cached per set.
+pub struct Joint<'a> {
+    input: &'a FitInput<'a>,
+    quiet: [f64; 8],
+    clock: Vec<Effect>,
+    cache: std::sync::Mutex<std::collections::BTreeMap<String, Vec<Option<Fit>>>>,
+}
+
+impl Joint<'_> {
+    /// The refitted fit of each effect of `set` (`None`: kept as fitted alone).
+    pub fn fits(&self, set: &[Effect]) -> Vec<Option<Fit>> {
+        if set.len() < 2 || !set.iter().any(conditional) {
+            return vec![None; set.len()];
+        }
+        let key = format!("{set:?}");
+        if let Some(hit) = self.cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
+            return hit;
+        }
+        let mut current = set.to_vec();
+        let mut out = vec![None; set.len()];
+        for i in 0..set.len() {
+            if !conditional(&set[i]) {
+                continue;
+            }
+            let others: Vec<Effect> = self
+                .clock
+                .iter()
+                .chain(
+                    current
+                        .iter()
+                        .enumerate()
+                        .filter(|(j, _)| *j != i)
+                        .map(|x| x.1),
+                )
+                .copied()
+                .filter(deterministic)
+                .collect();
+            if others.len() == self.clock.len() {
+                continue;
+            }
+            let known = Known::new(self.input, self.quiet, others);
+            if let Ok(f) = fit_one(self.input, &known, set[i]) {
+                current[i] = f.effect;
+                out[i] = Some(f);
+            }
+        }
+        if let Ok(mut c) = self.cache.lock() {
+            c.insert(key, out.clone());
+        }
+        out
+    }
+
+    /// The effects of `set` with their joint fits.
+    pub fn effects(&self, set: &[Effect]) -> Vec<Effect> {
+        set.iter()
+            .zip(self.fits(set))
+            .map(|(e, f)| f.map_or(*e, |f| f.effect))
+            .collect()
+    }
+}
+
+/// Relative mismatch at which the gain calibration stops iterating.
+const CALIBRATION_TOL: f64 = 2e-4;
+
+/// Fit every effect of the vocabulary on the training runs (alone, on top of a clock
+/// error seen in the time stamps), and the context for joint fits of sets.
+pub fn fit_all<'a>(input: &'a FitInput<'a>) -> (Vec<Fit>, Vec<Untestable>, Joint<'a>) {
     let mut fits = Vec::new();
     let mut untestable = Vec::new();
+    let quiet = input.noise_free(&[]);
+    let clock: Vec<Effect> = clock_fit(input)
+        .ok()
+        .filter(|f| f.passes)
+        .map(|f| f.effect)
+        .into_iter()
+        .collect();
+    let known = Known::new(input, quiet, clock.clone());
     for info in EFFECTS {
-        match fit_one(input, info.typical) {
+        match fit_one(input, &known, info.typical) {
             Ok(f) => fits.push(f),
             Err(reason) => untestable.push(Untestable {
                 id: info.id,
@@ -338,40 +463,105 @@ pub fn fit_all(input: &FitInput) -> (Vec<Fit>, Vec<Untestable>) {
             }),
         }
     }
-    (fits, untestable)
+    let joint = Joint {
+        input,
+        quiet,
+        clock,
+        cache: Default::default(),
+    };
+    (fits, untestable, joint)
 }
 
 /// A regression-coefficient effect: estimate, null z, gain-corrected parameter and CI.
+///
+/// `make` takes the first-order parameter, `to_param` maps a coefficient change to it.
+/// The estimate is the coefficient's excess over the null replicas, less what the known
+/// effects give; the parameter is the one whose noise-free simulation of the training
+/// runs (with the known effects) shows that excess: one gain step, then, for a candidate
+/// (|z| ≥ [`Z_CRITICAL`]), secant steps until it matches within [`CALIBRATION_TOL`]
+/// (held-out statistics resolve strong effects to a fraction of a percent).
 fn regression_fit(
     input: &FitInput,
+    known: &Known,
     index: usize,
     make: &dyn Fn(f64) -> Effect,
     to_param: &dyn Fn(f64) -> f64,
 ) -> (Effect, f64, (f64, f64)) {
     let (real, replicas) = input.pooled(&|f| f.coef[index]);
     let (m0, s0) = mean_sd(&replicas);
-    let z = (real - m0) / s0;
-    let raw = real - m0;
+    let raw = real - m0 - (known.with_effects[index] - known.quiet[index]);
+    let z = raw / s0;
     let half = 1.96 * s0 * (1.0 + 1.0 / replicas.len().max(1) as f64).sqrt();
-    // Gain: noise-free coefficient change per unit of the first-order parameter.
-    let mut gain = 1.0;
-    let param = to_param(raw);
-    if param != 0.0 && param.is_finite() {
-        let with = input.noise_free(&[make(param)], index);
-        let without = input.noise_free(&[], index);
-        let g = (with - without) / raw;
+    let response = |x: f64| -> f64 {
+        let mut set = known.effects.clone();
+        set.push(make(to_param(x)));
+        input.noise_free(&set)[index] - known.with_effects[index]
+    };
+    // x: the coefficient change the parameter would give at unit gain.
+    let mut x = raw;
+    if to_param(raw) != 0.0 && to_param(raw).is_finite() {
+        let r0 = response(raw);
+        let g = r0 / raw;
         if g.is_finite() && g > 0.2 && g < 5.0 {
-            gain = g;
+            x = raw / g;
+            if z.abs() >= Z_CRITICAL {
+                let (mut xa, mut ra) = (raw, r0);
+                for _ in 0..4 {
+                    let rb = response(x);
+                    if (rb - raw).abs() <= CALIBRATION_TOL * raw.abs() {
+                        break;
+                    }
+                    let slope = (rb - ra) / (x - xa);
+                    let next = x + (raw - rb) / slope;
+                    if !(slope.is_finite() && slope > 0.0 && next.is_finite())
+                        || (next / raw).abs() > 5.0
+                    {
+                        break;
+                    }
+                    (xa, ra) = (x, rb);
+                    x = next;
+                }
+            }
         }
     }
-    let est = raw / gain;
+    let gain = if x != 0.0 { raw / x } else { 1.0 };
     // Plus the systematic allowance of the simulation-calibrated gain.
     let half = (half * half + (SYSTEMATIC_REL * raw).powi(2)).sqrt();
     let (lo, hi) = ((raw - half) / gain, (raw + half) / gain);
-    (make(to_param(est)), z, (to_param(lo), to_param(hi)))
+    (make(to_param(x)), z, (to_param(lo), to_param(hi)))
 }
 
-fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
+/// Clock error from the time stamps ([`StampedClock`]): the training runs' mean ppm,
+/// tested against its standard error (between-run scatter and each run's stamp
+/// scatter; at least 0.01 ppm).
+fn clock_fit(input: &FitInput) -> Result<Fit, String> {
+    let clocks: Option<Vec<StampedClock>> = input.train.iter().map(|r| r.clock).collect();
+    let Some(clocks) = clocks else {
+        return Err(
+            "needs the nominal sample rate (`# sample_rate_hz` metadata or \
+                    --sample-rate-hz): a clock error shows as time stamps drifting from it"
+                .into(),
+        );
+    };
+    let ppm: Vec<f64> = clocks.iter().map(|c| c.ppm).collect();
+    let n = ppm.len() as f64;
+    let m = ppm.iter().sum::<f64>() / n;
+    let between = if ppm.len() > 1 { sample_var(&ppm) } else { 0.0 };
+    let within = clocks.iter().map(|c| c.se_ppm * c.se_ppm).sum::<f64>() / n;
+    let se = ((between + within) / n).sqrt().max(0.01);
+    let z = m / se;
+    let half = t95(ppm.len().saturating_sub(1)).max(1.96) * se;
+    Ok(Fit {
+        effect: Effect::ClockError { ppm: m },
+        ci95: vec![(Some(m - half), Some(m + half))],
+        z,
+        passes: z.abs() >= Z_CRITICAL,
+        test: "time stamps' period vs the nominal sample rate".into(),
+        direct: false,
+    })
+}
+
+fn fit_one(input: &FitInput, known: &Known, typical: Effect) -> Result<Fit, String> {
     let exact = f64::NAN;
     let temperature = || -> Result<(), String> {
         if input.temperature_ok {
@@ -401,8 +591,13 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
     let some = |(a, b): (f64, f64)| vec![(Some(a.min(b)), Some(a.max(b)))];
     Ok(match typical {
         Effect::ScaleFactor { .. } => {
-            let (e, z, ci) =
-                regression_fit(input, reg::RATE, &|k| Effect::ScaleFactor { k }, &|x| x);
+            let (e, z, ci) = regression_fit(
+                input,
+                known,
+                reg::RATE,
+                &|k| Effect::ScaleFactor { k },
+                &|x| x,
+            );
             fit(
                 e,
                 z,
@@ -411,22 +606,11 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
                 "regression slope on rate vs null replicas",
             )
         }
-        Effect::ClockError { .. } => {
-            let (e, z, ci) =
-                regression_fit(input, reg::RATE, &|ppm| Effect::ClockError { ppm }, &|x| {
-                    x * 1e6
-                });
-            fit(
-                e,
-                z,
-                some(ci),
-                true,
-                "regression slope on rate vs null replicas (x 1e6)",
-            )
-        }
+        Effect::ClockError { .. } => clock_fit(input)?,
         Effect::ScaleAsymmetry { .. } => {
             let (e, z, ci) = regression_fit(
                 input,
+                known,
                 reg::ABS_RATE,
                 &|k| Effect::ScaleAsymmetry { k },
                 &|x| x,
@@ -443,6 +627,7 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
             let scale = CUBIC_SCALE_DPS.powi(3);
             let (e, z, ci) = regression_fit(
                 input,
+                known,
                 reg::RATE_CUBED,
                 &|k3_per_dps2| Effect::Nonlinearity { k3_per_dps2 },
                 &|x| x / scale,
@@ -458,6 +643,7 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
         Effect::Latency { .. } => {
             let (e, z, ci) = regression_fit(
                 input,
+                known,
                 reg::ACCELERATION,
                 &|d| Effect::Latency {
                     delay_s: d.clamp(0.0, 1.0),
@@ -474,7 +660,8 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
             )
         }
         Effect::Bandwidth { .. } => {
-            // A two-pole low-pass delays slow motion by 2/(2π f_pole), f_pole = 1.554 f_c.
+            // A two-pole low-pass delays slow motion by 2/(2π f_pole), f_pole = 1.554 f_c:
+            // fitted as a delay (its first-order parameter), calibrated as a low-pass.
             let per_delay = 1.0 / (std::f64::consts::PI * 1.5538);
             let nyquist = 0.5 * input.model.sample_rate_hz;
             let to_cutoff = |d: f64| -> f64 {
@@ -484,32 +671,22 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
                     nyquist
                 }
             };
-            let (real, replicas) = input.pooled(&|f| f.coef[reg::ACCELERATION]);
-            let (m0, s0) = mean_sd(&replicas);
-            let z = -(real - m0) / s0;
-            let d = -(real - m0);
-            let half = 1.96 * s0 * (1.0 + 1.0 / replicas.len().max(1) as f64).sqrt();
-            let half = (half * half + (SYSTEMATIC_REL * d).powi(2)).sqrt();
-            let mut cutoff = to_cutoff(d);
-            if d > 0.0 {
-                // Gain: the delay a noise-free simulation at this cutoff shows.
-                let with = input.noise_free(
-                    &[Effect::Bandwidth { cutoff_hz: cutoff }],
-                    reg::ACCELERATION,
-                );
-                let without = input.noise_free(&[], reg::ACCELERATION);
-                let d_sim = -(with - without);
-                if d_sim > 0.0 && d_sim.is_finite() {
-                    cutoff = (cutoff * d_sim / d).min(nyquist);
-                }
-            }
-            let scale = if d > 0.0 { cutoff * d } else { per_delay };
-            let bound = |dd: f64| (dd > 0.0).then(|| (scale / dd).min(nyquist));
-            let ci = vec![(bound(d + half), bound(d - half))];
+            let (e, z, (d_lo, d_hi)) = regression_fit(
+                input,
+                known,
+                reg::ACCELERATION,
+                &|d| Effect::Bandwidth {
+                    cutoff_hz: to_cutoff(d),
+                },
+                &|x| -x,
+            );
+            // Interval: the (calibrated) delay's, mapped like the estimate.
+            let (d_lo, d_hi) = (d_lo.min(d_hi), d_lo.max(d_hi));
+            let bound = |dd: f64| (dd > 0.0).then(|| to_cutoff(dd));
             fit(
-                Effect::Bandwidth { cutoff_hz: cutoff },
-                z,
-                ci,
+                e,
+                -z,
+                vec![(bound(d_hi), bound(d_lo))],
                 false,
                 "delay from the acceleration regression vs null replicas (one-sided)",
             )
@@ -518,6 +695,7 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
             temperature()?;
             let (e, z, ci) = regression_fit(
                 input,
+                known,
                 reg::DELTA_T,
                 &|dps_per_c| Effect::TemperatureBias { dps_per_c },
                 &|x| x,
@@ -534,6 +712,7 @@ fn fit_one(input: &FitInput, typical: Effect) -> Result<Fit, String> {
             temperature()?;
             let (e, z, ci) = regression_fit(
                 input,
+                known,
                 reg::RATE_DELTA_T,
                 &|per_c| Effect::TemperatureScale { per_c },
                 &|x| x,

@@ -17,7 +17,10 @@
 //!    Effects are ranked by held-out gap reduction. When several are significant, each is
 //!    dropped in turn from the model holding all of them (leave-one-out); one whose
 //!    removal costs nothing significant is redundant: it is confounded with the others
-//!    (e.g. clock error and scale factor leave the same signature) and not named.
+//!    (e.g. a latency next to a bandwidth) and not named. A clock error is measured from
+//!    the time stamps against the nominal sample rate ([`ensemble::StampedClock`]); the
+//!    regression-based effects are fitted on top of it (on the nominal grid the pipeline
+//!    integrates on, a fast clock scales the rate like a scale factor).
 //! 4. **How far**: the gap with the selected effects on the training and held-out runs,
 //!    and the fraction of the held-out gap closed relative to the floor.
 
@@ -419,7 +422,7 @@ pub fn diagnose(
         temperature_ok,
         seed: options.seed,
     };
-    let (fits, untestable) = fit::fit_all(&input);
+    let (fits, untestable, joint) = fit::fit_all(&input);
     let before_c = rescore(&hold_refs, &base_hold.members, mc);
     let g_before_c = gap(&before_c);
     let observations: usize = before_c.iter().map(|s| s.count).sum();
@@ -460,6 +463,7 @@ pub fn diagnose(
         }
     };
     let eval_set = |set: &[Effect]| -> Vec<RunScore> {
+        let set = &joint.effects(set);
         let model = fit::model_with(&nominal, set, white_target);
         if set.iter().all(|e| fit::is_identity(e, &nominal)) && model == nominal {
             (0..mc * holdout.len()).for_each(|_| progress.tick());
@@ -699,7 +703,14 @@ pub fn diagnose(
     }
     let final_scores = current;
 
-    // 4. How far.
+    // 4. How far, with the joint fits of the selected effects (as they were scored).
+    let alone: Vec<Effect> = selected.iter().map(|&i| candidates[i].fit.effect).collect();
+    for (&i, refit) in selected.iter().zip(joint.fits(&alone)) {
+        if let Some(f) = refit {
+            candidates[i].fit.effect = f.effect;
+            candidates[i].fit.ci95 = f.ci95;
+        }
+    }
     let selected_effects: Vec<Effect> =
         selected.iter().map(|&i| candidates[i].fit.effect).collect();
     let final_model = fit::model_with(&nominal, &selected_effects, white_target);

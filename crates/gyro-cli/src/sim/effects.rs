@@ -45,7 +45,10 @@ pub enum Effect {
         /// Delay (s).
         delay_s: f64,
     },
-    /// The sample clock runs fast by `ppm`: samples labelled k/fs are taken at k/(fs(1+ε)).
+    /// The sensor's sample clock runs fast by `ppm`: sample k is taken at k/(fs(1+ε)), and
+    /// the log stamps it with that time (a logger's accurate clock) while `sample_rate_hz`
+    /// stays the nominal fs the firmware integrates with. The rate is right at its stamp;
+    /// integrated over nominal periods, the angle gains ε × the angle turned.
     ClockError {
         /// Clock error (parts per million).
         ppm: f64,
@@ -144,7 +147,7 @@ pub const EFFECTS: &[EffectInfo] = &[
     EffectInfo {
         id: "clock_error",
         params: &[("ppm", "ppm")],
-        signature: "angle error proportional to total angle; rate residual clean",
+        signature: "time stamps drift from the nominal rate; angle error proportional to total angle; rate residual clean at the stamps",
         typical: Effect::ClockError { ppm: 5000.0 },
     },
     EffectInfo {

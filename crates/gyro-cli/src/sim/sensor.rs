@@ -175,13 +175,20 @@ pub fn simulate(
 ) -> Log {
     let series = simulate_series(model, effects, motion, options, None);
     let fs = series.sample_rate_hz;
+    // Samples are stamped when they are taken, by the logger's (accurate) clock: a
+    // sensor clock error shows as stamps that drift from the nominal k / fs.
+    let clock = 1.0 + clock_ppm(effects) * 1e-6;
     // Rounded to what a logger would keep (and what reads back short from CSV).
     let round = |x: f64, step: f64| (x / step).round() * step;
     let rows = (0..series.rate_dps.len())
         .filter(|&k| series.rate_dps[k].is_finite())
         .map(|k| Row {
             line: 0,
-            time_s: k as f64 / fs,
+            time_s: if clock == 1.0 {
+                k as f64 / fs
+            } else {
+                round(k as f64 / (fs * clock), 1e-9)
+            },
             rate_dps: Some(round(series.rate_dps[k], 1e-6)),
             reference_deg: Some(round(series.reference_deg[k], 1e-6)),
             temperature_c: Some(round(series.temperature_c[k], 1e-3)),
@@ -204,7 +211,22 @@ pub fn simulate(
     }
 }
 
+/// The clock error of `effects` (ppm; 0 without one).
+fn clock_ppm(effects: &[Effect]) -> f64 {
+    effects
+        .iter()
+        .map(|e| match *e {
+            Effect::ClockError { ppm } => ppm,
+            _ => 0.0,
+        })
+        .sum()
+}
+
 /// Simulate `motion` as seen by `model` with `effects`, as columns.
+///
+/// A clock error takes sample `k` at `k / (fs (1 + ε))`: on the columns' nominal grid
+/// (sample `k` at `k / fs`, the period the firmware integrates with) the motion runs
+/// faster by 1 + ε; [`simulate`] stamps each sample with its true time.
 ///
 /// `temperature_c`, when given, is the temperature at each sample (a recorded run's, so
 /// a re-simulation sees the same temperatures; NaN entries take the previous value);
