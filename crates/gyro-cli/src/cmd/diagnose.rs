@@ -60,6 +60,10 @@ pub struct Args {
     /// Run the injection–recovery self-check instead of diagnosing logs.
     #[arg(long)]
     self_test: bool,
+    /// With --self-test: only the cases that inject this effect id (`none`: the null
+    /// cases); each case is the same as in the whole run.
+    #[arg(long, requires = "self_test")]
+    only: Option<String>,
     #[command(flatten)]
     grid: log::GridOptions,
     #[command(flatten)]
@@ -199,11 +203,23 @@ fn self_test(args: &Args) -> Result<()> {
         ProgressStyle::with_template("self-test {pos}/{len} {msg:<40} {elapsed_precise}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let result = selftest::run(args.seed, &options, &|k, total, label| {
-        bar.set_length(total as u64);
-        bar.set_position(k as u64);
-        bar.set_message(label.to_string());
-    });
+    if let Some(id) = args.only.as_deref() {
+        if id != "none" && !gyro_host::sim::EFFECTS.iter().any(|e| e.id == id) {
+            anyhow::bail!(
+                "--only {id}: not an effect id (see `gyro-cli simulate --list-effects`) nor `none`"
+            );
+        }
+    }
+    let result = selftest::run(
+        args.seed,
+        args.only.as_deref(),
+        &options,
+        &|k, total, label| {
+            bar.set_length(total as u64);
+            bar.set_position(k as u64);
+            bar.set_message(label.to_string());
+        },
+    );
     bar.finish_and_clear();
     let result = result?;
     let mut stdout = std::io::stdout().lock();

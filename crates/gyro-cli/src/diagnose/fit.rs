@@ -46,8 +46,9 @@ pub struct Fit {
     pub passes: bool,
     /// What the test was.
     pub test: String,
-    /// The effect is seen directly in the raw data (a grid, a plateau, gaps): it is
-    /// significant when the same direct test also passes on the held-out runs.
+    /// The effect is seen directly in the raw data (a grid, a plateau, gaps), or is a
+    /// between-run effect (turn-on bias): it is significant when the same test also
+    /// passes on the held-out runs.
     pub direct: bool,
 }
 
@@ -71,6 +72,41 @@ pub fn direct_evidence(effect: &Effect, runs: &[&RealRun], model: &SensorModel) 
         Effect::Dropouts { .. } => runs.iter().map(|r| r.gaps).sum::<u64>() >= MIN_GAPS,
         _ => false,
     }
+}
+
+/// The between-run spread of the bias (the regression intercept) of `runs` against
+/// their null ensembles: `(n−1) s²/v0` is χ²(n−1) without a turn-on bias (s²: the runs'
+/// sample variance, v0: the mean of the replicas'). Returns (its Wilson–Hilferty
+/// z-score, s², v0, n−1).
+fn bias_spread(runs: &[&RealRun], null: &[Vec<Member>]) -> (f64, f64, f64, f64) {
+    let real: Vec<f64> = runs
+        .iter()
+        .map(|r| r.features.coef[reg::INTERCEPT])
+        .collect();
+    let s2 = sample_var(&real);
+    let members = null.iter().map(Vec::len).min().unwrap_or(0);
+    let null_vars: Vec<f64> = (0..members)
+        .map(|j| {
+            let v: Vec<f64> = null
+                .iter()
+                .map(|m| m[j].features.coef[reg::INTERCEPT])
+                .collect();
+            sample_var(&v)
+        })
+        .collect();
+    let v0 = mean(null_vars.iter().copied());
+    let k = runs.len().saturating_sub(1) as f64;
+    let x = k * s2 / v0;
+    let c = 2.0 / (9.0 * k);
+    let z = ((x / k).cbrt() - (1.0 - c)) / c.sqrt();
+    (z, s2, v0, k)
+}
+
+/// A turn-on bias is a between-run effect: each held-out run alone says little (one run
+/// with a large bias, four with small ones), so, like the effects seen directly, it is
+/// significant when the training runs' test also passes on the held-out runs.
+pub fn turn_on_replicates(runs: &[&RealRun], null: &[Vec<Member>]) -> bool {
+    runs.len() >= 3 && bias_spread(runs, null).0 >= Z_CRITICAL
 }
 
 /// Two-sided 95% quantile of Student's t with `dof` degrees of freedom.
@@ -732,38 +768,21 @@ fn fit_one(input: &FitInput, known: &Known, typical: Effect) -> Result<Fit, Stri
                     "needs at least 3 training runs (between-run spread of the bias)".into(),
                 );
             }
-            let real: Vec<f64> = input
-                .train
-                .iter()
-                .map(|r| r.features.coef[reg::INTERCEPT])
-                .collect();
-            let s2 = sample_var(&real);
-            let null_vars: Vec<f64> = (0..input.members())
-                .map(|j| {
-                    let v: Vec<f64> = input
-                        .null
-                        .iter()
-                        .map(|m| m[j].features.coef[reg::INTERCEPT])
-                        .collect();
-                    sample_var(&v)
-                })
-                .collect();
-            let v0 = mean(null_vars.iter().copied());
-            let k = (n - 1) as f64;
-            // (n−1) s²/v0 ~ χ²(n−1) without the effect; Wilson–Hilferty to a z-score.
-            let x = k * s2 / v0;
-            let c = 2.0 / (9.0 * k);
-            let z = ((x / k).cbrt() - (1.0 - c)) / c.sqrt();
+            let (z, s2, v0, k) = bias_spread(input.train, input.null);
             let sigma = (s2 - v0).max(0.0).sqrt();
             let lo = (k * s2 / chi2_quantile(0.975, k) - v0).max(0.0).sqrt();
             let hi = (k * s2 / chi2_quantile(0.025, k) - v0).max(0.0).sqrt();
-            fit(
-                Effect::TurnOnBias { sigma_dps: sigma },
-                z,
-                vec![(Some(lo), Some(hi))],
-                false,
-                "between-run variance of the bias vs null replicas (chi-square, one-sided)",
-            )
+            Fit {
+                direct: true,
+                ..fit(
+                    Effect::TurnOnBias { sigma_dps: sigma },
+                    z,
+                    vec![(Some(lo), Some(hi))],
+                    false,
+                    "between-run variance of the bias vs null replicas (chi-square, one-sided; \
+                     replicated on the held-out runs)",
+                )
+            }
         }
         Effect::BiasInstability { .. } | Effect::RateRandomWalk { .. } => {
             let shape = |tau: f64| -> f64 {

@@ -84,6 +84,8 @@ pub struct CaseResult {
     pub fraction_closed: f64,
     /// Held-out gap before and after.
     pub holdout_gap: (f64, f64),
+    /// The diagnosis's table of effects (why an effect was or was not named).
+    pub effects: Vec<super::EffectResult>,
 }
 
 /// The self-check's summary.
@@ -189,12 +191,15 @@ fn score_case(kind: &'static str, injected: Vec<Effect>, d: &Diagnosis) -> CaseR
         covered,
         fraction_closed: d.verdict.fraction_closed_holdout,
         holdout_gap: (d.gap.holdout_before, d.gap.holdout_after),
+        effects: d.effects.clone(),
     }
 }
 
-/// Run the self-check; `progress` is told each case as it starts.
+/// Run the self-check (only the cases injecting `only`, or the null cases for `none`,
+/// when given); `progress` is told each case as it starts.
 pub fn run(
     seed: u64,
+    only: Option<&str>,
     options: &Options,
     progress: &dyn Fn(usize, usize, &str),
 ) -> Result<SelfTest, super::DiagnoseError> {
@@ -210,15 +215,25 @@ pub fn run(
     for _ in 0..NULL_CASES {
         plan.push(("null", Vec::new()));
     }
+    // Case seeds follow the position in the whole plan, so a case run alone is the same.
+    let plan: Vec<(usize, (&'static str, Vec<Effect>))> = plan
+        .into_iter()
+        .enumerate()
+        .filter(|(_, (_, effects))| match only {
+            None => true,
+            Some("none") => effects.is_empty(),
+            Some(id) => effects.iter().any(|e| e.id() == id),
+        })
+        .collect();
     let total = plan.len();
     let mut cases = Vec::new();
-    for (k, (kind, effects)) in plan.into_iter().enumerate() {
+    for (n, (k, (kind, effects))) in plan.into_iter().enumerate() {
         let label = if effects.is_empty() {
             "none".to_string()
         } else {
             effects.iter().map(|e| e.id()).collect::<Vec<_>>().join("+")
         };
-        progress(k, total, &label);
+        progress(n, total, &label);
         let case_seed = super::ensemble::member_seed(seed, 7_000_000 + k, 0);
         let (train, holdout) = case_runs(&effects, case_seed);
         let options = Options {
