@@ -52,10 +52,19 @@ pub struct Fit {
     pub direct: bool,
 }
 
-/// The direct test of saturation, quantisation or dropouts on `runs` (false for the
-/// other effects).
-pub fn direct_evidence(effect: &Effect, runs: &[&RealRun], model: &SensorModel) -> bool {
+/// The held-out replication of an effect whose significance is its own test passing
+/// again ([`Fit::direct`]): saturation, quantisation and dropouts seen directly in
+/// `runs`, and the turn-on bias's between-run spread against their `null` ensembles
+/// (each held-out run alone says little about a between-run effect: one run with a large
+/// bias cannot carry a bootstrap over runs). False for the other effects.
+pub fn direct_evidence(
+    effect: &Effect,
+    runs: &[&RealRun],
+    null: &[Vec<Member>],
+    model: &SensorModel,
+) -> bool {
     match effect {
+        Effect::TurnOnBias { .. } => runs.len() >= 3 && bias_spread(runs, null).0 >= Z_CRITICAL,
         Effect::Saturation { .. } => {
             runs.iter()
                 .map(|r| r.features.plateau_samples)
@@ -100,13 +109,6 @@ fn bias_spread(runs: &[&RealRun], null: &[Vec<Member>]) -> (f64, f64, f64, f64) 
     let c = 2.0 / (9.0 * k);
     let z = ((x / k).cbrt() - (1.0 - c)) / c.sqrt();
     (z, s2, v0, k)
-}
-
-/// A turn-on bias is a between-run effect: each held-out run alone says little (one run
-/// with a large bias, four with small ones), so, like the effects seen directly, it is
-/// significant when the training runs' test also passes on the held-out runs.
-pub fn turn_on_replicates(runs: &[&RealRun], null: &[Vec<Member>]) -> bool {
-    runs.len() >= 3 && bias_spread(runs, null).0 >= Z_CRITICAL
 }
 
 /// Two-sided 95% quantile of Student's t with `dof` degrees of freedom.

@@ -456,10 +456,8 @@ pub fn diagnose(
         }
     };
     let qualifies = |f: &fit::Fit, st: &Step| -> bool {
-        if let Effect::TurnOnBias { .. } = f.effect {
-            f.passes && fit::turn_on_replicates(&hold_refs, &base_hold.members)
-        } else if f.direct {
-            f.passes && fit::direct_evidence(&f.effect, &hold_refs, &nominal)
+        if f.direct {
+            f.passes && fit::direct_evidence(&f.effect, &hold_refs, &base_hold.members, &nominal)
         } else {
             f.passes && st.delta_bic > 0.0 && st.p < 0.05
         }
