@@ -5,8 +5,8 @@
 mod common;
 use common::{gyro, json_of, ok, temp_dir, write};
 
-use gyro_host::log;
-use gyro_host::sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+use gyro_log as log;
+use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
 use std::path::Path;
 
 /// A simulated bench run of `duration_s` at `fs`, written as CSV.

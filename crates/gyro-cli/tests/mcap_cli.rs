@@ -4,7 +4,7 @@
 mod common;
 use common::{gyro, ok, temp_dir, workspace_root};
 
-use gyro_host::log::{self, McapLogWriter, McapOptions, Row};
+use gyro_log::{self as log, McapLogWriter, McapOptions, Row};
 use std::path::Path;
 use std::process::Command;
 

@@ -8,11 +8,11 @@
 mod common;
 
 use common::{gyro, json_of, temp_dir, write};
+use gyro_analysis::model::{self, ModelError, ModelFile};
+use gyro_analysis::replay::{replay, replay_with, ReplayOptions};
 use gyro_core::{Config, Correction};
-use gyro_host::log::{self, GridOptions, RegularLog};
-use gyro_host::model::{self, ModelError, ModelFile};
-use gyro_host::replay::{replay, replay_with, ReplayOptions};
-use gyro_host::sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+use gyro_log::{self as log, GridOptions, RegularLog};
+use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
 
 const SCALE_K: f64 = 0.02;
 const TEMPERATURE_BIAS_DPS_PER_C: f64 = 0.05;
@@ -30,7 +30,7 @@ fn effects() -> [Effect; 3] {
 }
 
 /// A bench run (90 s of 90° rotations) of a sensor warming up by 10 °C.
-fn simulated(seed: u64) -> gyro_host::log::Log {
+fn simulated(seed: u64) -> gyro_log::Log {
     let motion = Motion::bench(&BenchProfile::default(), seed);
     let options = SimOptions {
         seed,

@@ -4,8 +4,8 @@
 mod common;
 use common::{gyro, json_of, temp_dir, write};
 
-use gyro_host::log;
-use gyro_host::sim::{simulate, Motion, Rotation, SensorModel, SimOptions};
+use gyro_log as log;
+use gyro_sim::{simulate, Motion, Rotation, SensorModel, SimOptions};
 use std::path::Path;
 use std::process::Output;
 
@@ -109,7 +109,7 @@ fn static_log_json_table_and_model_file() {
     assert!(!psd["bands"].as_array().unwrap().is_empty());
 
     // The model file: loadable, its sensor section from the fit, usable by `simulate`.
-    let fitted = gyro_host::model::load(Path::new(model_out)).unwrap();
+    let fitted = gyro_analysis::model::load(Path::new(model_out)).unwrap();
     assert_eq!(fitted.sensor.sample_rate_hz, 100.0);
     assert_eq!(fitted.sensor.arw_deg_per_rt_h, arw);
     assert_eq!(fitted.sensor.gm_sigma_dps, f(&gm["sigma_dps"]));

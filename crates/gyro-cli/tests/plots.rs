@@ -8,13 +8,13 @@
 mod common;
 use common::{bench_log, gyro};
 
+use gyro_analysis::calibrate::{calibrate, BenchRun, CalibrateOptions, Calibration};
+use gyro_analysis::noise::{self, Characterization, NoiseOptions};
+use gyro_analysis::replay::{replay, RunReport};
 use gyro_core::{Compensation, Config};
-use gyro_host::calibrate::{calibrate, BenchRun, CalibrateOptions, Calibration};
-use gyro_host::log::{self, GridOptions};
-use gyro_host::noise::{self, Characterization, NoiseOptions};
-use gyro_host::plot::{self, CalibrationPlot, Figure, ImageFormat, NoisePlot, RunPlot};
-use gyro_host::replay::{replay, RunReport};
-use gyro_host::sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+use gyro_log::{self as log, GridOptions};
+use gyro_report::plot::{self, CalibrationPlot, Figure, ImageFormat, NoisePlot, RunPlot};
+use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
 use std::path::{Path, PathBuf};
 
 /// Where plots go: `GYRO_PLOT_DIR` if set, else a fresh temporary directory.

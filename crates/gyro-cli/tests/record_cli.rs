@@ -6,8 +6,8 @@
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use crm100_driver::serial::serialport::{SerialPort, TTYPort};
-use gyro_host::bridge::{self, Emulator, EmulatorConfig, Pacing, Sample};
-use gyro_host::log::{self, McapOptions};
+use gyro_bridge::{self as bridge, Emulator, EmulatorConfig, Pacing, Sample};
+use gyro_log::{self as log, McapOptions};
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};

@@ -6,10 +6,10 @@
 
 mod common;
 use common::{bench_log, gyro, ok, temp_dir, workspace_root, write};
+use gyro_analysis::replay::{self, ReplayFileError, ReplayOptions, RunReport};
 use gyro_core::{Compensation, Config, Correction};
-use gyro_host::log::{self, GridOptions, LogOptions};
-use gyro_host::replay::{self, ReplayFileError, ReplayOptions, RunReport};
-use gyro_host::report;
+use gyro_log::{self as log, GridOptions, LogOptions};
+use gyro_report::run as report;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

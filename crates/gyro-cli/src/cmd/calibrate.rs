@@ -1,11 +1,12 @@
 //! `gyro-cli calibrate`: fit the error model on bench runs and write a model file.
 
 use anyhow::{Context, Result};
-use gyro_core::Config;
-use gyro_host::calibrate::{
+use gyro_analysis::calibrate::{
     calibrate, BenchRun, CalibrateOptions, Calibration, Objective, RunScore,
 };
-use gyro_host::{log, model};
+use gyro_analysis::model;
+use gyro_core::Config;
+use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 
@@ -45,7 +46,7 @@ pub struct Args {
     format: super::run::Format,
     /// Plot each run's max abs error without compensation, with the paper model and the
     /// Kalman form (training and hold-out runs) to this file: .svg or .png.
-    #[arg(long, value_parser = gyro_host::plot::parse_plot_path)]
+    #[arg(long, value_parser = gyro_report::plot::parse_plot_path)]
     plot: Option<PathBuf>,
 }
 
@@ -200,7 +201,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     eprintln!("wrote {}", args.out.display());
     if let Some(path) = &args.plot {
-        gyro_host::plot::calibrate_plot(path, &result)?;
+        gyro_report::plot::calibrate_plot(path, &result)?;
         eprintln!("wrote {}", path.display());
     }
     Ok(())

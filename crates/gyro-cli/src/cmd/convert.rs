@@ -1,7 +1,7 @@
 //! `gyro-cli convert`: a log from one format to another (CSV, MCAP, ROS 2 bag in MCAP).
 
 use anyhow::{bail, Result};
-use gyro_host::log;
+use gyro_log as log;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]

@@ -3,9 +3,10 @@
 
 use anyhow::{bail, Result};
 use clap::ValueEnum;
-use gyro_host::diagnose::ensemble::{split, RealRun};
-use gyro_host::diagnose::{self, selftest, Diagnosis, Options, Progress};
-use gyro_host::{log, model};
+use gyro_analysis::diagnose::ensemble::{split, RealRun};
+use gyro_analysis::diagnose::{self, selftest, Diagnosis, Options, Progress};
+use gyro_analysis::model;
+use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -204,7 +205,7 @@ fn self_test(args: &Args) -> Result<()> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     if let Some(id) = args.only.as_deref() {
-        if id != "none" && !gyro_host::sim::EFFECTS.iter().any(|e| e.id == id) {
+        if id != "none" && !gyro_sim::EFFECTS.iter().any(|e| e.id == id) {
             anyhow::bail!(
                 "--only {id}: not an effect id (see `gyro-cli simulate --list-effects`) nor `none`"
             );
@@ -336,7 +337,7 @@ fn write_report(
     holdout: &[RealRun],
     options: &Options,
 ) -> Result<()> {
-    diagnose::report::write_report(dir, result, train, holdout, options)?;
+    gyro_report::diagnose::write_report(dir, result, train, holdout, options)?;
     eprintln!("wrote {}", dir.join("index.html").display());
     Ok(())
 }

@@ -4,9 +4,9 @@
 use anyhow::{bail, Context, Result};
 use crm100_driver::serial::{self, serialport};
 use crm100_driver::Range;
-use gyro_host::bridge::{self, Emulator, EmulatorConfig, FaultSpec, Pacing, Sample};
-use gyro_host::log;
-use gyro_host::sim::SensorModel;
+use gyro_bridge::{self as bridge, Emulator, EmulatorConfig, FaultSpec, Pacing, Sample};
+use gyro_log as log;
+use gyro_sim::SensorModel;
 use std::io::Write;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;

@@ -2,8 +2,9 @@
 
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
-use gyro_host::noise::{self, Characterization, NoiseOptions, PsdOptions, TauGrid};
-use gyro_host::{log, model};
+use gyro_analysis::model;
+use gyro_analysis::noise::{self, Characterization, NoiseOptions, PsdOptions, TauGrid};
+use gyro_log as log;
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -71,7 +72,7 @@ pub struct Args {
     psd_out: Option<PathBuf>,
     /// Plot the Allan deviation with bounds, the fitted model and its terms, and the PSD
     /// to this file: .svg or .png (of all logs pooled, if several).
-    #[arg(long, value_parser = gyro_host::plot::parse_plot_path)]
+    #[arg(long, value_parser = gyro_report::plot::parse_plot_path)]
     plot: Option<PathBuf>,
     #[command(flatten)]
     grid: log::GridOptions,
@@ -221,7 +222,7 @@ pub fn run(args: &Args) -> Result<()> {
         };
         let file = match base {
             Some(base) => model::ModelFile {
-                sensor: gyro_host::sim::SensorModel {
+                sensor: gyro_sim::SensorModel {
                     range_dps: base.sensor.range_dps,
                     ..source.sensor_model()
                 },
@@ -248,10 +249,10 @@ pub fn run(args: &Args) -> Result<()> {
             let mut w = std::io::BufWriter::new(std::fs::File::create(out)?);
             writeln!(w, "log,frequency_hz,psd_dps2_per_hz")?;
             for (l, r) in loaded.iter().zip(&results) {
-                noise::report::psd_csv(&mut w, &l.file, r)?;
+                gyro_report::noise::psd_csv(&mut w, &l.file, r)?;
             }
             if let Some(c) = &combined {
-                noise::report::psd_csv(&mut w, "combined", c)?;
+                gyro_report::noise::psd_csv(&mut w, "combined", c)?;
             }
             w.flush()
         };
@@ -264,7 +265,7 @@ pub fn run(args: &Args) -> Result<()> {
             (None, [l, ..], [r, ..]) => (l.file.clone(), r),
             _ => bail!("no result to plot"),
         };
-        gyro_host::plot::noise_plot(path, &title, result)?;
+        gyro_report::plot::noise_plot(path, &title, result)?;
     }
 
     let mut stdout = std::io::stdout().lock();
@@ -280,11 +281,11 @@ pub fn run(args: &Args) -> Result<()> {
                 } else {
                     l.file.clone()
                 };
-                writeln!(stdout, "{}", noise::report::table(&label, r))?;
+                writeln!(stdout, "{}", gyro_report::noise::table(&label, r))?;
             }
             if let Some(c) = &combined {
                 let label = format!("all {} logs pooled", loaded.len());
-                writeln!(stdout, "{}", noise::report::table(&label, c))?;
+                writeln!(stdout, "{}", gyro_report::noise::table(&label, c))?;
             }
         }
         Format::Json => {

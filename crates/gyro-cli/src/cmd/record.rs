@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 use crm100_driver::{serial, Range};
-use gyro_host::bridge::{self, CsvSink, LiveStatus, McapSink, RecordOptions, RecordSink};
+use gyro_bridge::{self as bridge, CsvSink, LiveStatus, McapSink, RecordOptions, RecordSink};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Duration;

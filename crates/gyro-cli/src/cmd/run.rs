@@ -2,8 +2,11 @@
 
 use anyhow::{Context, Result};
 use clap::ValueEnum;
+use gyro_analysis::model;
+use gyro_analysis::replay;
 use gyro_core::{Compensation, Config};
-use gyro_host::{log, model, replay, report};
+use gyro_log as log;
+use gyro_report::run as report;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -45,7 +48,7 @@ pub struct Args {
     out: Option<PathBuf>,
     /// Plot angle vs reference, error (±1σ in Kalman mode), motion state and rate to this
     /// file: .svg or .png.
-    #[arg(long, value_parser = gyro_host::plot::parse_plot_path)]
+    #[arg(long, value_parser = gyro_report::plot::parse_plot_path)]
     plot: Option<PathBuf>,
     #[command(flatten)]
     grid: log::GridOptions,
@@ -108,7 +111,7 @@ pub fn run(args: &Args) -> Result<()> {
             .log
             .file_name()
             .map_or(file.clone(), |n| n.to_string_lossy().into());
-        gyro_host::plot::run_plot(path, &name, &result)?;
+        gyro_report::plot::run_plot(path, &name, &result)?;
     }
     Ok(())
 }

@@ -1,8 +1,9 @@
 //! `gyro-cli simulate`: the sensor simulator.
 
 use anyhow::{Context, Result};
-use gyro_host::sim::{self, BenchProfile, Effect, Motion, SensorModel, SimOptions};
-use gyro_host::{log, model};
+use gyro_analysis::model;
+use gyro_log as log;
+use gyro_sim::{self as sim, BenchProfile, Effect, Motion, SensorModel, SimOptions};
 use std::io::Write;
 use std::path::PathBuf;
 

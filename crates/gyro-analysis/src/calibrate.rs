@@ -1,0 +1,732 @@
+//! Fit the error model on bench runs with an encoder reference (the paper's calibration).
+//!
+//! The paper-mode parameters (β, b0, o0) only change what is subtracted per movement, not
+//! which samples are moving. So each run is replayed once through the real pipeline
+//! without compensation ([`Trace`]), and the paper-mode angle for any parameters is
+//! recomputed from that trace exactly as the pipeline would ([`Trace::paper_errors`];
+//! a test holds it to the pipeline). This makes an objective evaluation cost a pass over
+//! the 50 Hz samples instead of a 1 kHz replay. Reported per-run figures always come from
+//! real replays.
+//!
+//! Objective (fixed before fitting): by default the mean over runs of the max abs angle
+//! error over the run, as in the paper; alternatives: mean RMS error, worst max abs error.
+//! Parameters are searched as (ln β, b0, o0) with [`NelderMead`] within bounds
+//! β ∈ [1e-4, 10] 1/s, b0 ∈ [−10, 10] deg/s, o0 ∈ [−5, 5] deg, from β = 1/T of the rest
+//! data's correlation estimate (or 0.01 1/s), b0 = the median rest bias, o0 = 0.
+
+use crate::replay::{replay, RunReport, Summary};
+use gyro_core::{Compensation, Config, GaussMarkov, MotionState, Pipeline};
+use gyro_log::RegularLog;
+use nelder_mead::{Bounds, InitialSteps, NelderMead, Termination};
+use serde::Serialize;
+
+/// A bench run: a log with a reference.
+#[derive(Clone, Debug)]
+pub struct BenchRun {
+    /// Name shown in reports (the file).
+    pub name: String,
+    /// The log on its grid.
+    pub log: RegularLog,
+}
+
+/// What the fit minimises.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "snake_case")]
+pub enum Objective {
+    /// Mean over runs of the max abs angle error (the paper's).
+    #[default]
+    MeanMaxAbs,
+    /// Mean over runs of the RMS angle error.
+    MeanRms,
+    /// Max over runs of the max abs angle error.
+    WorstMaxAbs,
+    /// RMS over all completed movements of the movement's angle error (the angle a
+    /// wrench reports when the turn ends); least squares on the movement totals.
+    MovementRms,
+}
+
+impl Objective {
+    /// The objective over `traces` for paper-mode parameters `gm` (deg).
+    fn evaluate(self, traces: &[Trace], gm: &GaussMarkov) -> f64 {
+        if self == Objective::MovementRms {
+            let (mut sum_sq, mut n) = (0.0, 0_usize);
+            for e in traces.iter().flat_map(|t| t.paper_movement_errors(gm)) {
+                sum_sq += e * e;
+                n += 1;
+            }
+            return if n == 0 {
+                f64::INFINITY
+            } else {
+                (sum_sq / n as f64).sqrt()
+            };
+        }
+        let (mut sum, mut worst, mut n) = (0.0, 0.0_f64, 0_usize);
+        for trace in traces {
+            let (max_abs, rms) = trace.paper_errors(gm);
+            let v = if self == Objective::MeanRms {
+                rms
+            } else {
+                max_abs
+            };
+            sum += v;
+            worst = worst.max(v);
+            n += 1;
+        }
+        match self {
+            Objective::WorstMaxAbs => worst,
+            _ if n == 0 => f64::INFINITY,
+            _ => sum / n as f64,
+        }
+    }
+}
+
+/// One movement as the uncompensated pipeline saw it, in output-sample indices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Span {
+    /// Last quiet sample before the movement.
+    start: usize,
+    /// Sample at which the movement was confirmed.
+    confirmed: usize,
+    /// First quiet sample after it, and the sample confirming the rest (if it ended).
+    end: Option<(usize, usize)>,
+}
+
+/// A run replayed once without compensation: what paper-mode angles are computed from.
+#[derive(Clone, Debug)]
+pub struct Trace {
+    output_period_s: f64,
+    raw_deg: Vec<f64>,
+    reference_deg: Vec<Option<f64>>,
+    spans: Vec<Span>,
+    /// Mean rate of each rest of at least 1 s (deg/s).
+    pub rest_means_dps: Vec<f64>,
+    /// Standard deviation of the rate about its rest mean, pooled over rests (deg/s).
+    pub rest_noise_dps: Option<f64>,
+}
+
+impl Trace {
+    /// Replay `log` with `config` (compensation switched off) and keep what the paper
+    /// mode needs.
+    pub fn new(log: &RegularLog, config: &Config) -> Result<Self, gyro_core::Error> {
+        let none = Config {
+            compensation: Compensation::None,
+            ..*config
+        };
+        let report = replay(log, &none)?;
+        let delay_s = Pipeline::try_new(&report.config)?.filter_delay_s();
+        Ok(Self::from_report(&report, delay_s))
+    }
+
+    /// `delay_s`: the pipeline's filter delay, which it subtracts from movement times.
+    fn from_report(report: &RunReport, delay_s: f64) -> Self {
+        let series = &report.series;
+        let output_period_s = 1.0 / f64::from(report.output_rate_hz);
+        // The output sample a movement boundary belongs to: nearest to time + delay.
+        let index_of = |time_s: f64| -> usize {
+            let t = time_s + delay_s;
+            let i = series.partition_point(|p| p.time_s < t);
+            let i = if i > 0
+                && (i >= series.len() || (t - series[i - 1].time_s) < (series[i].time_s - t))
+            {
+                i - 1
+            } else {
+                i
+            };
+            i.min(series.len().saturating_sub(1))
+        };
+        let spans = report
+            .movements
+            .iter()
+            .map(|m| {
+                let start = index_of(m.start_time_s);
+                let confirmed = (start + 1..series.len())
+                    .find(|&k| series[k].motion == MotionState::Dynamic)
+                    .unwrap_or(series.len());
+                let end = m.complete.then(|| {
+                    let end = index_of(m.end_time_s);
+                    let ended = (confirmed..series.len())
+                        .find(|&k| series[k].motion == MotionState::Static)
+                        .unwrap_or(series.len());
+                    (end, ended)
+                });
+                Span {
+                    start,
+                    confirmed,
+                    end,
+                }
+            })
+            .collect();
+
+        // Rest statistics from stretches of static samples of at least 1 s.
+        let min_len = (1.0 / output_period_s).ceil() as usize;
+        let (mut rest_means_dps, mut sum_sq, mut count) = (Vec::new(), 0.0, 0_usize);
+        let mut k = 0;
+        while k < series.len() {
+            if series[k].motion != MotionState::Static {
+                k += 1;
+                continue;
+            }
+            let start = k;
+            while k < series.len() && series[k].motion == MotionState::Static {
+                k += 1;
+            }
+            // Skip 0.2 s at both ends of each static stretch: the filter's tail of the last
+            // movement, and the onset of the next one (static until it is confirmed).
+            let margin = min_len / 5;
+            let (lo, hi) = (start + margin, k.saturating_sub(margin));
+            let rest = if lo < hi { &series[lo..hi] } else { &[][..] };
+            if rest.len() >= min_len {
+                let mean =
+                    rest.iter().map(|p| f64::from(p.rate_dps)).sum::<f64>() / rest.len() as f64;
+                sum_sq += rest
+                    .iter()
+                    .map(|p| (f64::from(p.rate_dps) - mean).powi(2))
+                    .sum::<f64>();
+                count += rest.len() - 1;
+                rest_means_dps.push(mean);
+            }
+        }
+        Self {
+            output_period_s,
+            raw_deg: series.iter().map(|p| f64::from(p.raw_angle_deg)).collect(),
+            reference_deg: series.iter().map(|p| p.reference_deg).collect(),
+            spans,
+            rest_means_dps,
+            rest_noise_dps: (count > 0).then(|| (sum_sq / count as f64).sqrt()),
+        }
+    }
+
+    /// Paper-mode angle at every output sample for parameters `gm`.
+    pub fn paper_angles(&self, gm: &GaussMarkov) -> Vec<f64> {
+        let o = |samples: usize| {
+            f64::from(gm.misalignment_deg(samples as f32 * self.output_period_s as f32))
+        };
+        let mut angles = vec![0.0; self.raw_deg.len()];
+        let mut total = 0.0;
+        let mut k = 0;
+        for span in &self.spans {
+            let (stop, after) = match span.end {
+                Some((end, ended)) => (ended.min(angles.len()), Some((end, ended))),
+                None => (angles.len(), None),
+            };
+            while k < span.confirmed.min(angles.len()) {
+                angles[k] = total;
+                k += 1;
+            }
+            let raw_start = self.raw_deg[span.start];
+            while k < stop {
+                angles[k] = total + self.raw_deg[k] - raw_start - o(k - span.start);
+                k += 1;
+            }
+            if let Some((end, ended)) = after {
+                if ended < angles.len() {
+                    total += self.raw_deg[ended] - raw_start - o(end - span.start);
+                }
+            }
+        }
+        while k < angles.len() {
+            angles[k] = total;
+            k += 1;
+        }
+        angles
+    }
+
+    /// Paper-mode angle error of each completed movement (deg): the movement's angle
+    /// minus the reference's change over it.
+    pub fn paper_movement_errors(&self, gm: &GaussMarkov) -> Vec<f64> {
+        let o = |samples: usize| {
+            f64::from(gm.misalignment_deg(samples as f32 * self.output_period_s as f32))
+        };
+        self.spans
+            .iter()
+            .filter_map(|span| {
+                let (end, ended) = span.end?;
+                let reference = self.reference_deg.get(end)?.as_ref()?
+                    - self.reference_deg.get(span.start)?.as_ref()?;
+                let angle =
+                    self.raw_deg.get(ended)? - self.raw_deg[span.start] - o(end - span.start);
+                Some(angle - reference)
+            })
+            .collect()
+    }
+
+    /// Max abs and RMS of the paper-mode angle error against the reference.
+    pub fn paper_errors(&self, gm: &GaussMarkov) -> (f64, f64) {
+        let angles = self.paper_angles(gm);
+        let (mut max_abs, mut sum_sq, mut n) = (0.0_f64, 0.0, 0_usize);
+        for (a, r) in angles.iter().zip(&self.reference_deg) {
+            if let Some(r) = r {
+                let e = a - r;
+                max_abs = max_abs.max(e.abs());
+                sum_sq += e * e;
+                n += 1;
+            }
+        }
+        if n == 0 {
+            (f64::NAN, f64::NAN)
+        } else {
+            (max_abs, (sum_sq / n as f64).sqrt())
+        }
+    }
+}
+
+/// Errors of one run under each compensation, from real replays.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunScore {
+    /// The run.
+    pub name: String,
+    /// Max abs error without compensation (deg).
+    pub none_max_abs_deg: f64,
+    /// Max abs error with the paper error model (deg).
+    pub paper_max_abs_deg: f64,
+    /// Max abs error with the Kalman form (deg).
+    pub kalman_max_abs_deg: f64,
+    /// RMS errors (none, paper, kalman) (deg).
+    pub rms_deg: [f64; 3],
+}
+
+/// One parameter under leave-one-run-out refits.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ParamSpread {
+    /// Mean of the refits.
+    pub mean: f64,
+    /// Standard deviation of the refits.
+    pub sd: f64,
+    /// Smallest refit.
+    pub min: f64,
+    /// Largest refit.
+    pub max: f64,
+    /// Jackknife standard error of the full fit: `sqrt((n−1)/n · Σ(θ_i − θ̄)²)`. Refits
+    /// on n−1 of n runs barely differ, so their sd understates the uncertainty by ≈ √n.
+    pub standard_error: f64,
+}
+
+/// Spread of the parameters under leave-one-run-out refits.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Spread {
+    /// Refits done (one per left-out run).
+    pub refits: usize,
+    /// β (1/s).
+    pub beta_per_s: ParamSpread,
+    /// b0 (deg/s).
+    pub b0_dps: ParamSpread,
+    /// o0 (deg).
+    pub o0_deg: ParamSpread,
+}
+
+/// The outcome of a calibration.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Calibration {
+    /// Fitted paper-mode parameters.
+    pub paper: GaussMarkov,
+    /// Objective minimised.
+    pub objective: Objective,
+    /// Its value at the fit (deg).
+    pub objective_deg: f64,
+    /// Starting correlation time of the fit (s) and where it came from (`option`,
+    /// `rest_allan` or `default`).
+    pub initial_tau: (f64, &'static str),
+    /// Why the optimiser stopped.
+    pub termination: String,
+    /// Objective evaluations.
+    pub evaluations: usize,
+    /// The configuration written to the model file.
+    pub config: Config,
+    /// Per training run.
+    pub train: Vec<RunScore>,
+    /// Per hold-out run.
+    pub holdout: Vec<RunScore>,
+    /// Leave-one-run-out spread (with 3 or more training runs).
+    pub spread: Option<Spread>,
+}
+
+/// Why calibration failed.
+#[derive(Debug, thiserror::Error)]
+pub enum CalibrateError {
+    /// A run has no reference.
+    #[error("{0}: no reference_deg column; calibration needs the encoder angle")]
+    NoReference(String),
+    /// No runs.
+    #[error("no training runs")]
+    NoRuns,
+    /// No movement in any run.
+    #[error("no movement found in any training run: nothing to fit")]
+    NoMovement,
+    /// The configuration does not fit a run.
+    #[error("{name}: {source}")]
+    Config {
+        /// Run.
+        name: String,
+        /// Which setting.
+        source: gyro_core::Error,
+    },
+    /// The optimiser refused the problem.
+    #[error("optimiser: {0}")]
+    Optimiser(String),
+}
+
+fn param_spread(values: &[f64]) -> ParamSpread {
+    let [mean, sd, min, max] = stats(values);
+    let n = values.len() as f64;
+    ParamSpread {
+        mean,
+        sd,
+        min,
+        max,
+        standard_error: sd * (n - 1.0) / n.sqrt(),
+    }
+}
+
+fn stats(values: &[f64]) -> [f64; 4] {
+    let n = values.len().max(1) as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+    let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    [mean, var.sqrt(), min, max]
+}
+
+fn median(mut values: Vec<f64>) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    Some(values[values.len() / 2])
+}
+
+/// Fit (β, b0, o0) on `traces`; `progress` is called after each evaluation with the best
+/// objective so far.
+fn fit_paper(
+    traces: &[Trace],
+    objective: Objective,
+    start: GaussMarkov,
+    progress: &mut dyn FnMut(usize, f64),
+) -> Result<(GaussMarkov, f64, Termination, usize), CalibrateError> {
+    let to_gm = |x: &[f64]| GaussMarkov {
+        beta_per_s: x[0].exp() as f32,
+        b0_dps: x[1] as f32,
+        o0_deg: x[2] as f32,
+    };
+    let bounds = Bounds::new(
+        vec![1e-4_f64.ln(), -10.0, -5.0],
+        vec![10f64.ln(), 10.0, 5.0],
+    )
+    .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
+    // Initial steps of a size that matters for each parameter (scipy's 5 % rule would give
+    // o0 = 0 a step of 0.00025 and a flat simplex); one restart from the result guards
+    // against the simplex collapsing early.
+    let optimiser = NelderMead::new()
+        .with_bounds(bounds)
+        .with_initial_steps(InitialSteps::Absolute(vec![0.7, 0.1, 0.05]))
+        .and_then(|o| o.with_x_tolerance(1e-4))
+        .and_then(|o| o.with_f_tolerance(1e-6))
+        .and_then(|o| o.with_max_evaluations(1500))
+        .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
+    let mut x = vec![
+        f64::from(start.beta_per_s).clamp(1.1e-4, 9.0).ln(),
+        f64::from(start.b0_dps).clamp(-9.0, 9.0),
+        f64::from(start.o0_deg).clamp(-4.0, 4.0),
+    ];
+    let (mut evaluations, mut best) = (0, f64::INFINITY);
+    let mut outcome = None;
+    for _ in 0..2 {
+        let result = optimiser
+            .minimize(
+                |x| {
+                    let value = objective.evaluate(traces, &to_gm(x));
+                    evaluations += 1;
+                    best = best.min(value);
+                    progress(evaluations, best);
+                    value
+                },
+                x.clone(),
+            )
+            .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
+        x.clone_from(&result.x);
+        outcome = Some(result);
+    }
+    let outcome = outcome.ok_or_else(|| CalibrateError::Optimiser("no run".into()))?;
+    Ok((
+        to_gm(&outcome.x),
+        outcome.f,
+        outcome.termination,
+        evaluations,
+    ))
+}
+
+fn score(run: &BenchRun, config: &Config) -> Result<RunScore, CalibrateError> {
+    let summary = |compensation| -> Result<Summary, CalibrateError> {
+        let config = Config {
+            compensation,
+            ..*config
+        };
+        replay(&run.log, &config)
+            .map(|r| r.summary)
+            .map_err(|source| CalibrateError::Config {
+                name: run.name.clone(),
+                source,
+            })
+    };
+    let [none, paper, kalman] = [
+        Compensation::None,
+        Compensation::Paper,
+        Compensation::Kalman,
+    ]
+    .map(summary);
+    let (none, paper, kalman) = (none?, paper?, kalman?);
+    let nan = f64::NAN;
+    Ok(RunScore {
+        name: run.name.clone(),
+        none_max_abs_deg: none.max_abs_error_deg.unwrap_or(nan),
+        paper_max_abs_deg: paper.max_abs_error_deg.unwrap_or(nan),
+        kalman_max_abs_deg: kalman.max_abs_error_deg.unwrap_or(nan),
+        rms_deg: [
+            none.rms_error_deg.unwrap_or(nan),
+            paper.rms_error_deg.unwrap_or(nan),
+            kalman.rms_error_deg.unwrap_or(nan),
+        ],
+    })
+}
+
+/// Options of [`calibrate`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CalibrateOptions {
+    /// What to minimise.
+    pub objective: Objective,
+    /// Refit leaving each run out, for the parameters' spread.
+    pub leave_one_out: bool,
+    /// Initial correlation time of the bias (s), e.g. from `noise`; default: the
+    /// Gauss-Markov term fitted to the rest segments' Allan deviation, else 100 s.
+    pub initial_tau_s: Option<f64>,
+    /// Also fit the motion detector's thresholds (`enter_dps`, `exit_dps`).
+    pub fit_motion: bool,
+}
+
+/// The correlation time of the bias from the rest segments of `runs` (Allan deviation
+/// with a significant Gauss-Markov term), if they show one. Runs at another sample rate
+/// than the first are left out.
+fn rest_correlation_time(runs: &[BenchRun], base: &Config) -> Option<f64> {
+    let rate_hz = runs.first()?.log.sample_rate_hz;
+    let mut segments: Vec<Vec<f64>> = Vec::new();
+    for run in runs.iter().filter(|r| r.log.sample_rate_hz == rate_hz) {
+        let ranges = crate::noise::rest_segments(&run.log, base, 0.5, 1.0).ok()?;
+        for range in ranges {
+            segments.push(run.log.slots[range].iter().map(|s| s.rate_dps).collect());
+        }
+    }
+    let views: Vec<&[f64]> = segments.iter().map(Vec::as_slice).collect();
+    let c =
+        crate::noise::characterize(&views, rate_hz, &crate::noise::NoiseOptions::default()).ok()?;
+    let gm = c.fit.gauss_markov;
+    if gm.significant {
+        gm.corr_time_s
+    } else {
+        None
+    }
+}
+
+fn traces_for(runs: &[BenchRun], base: &Config) -> Result<Vec<Trace>, CalibrateError> {
+    runs.iter()
+        .map(|run| {
+            Trace::new(&run.log, base).map_err(|source| CalibrateError::Config {
+                name: run.name.clone(),
+                source,
+            })
+        })
+        .collect()
+}
+
+/// Fit the detector thresholds around the paper fit: an outer Nelder-Mead over
+/// (ln exit_dps, ln(enter_dps − exit_dps)), each point scored by the best paper fit on
+/// traces replayed with those thresholds.
+fn fit_motion(
+    train: &[BenchRun],
+    base: &Config,
+    objective: Objective,
+    start: GaussMarkov,
+    progress: &mut dyn FnMut(&str, usize, f64),
+) -> Result<Config, CalibrateError> {
+    let with = |x: &[f64]| {
+        let mut config = *base;
+        config.motion.exit_dps = x[0].exp() as f32;
+        config.motion.enter_dps = (x[0].exp() + x[1].exp()) as f32;
+        config
+    };
+    let bounds = Bounds::new(
+        vec![0.01_f64.ln(), 0.05_f64.ln()],
+        vec![2f64.ln(), 10f64.ln()],
+    )
+    .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
+    let optimiser = NelderMead::new()
+        .with_bounds(bounds)
+        .with_initial_steps(InitialSteps::Absolute(vec![0.4, 0.4]))
+        .and_then(|o| o.with_x_tolerance(0.02))
+        .and_then(|o| o.with_f_tolerance(1e-4))
+        .and_then(|o| o.with_max_evaluations(60))
+        .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
+    let exit = f64::from(base.motion.exit_dps).clamp(0.011, 1.9);
+    let gap = (f64::from(base.motion.enter_dps) - exit).clamp(0.051, 9.9);
+    let mut evaluations = 0;
+    let outcome = optimiser
+        .try_minimize(
+            |x| -> Result<f64, CalibrateError> {
+                let traces = traces_for(train, &with(x))?;
+                let (_, value, ..) = fit_paper(&traces, objective, start, &mut |_, _| {})?;
+                evaluations += 1;
+                progress("motion thresholds", evaluations, value);
+                Ok(value)
+            },
+            vec![exit.ln(), gap.ln()],
+        )
+        .map_err(|e| match e {
+            nelder_mead::Error::Objective(e) => e,
+            other => CalibrateError::Optimiser(other.to_string()),
+        })?;
+    Ok(with(&outcome.x))
+}
+
+/// Calibrate `base` on `train`; score on `train` and `holdout`.
+pub fn calibrate(
+    train: &[BenchRun],
+    holdout: &[BenchRun],
+    base: &Config,
+    options: &CalibrateOptions,
+    progress: &mut dyn FnMut(&str, usize, f64),
+) -> Result<Calibration, CalibrateError> {
+    if train.is_empty() {
+        return Err(CalibrateError::NoRuns);
+    }
+    for run in train.iter().chain(holdout) {
+        if !run.log.has_reference {
+            return Err(CalibrateError::NoReference(run.name.clone()));
+        }
+    }
+    let initial_tau = match options.initial_tau_s {
+        Some(tau_s) => (tau_s, "option"),
+        None => match rest_correlation_time(train, base) {
+            Some(tau_s) => (tau_s, "rest_allan"),
+            None => (100.0, "default"),
+        },
+    };
+    let mut base = *base;
+    let mut traces = traces_for(train, &base)?;
+    if traces.iter().all(|t| t.spans.is_empty()) {
+        return Err(CalibrateError::NoMovement);
+    }
+    let rest_means: Vec<f64> = traces
+        .iter()
+        .flat_map(|t| t.rest_means_dps.iter().copied())
+        .collect();
+    let start = GaussMarkov {
+        beta_per_s: (1.0 / initial_tau.0) as f32,
+        b0_dps: median(rest_means.clone()).unwrap_or(0.0) as f32,
+        o0_deg: 0.0,
+    };
+    if options.fit_motion {
+        base = fit_motion(train, &base, options.objective, start, progress)?;
+        traces = traces_for(train, &base)?;
+    }
+    let (paper, objective_deg, termination, evaluations) =
+        fit_paper(&traces, options.objective, start, &mut |n, best| {
+            progress("fit", n, best)
+        })?;
+
+    let spread = if options.leave_one_out && traces.len() >= 3 {
+        let mut fits = Vec::with_capacity(traces.len());
+        for i in 0..traces.len() {
+            let others: Vec<Trace> = traces
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, t)| t.clone())
+                .collect();
+            let (gm, ..) = fit_paper(&others, options.objective, paper, &mut |_, best| {
+                progress(
+                    &format!("leave-one-out {}/{}", i + 1, traces.len()),
+                    i,
+                    best,
+                )
+            })?;
+            fits.push(gm);
+        }
+        let pick = |f: fn(&GaussMarkov) -> f32| {
+            param_spread(&fits.iter().map(|g| f64::from(f(g))).collect::<Vec<_>>())
+        };
+        Some(Spread {
+            refits: fits.len(),
+            beta_per_s: pick(|g| g.beta_per_s),
+            b0_dps: pick(|g| g.b0_dps),
+            o0_deg: pick(|g| g.o0_deg),
+        })
+    } else {
+        None
+    };
+
+    // The Kalman form from the rest statistics. The bias wanders within a run (the spread
+    // of a run's rest means about their mean: the Gauss-Markov sigma) and differs between
+    // runs (turn-on: the initial uncertainty). Mixing the two would make the filter chase
+    // noise. White noise: of the filtered rate at rest.
+    let mut config = base;
+    config.paper = paper;
+    if let Some(mean) = median(rest_means.clone()) {
+        config.kalman.bias_mean_dps = mean as f32;
+    }
+    let (mut within_sq, mut within_n, mut run_means) = (0.0, 0_usize, Vec::new());
+    for t in &traces {
+        if let [first, ..] = t.rest_means_dps.as_slice() {
+            let mean = t.rest_means_dps.iter().sum::<f64>() / t.rest_means_dps.len() as f64;
+            within_sq += t
+                .rest_means_dps
+                .iter()
+                .map(|m| (m - mean).powi(2))
+                .sum::<f64>();
+            within_n += t.rest_means_dps.len() - 1;
+            run_means.push(if t.rest_means_dps.len() == 1 {
+                *first
+            } else {
+                mean
+            });
+        }
+    }
+    if within_n > 0 {
+        config.kalman.bias_sigma_dps = (within_sq / within_n as f64).sqrt().max(0.005) as f32;
+    }
+    if run_means.len() >= 2 {
+        config.kalman.initial_bias_sigma_dps =
+            (stats(&run_means)[1] as f32).max(config.kalman.bias_sigma_dps);
+    }
+    let noises: Vec<f64> = traces.iter().filter_map(|t| t.rest_noise_dps).collect();
+    if let Some(noise) = median(noises) {
+        config.kalman.rate_noise_dps = noise.max(1e-4) as f32;
+    }
+    let train_scores = train
+        .iter()
+        .map(|run| score(run, &config))
+        .collect::<Result<Vec<_>, _>>()?;
+    let holdout_scores = holdout
+        .iter()
+        .map(|run| score(run, &config))
+        .collect::<Result<Vec<_>, _>>()?;
+    // Use the compensation that did best on the training runs.
+    let mean = |f: fn(&RunScore) -> f64| {
+        train_scores.iter().map(f).sum::<f64>() / train_scores.len() as f64
+    };
+    config.compensation = if mean(|s| s.kalman_max_abs_deg) < mean(|s| s.paper_max_abs_deg) {
+        Compensation::Kalman
+    } else {
+        Compensation::Paper
+    };
+    Ok(Calibration {
+        paper,
+        objective: options.objective,
+        objective_deg,
+        initial_tau,
+        termination: format!("{termination:?}"),
+        evaluations,
+        config,
+        train: train_scores,
+        holdout: holdout_scores,
+        spread,
+    })
+}

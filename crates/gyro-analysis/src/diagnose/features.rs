@@ -1,0 +1,384 @@
+//! Per-run features from which the candidate effects' parameters are estimated.
+//!
+//! Every real run and every simulated ensemble member goes through [`features`], so an
+//! estimator's distribution under the nominal model is known from the ensemble (the
+//! null replicas), whatever its bias from the reference's differentiation or the bias
+//! wander.
+//!
+//! - **Joint regression** (one per run): the gyro averaged over the reference
+//!   derivative's window (trapezoid over ±h samples, so both sides see the same
+//!   smoothing and no lag is introduced) minus the reference rate ω, regressed on
+//!   `[1, ω, |ω|, (ω/100)³, α, dα/dt, ΔT, ω·ΔT]` (α: reference angular acceleration, ΔT:
+//!   temperature change since the run's first sample; the last two only when the run's
+//!   temperature varies). One regression separates effects that act together:
+//!   `scale_factor` (and, on the nominal grid, `clock_error`) → ω, `scale_asymmetry` → |ω|, `nonlinearity` →
+//!   ω³, `latency` and `bandwidth` → −α (a delay d gives −d·α + d²/2·dα/dt; a two-pole
+//!   low-pass of time constant τ gives −2τ·α + 3τ²·dα/dt, which is how they differ),
+//!   `temperature_bias` → ΔT, `temperature_scale` → ω·ΔT; the intercept is the run's
+//!   bias (`turn_on_bias` spreads it between runs). Samples on a clipped plateau are
+//!   left out (saturation is its own feature).
+//! - **Wander**: Allan variance of the regression residual at [`WANDER_TAUS_S`] (bias
+//!   wander not explained by the regressors: `bias_instability`, `rate_random_walk`).
+//! - **Plateau**: the largest |rate| and how many samples sit on it while the reference
+//!   is faster (`saturation`).
+
+// Small dense linear algebra reads best with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
+use super::stats::{stretches, Residuals, SMOOTH_WINDOW_S};
+use crate::noise::AllanDeviation;
+
+/// Regressor names, in coefficient order.
+pub const REGRESSORS: [&str; 8] = [
+    "intercept",
+    "rate",
+    "abs_rate",
+    "rate_cubed",
+    "acceleration",
+    "jerk",
+    "delta_temperature",
+    "rate_delta_temperature",
+];
+/// Index of each regressor.
+pub mod reg {
+    /// Intercept (deg/s).
+    pub const INTERCEPT: usize = 0;
+    /// ω (1).
+    pub const RATE: usize = 1;
+    /// |ω| (1).
+    pub const ABS_RATE: usize = 2;
+    /// (ω/100)³ (deg/s).
+    pub const RATE_CUBED: usize = 3;
+    /// α (s).
+    pub const ACCELERATION: usize = 4;
+    /// dα/dt (s²).
+    pub const JERK: usize = 5;
+    /// ΔT (deg/s/°C).
+    pub const DELTA_T: usize = 6;
+    /// ω·ΔT (1/°C).
+    pub const RATE_DELTA_T: usize = 7;
+}
+/// Scale of ω inside the cubic regressor (deg/s), for conditioning.
+pub const CUBIC_SCALE_DPS: f64 = 100.0;
+/// Averaging times of the wander feature (s).
+pub const WANDER_TAUS_S: [f64; 3] = [1.0, 4.0, 16.0];
+/// A run's temperature "varies" when its range exceeds this (°C).
+pub const MIN_TEMPERATURE_RANGE_C: f64 = 0.5;
+
+/// Features of one run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Features {
+    /// Regression coefficients ([`REGRESSORS`] order); NaN where the regressor was not used.
+    pub coef: [f64; 8],
+    /// Samples in the regression.
+    pub samples: usize,
+    /// Allan variance of the regression residual at [`WANDER_TAUS_S`] ((deg/s)²); NaN
+    /// when the run is too short.
+    pub wander_avar: [f64; 3],
+    /// Largest |rate| (deg/s).
+    pub max_abs_rate_dps: f64,
+    /// Samples with |rate| within `plateau_tol` of the largest while |reference rate|
+    /// exceeds it by more than the tolerance.
+    pub plateau_samples: usize,
+    /// The temperature varied enough for the temperature regressors.
+    pub temperature_varies: bool,
+    /// Mean of the smoothed-gyro residual's first differences squared / 2 on static
+    /// samples ((deg/s)²) and how many differences (white-noise level).
+    pub static_diff_var: (f64, usize),
+}
+
+/// The features of `r`; `plateau_tol_dps` is the tolerance of the clip plateau (e.g. an
+/// output step).
+pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
+    let n = r.rate_dps.len();
+    let fs = r.sample_rate_hz;
+    let h = ((fs * SMOOTH_WINDOW_S / 2.0).round() as usize).max(1);
+
+    // Plateau: samples at the largest |rate| while the reference is beyond it.
+    let max_abs = r
+        .rate_dps
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let tol = plateau_tol_dps.max(1e-9);
+    let on_plateau = |i: usize| r.rate_dps[i].abs() >= max_abs - tol;
+    let plateau_samples = (0..n)
+        .filter(|&i| on_plateau(i) && r.reference_rate_dps[i].abs() > max_abs + tol)
+        .count();
+    let clipped = plateau_samples >= 3;
+
+    // Smoothed gyro: trapezoid mean over [i − h, i + h], like the reference rate.
+    let mut smooth = vec![f64::NAN; n];
+    if n > 2 * h {
+        let mut prefix = Vec::with_capacity(n + 1);
+        prefix.push(0.0);
+        for v in &r.rate_dps {
+            prefix.push(prefix.last().copied().unwrap_or(0.0) + v);
+        }
+        for (i, s) in smooth.iter_mut().enumerate().take(n - h).skip(h) {
+            let inner = prefix[i + h] - prefix[i - h + 1];
+            *s = (inner + 0.5 * (r.rate_dps[i - h] + r.rate_dps[i + h])) / (2 * h) as f64;
+        }
+    }
+
+    let t_first = r.temperature_c.iter().copied().find(|t| t.is_finite());
+    let (t_min, t_max) = r
+        .temperature_c
+        .iter()
+        .filter(|t| t.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
+            (a.min(t), b.max(t))
+        });
+    let temperature_varies = t_first.is_some() && t_max - t_min >= MIN_TEMPERATURE_RANGE_C;
+    let used: usize = if temperature_varies { 8 } else { 6 };
+
+    // Jerk: the centred difference of the acceleration, like the acceleration of the rate.
+    let mut jerk = vec![f64::NAN; n];
+    for i in h..n.saturating_sub(h) {
+        jerk[i] = (r.reference_acceleration_dps2[i + h] - r.reference_acceleration_dps2[i - h])
+            * fs
+            / (2 * h) as f64;
+    }
+    let row = |i: usize| -> Option<([f64; 8], f64)> {
+        let (g, w, a, j) = (
+            smooth[i],
+            r.reference_rate_dps[i],
+            r.reference_acceleration_dps2[i],
+            jerk[i],
+        );
+        if !(g.is_finite() && w.is_finite() && a.is_finite() && j.is_finite()) {
+            return None;
+        }
+        if clipped && on_plateau(i) {
+            return None;
+        }
+        let dt = match t_first {
+            Some(t0) if temperature_varies => {
+                let t = r.temperature_c[i];
+                if !t.is_finite() {
+                    return None;
+                }
+                t - t0
+            }
+            _ => 0.0,
+        };
+        let u = w / CUBIC_SCALE_DPS;
+        Some(([1.0, w, w.abs(), u * u * u, a, j, dt, w * dt], g - w))
+    };
+    let mut xtx = [[0.0f64; 8]; 8];
+    let mut xty = [0.0f64; 8];
+    let mut samples = 0usize;
+    for i in 0..n {
+        if let Some((x, y)) = row(i) {
+            samples += 1;
+            for a in 0..used {
+                for b in a..used {
+                    xtx[a][b] += x[a] * x[b];
+                }
+                xty[a] += x[a] * y;
+            }
+        }
+    }
+    for a in 0..used {
+        for b in 0..a {
+            xtx[a][b] = xtx[b][a];
+        }
+    }
+    let mut coef = [f64::NAN; 8];
+    if samples > used + 2 {
+        if let Some(c) = solve_spd(&xtx, &xty, used) {
+            coef[..used].copy_from_slice(&c[..used]);
+        }
+    }
+
+    // Regression residual → wander.
+    let mut wander_avar = [f64::NAN; 3];
+    if coef[0].is_finite() {
+        let residual: Vec<f64> = (0..n)
+            .map(|i| match row(i) {
+                Some((x, y)) => y - (0..used).map(|k| coef[k] * x[k]).sum::<f64>(),
+                None => f64::NAN,
+            })
+            .collect();
+        let segments: Vec<&[f64]> = stretches(residual.len(), |i| residual[i].is_finite())
+            .into_iter()
+            .map(|run| &residual[run])
+            .collect();
+        let factors: Vec<usize> = WANDER_TAUS_S
+            .iter()
+            .map(|t| ((t * fs).round() as usize).max(1))
+            .collect();
+        let allan = AllanDeviation::compute(&segments, fs, &factors, 0.683);
+        for (k, m) in factors.iter().enumerate() {
+            if let Some(p) = allan.points.iter().find(|p| p.m == *m) {
+                wander_avar[k] = p.adev_dps * p.adev_dps;
+            }
+        }
+    }
+
+    // White-noise level from static samples: first differences of the raw residual.
+    let (mut sum, mut count) = (0.0, 0usize);
+    for i in 1..n {
+        if r.is_static[i] && r.is_static[i - 1] {
+            let d = r.rate_dps[i] - r.rate_dps[i - 1];
+            if d.is_finite() {
+                sum += d * d;
+                count += 1;
+            }
+        }
+    }
+    let static_diff_var = if count > 0 {
+        (sum / count as f64 / 2.0, count)
+    } else {
+        (f64::NAN, 0)
+    };
+
+    Features {
+        coef,
+        samples,
+        wander_avar,
+        max_abs_rate_dps: max_abs,
+        plateau_samples,
+        temperature_varies,
+        static_diff_var,
+    }
+}
+
+/// Solve the leading `n`×`n` block of a symmetric positive definite system by Cholesky
+/// with the regressors scaled to unit diagonal; `None` if it is singular.
+fn solve_spd(a: &[[f64; 8]; 8], b: &[f64; 8], n: usize) -> Option<[f64; 8]> {
+    let mut d = [1.0f64; 8];
+    for i in 0..n {
+        if a[i][i] <= 0.0 || !a[i][i].is_finite() {
+            return None;
+        }
+        d[i] = a[i][i].sqrt();
+    }
+    let mut l = [[0.0f64; 8]; 8];
+    for i in 0..n {
+        for j in 0..=i {
+            let mut s = a[i][j] / (d[i] * d[j]);
+            for k in 0..j {
+                s -= l[i][k] * l[j][k];
+            }
+            if i == j {
+                if s <= 1e-12 {
+                    return None;
+                }
+                l[i][i] = s.sqrt();
+            } else {
+                l[i][j] = s / l[j][j];
+            }
+        }
+    }
+    let mut y = [0.0f64; 8];
+    for i in 0..n {
+        let mut s = b[i] / d[i];
+        for k in 0..i {
+            s -= l[i][k] * y[k];
+        }
+        y[i] = s / l[i][i];
+    }
+    let mut x = [0.0f64; 8];
+    for i in (0..n).rev() {
+        let mut s = y[i];
+        for k in i + 1..n {
+            s -= l[k][i] * x[k];
+        }
+        x[i] = s / l[i][i];
+    }
+    for i in 0..n {
+        x[i] /= d[i];
+    }
+    Some(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnose::stats::residuals_of;
+    use gyro_sim::{simulate_series, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+
+    fn run_features(effects: &[Effect], seed: u64) -> Features {
+        let model = SensorModel::default();
+        let motion = Motion::bench(&BenchProfile::default(), 3);
+        let options = SimOptions {
+            seed,
+            ..SimOptions::default()
+        };
+        let s = simulate_series(&model, effects, &motion, &options, None);
+        let fs = s.sample_rate_hz;
+        let time: Vec<f64> = (0..s.rate_dps.len()).map(|k| k as f64 / fs).collect();
+        let r = residuals_of(fs, time, s.rate_dps, &s.reference_deg, s.temperature_c).unwrap();
+        features(&r, model.lsb_dps)
+    }
+
+    #[test]
+    fn regression_reads_each_deterministic_effect() {
+        let nominal = run_features(&[], 1);
+        let cases: [(Effect, usize, f64, f64); 6] = [
+            (Effect::ScaleFactor { k: 0.01 }, reg::RATE, 0.01, 1e-3),
+            (
+                Effect::ScaleAsymmetry { k: 0.005 },
+                reg::ABS_RATE,
+                0.005,
+                1e-3,
+            ),
+            (
+                Effect::Nonlinearity { k3_per_dps2: 2e-6 },
+                reg::RATE_CUBED,
+                2e-6 * 1e6,
+                0.3,
+            ),
+            (
+                Effect::Latency { delay_s: 0.005 },
+                reg::ACCELERATION,
+                -0.005,
+                1e-3,
+            ),
+            (
+                Effect::TemperatureBias { dps_per_c: 0.05 },
+                reg::DELTA_T,
+                0.05,
+                0.02,
+            ),
+            (
+                Effect::TemperatureScale { per_c: 2e-3 },
+                reg::RATE_DELTA_T,
+                2e-3,
+                5e-4,
+            ),
+        ];
+        for (effect, index, expect, tol) in cases {
+            let f = run_features(&[effect], 1);
+            let got = f.coef[index] - nominal.coef[index];
+            assert!(
+                (got - expect).abs() < tol,
+                "{}: coefficient {} read {got}, expected {expect}",
+                effect.id(),
+                REGRESSORS[index]
+            );
+        }
+    }
+
+    #[test]
+    fn plateau_counts_clipped_samples_only() {
+        assert_eq!(run_features(&[], 1).plateau_samples, 0);
+        let f = run_features(&[Effect::Saturation { limit_dps: 100.0 }], 1);
+        assert!(f.plateau_samples > 100, "{}", f.plateau_samples);
+        assert!((f.max_abs_rate_dps - 100.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn wander_grows_with_random_walk() {
+        let a = run_features(&[], 1).wander_avar;
+        let b = run_features(
+            &[Effect::RateRandomWalk {
+                k_dps_per_rt_s: 0.02,
+            }],
+            1,
+        )
+        .wander_avar;
+        assert!(b[2] > 2.0 * a[2], "{a:?} {b:?}");
+    }
+}

@@ -1,0 +1,1008 @@
+//! The nominal model fitted on the training runs, and a fitting procedure per effect.
+//!
+//! Every estimator is a function of the training runs' [`Features`]; applied to the
+//! baseline ensemble (member `j` of every run forms replica `j`) it gives the estimator's
+//! distribution when the effect is absent. The parameter test is the real estimate's
+//! z-score against those null replicas; the estimate is the real value minus the null
+//! mean (what the nominal sensor and the processing alone produce), rescaled by a
+//! noise-free simulation of the training runs with the effect where the feature is only
+//! proportional to the parameter to first order (the gain correction). Intervals are
+//! ±1.96 null standard deviations (deterministic effects), χ² bounds (turn-on bias) or
+//! ±1.96 null standard deviations of the variance (wander), mapped to the parameter.
+
+use super::ensemble::{simulate_features, simulate_member, Member, RealRun, StampedClock};
+use super::features::{reg, CUBIC_SCALE_DPS, WANDER_TAUS_S};
+use crate::noise::fit::gauss_markov_avar_continuous;
+use crate::noise::{chi2_quantile, rate_step};
+use gyro_sim::{Effect, SensorModel, EFFECTS};
+use rayon::prelude::*;
+
+/// |z| of the parameter test above which an effect is a candidate (Bonferroni over the
+/// 14 effects at a family-wise 0.1% is 3.9).
+pub const Z_CRITICAL: f64 = 4.0;
+/// Quantisation is named when the output grid is this many times coarser than the
+/// nominal step.
+pub const QUANT_RATIO: f64 = 1.5;
+/// Fewest clipped samples over the training runs for saturation.
+pub const MIN_CLIPPED: usize = 10;
+/// Relative systematic uncertainty added (in quadrature) to the intervals of the
+/// regression-based parameters: re-simulating a run from its sampled reference, and the
+/// gain calibrated by simulation, leave errors of about 1% (measured by the self-test on
+/// large effects, where the statistical interval is far narrower).
+pub const SYSTEMATIC_REL: f64 = 0.02;
+/// Fewest gaps over the training runs for dropouts.
+pub const MIN_GAPS: u64 = 3;
+
+/// The fitted candidate of one effect.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fit {
+    /// The effect with its fitted parameters.
+    pub effect: Effect,
+    /// 95% interval of each parameter (`None` bound: unbounded).
+    pub ci95: Vec<(Option<f64>, Option<f64>)>,
+    /// z-score of the parameter test (NaN where the test is exact, see `passes`).
+    pub z: f64,
+    /// The parameter test passes.
+    pub passes: bool,
+    /// What the test was.
+    pub test: String,
+    /// The effect is seen directly in the raw data (a grid, a plateau, gaps), or is a
+    /// between-run effect (turn-on bias): it is significant when the same test also
+    /// passes on the held-out runs.
+    pub direct: bool,
+}
+
+/// The held-out replication of an effect whose significance is its own test passing
+/// again ([`Fit::direct`]): saturation, quantisation and dropouts seen directly in
+/// `runs`, and the turn-on bias's between-run spread against their `null` ensembles
+/// (each held-out run alone says little about a between-run effect: one run with a large
+/// bias cannot carry a bootstrap over runs). False for the other effects.
+pub fn direct_evidence(
+    effect: &Effect,
+    runs: &[&RealRun],
+    null: &[Vec<Member>],
+    model: &SensorModel,
+) -> bool {
+    match effect {
+        Effect::TurnOnBias { .. } => runs.len() >= 3 && bias_spread(runs, null).0 >= Z_CRITICAL,
+        Effect::Saturation { .. } => {
+            runs.iter()
+                .map(|r| r.features.plateau_samples)
+                .sum::<usize>()
+                >= MIN_CLIPPED
+        }
+        Effect::Quantization { .. } => {
+            let values: Vec<f64> = runs
+                .iter()
+                .flat_map(|r| r.measured_rates_dps.iter().copied())
+                .collect();
+            rate_step(&values).is_some_and(|s| s >= QUANT_RATIO * model.lsb_dps && s > 0.0)
+        }
+        Effect::Dropouts { .. } => runs.iter().map(|r| r.gaps).sum::<u64>() >= MIN_GAPS,
+        _ => false,
+    }
+}
+
+/// The between-run spread of the bias (the regression intercept) of `runs` against
+/// their null ensembles: `(n−1) s²/v0` is χ²(n−1) without a turn-on bias (s²: the runs'
+/// sample variance, v0: the mean of the replicas'). Returns (its Wilson–Hilferty
+/// z-score, s², v0, n−1).
+fn bias_spread(runs: &[&RealRun], null: &[Vec<Member>]) -> (f64, f64, f64, f64) {
+    let real: Vec<f64> = runs
+        .iter()
+        .map(|r| r.features.coef[reg::INTERCEPT])
+        .collect();
+    let s2 = sample_var(&real);
+    let members = null.iter().map(Vec::len).min().unwrap_or(0);
+    let null_vars: Vec<f64> = (0..members)
+        .map(|j| {
+            let v: Vec<f64> = null
+                .iter()
+                .map(|m| m[j].features.coef[reg::INTERCEPT])
+                .collect();
+            sample_var(&v)
+        })
+        .collect();
+    let v0 = mean(null_vars.iter().copied());
+    let k = runs.len().saturating_sub(1) as f64;
+    let x = k * s2 / v0;
+    let c = 2.0 / (9.0 * k);
+    let z = ((x / k).cbrt() - (1.0 - c)) / c.sqrt();
+    (z, s2, v0, k)
+}
+
+/// Two-sided 95% quantile of Student's t with `dof` degrees of freedom.
+pub fn t95(dof: usize) -> f64 {
+    const T: [f64; 30] = [
+        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
+        2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
+        2.052, 2.048, 2.045, 2.042,
+    ];
+    match dof {
+        0 => f64::INFINITY,
+        d if d <= 30 => T[d - 1],
+        _ => 1.96,
+    }
+}
+
+/// An effect that cannot be tested on these runs, and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Untestable {
+    /// Effect id.
+    pub id: &'static str,
+    /// What data is missing.
+    pub reason: String,
+}
+
+/// The nominal model for these training runs, notes on where each value came from, and
+/// the static first-difference variance the white noise was matched to (if measured).
+pub fn nominal_model(
+    train: &[&RealRun],
+    prior: &SensorModel,
+) -> (SensorModel, Vec<String>, Option<f64>) {
+    let mut model = *prior;
+    let mut notes = Vec::new();
+    if let Some(run) = train.first() {
+        model.sample_rate_hz = run.sample_rate_hz;
+    }
+    let intercepts: Vec<f64> = train
+        .iter()
+        .map(|r| r.features.coef[reg::INTERCEPT])
+        .filter(|c| c.is_finite())
+        .collect();
+    if !intercepts.is_empty() {
+        model.bias_dps = intercepts.iter().sum::<f64>() / intercepts.len() as f64;
+        notes.push(format!(
+            "bias {:.4} deg/s: mean regression intercept of the training runs",
+            model.bias_dps
+        ));
+    }
+    let (sum, count) = train.iter().fold((0.0, 0usize), |(s, c), r| {
+        let (v, n) = r.features.static_diff_var;
+        if n > 0 && v.is_finite() {
+            (s + v * n as f64, c + n)
+        } else {
+            (s, c)
+        }
+    });
+    let needed = (2.0 * model.sample_rate_hz) as usize;
+    let mut target = None;
+    if count >= needed.max(20) {
+        let v = sum / count as f64;
+        let sigma = solve_white_sigma(v, &model, &[model.lsb_dps]);
+        model.arw_deg_per_rt_h = sigma * 60.0 / model.sample_rate_hz.sqrt();
+        target = Some(v);
+        notes.push(format!(
+            "angle random walk {:.4} deg/sqrt(h): matched to the first differences of {count} static samples (output rounding included)",
+            model.arw_deg_per_rt_h
+        ));
+    } else {
+        notes.push(format!(
+            "angle random walk {:.4} deg/sqrt(h) from the prior model: fewer than 2 s of static samples",
+            model.arw_deg_per_rt_h
+        ));
+    }
+    notes.push(format!(
+        "Gauss-Markov bias sigma {} deg/s, T {} s, output step {:.5} deg/s, range {} deg/s: from the prior model",
+        model.gm_sigma_dps, model.gm_tau_s, model.lsb_dps, model.range_dps
+    ));
+    (model, notes, target)
+}
+
+/// The white-noise σ (deg/s per sample) whose simulated static output — bias, the
+/// Gauss-Markov wander, white noise, rounded to each of `lsbs` in turn — has half the
+/// mean squared first difference `target`. Rounding a signal that barely moves is not
+/// the textbook lsb²/12, so the match is by simulation (40 000 samples, fixed seed,
+/// bisection).
+pub fn solve_white_sigma(target: f64, model: &SensorModel, lsbs: &[f64]) -> f64 {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+    const N: usize = 40_000;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x000A_11A4);
+    let white: Vec<f64> = (0..N).map(|_| StandardNormal.sample(&mut rng)).collect();
+    let dt = 1.0 / model.sample_rate_hz;
+    let phi = (-dt / model.gm_tau_s).exp();
+    let drive = model.gm_sigma_dps * (1.0 - phi * phi).sqrt();
+    let mut g = model.gm_sigma_dps * {
+        let x: f64 = StandardNormal.sample(&mut rng);
+        x
+    };
+    let wander: Vec<f64> = (0..N)
+        .map(|_| {
+            let x: f64 = StandardNormal.sample(&mut rng);
+            g = phi * g + drive * x;
+            g
+        })
+        .collect();
+    let diff_var = |sigma: f64| -> f64 {
+        let mut prev = f64::NAN;
+        let (mut sum, mut n) = (0.0, 0usize);
+        for k in 0..N {
+            let mut x = model.bias_dps + wander[k] + sigma * white[k];
+            for &q in lsbs {
+                if q > 0.0 {
+                    x = (x / q).round() * q;
+                }
+            }
+            if prev.is_finite() {
+                sum += (x - prev) * (x - prev);
+                n += 1;
+            }
+            prev = x;
+        }
+        sum / n.max(1) as f64 / 2.0
+    };
+    let (mut lo, mut hi) = (0.0, (2.0 * target).sqrt().max(1e-6) * 2.0);
+    if diff_var(lo) >= target {
+        return 0.0;
+    }
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if diff_var(mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The model to simulate with `effects` added. With quantisation, the white noise is
+/// matched again to the measured static differences `white_target` (it was measured
+/// with the rounding in it).
+pub fn model_with(
+    nominal: &SensorModel,
+    effects: &[Effect],
+    white_target: Option<f64>,
+) -> SensorModel {
+    let mut model = *nominal;
+    if let Some(target) = white_target {
+        for e in effects.iter().filter(|e| !is_identity(e, nominal)) {
+            if let Effect::Quantization { lsb_dps } = *e {
+                let sigma = solve_white_sigma(target, nominal, &[nominal.lsb_dps, lsb_dps]);
+                model.arw_deg_per_rt_h = sigma * 60.0 / model.sample_rate_hz.sqrt();
+            }
+        }
+    }
+    model
+}
+
+/// True if adding `effect` to `model` changes no simulated sample (a zero-size wander,
+/// no dropouts, the nominal grid again, a clip above the range): its ensemble is the
+/// baseline's, seed for seed, so it need not be simulated.
+pub fn is_identity(effect: &Effect, model: &SensorModel) -> bool {
+    match *effect {
+        Effect::BiasInstability { sigma_dps } | Effect::TurnOnBias { sigma_dps } => {
+            sigma_dps == 0.0
+        }
+        Effect::RateRandomWalk { k_dps_per_rt_s } => k_dps_per_rt_s == 0.0,
+        Effect::Dropouts { rate_per_s, .. } => rate_per_s == 0.0,
+        Effect::Quantization { lsb_dps } => {
+            lsb_dps == 0.0 || (lsb_dps - model.lsb_dps).abs() <= 1e-3 * model.lsb_dps
+        }
+        Effect::Saturation { limit_dps } => limit_dps >= model.range_dps,
+        Effect::ScaleFactor { k } | Effect::ScaleAsymmetry { k } => k == 0.0,
+        Effect::Nonlinearity { k3_per_dps2 } => k3_per_dps2 == 0.0,
+        Effect::Latency { delay_s } => delay_s == 0.0,
+        Effect::ClockError { ppm } => ppm == 0.0,
+        Effect::TemperatureBias { dps_per_c } => dps_per_c == 0.0,
+        Effect::TemperatureScale { per_c } => per_c == 0.0,
+        // The fit's stand-in for "no limit".
+        Effect::Bandwidth { cutoff_hz } => cutoff_hz >= 0.5 * model.sample_rate_hz,
+    }
+}
+
+fn mean(v: impl Iterator<Item = f64>) -> f64 {
+    let (s, n) = v
+        .filter(|x| x.is_finite())
+        .fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+    if n == 0 {
+        f64::NAN
+    } else {
+        s / n as f64
+    }
+}
+
+fn mean_sd(v: &[f64]) -> (f64, f64) {
+    let f: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if f.len() < 2 {
+        return (f64::NAN, f64::NAN);
+    }
+    let m = f.iter().sum::<f64>() / f.len() as f64;
+    let var = f.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (f.len() - 1) as f64;
+    (m, var.sqrt())
+}
+
+fn sample_var(v: &[f64]) -> f64 {
+    let (_, sd) = mean_sd(v);
+    sd * sd
+}
+
+/// Everything the estimators need.
+pub struct FitInput<'a> {
+    /// Training runs.
+    pub train: &'a [&'a RealRun],
+    /// Their baseline ensembles (same member count each).
+    pub null: &'a [Vec<Member>],
+    /// The nominal model.
+    pub model: &'a SensorModel,
+    /// Every training run's temperature varies.
+    pub temperature_ok: bool,
+    /// Seed of the ensembles (training run `i` has seed index `i`).
+    pub seed: u64,
+}
+
+impl FitInput<'_> {
+    fn members(&self) -> usize {
+        self.null.iter().map(Vec::len).min().unwrap_or(0)
+    }
+
+    /// Pooled value of `f` over the real runs and over each null replica.
+    fn pooled(&self, f: &dyn Fn(&super::features::Features) -> f64) -> (f64, Vec<f64>) {
+        let real = mean(self.train.iter().map(|r| f(&r.features)));
+        let replicas = (0..self.members())
+            .map(|j| mean(self.null.iter().map(|m| f(&m[j].features))))
+            .collect();
+        (real, replicas)
+    }
+
+    /// Pooled regression coefficients of noise-free simulations with `effects`.
+    fn noise_free(&self, effects: &[Effect]) -> [f64; 8] {
+        let quiet = SensorModel {
+            arw_deg_per_rt_h: 0.0,
+            gm_sigma_dps: 0.0,
+            lsb_dps: 0.0,
+            ..*self.model
+        };
+        let coefs: Vec<[f64; 8]> = self
+            .train
+            .par_iter()
+            .map(|r| simulate_features(r, &quiet, effects, 1))
+            .collect();
+        std::array::from_fn(|i| mean(coefs.iter().map(|c| c[i])))
+    }
+}
+
+/// What the regression fits share: the noise-free coefficients without any effect, and
+/// the effects already established from direct evidence (a clock error from the time
+/// stamps), on top of which the others are fitted.
+struct Known {
+    quiet: [f64; 8],
+    effects: Vec<Effect>,
+    /// Noise-free coefficients with `effects`.
+    with_effects: [f64; 8],
+}
+
+impl Known {
+    fn new(input: &FitInput, quiet: [f64; 8], effects: Vec<Effect>) -> Self {
+        let with_effects = if effects.is_empty() {
+            quiet
+        } else {
+            input.noise_free(&effects)
+        };
+        Self {
+            quiet,
+            effects,
+            with_effects,
+        }
+    }
+}
+
+/// Effects fitted from the joint regression, which [`Joint`] refits given the others.
+fn conditional(effect: &Effect) -> bool {
+    matches!(
+        effect,
+        Effect::ScaleFactor { .. }
+            | Effect::ScaleAsymmetry { .. }
+            | Effect::Nonlinearity { .. }
+            | Effect::Latency { .. }
+            | Effect::Bandwidth { .. }
+            | Effect::TemperatureBias { .. }
+            | Effect::TemperatureScale { .. }
+    )
+}
+
+/// Deterministic effects, which a noise-free calibration can hold as known.
+fn deterministic(effect: &Effect) -> bool {
+    conditional(effect)
+        || matches!(
+            effect,
+            Effect::ClockError { .. } | Effect::Saturation { .. }
+        )
+}
+
+/// Joint fits of a set of effects: each regression-based effect refitted with the others
+/// of the set (and the stamped clock) held as known, one pass in the set's order. Each
+/// effect alone is fitted against the nominal model, which misses products of effects
+/// (a 1% scale factor makes a latency look 1% longer); held-out statistics resolve such
+/// differences, so sets are scored with their joint fits. Cached per set.
+pub struct Joint<'a> {
+    input: &'a FitInput<'a>,
+    quiet: [f64; 8],
+    clock: Vec<Effect>,
+    cache: std::sync::Mutex<std::collections::BTreeMap<String, Vec<Option<Fit>>>>,
+}
+
+impl Joint<'_> {
+    /// The refitted fit of each effect of `set` (`None`: kept as fitted alone).
+    pub fn fits(&self, set: &[Effect]) -> Vec<Option<Fit>> {
+        if set.len() < 2 || !set.iter().any(conditional) {
+            return vec![None; set.len()];
+        }
+        let key = format!("{set:?}");
+        if let Some(hit) = self.cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
+            return hit;
+        }
+        let mut current = set.to_vec();
+        let mut out = vec![None; set.len()];
+        for i in 0..set.len() {
+            if !conditional(&set[i]) {
+                continue;
+            }
+            let others: Vec<Effect> = self
+                .clock
+                .iter()
+                .chain(
+                    current
+                        .iter()
+                        .enumerate()
+                        .filter(|(j, _)| *j != i)
+                        .map(|x| x.1),
+                )
+                .copied()
+                .filter(deterministic)
+                .collect();
+            if others.len() == self.clock.len() {
+                continue;
+            }
+            let known = Known::new(self.input, self.quiet, others);
+            if let Ok(f) = fit_one(self.input, &known, set[i]) {
+                current[i] = f.effect;
+                out[i] = Some(f);
+            }
+        }
+        if let Ok(mut c) = self.cache.lock() {
+            c.insert(key, out.clone());
+        }
+        out
+    }
+
+    /// The effects of `set` with their joint fits.
+    pub fn effects(&self, set: &[Effect]) -> Vec<Effect> {
+        set.iter()
+            .zip(self.fits(set))
+            .map(|(e, f)| f.map_or(*e, |f| f.effect))
+            .collect()
+    }
+}
+
+/// Relative mismatch at which the gain calibration stops iterating.
+const CALIBRATION_TOL: f64 = 2e-4;
+
+/// Fit every effect of the vocabulary on the training runs (alone, on top of a clock
+/// error seen in the time stamps), and the context for joint fits of sets.
+pub fn fit_all<'a>(input: &'a FitInput<'a>) -> (Vec<Fit>, Vec<Untestable>, Joint<'a>) {
+    let mut fits = Vec::new();
+    let mut untestable = Vec::new();
+    let quiet = input.noise_free(&[]);
+    let clock: Vec<Effect> = clock_fit(input)
+        .ok()
+        .filter(|f| f.passes)
+        .map(|f| f.effect)
+        .into_iter()
+        .collect();
+    let known = Known::new(input, quiet, clock.clone());
+    for info in EFFECTS {
+        match fit_one(input, &known, info.typical) {
+            Ok(f) => fits.push(f),
+            Err(reason) => untestable.push(Untestable {
+                id: info.id,
+                reason,
+            }),
+        }
+    }
+    let joint = Joint {
+        input,
+        quiet,
+        clock,
+        cache: Default::default(),
+    };
+    (fits, untestable, joint)
+}
+
+/// A regression-coefficient effect: estimate, null z, gain-corrected parameter and CI.
+///
+/// `make` takes the first-order parameter, `to_param` maps a coefficient change to it.
+/// The estimate is the coefficient's excess over the null replicas, less what the known
+/// effects give; the parameter is the one whose noise-free simulation of the training
+/// runs (with the known effects) shows that excess: one gain step, then, for a candidate
+/// (|z| ≥ [`Z_CRITICAL`]), secant steps until it matches within [`CALIBRATION_TOL`]
+/// (held-out statistics resolve strong effects to a fraction of a percent).
+fn regression_fit(
+    input: &FitInput,
+    known: &Known,
+    index: usize,
+    make: &dyn Fn(f64) -> Effect,
+    to_param: &dyn Fn(f64) -> f64,
+) -> (Effect, f64, (f64, f64)) {
+    let (real, replicas) = input.pooled(&|f| f.coef[index]);
+    let (m0, s0) = mean_sd(&replicas);
+    let raw = real - m0 - (known.with_effects[index] - known.quiet[index]);
+    let z = raw / s0;
+    let half = 1.96 * s0 * (1.0 + 1.0 / replicas.len().max(1) as f64).sqrt();
+    let response = |x: f64| -> f64 {
+        let mut set = known.effects.clone();
+        set.push(make(to_param(x)));
+        input.noise_free(&set)[index] - known.with_effects[index]
+    };
+    // x: the coefficient change the parameter would give at unit gain.
+    let mut x = raw;
+    if to_param(raw) != 0.0 && to_param(raw).is_finite() {
+        let r0 = response(raw);
+        let g = r0 / raw;
+        if g.is_finite() && g > 0.2 && g < 5.0 {
+            x = raw / g;
+            if z.abs() >= Z_CRITICAL {
+                let (mut xa, mut ra) = (raw, r0);
+                for _ in 0..4 {
+                    let rb = response(x);
+                    if (rb - raw).abs() <= CALIBRATION_TOL * raw.abs() {
+                        break;
+                    }
+                    let slope = (rb - ra) / (x - xa);
+                    let next = x + (raw - rb) / slope;
+                    if !(slope.is_finite() && slope > 0.0 && next.is_finite())
+                        || (next / raw).abs() > 5.0
+                    {
+                        break;
+                    }
+                    (xa, ra) = (x, rb);
+                    x = next;
+                }
+            }
+        }
+    }
+    let gain = if x != 0.0 { raw / x } else { 1.0 };
+    // Plus the systematic allowance of the simulation-calibrated gain.
+    let half = (half * half + (SYSTEMATIC_REL * raw).powi(2)).sqrt();
+    let (lo, hi) = ((raw - half) / gain, (raw + half) / gain);
+    (make(to_param(x)), z, (to_param(lo), to_param(hi)))
+}
+
+/// Clock error from the time stamps ([`StampedClock`]): the training runs' mean ppm,
+/// tested against its standard error (between-run scatter and each run's stamp
+/// scatter; at least 0.01 ppm).
+fn clock_fit(input: &FitInput) -> Result<Fit, String> {
+    let clocks: Option<Vec<StampedClock>> = input.train.iter().map(|r| r.clock).collect();
+    let Some(clocks) = clocks else {
+        return Err(
+            "needs the nominal sample rate (`# sample_rate_hz` metadata or \
+                    --sample-rate-hz): a clock error shows as time stamps drifting from it"
+                .into(),
+        );
+    };
+    let ppm: Vec<f64> = clocks.iter().map(|c| c.ppm).collect();
+    let n = ppm.len() as f64;
+    let m = ppm.iter().sum::<f64>() / n;
+    let between = if ppm.len() > 1 { sample_var(&ppm) } else { 0.0 };
+    let within = clocks.iter().map(|c| c.se_ppm * c.se_ppm).sum::<f64>() / n;
+    let se = ((between + within) / n).sqrt().max(0.01);
+    let z = m / se;
+    let half = t95(ppm.len().saturating_sub(1)).max(1.96) * se;
+    Ok(Fit {
+        effect: Effect::ClockError { ppm: m },
+        ci95: vec![(Some(m - half), Some(m + half))],
+        z,
+        passes: z.abs() >= Z_CRITICAL,
+        test: "time stamps' period vs the nominal sample rate".into(),
+        direct: false,
+    })
+}
+
+fn fit_one(input: &FitInput, known: &Known, typical: Effect) -> Result<Fit, String> {
+    let exact = f64::NAN;
+    let temperature = || -> Result<(), String> {
+        if input.temperature_ok {
+            Ok(())
+        } else {
+            Err(format!(
+                "needs a temperature column that varies by at least {} degC in every training run",
+                super::features::MIN_TEMPERATURE_RANGE_C
+            ))
+        }
+    };
+    let fit = |effect, z: f64, ci: Vec<(Option<f64>, Option<f64>)>, two_sided: bool, test: &str| {
+        let passes = if two_sided {
+            z.abs() >= Z_CRITICAL
+        } else {
+            z >= Z_CRITICAL
+        };
+        Fit {
+            effect,
+            ci95: ci,
+            z,
+            passes,
+            test: test.to_string(),
+            direct: false,
+        }
+    };
+    let some = |(a, b): (f64, f64)| vec![(Some(a.min(b)), Some(a.max(b)))];
+    Ok(match typical {
+        Effect::ScaleFactor { .. } => {
+            let (e, z, ci) = regression_fit(
+                input,
+                known,
+                reg::RATE,
+                &|k| Effect::ScaleFactor { k },
+                &|x| x,
+            );
+            fit(
+                e,
+                z,
+                some(ci),
+                true,
+                "regression slope on rate vs null replicas",
+            )
+        }
+        Effect::ClockError { .. } => clock_fit(input)?,
+        Effect::ScaleAsymmetry { .. } => {
+            let (e, z, ci) = regression_fit(
+                input,
+                known,
+                reg::ABS_RATE,
+                &|k| Effect::ScaleAsymmetry { k },
+                &|x| x,
+            );
+            fit(
+                e,
+                z,
+                some(ci),
+                true,
+                "regression slope on |rate| vs null replicas",
+            )
+        }
+        Effect::Nonlinearity { .. } => {
+            let scale = CUBIC_SCALE_DPS.powi(3);
+            let (e, z, ci) = regression_fit(
+                input,
+                known,
+                reg::RATE_CUBED,
+                &|k3_per_dps2| Effect::Nonlinearity { k3_per_dps2 },
+                &|x| x / scale,
+            );
+            fit(
+                e,
+                z,
+                some(ci),
+                true,
+                "regression on rate^3 vs null replicas",
+            )
+        }
+        Effect::Latency { .. } => {
+            let (e, z, ci) = regression_fit(
+                input,
+                known,
+                reg::ACCELERATION,
+                &|d| Effect::Latency {
+                    delay_s: d.clamp(0.0, 1.0),
+                },
+                &|x| -x,
+            );
+            let ci = vec![(Some(ci.0.min(ci.1)), Some(ci.0.max(ci.1)))];
+            fit(
+                e,
+                -z,
+                ci,
+                false,
+                "regression on angular acceleration vs null replicas (one-sided)",
+            )
+        }
+        Effect::Bandwidth { .. } => {
+            // A two-pole low-pass delays slow motion by 2/(2π f_pole), f_pole = 1.554 f_c:
+            // fitted as a delay (its first-order parameter), calibrated as a low-pass.
+            let per_delay = 1.0 / (std::f64::consts::PI * 1.5538);
+            let nyquist = 0.5 * input.model.sample_rate_hz;
+            let to_cutoff = |d: f64| -> f64 {
+                if d > 0.0 {
+                    (per_delay / d).min(nyquist)
+                } else {
+                    nyquist
+                }
+            };
+            let (e, z, (d_lo, d_hi)) = regression_fit(
+                input,
+                known,
+                reg::ACCELERATION,
+                &|d| Effect::Bandwidth {
+                    cutoff_hz: to_cutoff(d),
+                },
+                &|x| -x,
+            );
+            // Interval: the (calibrated) delay's, mapped like the estimate.
+            let (d_lo, d_hi) = (d_lo.min(d_hi), d_lo.max(d_hi));
+            let bound = |dd: f64| (dd > 0.0).then(|| to_cutoff(dd));
+            fit(
+                e,
+                -z,
+                vec![(bound(d_hi), bound(d_lo))],
+                false,
+                "delay from the acceleration regression vs null replicas (one-sided)",
+            )
+        }
+        Effect::TemperatureBias { .. } => {
+            temperature()?;
+            let (e, z, ci) = regression_fit(
+                input,
+                known,
+                reg::DELTA_T,
+                &|dps_per_c| Effect::TemperatureBias { dps_per_c },
+                &|x| x,
+            );
+            fit(
+                e,
+                z,
+                some(ci),
+                true,
+                "regression on temperature change vs null replicas",
+            )
+        }
+        Effect::TemperatureScale { .. } => {
+            temperature()?;
+            let (e, z, ci) = regression_fit(
+                input,
+                known,
+                reg::RATE_DELTA_T,
+                &|per_c| Effect::TemperatureScale { per_c },
+                &|x| x,
+            );
+            fit(
+                e,
+                z,
+                some(ci),
+                true,
+                "regression on rate x temperature change vs null replicas",
+            )
+        }
+        Effect::TurnOnBias { .. } => {
+            let n = input.train.len();
+            if n < 3 {
+                return Err(
+                    "needs at least 3 training runs (between-run spread of the bias)".into(),
+                );
+            }
+            let (z, s2, v0, k) = bias_spread(input.train, input.null);
+            let sigma = (s2 - v0).max(0.0).sqrt();
+            let lo = (k * s2 / chi2_quantile(0.975, k) - v0).max(0.0).sqrt();
+            let hi = (k * s2 / chi2_quantile(0.025, k) - v0).max(0.0).sqrt();
+            Fit {
+                direct: true,
+                ..fit(
+                    Effect::TurnOnBias { sigma_dps: sigma },
+                    z,
+                    vec![(Some(lo), Some(hi))],
+                    false,
+                    "between-run variance of the bias vs null replicas (chi-square, one-sided; \
+                     replicated on the held-out runs)",
+                )
+            }
+        }
+        Effect::BiasInstability { .. } | Effect::RateRandomWalk { .. } => {
+            let shape = |tau: f64| -> f64 {
+                match typical {
+                    Effect::RateRandomWalk { .. } => tau / 3.0,
+                    _ => (0..6)
+                        .map(|i| {
+                            gauss_markov_avar_continuous(tau, 1.0, 10f64.powf(0.6 * i as f64)) / 6.0
+                        })
+                        .sum(),
+                }
+            };
+            let usable = input
+                .train
+                .iter()
+                .filter(|r| r.features.wander_avar[2].is_finite())
+                .count();
+            if usable < 2 {
+                return Err(format!(
+                    "needs at least 2 training runs longer than {} s",
+                    2.0 * WANDER_TAUS_S[2]
+                ));
+            }
+            let mut per_tau = Vec::new();
+            for (k, &tau) in WANDER_TAUS_S.iter().enumerate() {
+                let (real, replicas) = input.pooled(&|f| f.wander_avar[k]);
+                let (m0, s0) = mean_sd(&replicas);
+                per_tau.push((real, replicas, m0, s0, shape(tau)));
+            }
+            // Weighted least squares of the excess on the shape: θ = σ² or K².
+            let solve = |excess: &dyn Fn(usize) -> f64| -> f64 {
+                let (mut num, mut den) = (0.0, 0.0);
+                for (k, (_, _, _, s0, f)) in per_tau.iter().enumerate() {
+                    let w = 1.0 / (s0 * s0).max(1e-30);
+                    num += w * f * excess(k);
+                    den += w * f * f;
+                }
+                num / den
+            };
+            let null_thetas: Vec<f64> = (0..input.members())
+                .map(|j| solve(&|k| per_tau[k].1[j] - per_tau[k].2))
+                .collect();
+            let (_, s_theta) = mean_sd(&null_thetas);
+            // Per run: the excess over that run's own ensemble mean.
+            let per_run = |f: &dyn Fn(usize, usize) -> f64, r: usize, members: &[Member]| {
+                solve(&|k| f(r, k) - mean(members.iter().map(|m| m.features.wander_avar[k])))
+            };
+            let thetas: Vec<f64> = (0..input.train.len())
+                .map(|r| {
+                    per_run(
+                        &|r, k| input.train[r].features.wander_avar[k],
+                        r,
+                        &input.null[r],
+                    )
+                })
+                .filter(|t| t.is_finite())
+                .collect();
+            let (mut theta, sd) = mean_sd(&thetas);
+            let z = theta / s_theta;
+            let mut half = t95(thetas.len().saturating_sub(1)) * sd / (thetas.len() as f64).sqrt();
+            let make = |theta: f64| match typical {
+                Effect::RateRandomWalk { .. } => Effect::RateRandomWalk {
+                    k_dps_per_rt_s: theta.max(0.0).sqrt(),
+                },
+                _ => Effect::BiasInstability {
+                    sigma_dps: theta.max(0.0).sqrt(),
+                },
+            };
+            if z >= Z_CRITICAL && theta > 0.0 {
+                // Gain: the same estimator on the training runs simulated with the
+                // effect, against the same seeds without it.
+                const GAIN_MEMBERS: usize = 8;
+                let effect = [make(theta)];
+                let sims: Vec<Vec<Member>> = (0..input.train.len())
+                    .into_par_iter()
+                    .map(|r| {
+                        (0..GAIN_MEMBERS.min(input.null[r].len()))
+                            .map(|j| {
+                                simulate_member(
+                                    input.train[r],
+                                    input.model,
+                                    &effect,
+                                    super::ensemble::member_seed(input.seed, r, j),
+                                )
+                            })
+                            .collect()
+                    })
+                    .collect();
+                let gains: Vec<f64> = (0..input.train.len())
+                    .flat_map(|r| {
+                        let sims = &sims[r];
+                        (0..sims.len()).map(move |j| (r, j))
+                    })
+                    .map(|(r, j)| {
+                        let k_sim = per_run(
+                            &|r, k| sims[r][j].features.wander_avar[k],
+                            r,
+                            &input.null[r],
+                        );
+                        let k_null = per_run(
+                            &|r, k| input.null[r][j].features.wander_avar[k],
+                            r,
+                            &input.null[r],
+                        );
+                        k_sim - k_null
+                    })
+                    .collect();
+                let gain = mean(gains.into_iter()) / theta;
+                if gain.is_finite() && gain > 0.1 && gain < 10.0 {
+                    theta /= gain;
+                    half /= gain;
+                }
+            }
+            let lo = (theta - half).max(0.0).sqrt();
+            let hi = (theta + half).max(0.0).sqrt();
+            fit(
+                make(theta),
+                z,
+                vec![(Some(lo), Some(hi))],
+                false,
+                "Allan variance of the regression residual at 1/4/16 s vs null replicas (one-sided)",
+            )
+        }
+        Effect::Saturation { .. } => {
+            let clipped: usize = input.train.iter().map(|r| r.features.plateau_samples).sum();
+            let limit = input
+                .train
+                .iter()
+                .map(|r| r.features.max_abs_rate_dps)
+                .fold(0.0f64, f64::max);
+            let null: Vec<f64> = (0..input.members())
+                .map(|j| {
+                    input
+                        .null
+                        .iter()
+                        .map(|m| m[j].features.plateau_samples as f64)
+                        .sum()
+                })
+                .collect();
+            let (m0, s0) = mean_sd(&null);
+            let z = (clipped as f64 - m0) / s0.max(1.0);
+            let tol = input.model.lsb_dps.max(1e-6);
+            // No plateau: no clip seen below the range.
+            let limit = if clipped >= MIN_CLIPPED {
+                limit
+            } else {
+                input.model.range_dps
+            };
+            let mut f = fit(
+                Effect::Saturation { limit_dps: limit.max(1e-3) },
+                z,
+                vec![(Some(limit - tol), Some(limit + tol))],
+                false,
+                "samples on a plateau at the largest |rate| while the reference is faster, vs null replicas",
+            );
+            f.passes = f.passes && clipped >= MIN_CLIPPED;
+            f.direct = true;
+            f
+        }
+        Effect::Quantization { .. } => {
+            let values: Vec<f64> = input
+                .train
+                .iter()
+                .flat_map(|r| r.measured_rates_dps.iter().copied())
+                .collect();
+            let nominal = input.model.lsb_dps;
+            match rate_step(&values) {
+                Some(step) => {
+                    let passes = step >= QUANT_RATIO * nominal && step > 0.0;
+                    Fit {
+                        effect: Effect::Quantization { lsb_dps: step },
+                        ci95: vec![(Some(step * 0.999), Some(step * 1.001))],
+                        z: exact,
+                        passes,
+                        direct: true,
+                        test: format!(
+                            "output grid step {step:.6} deg/s vs nominal {nominal:.6} (named above {QUANT_RATIO}x)"
+                        ),
+                    }
+                }
+                None => Fit {
+                    effect: Effect::Quantization { lsb_dps: nominal },
+                    ci95: vec![(Some(0.0), Some(QUANT_RATIO * nominal))],
+                    z: exact,
+                    passes: false,
+                    direct: true,
+                    test: "no output grid coarser than the nominal step".into(),
+                },
+            }
+        }
+        Effect::Dropouts { .. } => {
+            let gaps: u64 = input.train.iter().map(|r| r.gaps).sum();
+            let filled: u64 = input.train.iter().map(|r| r.filled_slots).sum();
+            let duration: f64 = input.train.iter().map(|r| r.duration_s).sum();
+            let g = gaps as f64;
+            let rate = g / duration.max(1e-9);
+            let mean_samples = if gaps > 0 {
+                (filled as f64 / g).max(1.0)
+            } else {
+                1.0
+            };
+            let rate_half = 1.96 * g.sqrt() / duration.max(1e-9);
+            let sd = (mean_samples * (mean_samples - 1.0)).sqrt();
+            let len_half = 1.96 * sd / g.max(1.0).sqrt();
+            Fit {
+                effect: Effect::Dropouts {
+                    rate_per_s: rate,
+                    mean_samples,
+                },
+                ci95: vec![
+                    (Some((rate - rate_half).max(0.0)), Some(rate + rate_half)),
+                    (Some((mean_samples - len_half).max(1.0)), Some(mean_samples + len_half)),
+                ],
+                z: exact,
+                passes: gaps >= MIN_GAPS,
+                direct: true,
+                test: format!("{gaps} gaps ({filled} samples filled) in the training runs; the nominal model has none (named from {MIN_GAPS})"),
+            }
+        }
+    })
+}

@@ -1,0 +1,844 @@
+//! "Where" statistics: named scalars of the residual rate per segment and stratum, and
+//! their z-scores against an ensemble of simulated runs.
+//!
+//! Definitions (every number below is a constant of this module):
+//! - **Reference rate**: the centred difference `(θ[i+h] − θ[i−h]) / (2h·dt)` of the
+//!   reference angle with `h = max(1, round(fs · SMOOTH_WINDOW_S / 2))`. This is exactly
+//!   the derivative of the reference angle averaged over a boxcar of `2h` samples
+//!   (≈ 20 ms), centred, so it adds no lag. Samples whose `i ± h` neighbours lack a
+//!   reference (or lie outside the log) get no reference rate and are left out of every
+//!   statistic.
+//! - **Residual rate**: gyro rate − reference rate (deg/s); the gyro rate is not smoothed.
+//! - **Segments**: `static` = runs of consecutive samples with |reference rate| <
+//!   [`STATIC_RATE_DPS`] lasting at least [`STATIC_MIN_S`]; `dynamic` = every other
+//!   sample that has a residual.
+//! - **Strata** of `dynamic`: by |reference rate| ([`RATE_BINS_DPS`], segment
+//!   `dynamic/rate_<lo>_<hi>`, the last `dynamic/rate_300_inf`; a bin without samples
+//!   gives no statistic), by sign (`dynamic/positive`, `dynamic/negative`). Of both
+//!   `static` and `dynamic`: by temperature tercile of the run (`<seg>/temperature_1..3`,
+//!   only if the log has temperatures) and by time since start in thirds of the run
+//!   (`<seg>/time_1..3`).
+//!
+//! Statistics (name: segment(s)):
+//! - `residual_mean`, `residual_std` (deg/s): every segment and stratum with ≥ 2 samples.
+//! - `slope_vs_rate` (1): least-squares slope of residual on reference rate, with
+//!   intercept: `dynamic`, `dynamic/positive`, `dynamic/negative`.
+//! - `slope_vs_acceleration` (s): least-squares slope of residual on reference angular
+//!   acceleration (the same centred difference, applied to the reference rate), with
+//!   intercept: `dynamic`. A gyro lagging the reference by `d` gives ≈ −`d`.
+//! - `cubic_vs_rate` (1/(deg/s)²): cubic coefficient of a least-squares cubic polynomial
+//!   of residual on reference rate: `dynamic`.
+//! - `allan_log10_adev_<lo>_<hi>s` (log10 deg/s): mean log10 of the overlapping Allan
+//!   deviation of the static residual (each static run its own segment, mean removed) at
+//!   [`ALLAN_FACTORS_PER_BAND`] log-spaced τ in each band of [`ALLAN_BANDS_S`]: `static`.
+//!   Left out when no τ of the band fits in the static runs.
+//! - `lag1_autocorrelation` (1): pooled lag-1 autocorrelation of the residual, mean
+//!   removed per contiguous run (whiteness; 0 for white noise): `static`, `dynamic`.
+//! - `xcorr_peak_lag_s` (s): lag of the peak of the cross-correlation of gyro rate and
+//!   reference rate (means removed) within ±[`MAX_LAG_S`], refined by a parabola through
+//!   the peak and its neighbours; positive when the gyro lags the reference: `all`.
+//! - `angle_error_rms_<H>s` (deg): RMS over non-overlapping windows of `H` s
+//!   ([`HORIZONS_S`]) of the residual integrated over the window, after removing the
+//!   static residual mean (the bias; the mean over all samples when there is no static
+//!   run); windows with a sample lacking a residual are skipped: `all`.
+
+use crate::noise::{AllanDeviation, ONE_SIGMA};
+use gyro_log::RegularLog;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fmt;
+
+/// Width of the boxcar over which the reference angle is differentiated (s).
+pub const SMOOTH_WINDOW_S: f64 = 0.02;
+/// A sample is still when |reference rate| is below this (deg/s).
+pub const STATIC_RATE_DPS: f64 = 1.0;
+/// Shortest still run counted as static (s).
+pub const STATIC_MIN_S: f64 = 0.5;
+/// Bins of |reference rate| of the dynamic samples (deg/s): `[lo, hi)`.
+pub const RATE_BINS_DPS: [(f64, f64); 4] = [
+    (0.0, 30.0),
+    (30.0, 100.0),
+    (100.0, 300.0),
+    (300.0, f64::INFINITY),
+];
+/// τ bands of the static Allan deviation (s).
+pub const ALLAN_BANDS_S: [(f64, f64); 3] = [(0.01, 0.1), (0.1, 1.0), (1.0, 10.0)];
+/// Averaging factors tried per Allan band (log-spaced, duplicates dropped).
+pub const ALLAN_FACTORS_PER_BAND: usize = 5;
+/// Largest lag searched by the cross-correlation (s).
+pub const MAX_LAG_S: f64 = 0.05;
+/// Horizons of the angle error growth (s).
+pub const HORIZONS_S: [f64; 3] = [1.0, 5.0, 20.0];
+/// Absolute floor of the ensemble standard deviation in [`z_scores`].
+pub const STD_FLOOR_ABS: f64 = 1e-12;
+/// Relative floor of the ensemble standard deviation in [`z_scores`], times
+/// max(|ensemble mean|, |real|).
+pub const STD_FLOOR_REL: f64 = 1e-3;
+
+/// One named scalar statistic of one segment or stratum.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Stat {
+    /// Segment or stratum, e.g. `static`, `dynamic/rate_30_100`, `all`.
+    pub segment: String,
+    /// Statistic, e.g. `residual_mean`, `slope_vs_rate`.
+    pub statistic: String,
+    /// Value (units depend on the statistic; see the module documentation).
+    pub value: f64,
+}
+
+/// Why the statistics cannot be computed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StatsError {
+    /// The log has no reference angle.
+    NoReference,
+    /// Fewer samples with a residual than needed (the count found).
+    TooShort(usize),
+}
+
+impl fmt::Display for StatsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StatsError::NoReference => write!(f, "the log has no reference angle"),
+            StatsError::TooShort(n) => {
+                write!(f, "only {n} samples have a residual rate; too few")
+            }
+        }
+    }
+}
+
+impl std::error::Error for StatsError {}
+
+/// The residual rate of a log, sample by sample (NaN where undefined).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Residuals {
+    /// Sample rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Time since the first slot (s).
+    pub time_s: Vec<f64>,
+    /// Gyro rate (deg/s).
+    pub rate_dps: Vec<f64>,
+    /// Reference rate (deg/s), NaN where undefined.
+    pub reference_rate_dps: Vec<f64>,
+    /// Reference angular acceleration (deg/s²), NaN where undefined.
+    pub reference_acceleration_dps2: Vec<f64>,
+    /// Gyro − reference rate (deg/s), NaN where undefined.
+    pub residual_dps: Vec<f64>,
+    /// Temperature (°C), NaN where absent.
+    pub temperature_c: Vec<f64>,
+    /// Whether the sample belongs to the static segment.
+    pub is_static: Vec<bool>,
+}
+
+/// Fewest samples with a residual accepted by [`residuals`].
+const MIN_SAMPLES: usize = 10;
+
+/// Residual rate and static/dynamic segmentation of `log` (see the module documentation).
+pub fn residuals(log: &RegularLog) -> Result<Residuals, StatsError> {
+    if !log.has_reference {
+        return Err(StatsError::NoReference);
+    }
+    let t0 = log.slots.first().map_or(0.0, |s| s.time_s);
+    let reference: Vec<f64> = log
+        .slots
+        .iter()
+        .map(|s| s.reference_deg.unwrap_or(f64::NAN))
+        .collect();
+    let rate: Vec<f64> = log.slots.iter().map(|s| s.rate_dps).collect();
+    let temperature: Vec<f64> = log
+        .slots
+        .iter()
+        .map(|s| s.temperature_c.unwrap_or(f64::NAN))
+        .collect();
+    let time_s = log.slots.iter().map(|s| s.time_s - t0).collect();
+    residuals_of(log.sample_rate_hz, time_s, rate, &reference, temperature)
+}
+
+/// [`residuals`] of columns on a regular grid at `fs` (NaN where a reference is absent).
+pub fn residuals_of(
+    fs: f64,
+    time_s: Vec<f64>,
+    rate_dps: Vec<f64>,
+    reference_deg: &[f64],
+    temperature_c: Vec<f64>,
+) -> Result<Residuals, StatsError> {
+    let n = rate_dps.len();
+    let h = ((fs * SMOOTH_WINDOW_S / 2.0).round() as usize).max(1);
+    let mut reference_rate_dps = vec![f64::NAN; n];
+    for (i, r) in reference_rate_dps.iter_mut().enumerate() {
+        if i < h || i + h >= n {
+            continue;
+        }
+        *r = (reference_deg[i + h] - reference_deg[i - h]) * fs / (2 * h) as f64;
+    }
+    let mut reference_acceleration_dps2 = vec![f64::NAN; n];
+    for (i, a) in reference_acceleration_dps2.iter_mut().enumerate() {
+        if i >= h && i + h < n {
+            *a = (reference_rate_dps[i + h] - reference_rate_dps[i - h]) * fs / (2 * h) as f64;
+        }
+    }
+    let residual_dps: Vec<f64> = rate_dps
+        .iter()
+        .zip(&reference_rate_dps)
+        .map(|(g, r)| g - r)
+        .collect();
+    let valid = residual_dps.iter().filter(|r| r.is_finite()).count();
+    if valid < MIN_SAMPLES {
+        return Err(StatsError::TooShort(valid));
+    }
+    let still: Vec<bool> = reference_rate_dps
+        .iter()
+        .map(|r| r.abs() < STATIC_RATE_DPS)
+        .collect();
+    let min_len = ((STATIC_MIN_S * fs).ceil() as usize).max(1);
+    let mut is_static = vec![false; n];
+    for run in runs(&still) {
+        if run.len() >= min_len {
+            is_static[run].iter_mut().for_each(|s| *s = true);
+        }
+    }
+    Ok(Residuals {
+        sample_rate_hz: fs,
+        time_s,
+        rate_dps,
+        reference_rate_dps,
+        reference_acceleration_dps2,
+        residual_dps,
+        temperature_c,
+        is_static,
+    })
+}
+
+/// Maximal runs of consecutive `true`.
+fn runs(mask: &[bool]) -> Vec<std::ops::Range<usize>> {
+    stretches(mask.len(), |i| mask[i])
+}
+
+/// Maximal runs of consecutive indices below `n` for which `ok` holds.
+pub fn stretches(n: usize, ok: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for i in 0..n {
+        match (ok(i), start) {
+            (true, None) => start = Some(i),
+            (false, Some(s)) => {
+                out.push(s..i);
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some(s) = start {
+        out.push(s..n);
+    }
+    out
+}
+
+/// The "where" statistics of `log` (see the module documentation).
+pub fn where_stats(log: &RegularLog) -> Result<Vec<Stat>, StatsError> {
+    Ok(stats_of(&residuals(log)?))
+}
+
+/// Statistics collector.
+struct Out(Vec<Stat>);
+
+impl Out {
+    fn push(&mut self, segment: &str, statistic: &str, value: f64) {
+        if value.is_finite() {
+            self.0.push(Stat {
+                segment: segment.to_string(),
+                statistic: statistic.to_string(),
+                value,
+            });
+        }
+    }
+}
+
+fn mean_std(values: &[f64]) -> Option<(f64, f64)> {
+    if values.len() < 2 {
+        return None;
+    }
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0);
+    Some((mean, var.sqrt()))
+}
+
+/// Least-squares slope of y on x with intercept.
+fn slope(points: &[(f64, f64)]) -> Option<f64> {
+    if points.len() < 3 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
+    let (mut sxy, mut sxx) = (0.0, 0.0);
+    for (x, y) in points {
+        sxy += (x - mx) * (y - my);
+        sxx += (x - mx) * (x - mx);
+    }
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// Solve `a x = b` (small, dense) by Gaussian elimination with partial pivoting.
+fn solve<const N: usize>(mut a: [[f64; N]; N], mut b: [f64; N]) -> Option<[f64; N]> {
+    for col in 0..N {
+        let pivot = (col..N).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[pivot][col].abs() < 1e-300 {
+            return None;
+        }
+        a.swap(col, pivot);
+        b.swap(col, pivot);
+        let pivot_row = a[col];
+        for row in col + 1..N {
+            let f = a[row][col] / pivot_row[col];
+            for (x, p) in a[row][col..].iter_mut().zip(&pivot_row[col..]) {
+                *x -= f * p;
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = [0.0; N];
+    for row in (0..N).rev() {
+        let s: f64 = (row + 1..N).map(|k| a[row][k] * x[k]).sum();
+        x[row] = (b[row] - s) / a[row][row];
+    }
+    Some(x)
+}
+
+/// Cubic coefficient of the least-squares cubic of y on x.
+fn cubic(points: &[(f64, f64)]) -> Option<f64> {
+    if points.len() < 5 {
+        return None;
+    }
+    // Scale x for conditioning.
+    let scale = points.iter().map(|p| p.0.abs()).fold(0.0, f64::max);
+    if scale <= 0.0 {
+        return None;
+    }
+    let mut a = [[0.0; 4]; 4];
+    let mut b = [0.0; 4];
+    for (x, y) in points {
+        let u = x / scale;
+        let powers = [1.0, u, u * u, u * u * u];
+        for i in 0..4 {
+            for j in 0..4 {
+                a[i][j] += powers[i] * powers[j];
+            }
+            b[i] += powers[i] * y;
+        }
+    }
+    solve(a, b).map(|c| c[3] / (scale * scale * scale))
+}
+
+/// Pooled lag-1 autocorrelation over `runs` of `x`, mean removed per run.
+fn lag1(x: &[f64], runs: &[std::ops::Range<usize>]) -> Option<f64> {
+    let (mut num, mut den) = (0.0, 0.0);
+    for run in runs {
+        let seg = &x[run.clone()];
+        if seg.len() < 2 {
+            continue;
+        }
+        let mean = seg.iter().sum::<f64>() / seg.len() as f64;
+        for w in seg.windows(2) {
+            num += (w[0] - mean) * (w[1] - mean);
+        }
+        den += seg.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>();
+    }
+    (den > 0.0).then(|| num / den)
+}
+
+/// Cross-correlation peak lag (s) of `gyro` against `reference` within ±`max_lag` samples.
+///
+/// Samples where either is undefined count as zero after mean removal. The correlation of
+/// rates is smooth in the lag, so it is searched every few lags and then refined around
+/// the best one (the same peak as an exhaustive search unless two peaks lie within a few
+/// samples of each other).
+fn xcorr_peak_lag(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
+    let n = gyro.len();
+    let max_lag = ((MAX_LAG_S * fs).round() as usize).max(1);
+    let both = |i: usize| gyro[i].is_finite() && reference[i].is_finite();
+    let count = (0..n).filter(|&i| both(i)).count();
+    if count < 3 {
+        return None;
+    }
+    let mg = (0..n).filter(|&i| both(i)).map(|i| gyro[i]).sum::<f64>() / count as f64;
+    let mr = (0..n)
+        .filter(|&i| both(i))
+        .map(|i| reference[i])
+        .sum::<f64>()
+        / count as f64;
+    let g: Vec<f64> = (0..n)
+        .map(|i| if both(i) { gyro[i] - mg } else { 0.0 })
+        .collect();
+    let r: Vec<f64> = (0..n)
+        .map(|i| if both(i) { reference[i] - mr } else { 0.0 })
+        .collect();
+    // c(lag) = Σ g[i + lag] r[i] / overlap.
+    let corr = |lag: i64| -> f64 {
+        let l = lag.unsigned_abs() as usize;
+        if l >= n {
+            return f64::NEG_INFINITY;
+        }
+        let (a, b) = if lag >= 0 {
+            (&g[l..], &r[..n - l])
+        } else {
+            (&g[..n - l], &r[l..])
+        };
+        let mut acc = [0.0f64; 4];
+        let chunks = a.len() / 4;
+        for k in 0..chunks {
+            for j in 0..4 {
+                acc[j] += a[4 * k + j] * b[4 * k + j];
+            }
+        }
+        let mut sum = acc.iter().sum::<f64>();
+        for k in 4 * chunks..a.len() {
+            sum += a[k] * b[k];
+        }
+        sum / (n - l) as f64
+    };
+    let max_lag = max_lag as i64;
+    let step = (max_lag / 10).clamp(1, 8);
+    let mut best = (0i64, f64::NEG_INFINITY);
+    let mut lag = -max_lag;
+    while lag <= max_lag {
+        let c = corr(lag);
+        if c > best.1 {
+            best = (lag, c);
+        }
+        lag += step;
+    }
+    let (lo, hi) = ((best.0 - step).max(-max_lag), (best.0 + step).min(max_lag));
+    for lag in lo..=hi {
+        let c = corr(lag);
+        if c > best.1 {
+            best = (lag, c);
+        }
+    }
+    if !best.1.is_finite() {
+        return None;
+    }
+    let k = best.0;
+    let mut offset = 0.0;
+    if k > -max_lag && k < max_lag {
+        let (a, b, d) = (corr(k - 1), best.1, corr(k + 1));
+        let denom = a - 2.0 * b + d;
+        if denom < 0.0 {
+            offset = (0.5 * (a - d) / denom).clamp(-0.5, 0.5);
+        }
+    }
+    Some((k as f64 + offset) / fs)
+}
+
+/// Averaging factors for the Allan bands at `fs`.
+fn allan_factors(fs: f64) -> Vec<usize> {
+    let mut factors: Vec<usize> = ALLAN_BANDS_S
+        .iter()
+        .flat_map(|&(lo, hi)| {
+            let (a, b) = ((lo * fs).max(1.0), hi * fs);
+            (0..ALLAN_FACTORS_PER_BAND).map(move |i| {
+                let f = i as f64 / (ALLAN_FACTORS_PER_BAND - 1).max(1) as f64;
+                (a * (b / a).powf(f)).round() as usize
+            })
+        })
+        .filter(|&m| m >= 1)
+        .collect();
+    factors.sort_unstable();
+    factors.dedup();
+    factors
+}
+
+/// Residual mean and std of `values`, pushed as `segment`.
+/// Running mean and sum of squared deviations (Welford).
+#[derive(Clone, Copy, Default)]
+struct Welford {
+    n: usize,
+    mean: f64,
+    m2: f64,
+}
+
+impl Welford {
+    fn add(&mut self, x: f64) {
+        self.n += 1;
+        let d = x - self.mean;
+        self.mean += d / self.n as f64;
+        self.m2 += d * (x - self.mean);
+    }
+
+    /// Mean and sample standard deviation (n − 1), from 2 values on.
+    fn mean_std(&self) -> Option<(f64, f64)> {
+        (self.n >= 2).then(|| (self.mean, (self.m2 / (self.n - 1) as f64).max(0.0).sqrt()))
+    }
+}
+
+/// Tercile thresholds of the finite values.
+fn terciles(values: &[f64]) -> Option<(f64, f64)> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.len() < 3 {
+        return None;
+    }
+    let (i, j) = (v.len() / 3, 2 * v.len() / 3);
+    let a = *v.select_nth_unstable_by(i, f64::total_cmp).1;
+    let b = *v.select_nth_unstable_by(j, f64::total_cmp).1;
+    Some((a, b))
+}
+
+/// The "where" statistics of `residuals` (see the module documentation).
+pub fn stats_of(r: &Residuals) -> Vec<Stat> {
+    let fs = r.sample_rate_hz;
+    let n = r.residual_dps.len();
+    let valid: Vec<bool> = r.residual_dps.iter().map(|x| x.is_finite()).collect();
+    let dynamic: Vec<bool> = (0..n).map(|i| valid[i] && !r.is_static[i]).collect();
+    let mut out = Out(Vec::new());
+
+    // Moments of every segment and stratum in one pass (Welford accumulators).
+    const ALL: usize = 0;
+    const STATIC: usize = 1;
+    const DYNAMIC: usize = 2;
+    const BIN0: usize = 3; // 4 rate bins
+    const POSITIVE: usize = 7;
+    const NEGATIVE: usize = 8;
+    const SEGS: usize = 9; // [seg][k]: time at 9 + 6·seg + k, temperature at 12 + 6·seg + k
+    let mut acc = [Welford::default(); 21];
+    let tercile = |x: f64, (a, b): (f64, f64)| -> usize {
+        if x < a {
+            0
+        } else if x < b {
+            1
+        } else {
+            2
+        }
+    };
+    let duration = r
+        .time_s
+        .last()
+        .copied()
+        .unwrap_or(0.0)
+        .max(f64::MIN_POSITIVE);
+    let third = |i: usize| ((3.0 * r.time_s[i] / duration).floor() as usize).min(2);
+    let temp_cuts = terciles(&r.temperature_c);
+    for i in 0..n {
+        if !valid[i] {
+            continue;
+        }
+        let x = r.residual_dps[i];
+        acc[ALL].add(x);
+        let seg = if r.is_static[i] {
+            acc[STATIC].add(x);
+            0
+        } else {
+            acc[DYNAMIC].add(x);
+            let w = r.reference_rate_dps[i];
+            let a = w.abs();
+            if let Some(b) = RATE_BINS_DPS.iter().position(|&(lo, hi)| a >= lo && a < hi) {
+                acc[BIN0 + b].add(x);
+            }
+            if w > 0.0 {
+                acc[POSITIVE].add(x);
+            } else if w < 0.0 {
+                acc[NEGATIVE].add(x);
+            }
+            1
+        };
+        acc[SEGS + 6 * seg + third(i)].add(x);
+        if let Some(cuts) = temp_cuts {
+            let t = r.temperature_c[i];
+            if t.is_finite() {
+                acc[SEGS + 3 + 6 * seg + tercile(t, cuts)].add(x);
+            }
+        }
+    }
+    let mut moments = |segment: &str, a: &Welford| {
+        if let Some((mean, std)) = a.mean_std() {
+            out.push(segment, "residual_mean", mean);
+            out.push(segment, "residual_std", std);
+        }
+    };
+    moments("all", &acc[ALL]);
+    moments("static", &acc[STATIC]);
+    moments("dynamic", &acc[DYNAMIC]);
+    for (b, (lo, hi)) in RATE_BINS_DPS.iter().enumerate() {
+        let name = if hi.is_finite() {
+            format!("dynamic/rate_{lo}_{hi}")
+        } else {
+            format!("dynamic/rate_{lo}_inf")
+        };
+        moments(&name, &acc[BIN0 + b]);
+    }
+    moments("dynamic/positive", &acc[POSITIVE]);
+    moments("dynamic/negative", &acc[NEGATIVE]);
+    for (seg, name) in ["static", "dynamic"].iter().enumerate() {
+        for k in 0..3 {
+            moments(&format!("{name}/time_{}", k + 1), &acc[SEGS + 6 * seg + k]);
+            if temp_cuts.is_some() {
+                moments(
+                    &format!("{name}/temperature_{}", k + 1),
+                    &acc[SEGS + 3 + 6 * seg + k],
+                );
+            }
+        }
+    }
+
+    // Residual against rate, in motion.
+    let points = |keep: &dyn Fn(f64) -> bool| -> Vec<(f64, f64)> {
+        (0..n)
+            .filter(|&i| dynamic[i] && keep(r.reference_rate_dps[i]))
+            .map(|i| (r.reference_rate_dps[i], r.residual_dps[i]))
+            .collect()
+    };
+    let all_points = points(&|_| true);
+    if let Some(s) = slope(&all_points) {
+        out.push("dynamic", "slope_vs_rate", s);
+    }
+    if let Some(s) = slope(&points(&|x| x > 0.0)) {
+        out.push("dynamic/positive", "slope_vs_rate", s);
+    }
+    if let Some(s) = slope(&points(&|x| x < 0.0)) {
+        out.push("dynamic/negative", "slope_vs_rate", s);
+    }
+    let accel_points: Vec<(f64, f64)> = (0..n)
+        .filter(|&i| dynamic[i] && r.reference_acceleration_dps2[i].is_finite())
+        .map(|i| (r.reference_acceleration_dps2[i], r.residual_dps[i]))
+        .collect();
+    if let Some(s) = slope(&accel_points) {
+        out.push("dynamic", "slope_vs_acceleration", s);
+    }
+    if let Some(c) = cubic(&all_points) {
+        out.push("dynamic", "cubic_vs_rate", c);
+    }
+
+    // Static Allan deviation per τ band.
+    let static_runs: Vec<_> = runs(&r.is_static);
+    let segments: Vec<&[f64]> = static_runs
+        .iter()
+        .map(|run| &r.residual_dps[run.clone()])
+        .collect();
+    if !segments.is_empty() {
+        let allan = AllanDeviation::compute(&segments, fs, &allan_factors(fs), ONE_SIGMA);
+        for (lo, hi) in ALLAN_BANDS_S {
+            let logs: Vec<f64> = allan
+                .points
+                .iter()
+                .filter(|p| p.tau_s >= lo * (1.0 - 1e-9) && p.tau_s <= hi * (1.0 + 1e-9))
+                .filter(|p| p.adev_dps > 0.0)
+                .map(|p| p.adev_dps.log10())
+                .collect();
+            if !logs.is_empty() {
+                let mean = logs.iter().sum::<f64>() / logs.len() as f64;
+                out.push("static", &format!("allan_log10_adev_{lo}_{hi}s"), mean);
+            }
+        }
+    }
+
+    // Whiteness.
+    if let Some(a) = lag1(&r.residual_dps, &static_runs) {
+        out.push("static", "lag1_autocorrelation", a);
+    }
+    if let Some(a) = lag1(&r.residual_dps, &runs(&dynamic)) {
+        out.push("dynamic", "lag1_autocorrelation", a);
+    }
+    if let Some(lag) = xcorr_peak_lag(&r.rate_dps, &r.reference_rate_dps, fs) {
+        out.push("all", "xcorr_peak_lag_s", lag);
+    }
+
+    // Angle error growth.
+    let bias = acc[STATIC]
+        .mean_std()
+        .or_else(|| acc[ALL].mean_std())
+        .map_or(0.0, |(m, _)| m);
+    for h in HORIZONS_S {
+        let len = (h * fs).round() as usize;
+        if len == 0 {
+            continue;
+        }
+        let errors: Vec<f64> = r
+            .residual_dps
+            .chunks_exact(len)
+            .filter(|w| w.iter().all(|x| x.is_finite()))
+            .map(|w| w.iter().map(|x| x - bias).sum::<f64>() / fs)
+            .collect();
+        if !errors.is_empty() {
+            let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+            out.push("all", &format!("angle_error_rms_{h}s"), rms);
+        }
+    }
+    out.0
+}
+
+/// Z-score of each `real` statistic against the `ensemble` (one `Vec<Stat>` per simulated
+/// run), matched by (segment, statistic): `z = (real − mean) / std`, with the sample
+/// standard deviation (n − 1) of the ensemble values.
+///
+/// Explicit cases:
+/// - fewer than 2 ensemble runs have the statistic: z is NaN (no reference to compare to);
+/// - the std is floored at max([`STD_FLOOR_ABS`], [`STD_FLOOR_REL`] · max(|mean|, |real|)),
+///   so a statistic constant over the ensemble gives z = 0 when real equals it and a large
+///   but finite z otherwise.
+pub fn z_scores(real: &[Stat], ensemble: &[Vec<Stat>]) -> Vec<(Stat, f64)> {
+    let mut values: BTreeMap<(&str, &str), Vec<f64>> = BTreeMap::new();
+    for run in ensemble {
+        for s in run {
+            if s.value.is_finite() {
+                values
+                    .entry((s.segment.as_str(), s.statistic.as_str()))
+                    .or_default()
+                    .push(s.value);
+            }
+        }
+    }
+    real.iter()
+        .map(|s| {
+            let z = match values
+                .get(&(s.segment.as_str(), s.statistic.as_str()))
+                .and_then(|v| mean_std(v))
+            {
+                None => f64::NAN,
+                Some((mean, std)) => {
+                    let floor = STD_FLOOR_ABS.max(STD_FLOOR_REL * mean.abs().max(s.value.abs()));
+                    (s.value - mean) / std.max(floor)
+                }
+            };
+            (s.clone(), z)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gyro_log::{regularize, GridOptions};
+    use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+
+    const FS: f64 = 200.0;
+
+    fn run(effects: &[Effect], seed: u64) -> Vec<Stat> {
+        let model = SensorModel {
+            sample_rate_hz: FS,
+            ..SensorModel::default()
+        };
+        let motion = Motion::bench(&BenchProfile::default(), 7);
+        let options = SimOptions {
+            seed,
+            ..SimOptions::default()
+        };
+        let log = simulate(&model, effects, &motion, &options);
+        let regular = regularize(&log, &GridOptions::default()).unwrap();
+        where_stats(&regular).unwrap()
+    }
+
+    fn get(stats: &[Stat], segment: &str, statistic: &str) -> f64 {
+        stats
+            .iter()
+            .find(|s| s.segment == segment && s.statistic == statistic)
+            .map(|s| s.value)
+            .unwrap_or_else(|| panic!("missing {segment} {statistic}"))
+    }
+
+    #[test]
+    fn nominal_statistics_are_present_and_finite() {
+        let stats = run(&[], 1);
+        assert!(stats.iter().all(|s| s.value.is_finite()));
+        for (seg, stat) in [
+            ("static", "residual_mean"),
+            ("dynamic", "residual_std"),
+            ("dynamic/rate_0_30", "residual_mean"),
+            ("dynamic/positive", "residual_mean"),
+            ("static/temperature_3", "residual_mean"),
+            ("dynamic/time_2", "residual_std"),
+            ("dynamic", "slope_vs_rate"),
+            ("dynamic/negative", "slope_vs_rate"),
+            ("dynamic", "cubic_vs_rate"),
+            ("static", "allan_log10_adev_0.01_0.1s"),
+            ("static", "allan_log10_adev_1_10s"),
+            ("static", "lag1_autocorrelation"),
+            ("all", "xcorr_peak_lag_s"),
+            ("all", "angle_error_rms_20s"),
+        ] {
+            get(&stats, seg, stat);
+        }
+        // Static mean ≈ nominal bias 0.3 °/s (plus a Gauss-Markov draw of σ 0.05).
+        assert!((get(&stats, "static", "residual_mean") - 0.3).abs() < 0.2);
+        // White static residual.
+        assert!(get(&stats, "static", "lag1_autocorrelation").abs() < 0.1);
+    }
+
+    #[test]
+    fn slope_recovers_scale_factor() {
+        let nominal = get(&run(&[], 1), "dynamic", "slope_vs_rate");
+        assert!(nominal.abs() < 2e-3, "nominal slope {nominal}");
+        let scaled = run(&[Effect::ScaleFactor { k: 0.01 }], 1);
+        for seg in ["dynamic", "dynamic/positive", "dynamic/negative"] {
+            let s = get(&scaled, seg, "slope_vs_rate");
+            assert!((s - 0.01).abs() < 2e-3, "{seg} slope {s}");
+        }
+        // Asymmetry: the sign strata see opposite slopes.
+        let asym = run(&[Effect::ScaleAsymmetry { k: 0.01 }], 1);
+        let (pos, neg) = (
+            get(&asym, "dynamic/positive", "slope_vs_rate"),
+            get(&asym, "dynamic/negative", "slope_vs_rate"),
+        );
+        assert!((pos - 0.01).abs() < 2e-3, "positive slope {pos}");
+        assert!((neg + 0.01).abs() < 2e-3, "negative slope {neg}");
+    }
+
+    #[test]
+    fn lag_detects_latency() {
+        let nominal = get(&run(&[], 1), "all", "xcorr_peak_lag_s");
+        assert!(nominal.abs() < 2e-3, "nominal lag {nominal}");
+        let nominal = get(&run(&[], 1), "dynamic", "slope_vs_acceleration");
+        assert!(nominal.abs() < 1e-3, "nominal acceleration slope {nominal}");
+        let late = run(&[Effect::Latency { delay_s: 0.01 }], 1);
+        let lag = get(&late, "all", "xcorr_peak_lag_s");
+        assert!((lag - 0.01).abs() < 3e-3, "lag {lag}");
+        let slope = get(&late, "dynamic", "slope_vs_acceleration");
+        assert!((slope + 0.01).abs() < 1e-3, "acceleration slope {slope}");
+    }
+
+    #[test]
+    fn z_scores_against_nominal_ensemble() {
+        let ensemble: Vec<Vec<Stat>> = (100..120).map(|seed| run(&[], seed)).collect();
+        let z = z_scores(&run(&[], 1), &ensemble);
+        assert!(z.len() > 30);
+        let within = z.iter().filter(|(_, z)| z.abs() < 3.0).count();
+        assert!(
+            within as f64 >= 0.9 * z.len() as f64,
+            "{within} of {} within 3: {:?}",
+            z.len(),
+            z.iter().filter(|(_, z)| z.abs() >= 3.0).collect::<Vec<_>>()
+        );
+        let z = z_scores(&run(&[Effect::ScaleFactor { k: 0.01 }], 1), &ensemble);
+        let slope = z
+            .iter()
+            .find(|(s, _)| s.segment == "dynamic" && s.statistic == "slope_vs_rate")
+            .unwrap();
+        assert!(slope.1.abs() > 5.0, "slope z {}", slope.1);
+    }
+
+    #[test]
+    fn z_scores_explicit_cases() {
+        let stat = |segment: &str, value: f64| Stat {
+            segment: segment.into(),
+            statistic: "x".into(),
+            value,
+        };
+        let ensemble = vec![
+            vec![stat("a", 1.0), stat("c", 2.0)],
+            vec![stat("a", 3.0), stat("c", 2.0)],
+        ];
+        let z = z_scores(
+            &[
+                stat("a", 4.0),
+                stat("b", 1.0),
+                stat("c", 2.0),
+                stat("c", 3.0),
+            ],
+            &ensemble,
+        );
+        // mean 2, std √2.
+        assert!((z[0].1 - 2.0 / 2f64.sqrt()).abs() < 1e-12);
+        assert!(z[1].1.is_nan());
+        assert_eq!(z[2].1, 0.0);
+        // Floor 1e-3 · 3.
+        assert!((z[3].1 - 1.0 / 3e-3).abs() < 1e-6);
+    }
+}

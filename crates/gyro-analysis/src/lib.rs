@@ -1,0 +1,18 @@
+//! Analysis of gyro logs: replay through exactly the `gyro-core` pipeline the firmware runs,
+//! the model file, noise characterisation, calibration on bench runs and the sim-to-real
+//! diagnosis.
+//!
+//! ```no_run
+//! use gyro_analysis::replay;
+//! let raw = gyro_log::read_csv("fixtures/logs/bench_run.csv".as_ref(), &gyro_log::ColumnOptions::default())?;
+//! let regular = gyro_log::regularize(&raw, &gyro_log::GridOptions::default())?;
+//! let report = replay::replay(&regular, &gyro_core::Config::default())?;
+//! println!("max abs error: {:?} deg", report.summary.max_abs_error_deg);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub mod calibrate;
+pub mod diagnose;
+pub mod model;
+pub mod noise;
+pub mod replay;

@@ -1,0 +1,261 @@
+//! The model file: a versioned JSON wrapper around the core's [`Config`].
+//!
+//! ```json
+//! {"format": "gyro-model", "version": 1, "config": {"compensation": "paper", "paper": {"beta_per_s": 0.01, "b0_dps": 0.2, "o0_deg": 0.0}}}
+//! ```
+//! Missing settings take the core's defaults; unknown keys are errors (a typo must not be
+//! silently ignored). `config.sample_rate_hz` is replaced by the log's rate when replaying.
+//!
+//! Fitted sensor errors (from `diagnose`) go in two places:
+//! - `config.correction` ([`gyro_core::Correction`]): scale, asymmetry and temperature
+//!   errors, which the core removes from every sample — on the wrench as in `run`;
+//! - `reference_delay_s`: the gyro's latency behind the reference, which only scoring uses
+//!   (the reference is shifted by it before comparing; see [`crate::replay::ReplayOptions`]).
+//!
+//! ```json
+//! {"format": "gyro-model", "version": 1,
+//!  "config": {"correction": {"scale_k": 0.02, "bias_dps_per_c": 0.05}},
+//!  "reference_delay_s": 0.01}
+//! ```
+//! Both are left out when written as the identity and zero, so such files stay readable by
+//! builds that predate them.
+
+use gyro_core::{Config, Pipeline};
+use gyro_sim::SensorModel;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The `format` value of every model file.
+pub const FORMAT: &str = "gyro-model";
+/// The model file version this build reads and writes.
+pub const VERSION: u32 = 1;
+/// The largest |`reference_delay_s`| accepted (s): a gyro's latency is milliseconds; a
+/// second is a wrong unit or a wrong sign convention, not a latency.
+pub const MAX_REFERENCE_DELAY_S: f64 = 1.0;
+
+/// A model file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// Always [`FORMAT`].
+    pub format: String,
+    /// File version ([`VERSION`]).
+    pub version: u32,
+    /// The pipeline configuration.
+    #[serde(default)]
+    pub config: Config,
+    /// The sensor's noise and error model (for `simulate`, from `noise`/`calibrate`).
+    #[serde(default)]
+    pub sensor: SensorModel,
+    /// The gyro lags the reference by this much (s; negative: it leads), as fitted by
+    /// `diagnose` (effect `latency`). Applied when scoring, not by the core: `run` compares
+    /// the angle at `t` with the reference at `t − reference_delay_s` (linear between grid
+    /// slots), so that the error measures the sensor, not the logger's timing. Default 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub reference_delay_s: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+impl ModelFile {
+    /// A model file holding `config`.
+    pub fn new(config: Config) -> Self {
+        Self {
+            format: FORMAT.into(),
+            version: VERSION,
+            config,
+            sensor: SensorModel::default(),
+            reference_delay_s: 0.0,
+        }
+    }
+}
+
+/// Why a model file could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelError {
+    /// Not readable.
+    #[error("{path}: {cause}")]
+    Io {
+        /// File.
+        path: PathBuf,
+        /// Cause (in the message, not chained: it would print twice).
+        cause: std::io::Error,
+    },
+    /// Not valid JSON for a model file.
+    #[error("{path}:{line}:{column}: {message}")]
+    Json {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// Another format or version.
+    #[error(
+        "{path}: expected format `{FORMAT}` version {VERSION}, found `{format}` version {version}"
+    )]
+    Version {
+        /// File.
+        path: PathBuf,
+        /// Format found.
+        format: String,
+        /// Version found.
+        version: u32,
+    },
+    /// The sensor model is invalid.
+    #[error("{path}: {message}")]
+    Sensor {
+        /// File.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// `reference_delay_s` is not finite or beyond ±[`MAX_REFERENCE_DELAY_S`].
+    #[error("{path}: reference_delay_s must be within ±{MAX_REFERENCE_DELAY_S} s, found {value}")]
+    ReferenceDelay {
+        /// File.
+        path: PathBuf,
+        /// The value found.
+        value: f64,
+    },
+    /// A setting is invalid.
+    #[error("{path}: {source}")]
+    Invalid {
+        /// File.
+        path: PathBuf,
+        /// Which setting.
+        source: gyro_core::Error,
+    },
+}
+
+/// Read and validate a model file.
+pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
+    let text = std::fs::read_to_string(path).map_err(|cause| ModelError::Io {
+        path: path.to_path_buf(),
+        cause,
+    })?;
+    let model: ModelFile = serde_json::from_str(&text).map_err(|e| ModelError::Json {
+        path: path.to_path_buf(),
+        line: e.line(),
+        column: e.column(),
+        message: e.to_string(),
+    })?;
+    if model.format != FORMAT || model.version != VERSION {
+        return Err(ModelError::Version {
+            path: path.to_path_buf(),
+            format: model.format,
+            version: model.version,
+        });
+    }
+    Pipeline::try_new(&model.config).map_err(|source| ModelError::Invalid {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    model
+        .sensor
+        .validate()
+        .map_err(|message| ModelError::Sensor {
+            path: path.to_path_buf(),
+            message,
+        })?;
+    // (JSON has no NaN or infinity; the check keeps the bound honest for any caller.)
+    let delay_ok = model.reference_delay_s.is_finite()
+        && model.reference_delay_s.abs() <= MAX_REFERENCE_DELAY_S;
+    if !delay_ok {
+        return Err(ModelError::ReferenceDelay {
+            path: path.to_path_buf(),
+            value: model.reference_delay_s,
+        });
+    }
+    Ok(model)
+}
+
+/// Write a model file (pretty JSON).
+pub fn save(path: &Path, model: &ModelFile) -> Result<(), ModelError> {
+    let io = |cause| ModelError::Io {
+        path: path.to_path_buf(),
+        cause,
+    };
+    let text = serde_json::to_string_pretty(model).map_err(|e| io(std::io::Error::other(e)))?;
+    std::fs::write(path, text + "\n").map_err(io)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gyro_core::Compensation;
+
+    fn temp(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("gyro-model-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir.join(name)
+    }
+
+    #[test]
+    fn round_trip() {
+        let mut config = Config {
+            compensation: Compensation::Kalman,
+            ..Config::default()
+        };
+        config.paper.b0_dps = 0.25;
+        let path = temp("m.json");
+        save(&path, &ModelFile::new(config)).unwrap();
+        assert_eq!(load(&path).unwrap().config, config);
+    }
+
+    #[test]
+    fn correction_and_delay_round_trip() {
+        let mut config = Config::default();
+        config.correction.scale_k = 0.015;
+        config.correction.asymmetry_k = -0.004;
+        config.correction.bias_dps_per_c = 0.05;
+        config.correction.scale_per_c = 8e-4;
+        config.correction.temperature_ref_c = Some(24.5);
+        let model = ModelFile {
+            reference_delay_s: 0.0125,
+            ..ModelFile::new(config)
+        };
+        let path = temp("corrected.json");
+        save(&path, &model).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains("\"reference_delay_s\": 0.0125"), "{text}");
+        assert!(text.contains("\"temperature_ref_c\": 24.5"), "{text}");
+        assert_eq!(load(&path).unwrap(), model);
+    }
+
+    #[test]
+    fn partial_file_takes_defaults_and_typos_are_errors() {
+        let path = temp("partial.json");
+        std::fs::write(
+            &path,
+            r#"{"format":"gyro-model","version":1,"config":{"compensation":"none"}}"#,
+        )
+        .unwrap();
+        let model = load(&path).unwrap();
+        assert_eq!(model.config.compensation, Compensation::None);
+        assert_eq!(model.config.filter, Config::default().filter);
+
+        std::fs::write(
+            &path,
+            r#"{"format":"gyro-model","version":1,"config":{"compensaton":"none"}}"#,
+        )
+        .unwrap();
+        let err = load(&path).unwrap_err().to_string();
+        assert!(err.contains("compensaton"), "{err}");
+
+        std::fs::write(&path, r#"{"format":"gyro-model","version":2}"#).unwrap();
+        assert!(matches!(
+            load(&path),
+            Err(ModelError::Version { version: 2, .. })
+        ));
+
+        std::fs::write(&path, r#"{"format":"gyro-model","version":1,"config":{"filter":{"order":12,"cutoff_hz":10}}}"#).unwrap();
+        let err = load(&path).unwrap_err().to_string();
+        assert!(err.contains("filter.order"), "{err}");
+    }
+}

@@ -1,0 +1,637 @@
+//! Replay a regular log through the core [`Pipeline`] and score it against the reference.
+//!
+//! The reference angle goes through the same decimator and low-pass as the rate (both
+//! linear, so filtering the angle equals integrating the filtered rate): the comparison
+//! measures sensor and integration error, not the filter's intended lag. Both start at 0.
+//!
+//! Samples go through the core exactly as on the wrench: with their temperature
+//! ([`Pipeline::push_with_temperature`]) when the log has one, so that the configured
+//! [`gyro_core::Correction`] applies in full. A known latency of the gyro behind the
+//! reference ([`ReplayOptions::reference_delay_s`], the model file's `reference_delay_s`)
+//! is a matter of scoring only: the reference is shifted by it before the comparison.
+
+use crate::model::ModelFile;
+use gyro_core::{Compensation, Config, Decimator, Event, MotionState, Pipeline, Sos, SosState};
+use gyro_log::{
+    metadata_rate_hz, place, read_ahead, read_log_with_warnings, read_mcap, regularize, CsvRows,
+    GridOptions, LogError, LogFormat, LogInfo, LogOptions, Quality, RegularLog, Slot, SlotSink,
+};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// One output sample of the run, with the reference where present.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SeriesPoint {
+    /// Time (s).
+    pub time_s: f64,
+    /// Filtered rate (deg/s).
+    pub rate_dps: f32,
+    /// Motion state.
+    pub motion: MotionState,
+    /// Compensated angle (deg).
+    pub angle_deg: f32,
+    /// Uncompensated angle (deg).
+    pub raw_angle_deg: f32,
+    /// Standard deviation of the angle (deg), Kalman mode.
+    pub angle_std_deg: Option<f32>,
+    /// Bias estimate (deg/s).
+    pub bias_dps: f32,
+    /// Reference angle change since the start, filtered like the rate (deg).
+    pub reference_deg: Option<f64>,
+}
+
+impl SeriesPoint {
+    /// Compensated angle minus reference (deg).
+    pub fn error_deg(&self) -> Option<f64> {
+        self.reference_deg.map(|r| f64::from(self.angle_deg) - r)
+    }
+}
+
+/// One movement found in the run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MovementResult {
+    /// 1-based number.
+    pub index: usize,
+    /// Start (s).
+    pub start_time_s: f64,
+    /// End (s), or the last sample's time if the log ends while moving.
+    pub end_time_s: f64,
+    /// Duration (s).
+    pub duration_s: f64,
+    /// False if the log ended during the movement.
+    pub complete: bool,
+    /// Angle turned, compensated (deg).
+    pub angle_deg: f32,
+    /// Angle turned, uncompensated (deg).
+    pub raw_angle_deg: f32,
+    /// Reference angle change over the movement (deg).
+    pub reference_deg: Option<f64>,
+    /// `angle_deg − reference_deg`.
+    pub error_deg: Option<f64>,
+    /// `raw_angle_deg − reference_deg`.
+    pub raw_error_deg: Option<f64>,
+}
+
+/// Error statistics over the run.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Summary {
+    /// Compensation used.
+    pub compensation: Compensation,
+    /// Output samples.
+    pub outputs: usize,
+    /// Duration covered (s).
+    pub duration_s: f64,
+    /// Movements (complete or not).
+    pub movements: usize,
+    /// Input samples the pipeline rejected (non-finite or implausible).
+    pub rejected_samples: u32,
+    /// Final compensated angle (deg).
+    pub final_angle_deg: f32,
+    /// Final uncompensated angle (deg).
+    pub final_raw_angle_deg: f32,
+    /// Max |angle − reference| over the run (deg).
+    pub max_abs_error_deg: Option<f64>,
+    /// RMS of angle − reference (deg).
+    pub rms_error_deg: Option<f64>,
+    /// angle − reference at the last sample (deg).
+    pub final_error_deg: Option<f64>,
+    /// Max |raw angle − reference| (deg).
+    pub raw_max_abs_error_deg: Option<f64>,
+    /// RMS of raw angle − reference (deg).
+    pub raw_rms_error_deg: Option<f64>,
+    /// Raw angle − reference at the last sample (deg).
+    pub raw_final_error_deg: Option<f64>,
+}
+
+/// How a replay is scored, beyond the pipeline's configuration.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ReplayOptions {
+    /// The gyro lags the reference by this much (s; negative: it leads). The angle at `t`
+    /// is compared with the reference at `t − reference_delay_s`, interpolated linearly
+    /// between grid slots; where that time falls outside the log (or next to a slot without
+    /// reference) the sample has no reference. 0: the reference as logged.
+    pub reference_delay_s: f64,
+}
+
+impl ReplayOptions {
+    /// The options a model file asks for.
+    pub fn from_model(model: &ModelFile) -> Self {
+        Self {
+            reference_delay_s: model.reference_delay_s,
+        }
+    }
+}
+
+/// The result of replaying one log.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunReport {
+    /// Input grid rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Decimation factor.
+    pub decimation_factor: u16,
+    /// Output rate (Hz).
+    pub output_rate_hz: f32,
+    /// What was irregular in the input.
+    pub input: Quality,
+    /// The configuration used.
+    pub config: Config,
+    /// The gyro's delay behind the reference the scoring allowed for (s).
+    pub reference_delay_s: f64,
+    /// The temperature (°C) from which the correction measured ΔT: the configured
+    /// reference, else the log's first valid temperature; `None` if there was neither (the
+    /// correction's temperature terms were then not applied).
+    pub temperature_reference_c: Option<f32>,
+    /// Error statistics.
+    pub summary: Summary,
+    /// The movements.
+    pub movements: Vec<MovementResult>,
+    /// The output series (written by `--out`, not in JSON).
+    #[serde(skip)]
+    pub series: Vec<SeriesPoint>,
+}
+
+/// Max |e|, RMS and last value of a series of errors.
+fn error_stats(errors: impl Iterator<Item = f64>) -> (Option<f64>, Option<f64>, Option<f64>) {
+    let (mut max_abs, mut sum_sq, mut n, mut last) = (0.0_f64, 0.0_f64, 0_usize, None);
+    for e in errors {
+        max_abs = max_abs.max(e.abs());
+        sum_sq += e * e;
+        n += 1;
+        last = Some(e);
+    }
+    if n == 0 {
+        (None, None, None)
+    } else {
+        (Some(max_abs), Some((sum_sq / n as f64).sqrt()), last)
+    }
+}
+
+/// Replay `log` through a pipeline configured by `config` (its sample rate replaced by the
+/// log's), scoring against the reference as logged.
+pub fn replay(log: &RegularLog, config: &Config) -> Result<RunReport, gyro_core::Error> {
+    replay_with(log, config, &ReplayOptions::default())
+}
+
+/// Replay `log` through a pipeline configured by `config` (its sample rate replaced by the
+/// log's), scoring as `options` say.
+pub fn replay_with(
+    log: &RegularLog,
+    config: &Config,
+    options: &ReplayOptions,
+) -> Result<RunReport, gyro_core::Error> {
+    let mut replayer = Replayer::new(log.sample_rate_hz, config, options, log.has_temperature)?;
+    // The reference's shift in grid slots (a non-finite delay is treated as none).
+    let shift_slots = if options.reference_delay_s.is_finite() {
+        options.reference_delay_s * log.sample_rate_hz
+    } else {
+        0.0
+    };
+    if shift_slots == 0.0 {
+        for slot in &log.slots {
+            replayer.push(slot);
+        }
+    } else {
+        // The reference at other slots, ahead or behind: the whole log is at hand.
+        replayer.reference_origin = log.slots.iter().find_map(|s| s.reference_deg);
+        for (i, slot) in log.slots.iter().enumerate() {
+            replayer.push_scored(slot, shifted_reference(&log.slots, i, shift_slots));
+        }
+    }
+    Ok(replayer.finish(log.quality.clone()))
+}
+
+/// Why [`replay_file`] failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayFileError {
+    /// The log cannot be read or placed on the grid.
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// The pipeline cannot be configured for the log's sample rate.
+    #[error("{path}: cannot configure the pipeline for this log")]
+    Config {
+        /// The log.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        cause: gyro_core::Error,
+    },
+}
+
+/// Read, place on the grid and replay a log: what [`read_log_with_warnings`],
+/// [`regularize`] and [`replay_with`] do, with the same result and the same errors, in
+/// one pass without holding the log: a CSV log is streamed row by row (memory: the rate
+/// look-ahead, the output series); an MCAP log is read whole, then streamed from its rows.
+/// Scoring against a reference shifted by a delay needs the reference ahead: then the log
+/// is placed whole and replayed by [`replay_with`]. MCAP warnings go to `warn` before
+/// anything else is reported.
+pub fn replay_file(
+    path: &Path,
+    options: &LogOptions,
+    grid: &GridOptions,
+    config: &Config,
+    replay_options: &ReplayOptions,
+    warn: &mut dyn FnMut(&str),
+) -> Result<RunReport, ReplayFileError> {
+    let config_error = |cause| ReplayFileError::Config {
+        path: path.to_path_buf(),
+        cause,
+    };
+    let delay = replay_options.reference_delay_s;
+    if delay.is_finite() && delay != 0.0 {
+        let (raw, warnings) = read_log_with_warnings(path, options)?;
+        for warning in &warnings {
+            warn(warning);
+        }
+        let regular = regularize(&raw, grid)?;
+        drop(raw);
+        return replay_with(&regular, config, replay_options).map_err(config_error);
+    }
+    let mut sink = ReplaySink {
+        config,
+        options: replay_options,
+        has_temperature: false,
+        replayer: None,
+    };
+    let quality = match LogFormat::detect(path) {
+        LogFormat::Csv => {
+            let rows = CsvRows::open(path, &options.columns)?;
+            let info = LogInfo {
+                path,
+                metadata_rate_hz: metadata_rate_hz(rows.metadata()),
+                has_reference: rows.has_reference(),
+                has_temperature: rows.has_temperature(),
+            };
+            sink.has_temperature = info.has_temperature;
+            // Parsing on a second thread, the grid and the pipeline on this one.
+            read_ahead(rows, |rows| place(&info, rows, grid, &mut sink))?
+        }
+        LogFormat::Mcap => {
+            let read = read_mcap(path, &options.mcap)?;
+            for warning in &read.warnings {
+                warn(warning);
+            }
+            sink.has_temperature = read.log.has_temperature;
+            place(
+                &LogInfo::of(&read.log),
+                read.log.rows.iter().copied().map(Ok),
+                grid,
+                &mut sink,
+            )?
+        }
+    };
+    match sink.replayer {
+        Some(Ok(replayer)) => Ok(replayer.finish(quality)),
+        Some(Err(cause)) => Err(config_error(cause)),
+        // `place` succeeded, so it gave the rate: not reached.
+        None => Replayer::new(
+            quality.sample_rate_hz,
+            config,
+            replay_options,
+            sink.has_temperature,
+        )
+        .map(|replayer| replayer.finish(quality))
+        .map_err(config_error),
+    }
+}
+
+/// The sink of [`replay_file`]: a replayer built once the rate is known. If the pipeline
+/// cannot be configured, the error waits until the log has been read (its errors first).
+struct ReplaySink<'c> {
+    config: &'c Config,
+    options: &'c ReplayOptions,
+    has_temperature: bool,
+    replayer: Option<Result<Replayer, gyro_core::Error>>,
+}
+
+impl SlotSink for ReplaySink<'_> {
+    fn start(&mut self, sample_rate_hz: f64) {
+        self.replayer = Some(Replayer::new(
+            sample_rate_hz,
+            self.config,
+            self.options,
+            self.has_temperature,
+        ));
+    }
+
+    fn slot(&mut self, slot: &Slot) {
+        if let Some(Ok(replayer)) = &mut self.replayer {
+            replayer.push(slot);
+        }
+    }
+}
+
+/// Replays slots one at a time: the state of [`replay_with`] between two slots. Holds the
+/// output series (decimated), not the input.
+pub struct Replayer {
+    sample_rate_hz: f64,
+    config: Config,
+    reference_delay_s: f64,
+    /// The log has a temperature column: every sample goes in with its temperature.
+    has_temperature: bool,
+    pipeline: Pipeline,
+    factor: u16,
+    output_rate_hz: f32,
+    // The reference path: same decimation and low-pass, on the angle relative to its start.
+    reference_origin: Option<f64>,
+    ref_decimator: Decimator,
+    ref_sos: Sos,
+    ref_state: SosState,
+    ref_last: f32,
+    ref_block_complete: bool,
+    series: Vec<SeriesPoint>,
+    movements: Vec<MovementResult>,
+    open: Option<(f64, usize)>,
+}
+
+impl Replayer {
+    /// A replayer for slots at `sample_rate_hz`, with a pipeline configured by `config`
+    /// (its sample rate replaced); `options.reference_delay_s` is reported (the shift
+    /// itself is [`replay_with`]'s); `has_temperature`: the log has a temperature column.
+    pub fn new(
+        sample_rate_hz: f64,
+        config: &Config,
+        options: &ReplayOptions,
+        has_temperature: bool,
+    ) -> Result<Self, gyro_core::Error> {
+        let config = Config {
+            sample_rate_hz: sample_rate_hz as f32,
+            ..*config
+        };
+        let pipeline = Pipeline::try_new(&config)?;
+        let factor = config.decimation_factor()?;
+        let output_rate_hz = config.effective_output_rate_hz()?;
+        let ref_decimator = Decimator::try_new(factor)?;
+        let ref_sos: Sos = config.filter.sos(output_rate_hz.into())?;
+        Ok(Self {
+            sample_rate_hz,
+            config,
+            reference_delay_s: options.reference_delay_s,
+            has_temperature,
+            pipeline,
+            factor,
+            output_rate_hz,
+            reference_origin: None,
+            ref_decimator,
+            ref_sos,
+            ref_state: SosState::new(),
+            ref_last: 0.0,
+            ref_block_complete: true,
+            series: Vec::new(),
+            movements: Vec::new(),
+            open: None,
+        })
+    }
+
+    /// One slot of the grid, scored against its own reference.
+    ///
+    /// The reference origin is the first reference value. Until it comes, every block is
+    /// incomplete (no reference) and the reference filter sees zeros: running it then is
+    /// the same as not running it when the log has no reference at all.
+    pub fn push(&mut self, slot: &Slot) {
+        if self.reference_origin.is_none() {
+            self.reference_origin = slot.reference_deg;
+        }
+        self.push_scored(slot, slot.reference_deg);
+    }
+
+    /// One slot, scored against `reference` (deg; the origin is set).
+    fn push_scored(&mut self, slot: &Slot, reference: Option<f64>) {
+        let reference = match (reference, self.reference_origin) {
+            (Some(r), Some(origin)) => {
+                self.ref_last = (r - origin) as f32;
+                Some(self.ref_last)
+            }
+            _ => {
+                self.ref_block_complete = false;
+                None
+            }
+        };
+        let ref_mean = self.ref_decimator.push(reference.unwrap_or(self.ref_last));
+        // A slot without temperature in a log that has them (a filled gap) keeps the last
+        // valid temperature: NaN tells the pipeline so.
+        let out = if self.has_temperature || slot.temperature_c.is_some() {
+            let temperature_c = slot.temperature_c.map_or(f32::NAN, |t| t as f32);
+            self.pipeline
+                .push_with_temperature(slot.time_s, slot.rate_dps as f32, temperature_c)
+        } else {
+            self.pipeline.push(slot.time_s, slot.rate_dps as f32)
+        };
+        let Some(out) = out else {
+            return;
+        };
+        let reference_deg = match ref_mean {
+            Some(mean) => {
+                if self.series.is_empty() {
+                    self.ref_sos.settle(&mut self.ref_state, mean);
+                }
+                let filtered = self.ref_sos.process(&mut self.ref_state, mean);
+                let complete = self.ref_block_complete;
+                self.ref_block_complete = true;
+                complete.then_some(f64::from(filtered))
+            }
+            None => None,
+        };
+        let series = &mut self.series;
+        series.push(SeriesPoint {
+            time_s: out.time_s,
+            rate_dps: out.rate_dps,
+            motion: out.motion,
+            angle_deg: out.angle_deg,
+            raw_angle_deg: out.raw_angle_deg,
+            angle_std_deg: out.angle_std_deg,
+            bias_dps: out.bias_dps,
+            reference_deg,
+        });
+        match out.event {
+            Some(Event::MovementStarted { start_time_s }) => {
+                self.open = Some((start_time_s, index_at(series, start_time_s)));
+            }
+            Some(Event::MovementEnded(m)) => {
+                let start = self
+                    .open
+                    .take()
+                    .map_or(index_at(series, m.start_time_s), |o| o.1);
+                let end = index_at(series, m.end_time_s);
+                self.movements.push(movement_result(
+                    self.movements.len() + 1,
+                    (m.start_time_s, m.end_time_s),
+                    true,
+                    (m.angle_deg, m.raw_angle_deg),
+                    reference_change(series, start, end),
+                ));
+            }
+            None => {}
+        }
+    }
+
+    /// The report, with `input` the quality of the grid the slots came from.
+    pub fn finish(self, input: Quality) -> RunReport {
+        let Self {
+            sample_rate_hz,
+            config,
+            reference_delay_s,
+            pipeline,
+            factor,
+            output_rate_hz,
+            series,
+            mut movements,
+            open,
+            ..
+        } = self;
+        if let (Some((start_time_s, start)), Some(last)) = (open, series.last()) {
+            let first = &series[start];
+            movements.push(movement_result(
+                movements.len() + 1,
+                (start_time_s, last.time_s),
+                false,
+                (
+                    last.angle_deg - first.angle_deg,
+                    last.raw_angle_deg - first.raw_angle_deg,
+                ),
+                reference_change(&series, start, series.len() - 1),
+            ));
+        }
+
+        let (max_abs, rms, final_e) = error_stats(series.iter().filter_map(SeriesPoint::error_deg));
+        let (raw_max_abs, raw_rms, raw_final) = error_stats(
+            series
+                .iter()
+                .filter_map(|p| p.reference_deg.map(|r| f64::from(p.raw_angle_deg) - r)),
+        );
+        let summary = Summary {
+            compensation: config.compensation,
+            outputs: series.len(),
+            duration_s: match (series.first(), series.last()) {
+                (Some(a), Some(b)) => b.time_s - a.time_s,
+                _ => 0.0,
+            },
+            movements: movements.len(),
+            rejected_samples: pipeline.rejected_samples(),
+            final_angle_deg: series.last().map_or(0.0, |p| p.angle_deg),
+            final_raw_angle_deg: series.last().map_or(0.0, |p| p.raw_angle_deg),
+            max_abs_error_deg: max_abs,
+            rms_error_deg: rms,
+            final_error_deg: final_e,
+            raw_max_abs_error_deg: raw_max_abs,
+            raw_rms_error_deg: raw_rms,
+            raw_final_error_deg: raw_final,
+        };
+        RunReport {
+            sample_rate_hz,
+            decimation_factor: factor,
+            output_rate_hz,
+            input,
+            config,
+            reference_delay_s,
+            temperature_reference_c: pipeline.corrector().reference_c(),
+            summary,
+            movements,
+            series,
+        }
+    }
+}
+
+/// The reference angle at grid position `i − shift_slots`, linear between slots: `None`
+/// outside the log or next to a slot without reference. A zero shift gives the slot's own
+/// value, untouched.
+fn shifted_reference(slots: &[Slot], i: usize, shift_slots: f64) -> Option<f64> {
+    if shift_slots == 0.0 {
+        return slots.get(i)?.reference_deg;
+    }
+    let position = i as f64 - shift_slots;
+    if position.is_nan() || position < 0.0 {
+        return None;
+    }
+    let below = position.floor();
+    let fraction = position - below;
+    // Saturating: a position past `usize::MAX` is simply outside the log.
+    let below = below as usize;
+    let a = slots.get(below)?.reference_deg?;
+    if fraction == 0.0 {
+        return Some(a);
+    }
+    let b = slots.get(below.checked_add(1)?)?.reference_deg?;
+    Some(a + fraction * (b - a))
+}
+
+/// Index of the output sample nearest to `time_s`.
+fn index_at(series: &[SeriesPoint], time_s: f64) -> usize {
+    let i = series.partition_point(|p| p.time_s < time_s);
+    if i == 0 {
+        return 0;
+    }
+    if i >= series.len() {
+        return series.len() - 1;
+    }
+    if (series[i].time_s - time_s).abs() < (time_s - series[i - 1].time_s).abs() {
+        i
+    } else {
+        i - 1
+    }
+}
+
+fn reference_change(series: &[SeriesPoint], start: usize, end: usize) -> Option<f64> {
+    Some(series.get(end)?.reference_deg? - series.get(start)?.reference_deg?)
+}
+
+fn movement_result(
+    index: usize,
+    (start_time_s, end_time_s): (f64, f64),
+    complete: bool,
+    (angle_deg, raw_angle_deg): (f32, f32),
+    reference_deg: Option<f64>,
+) -> MovementResult {
+    MovementResult {
+        index,
+        start_time_s,
+        end_time_s,
+        duration_s: end_time_s - start_time_s,
+        complete,
+        angle_deg,
+        raw_angle_deg,
+        reference_deg,
+        error_deg: reference_deg.map(|r| f64::from(angle_deg) - r),
+        raw_error_deg: reference_deg.map(|r| f64::from(raw_angle_deg) - r),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn slots(references: &[Option<f64>]) -> Vec<Slot> {
+        references
+            .iter()
+            .enumerate()
+            .map(|(i, &reference_deg)| Slot {
+                time_s: i as f64 * 1e-3,
+                rate_dps: 0.0,
+                reference_deg,
+                temperature_c: None,
+                line: i as u64 + 2,
+                filled: false,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn reference_shift_interpolates_on_the_grid() {
+        let s = slots(&[Some(0.0), Some(1.0), Some(3.0), None, Some(10.0)]);
+        // No shift: the slot's own value, missing ones included.
+        assert_eq!(shifted_reference(&s, 2, 0.0), Some(3.0));
+        assert_eq!(shifted_reference(&s, 3, 0.0), None);
+        // The gyro lags by 1.5 slots: slot 2 is compared with position 0.5.
+        assert_eq!(shifted_reference(&s, 2, 1.5), Some(0.5));
+        assert_eq!(shifted_reference(&s, 2, 1.0), Some(1.0));
+        // Before the log, past its end, or next to a missing reference: none.
+        assert_eq!(shifted_reference(&s, 0, 0.25), None);
+        assert_eq!(shifted_reference(&s, 4, -0.5), None);
+        assert_eq!(shifted_reference(&s, 2, -0.5), None);
+        assert_eq!(shifted_reference(&s, 4, 2.5), Some(2.0));
+        // Leading: slot 0 is compared with position 1.25.
+        assert_eq!(shifted_reference(&s, 0, -1.25), Some(1.5));
+        assert_eq!(shifted_reference(&s, 0, f64::MAX), None);
+        assert_eq!(shifted_reference(&s, 0, -f64::MAX), None);
+        assert_eq!(shifted_reference(&s, 0, f64::NAN), None);
+    }
+}

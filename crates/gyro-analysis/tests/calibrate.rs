@@ -1,0 +1,280 @@
+//! Calibration: the fast paper-mode path equals the pipeline, and a fit on runs made by
+//! the paper's own error model recovers its parameters.
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+use gyro_analysis::calibrate::{calibrate, BenchRun, CalibrateOptions, Objective, Trace};
+use gyro_analysis::replay::replay;
+use gyro_core::{Compensation, Config, GaussMarkov};
+use gyro_log::{regularize, GridOptions, Log, Row};
+use gyro_sim::{self as sim, BenchProfile, Motion, SensorModel, SimOptions};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
+
+const FS: f64 = 200.0;
+
+/// A bench run whose gyro error follows the paper's model exactly: during each rotation
+/// the bias decays from b0 with rate β (at rest it is b0), and each rotation gains o0 from
+/// a short rate pulse at its start; plus white noise.
+fn paper_model_run(truth: &GaussMarkov, seed: u64) -> BenchRun {
+    let motion = Motion::bench(&BenchProfile::default(), seed);
+    let rotations = motion.rotations().to_vec();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed + 1000);
+    let noise = Normal::new(0.0, 0.02).unwrap();
+    let (beta, b0, o0) = (
+        f64::from(truth.beta_per_s),
+        f64::from(truth.b0_dps),
+        f64::from(truth.o0_deg),
+    );
+    let pulse_s = 0.1;
+    let n = (motion.duration_s() * FS) as usize;
+    let rows = (0..n)
+        .map(|k| {
+            let t = k as f64 / FS;
+            let bias = match rotations
+                .iter()
+                .find(|r| t >= r.start_s && t < r.start_s + r.duration_s)
+            {
+                Some(r) => {
+                    let pulse = if t < r.start_s + pulse_s {
+                        o0 / pulse_s
+                    } else {
+                        0.0
+                    };
+                    b0 * (-beta * (t - r.start_s)).exp() + pulse
+                }
+                None => b0,
+            };
+            Row {
+                line: k as u64 + 2,
+                time_s: t,
+                rate_dps: Some(motion.rate_dps(t) + bias + noise.sample(&mut rng)),
+                reference_deg: Some(motion.angle_deg(t)),
+                temperature_c: None,
+            }
+        })
+        .collect();
+    let log = Log {
+        path: format!("paper-model-{seed}").into(),
+        metadata: [("sample_rate_hz".to_string(), FS.to_string())].into(),
+        has_reference: true,
+        has_temperature: false,
+        rows,
+    };
+    BenchRun {
+        name: format!("paper-model-{seed}"),
+        log: regularize(&log, &GridOptions::default()).unwrap(),
+    }
+}
+
+#[test]
+fn fast_paper_path_equals_the_pipeline() {
+    let sensor = SensorModel {
+        sample_rate_hz: FS,
+        ..SensorModel::default()
+    };
+    let motion = Motion::bench(&BenchProfile::default(), 11);
+    let log = sim::simulate(&sensor, &[], &motion, &SimOptions::default());
+    let regular = regularize(&log, &GridOptions::default()).unwrap();
+    let config = Config::default();
+    let trace = Trace::new(&regular, &config).unwrap();
+    for gm in [
+        GaussMarkov {
+            beta_per_s: 0.5,
+            b0_dps: 0.3,
+            o0_deg: 0.1,
+        },
+        GaussMarkov {
+            beta_per_s: 0.0,
+            b0_dps: -0.2,
+            o0_deg: 0.0,
+        },
+        GaussMarkov {
+            beta_per_s: 3.0,
+            b0_dps: 1.5,
+            o0_deg: -0.4,
+        },
+    ] {
+        let paper = Config {
+            compensation: Compensation::Paper,
+            paper: gm,
+            ..config
+        };
+        let report = replay(&regular, &paper).unwrap();
+        let fast = trace.paper_angles(&gm);
+        assert_eq!(fast.len(), report.series.len());
+        let worst = fast
+            .iter()
+            .zip(&report.series)
+            .map(|(a, p)| (a - f64::from(p.angle_deg)).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            worst < 1e-3,
+            "{gm:?}: fast path differs from the pipeline by {worst} deg"
+        );
+        let (max_abs, _) = trace.paper_errors(&gm);
+        let real = report.summary.max_abs_error_deg.unwrap();
+        assert!((max_abs - real).abs() < 1e-3, "{max_abs} vs {real}");
+    }
+}
+
+#[test]
+fn fit_recovers_the_paper_model_and_halves_holdout_error() {
+    let truth = GaussMarkov {
+        beta_per_s: 0.5,
+        b0_dps: 0.4,
+        o0_deg: 0.1,
+    };
+    let runs: Vec<BenchRun> = (1..=20).map(|seed| paper_model_run(&truth, seed)).collect();
+    let (train, holdout) = runs.split_at(10);
+    // Least squares on the movement totals: the estimator for parameter recovery (the
+    // paper's max-abs objective weighs transients inside movements, see the next test).
+    let options = CalibrateOptions {
+        objective: Objective::MovementRms,
+        leave_one_out: true,
+        initial_tau_s: None,
+        fit_motion: false,
+    };
+    let result = calibrate(
+        train,
+        holdout,
+        &Config::default(),
+        &options,
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    let fit = result.paper;
+    println!("truth {truth:?}\nfit   {fit:?}\nspread {:?}", result.spread);
+    // Each parameter within two jackknife standard errors of the truth. (β, b0, o0) trade
+    // off against each other over movements of 0.8-4 s, so the curve o(t) is pinned much
+    // more tightly than the parameters: within 0.04 deg of the truth over that range. The
+    // model is applied over the *detected* movement, whose ends differ from the generated
+    // rotation's by up to ~50 ms, during which the 0.4 deg/s bias adds 0.02 deg per end.
+    let spread = result.spread.unwrap();
+    assert_eq!(spread.refits, 10);
+    // The standard errors themselves must be small enough to mean something.
+    for (name, got, want, p, max_se) in [
+        (
+            "beta",
+            fit.beta_per_s,
+            truth.beta_per_s,
+            spread.beta_per_s,
+            0.2,
+        ),
+        ("b0", fit.b0_dps, truth.b0_dps, spread.b0_dps, 0.1),
+        ("o0", fit.o0_deg, truth.o0_deg, spread.o0_deg, 0.1),
+    ] {
+        let miss = f64::from(got - want).abs();
+        assert!(
+            miss <= 2.0 * p.standard_error,
+            "{name}: {got} vs {want}, se {}",
+            p.standard_error
+        );
+        assert!(p.standard_error < max_se, "{name}: se {}", p.standard_error);
+    }
+    for t in [0.8_f32, 1.5, 2.5, 4.0] {
+        let miss = (fit.misalignment_deg(t) - truth.misalignment_deg(t)).abs();
+        assert!(miss < 0.04, "o({t}) misses by {miss} deg");
+    }
+
+    let max = |f: fn(&gyro_analysis::calibrate::RunScore) -> f64| {
+        result.holdout.iter().map(f).fold(0.0, f64::max)
+    };
+    let (none, paper) = (max(|s| s.none_max_abs_deg), max(|s| s.paper_max_abs_deg));
+    println!("hold-out worst max abs error: none {none:.3} deg, paper {paper:.3} deg");
+    assert!(paper <= 0.5 * none, "paper {paper} vs none {none}");
+    for s in &result.holdout {
+        assert!(s.paper_max_abs_deg <= 0.5 * s.none_max_abs_deg, "{s:?}");
+    }
+}
+
+#[test]
+fn paper_objective_also_halves_holdout_error() {
+    let truth = GaussMarkov {
+        beta_per_s: 0.5,
+        b0_dps: 0.4,
+        o0_deg: 0.1,
+    };
+    let runs: Vec<BenchRun> = (21..=30)
+        .map(|seed| paper_model_run(&truth, seed))
+        .collect();
+    let (train, holdout) = runs.split_at(5);
+    let options = CalibrateOptions {
+        objective: Objective::MeanMaxAbs,
+        leave_one_out: false,
+        initial_tau_s: None,
+        fit_motion: false,
+    };
+    let result = calibrate(
+        train,
+        holdout,
+        &Config::default(),
+        &options,
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    println!("paper objective fit {:?}", result.paper);
+    for s in &result.holdout {
+        assert!(s.paper_max_abs_deg <= 0.5 * s.none_max_abs_deg, "{s:?}");
+    }
+}
+
+#[test]
+fn runs_without_reference_are_refused() {
+    let mut run = paper_model_run(&GaussMarkov::default(), 1);
+    run.log.has_reference = false;
+    let options = CalibrateOptions {
+        objective: Objective::MeanMaxAbs,
+        leave_one_out: false,
+        initial_tau_s: None,
+        fit_motion: false,
+    };
+    let err = calibrate(&[run], &[], &Config::default(), &options, &mut |_, _, _| {}).unwrap_err();
+    assert!(err.to_string().contains("no reference_deg column"), "{err}");
+}
+
+#[test]
+fn motion_thresholds_fit_never_worsens_the_objective() {
+    let truth = GaussMarkov {
+        beta_per_s: 0.5,
+        b0_dps: 0.4,
+        o0_deg: 0.1,
+    };
+    let runs: Vec<BenchRun> = (31..=33)
+        .map(|seed| paper_model_run(&truth, seed))
+        .collect();
+    let options = |fit_motion| CalibrateOptions {
+        objective: Objective::MeanMaxAbs,
+        leave_one_out: false,
+        initial_tau_s: Some(2.0),
+        fit_motion,
+    };
+    let fixed = calibrate(
+        &runs,
+        &[],
+        &Config::default(),
+        &options(false),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    let fitted = calibrate(
+        &runs,
+        &[],
+        &Config::default(),
+        &options(true),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    assert!(
+        fitted.objective_deg <= fixed.objective_deg + 1e-9,
+        "{} vs {}",
+        fitted.objective_deg,
+        fixed.objective_deg
+    );
+    let m = fitted.config.motion;
+    assert!(
+        m.exit_dps >= 0.01 && m.exit_dps <= 2.0 && m.enter_dps > m.exit_dps,
+        "{m:?}"
+    );
+    assert_eq!(fitted.initial_tau, (2.0, "option"));
+}

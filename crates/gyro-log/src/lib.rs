@@ -1,0 +1,316 @@
+//! Gyro logs: the shared CSV and MCAP contract (DESIGN.md "Log formats"), read into rows,
+//! then put on a regular time grid with every irregularity counted.
+//!
+//! [`read_log`] reads either format (by content, else by extension); [`write_log`] writes
+//! either by extension.
+
+mod ahead;
+mod csv_log;
+pub mod mcap;
+mod regular;
+
+pub use ahead::read_ahead;
+pub use csv_log::{read_csv, write_csv, ColumnOptions, CsvRows, RateUnit, TimeUnit};
+pub use mcap::{
+    read_mcap, write_mcap, Axis, JsonChannel, McapLogWriter, McapOptions, McapRead,
+    McapWriteOptions, TimeSource,
+};
+pub use regular::{
+    place, regularize, GridOptions, LogInfo, Quality, RegularLog, Slot, SlotSink, RATE_WINDOW_STEPS,
+};
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// A log file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum LogFormat {
+    /// CSV with `# key: value` metadata lines and a header.
+    Csv,
+    /// MCAP (JSON channels `/gyro`, `/reference`; or a ROS 2 bag with an Imu channel).
+    Mcap,
+}
+
+impl LogFormat {
+    /// The format a file name asks for: `.csv` or `.mcap` (any case), else `None`.
+    pub fn from_extension(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "csv" => Some(Self::Csv),
+            "mcap" => Some(Self::Mcap),
+            _ => None,
+        }
+    }
+
+    /// The format of an existing file: MCAP if it starts with the MCAP magic, else by
+    /// extension, else CSV. A file that cannot be opened is judged by its extension (the
+    /// reader then reports the error).
+    pub fn detect(path: &Path) -> Self {
+        use std::io::Read;
+        let mut head = [0_u8; 5];
+        let starts_mcap = std::fs::File::open(path)
+            .and_then(|mut f| f.read_exact(&mut head))
+            .is_ok()
+            && head == mcap::MAGIC[..5];
+        if starts_mcap {
+            Self::Mcap
+        } else {
+            Self::from_extension(path).unwrap_or(Self::Csv)
+        }
+    }
+}
+
+/// How to read a log of either format.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct LogOptions {
+    /// CSV columns and units.
+    #[cfg_attr(feature = "clap", command(flatten, next_help_heading = "CSV input"))]
+    pub columns: ColumnOptions,
+    /// MCAP channels and ROS 2 options.
+    #[cfg_attr(
+        feature = "clap",
+        command(flatten, next_help_heading = "MCAP / ROS 2 input")
+    )]
+    pub mcap: McapOptions,
+}
+
+/// Read a CSV or MCAP log (format from [`LogFormat::detect`]). MCAP damage that did not
+/// stop reading (an interrupted recording) is returned as warnings, one line each.
+pub fn read_log_with_warnings(
+    path: &Path,
+    options: &LogOptions,
+) -> Result<(Log, Vec<String>), LogError> {
+    match LogFormat::detect(path) {
+        LogFormat::Csv => Ok((read_csv(path, &options.columns)?, Vec::new())),
+        LogFormat::Mcap => {
+            let read = read_mcap(path, &options.mcap)?;
+            Ok((read.log, read.warnings))
+        }
+    }
+}
+
+/// Read a CSV or MCAP log (format from [`LogFormat::detect`]); warnings are dropped (see
+/// [`read_log_with_warnings`]).
+pub fn read_log(path: &Path, options: &LogOptions) -> Result<Log, LogError> {
+    read_log_with_warnings(path, options).map(|(log, _)| log)
+}
+
+/// Write `log` to `path` as `format`, or by the path's extension (`.csv`, `.mcap`).
+pub fn write_log(path: &Path, log: &Log, format: Option<LogFormat>) -> Result<(), LogError> {
+    let format = format
+        .or_else(|| LogFormat::from_extension(path))
+        .ok_or_else(|| LogError::Format {
+            path: path.to_path_buf(),
+            message: "unknown output format: name it .csv or .mcap".into(),
+        })?;
+    match format {
+        LogFormat::Mcap => write_mcap(path, log),
+        LogFormat::Csv => {
+            let io_err = |cause| LogError::Io {
+                path: path.to_path_buf(),
+                cause,
+            };
+            let mut out = std::io::BufWriter::new(std::fs::File::create(path).map_err(io_err)?);
+            write_csv(&mut out, log).map_err(io_err)?;
+            std::io::Write::flush(&mut out).map_err(io_err)
+        }
+    }
+}
+
+/// One row of a log as recorded (units converted to s, deg/s, deg, °C).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Row {
+    /// 1-based line number in the file.
+    pub line: u64,
+    /// Time stamp (s).
+    pub time_s: f64,
+    /// Angular rate (deg/s); `None` if the field is empty or NaN.
+    pub rate_dps: Option<f64>,
+    /// Reference (encoder) angle (deg), if the log has one and the field is present.
+    pub reference_deg: Option<f64>,
+    /// Sensor temperature (°C), if present.
+    pub temperature_c: Option<f64>,
+}
+
+/// A log read into memory.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Log {
+    /// Where it came from.
+    pub path: PathBuf,
+    /// `# key: value` metadata lines before the header.
+    pub metadata: BTreeMap<String, String>,
+    /// True if the log has a reference column.
+    pub has_reference: bool,
+    /// True if the log has a temperature column.
+    pub has_temperature: bool,
+    /// The rows in file order.
+    pub rows: Vec<Row>,
+}
+
+impl Log {
+    /// The `sample_rate_hz` metadata value, if present and a positive number.
+    pub fn metadata_rate_hz(&self) -> Option<f64> {
+        metadata_rate_hz(&self.metadata)
+    }
+}
+
+/// The `sample_rate_hz` value of a log's metadata, if present and a positive number.
+pub fn metadata_rate_hz(metadata: &BTreeMap<String, String>) -> Option<f64> {
+    metadata
+        .get("sample_rate_hz")
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .filter(|v| v.is_finite() && *v > 0.0)
+}
+
+/// Why a log could not be read. Every variant names the file; row-level ones the line.
+#[derive(Debug, thiserror::Error)]
+pub enum LogError {
+    /// The file could not be opened or read.
+    #[error("{path}: {cause}")]
+    Io {
+        /// File.
+        path: PathBuf,
+        /// Cause (in the message, not chained: it would print twice).
+        cause: std::io::Error,
+    },
+    /// The CSV structure is broken (e.g. a row with the wrong number of fields).
+    #[error("{path}:{line}: {message}")]
+    Csv {
+        /// File.
+        path: PathBuf,
+        /// Line (1-based).
+        line: u64,
+        /// What is wrong.
+        message: String,
+    },
+    /// No header line.
+    #[error("{path}: no header line (expected e.g. `time_s,rate_dps,reference_deg`)")]
+    NoHeader {
+        /// File.
+        path: PathBuf,
+    },
+    /// A required column is missing.
+    #[error("{path}:{line}: no column `{column}` in the header (columns: {available})")]
+    MissingColumn {
+        /// File.
+        path: PathBuf,
+        /// Header line.
+        line: u64,
+        /// The column looked for.
+        column: String,
+        /// The header's columns.
+        available: String,
+    },
+    /// A field is not a number.
+    #[error("{path}:{line}: column `{column}`: `{value}` is not a number")]
+    NotANumber {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: u64,
+        /// Column name.
+        column: String,
+        /// The field as written.
+        value: String,
+    },
+    /// A time stamp is missing or not finite.
+    #[error("{path}:{line}: missing or non-finite time stamp in column `{column}`")]
+    BadTime {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: u64,
+        /// Column name.
+        column: String,
+    },
+    /// No data rows (or none with a usable rate).
+    #[error("{path}: {what}")]
+    NoData {
+        /// File.
+        path: PathBuf,
+        /// What is missing.
+        what: String,
+    },
+    /// The sample rate could not be determined or is invalid.
+    #[error("{path}: {message}")]
+    SampleRate {
+        /// File.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// Time runs backwards by more than the tolerated amount.
+    #[error(
+        "{path}:{line}: time goes back by {back_s:.6} s (from {previous_s:.6} s at line {previous_line} to {time_s:.6} s); concatenated or corrupt log?"
+    )]
+    TimeBackwards {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: u64,
+        /// Line of the previous kept row.
+        previous_line: u64,
+        /// Previous time (s).
+        previous_s: f64,
+        /// This row's time (s).
+        time_s: f64,
+        /// How far back (s).
+        back_s: f64,
+    },
+    /// A gap in time longer than the longest one bridged by interpolation.
+    #[error(
+        "{path}:{line}: gap of {gap_s:.3} s in the data (after line {previous_line}) exceeds --max-gap-s {max_gap_s} s; the rotation during it cannot be recovered"
+    )]
+    Gap {
+        /// File.
+        path: PathBuf,
+        /// Line after the gap.
+        line: u64,
+        /// Line before the gap.
+        previous_line: u64,
+        /// Gap length (s).
+        gap_s: f64,
+        /// The limit (s).
+        max_gap_s: f64,
+    },
+    /// An MCAP file that cannot be read (not MCAP, empty, corrupt) or written.
+    #[error("{path}: {message}")]
+    Mcap {
+        /// File.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// An MCAP channel the log needs has the wrong schema or encoding.
+    #[error("{path}: channel `{channel}`: {message}")]
+    McapChannel {
+        /// File.
+        path: PathBuf,
+        /// Topic.
+        channel: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// An MCAP message cannot be decoded.
+    #[error("{path}: channel `{channel}` message {index}: {message}")]
+    McapMessage {
+        /// File.
+        path: PathBuf,
+        /// Topic.
+        channel: String,
+        /// 1-based index of the message on its channel.
+        index: u64,
+        /// What is wrong.
+        message: String,
+    },
+    /// The file format is unknown or unsupported.
+    #[error("{path}: {message}")]
+    Format {
+        /// File.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}

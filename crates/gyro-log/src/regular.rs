@@ -1,0 +1,1147 @@
+//! Put a log's rows on the regular grid the pipeline expects, counting every irregularity.
+//!
+//! The pipeline (like the firmware) runs at a fixed sample rate. Rows are placed by their
+//! time step from the previous row: a step of `dt` advances `max(1, round(dt / period))`
+//! slots, so jitter (9 or 11 ms at a nominal 10 ms) keeps every sample, and a step of two
+//! or more periods leaves empty slots (a gap). The rules:
+//!
+//! - an exact copy of the previous row (time and every value) is a *duplicate*: dropped
+//!   (loggers repeat the last row when a sample is lost; the gap after it is filled);
+//! - the same time stamp with different values, or a small step back in time, is kept
+//!   as the next slot and counted; a step back of more than `max_gap_s` is an error;
+//! - a missing or non-finite rate, and the slots of a gap, are filled by linear
+//!   interpolation between their neighbours, counted; a run longer than `max_gap_s` is an
+//!   error naming the line after it; missing slots at the very start or end are trimmed;
+//! - a missing reference or temperature is interpolated the same way within `max_gap_s`,
+//!   else left missing.
+//!
+//! Nothing is invented silently: [`Quality`] reports each count with example lines.
+
+use super::{Log, LogError, Row};
+use serde::Serialize;
+use std::path::Path;
+
+/// How to build the grid (also the command-line options of every command reading logs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct GridOptions {
+    /// Sample rate of the log (Hz); default: its `sample_rate_hz` metadata, else the median
+    /// time step.
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub sample_rate_hz: Option<f64>,
+    /// Longest stretch of missing data (s) bridged by interpolation; longer is an error.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 0.5))]
+    pub max_gap_s: f64,
+}
+
+impl Default for GridOptions {
+    fn default() -> Self {
+        Self {
+            sample_rate_hz: None,
+            max_gap_s: 0.5,
+        }
+    }
+}
+
+/// One slot of the regular grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Slot {
+    /// Time stamp (s): the row's, or interpolated for a filled slot.
+    pub time_s: f64,
+    /// Rate (deg/s).
+    pub rate_dps: f64,
+    /// Reference angle (deg).
+    pub reference_deg: Option<f64>,
+    /// Temperature (°C).
+    pub temperature_c: Option<f64>,
+    /// Line of the row (0 for a slot filled in a gap).
+    pub line: u64,
+    /// True if the rate was interpolated.
+    pub filled: bool,
+}
+
+/// What was irregular in a log, and what was done about it.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Quality {
+    /// Data rows read.
+    pub rows: u64,
+    /// Slots of the regular grid.
+    pub slots: u64,
+    /// Sample rate of the grid (Hz).
+    pub sample_rate_hz: f64,
+    /// Where the rate came from: `option`, `metadata` or `median_step`.
+    pub sample_rate_source: &'static str,
+    /// Slots over the time the log spans (Hz): differs from the grid rate if the
+    /// logger's clock or the nominal rate is off.
+    pub effective_rate_hz: f64,
+    /// Exact copies of the previous row, dropped.
+    pub duplicate_rows: u64,
+    /// Rows with the previous row's time stamp but other values, kept.
+    pub same_time_rows: u64,
+    /// Rows stamped earlier than the previous row (by less than `max_gap_s`), kept.
+    pub backward_steps: u64,
+    /// Steps differing from the period by more than 5% (but less than 1.5 periods).
+    pub jittered_steps: u64,
+    /// Gaps (steps of 1.5 periods or more).
+    pub gaps: u64,
+    /// Longest step between rows (s).
+    pub longest_step_s: f64,
+    /// Rows whose rate was empty, NaN or infinite.
+    pub missing_rate_rows: u64,
+    /// Slots whose rate was interpolated (gaps and missing rates).
+    pub filled_slots: u64,
+    /// Slots trimmed at the start or end for lack of a rate.
+    pub trimmed_slots: u64,
+    /// Slots without a reference after interpolation (only if the log has one).
+    pub missing_reference_slots: u64,
+    /// The first few irregular lines: (what, line).
+    pub examples: Vec<(String, u64)>,
+}
+
+const MAX_EXAMPLES: usize = 12;
+
+impl Quality {
+    fn note(&mut self, what: &str, line: u64) {
+        if self.examples.len() < MAX_EXAMPLES {
+            self.examples.push((what.to_string(), line));
+        }
+    }
+}
+
+/// A log on a regular grid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RegularLog {
+    /// The slots.
+    pub slots: Vec<Slot>,
+    /// Grid rate (Hz).
+    pub sample_rate_hz: f64,
+    /// True if the log has a reference column.
+    pub has_reference: bool,
+    /// True if the log has a temperature column.
+    pub has_temperature: bool,
+    /// What was irregular.
+    pub quality: Quality,
+}
+
+/// The grid rate is estimated from the median positive step among the first this many
+/// steps, so a log without a rate holds this many rows back before placing any.
+pub const RATE_WINDOW_STEPS: usize = 100_000;
+
+/// What placing rows on the grid needs to know about a log besides its rows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LogInfo<'a> {
+    /// The file (for errors).
+    pub path: &'a Path,
+    /// The `sample_rate_hz` metadata value, if valid ([`super::metadata_rate_hz`]).
+    pub metadata_rate_hz: Option<f64>,
+    /// True if the log has a reference column.
+    pub has_reference: bool,
+    /// True if the log has a temperature column.
+    pub has_temperature: bool,
+}
+
+impl<'a> LogInfo<'a> {
+    /// The description of a log read into memory.
+    pub fn of(log: &'a Log) -> Self {
+        Self {
+            path: &log.path,
+            metadata_rate_hz: log.metadata_rate_hz(),
+            has_reference: log.has_reference,
+            has_temperature: log.has_temperature,
+        }
+    }
+}
+
+/// Where [`place`] delivers the slots, in order, as soon as each is final.
+pub trait SlotSink {
+    /// Called once with the grid rate (Hz), before the first slot.
+    fn start(&mut self, sample_rate_hz: f64);
+    /// One slot of the grid.
+    fn slot(&mut self, slot: &Slot);
+}
+
+fn same_row(a: &Row, b: &Row) -> bool {
+    a.time_s == b.time_s
+        && a.rate_dps == b.rate_dps
+        && a.reference_deg == b.reference_deg
+        && a.temperature_c == b.temperature_c
+}
+
+/// The rate given by the option, or the metadata; `None` if it must be estimated.
+fn given_rate(
+    info: &LogInfo<'_>,
+    options: &GridOptions,
+) -> Option<Result<(f64, &'static str), LogError>> {
+    if let Some(rate) = options.sample_rate_hz {
+        if !(rate.is_finite() && rate > 0.0) {
+            return Some(Err(LogError::SampleRate {
+                path: info.path.to_path_buf(),
+                message: format!("--sample-rate-hz {rate} is not a positive number"),
+            }));
+        }
+        return Some(Ok((rate, "option")));
+    }
+    info.metadata_rate_hz.map(|rate| Ok((rate, "metadata")))
+}
+
+/// The rate from the median positive step of the first [`RATE_WINDOW_STEPS`] steps.
+fn median_step_rate(path: &Path, rows: &[Row]) -> Result<(f64, &'static str), LogError> {
+    let mut steps: Vec<f64> = rows
+        .windows(2)
+        .take(RATE_WINDOW_STEPS)
+        .map(|w| w[1].time_s - w[0].time_s)
+        .filter(|dt| *dt > 0.0)
+        .collect();
+    if steps.is_empty() {
+        return Err(LogError::SampleRate {
+            path: path.to_path_buf(),
+            message: "cannot estimate the sample rate (fewer than two distinct time stamps); pass --sample-rate-hz".into(),
+        });
+    }
+    steps.sort_by(f64::total_cmp);
+    Ok((1.0 / steps[steps.len() / 2], "median_step"))
+}
+
+/// Place the rows of `log` on a regular grid (all of it in memory; see [`place`] for the
+/// streaming form, which this wraps).
+pub fn regularize(log: &Log, options: &GridOptions) -> Result<RegularLog, LogError> {
+    struct Collect(Vec<Slot>);
+    impl SlotSink for Collect {
+        fn start(&mut self, _sample_rate_hz: f64) {}
+        fn slot(&mut self, slot: &Slot) {
+            self.0.push(*slot);
+        }
+    }
+    let mut collect = Collect(Vec::with_capacity(log.rows.len() + 16));
+    let quality = place(
+        &LogInfo::of(log),
+        log.rows.iter().copied().map(Ok),
+        options,
+        &mut collect,
+    )?;
+    Ok(RegularLog {
+        slots: collect.0,
+        sample_rate_hz: quality.sample_rate_hz,
+        has_reference: log.has_reference,
+        has_temperature: log.has_temperature,
+        quality,
+    })
+}
+
+/// Place rows on a regular grid as they come, handing each slot to `sink` as soon as it is
+/// final, and return the quality report once the rows are done.
+///
+/// Memory stays bounded: at most [`RATE_WINDOW_STEPS`] + 1 rows are held back while the
+/// rate is estimated (none if the option or the metadata gives it), and then only the
+/// slots of a run still waiting for interpolation (at most `max_gap_s` of them).
+///
+/// The outcome is that of reading the whole log, then placing it: a read error anywhere
+/// wins over any placement error, and placement errors come in the order of the passes
+/// over a whole log (an empty log; the rate; steps back and gaps between rows; no rate at
+/// all; a run of missing rates too long to interpolate), the first of each kind. So after
+/// an error the rest of the rows are still read (and placed as far as they can decide
+/// the outcome), and `sink` gets no more slots; on an error, what it got is to be
+/// discarded.
+pub fn place<S: SlotSink + ?Sized>(
+    info: &LogInfo<'_>,
+    rows: impl IntoIterator<Item = Result<Row, LogError>>,
+    options: &GridOptions,
+    sink: &mut S,
+) -> Result<Quality, LogError> {
+    let mut rows = rows.into_iter();
+    // Rows held back while the rate is estimated.
+    let mut ahead: Vec<Row> = Vec::new();
+    let rate = match given_rate(info, options) {
+        Some(rate) => rate,
+        None => {
+            while ahead.len() <= RATE_WINDOW_STEPS {
+                match rows.next() {
+                    Some(row) => ahead.push(row?),
+                    None => break,
+                }
+            }
+            median_step_rate(info.path, &ahead)
+        }
+    };
+    if ahead.is_empty() {
+        match rows.next() {
+            Some(row) => ahead.push(row?),
+            None => {
+                return Err(LogError::NoData {
+                    path: info.path.to_path_buf(),
+                    what: "no data rows after the header".into(),
+                })
+            }
+        }
+    }
+    let (rate_hz, source) = match rate {
+        Ok(rate) => rate,
+        Err(e) => {
+            // A read error further on comes first.
+            for row in rows {
+                row?;
+            }
+            return Err(e);
+        }
+    };
+    sink.start(rate_hz);
+    let mut placer = Placer::new(info, options, rate_hz, source, sink);
+    for row in std::mem::take(&mut ahead) {
+        placer.row(&row);
+    }
+    for row in rows {
+        placer.row(&row?);
+    }
+    placer.finish()
+}
+
+/// The streaming form of the rules in the module documentation: rows in, final slots out.
+///
+/// Three stages, each the streaming form of one pass over a whole log: rows to slots
+/// (duplicates, steps back, gaps: `row`); trimming and interpolating the rate (`rate`);
+/// interpolating the reference and the temperature (`channels`), which hands the slots to
+/// the sink.
+struct Placer<'p, S: SlotSink + ?Sized> {
+    path: &'p Path,
+    period_s: f64,
+    max_gap_s: f64,
+    /// Longest run of missing slots interpolated.
+    max_run: usize,
+    quality: Quality,
+    /// Stage 1: the last row kept.
+    previous: Option<Row>,
+    /// A step back or gap between rows too long: stage 1 stops (the rows are still read).
+    row_error: Option<LogError>,
+    /// A run of missing rates too long: stages 2 and 3 stop.
+    fill_error: Option<LogError>,
+    /// Stage 2: slots without a rate before the first with one (trimmed).
+    leading_missing: u64,
+    /// Stage 2: the last slot with a rate.
+    last_rate: Option<Slot>,
+    /// Stage 2: the slots without a rate since `last_rate`, up to `max_run` of them (a
+    /// longer run is an error, unless it ends the log: trimmed).
+    missing: Vec<Slot>,
+    /// Stage 2: how many slots without a rate since `last_rate`.
+    missing_count: u64,
+    /// Stage 3: slots waiting for a reference or temperature interpolation.
+    pending: std::collections::VecDeque<Slot>,
+    /// Stage 3: index of the first slot in `pending`.
+    pending_start: u64,
+    /// Stage 3: index of the next slot.
+    next_index: u64,
+    reference: Channel,
+    temperature: Channel,
+    /// Stage 3: time of the first and last slot delivered.
+    first_time_s: Option<f64>,
+    last_time_s: f64,
+    sink: &'p mut S,
+}
+
+/// An optional value (reference, temperature) interpolated across short runs.
+struct Channel {
+    /// False if the log has no such column: nothing is interpolated.
+    enabled: bool,
+    /// The index and value of the last slot with a value.
+    last_known: Option<(u64, f64)>,
+}
+
+impl Channel {
+    /// True if the slot at `index`, with `value`, cannot change any more when `latest` is
+    /// the index of the latest slot.
+    fn is_final(&self, index: u64, value: Option<f64>, latest: u64, max_run: usize) -> bool {
+        if !self.enabled || value.is_some() {
+            return true;
+        }
+        match self.last_known {
+            // Before any value: never interpolated.
+            None => true,
+            // Inside a run already decided.
+            Some((known, _)) if index < known => true,
+            // Inside an open run: final once it is too long to interpolate.
+            Some((known, _)) => latest - known > max_run as u64,
+        }
+    }
+}
+
+impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
+    fn new(
+        info: &LogInfo<'p>,
+        options: &GridOptions,
+        rate_hz: f64,
+        source: &'static str,
+        sink: &'p mut S,
+    ) -> Self {
+        let period_s = 1.0 / rate_hz;
+        Self {
+            path: info.path,
+            period_s,
+            max_gap_s: options.max_gap_s,
+            max_run: ((options.max_gap_s / period_s).floor() as usize).max(1),
+            quality: Quality {
+                sample_rate_hz: rate_hz,
+                sample_rate_source: source,
+                ..Quality::default()
+            },
+            previous: None,
+            row_error: None,
+            fill_error: None,
+            leading_missing: 0,
+            last_rate: None,
+            missing: Vec::new(),
+            missing_count: 0,
+            pending: std::collections::VecDeque::new(),
+            pending_start: 0,
+            next_index: 0,
+            reference: Channel {
+                enabled: info.has_reference,
+                last_known: None,
+            },
+            temperature: Channel {
+                enabled: info.has_temperature,
+                last_known: None,
+            },
+            first_time_s: None,
+            last_time_s: 0.0,
+            sink,
+        }
+    }
+
+    /// Stage 1: a row to its slot, after the slots of a gap before it. A missing rate is
+    /// NaN (and `filled`) for now.
+    fn row(&mut self, row: &Row) {
+        self.quality.rows += 1;
+        if self.row_error.is_some() {
+            return;
+        }
+        if let Some(prev) = self.previous {
+            if same_row(&prev, row) {
+                self.quality.duplicate_rows += 1;
+                self.quality.note("duplicate row dropped", row.line);
+                return;
+            }
+            let dt = row.time_s - prev.time_s;
+            self.quality.longest_step_s = self.quality.longest_step_s.max(dt);
+            if dt < 0.0 {
+                if -dt > self.max_gap_s {
+                    self.row_error = Some(LogError::TimeBackwards {
+                        path: self.path.to_path_buf(),
+                        line: row.line,
+                        previous_line: prev.line,
+                        previous_s: prev.time_s,
+                        time_s: row.time_s,
+                        back_s: -dt,
+                    });
+                    return;
+                }
+                self.quality.backward_steps += 1;
+                self.quality
+                    .note("time stamp before the previous row", row.line);
+            } else if dt == 0.0 {
+                self.quality.same_time_rows += 1;
+                self.quality
+                    .note("same time stamp as the previous row", row.line);
+            }
+            let steps = if dt <= 0.0 {
+                1
+            } else {
+                ((dt / self.period_s).round() as u64).max(1)
+            };
+            if steps > 1 {
+                if dt > self.max_gap_s {
+                    self.row_error = Some(LogError::Gap {
+                        path: self.path.to_path_buf(),
+                        line: row.line,
+                        previous_line: prev.line,
+                        gap_s: dt,
+                        max_gap_s: self.max_gap_s,
+                    });
+                    return;
+                }
+                self.quality.gaps += 1;
+                self.quality.note("gap filled by interpolation", row.line);
+                for j in 1..steps {
+                    let time_s = prev.time_s + dt * j as f64 / steps as f64;
+                    self.rate(Slot {
+                        time_s,
+                        rate_dps: f64::NAN,
+                        reference_deg: None,
+                        temperature_c: None,
+                        line: 0,
+                        filled: true,
+                    });
+                }
+            } else if dt > 0.0 && (dt - self.period_s).abs() > 0.05 * self.period_s {
+                self.quality.jittered_steps += 1;
+            }
+        }
+        if row.rate_dps.is_none() {
+            self.quality.missing_rate_rows += 1;
+            self.quality.note("missing rate interpolated", row.line);
+        }
+        self.rate(Slot {
+            time_s: row.time_s,
+            rate_dps: row.rate_dps.unwrap_or(f64::NAN),
+            reference_deg: row.reference_deg,
+            temperature_c: row.temperature_c,
+            line: row.line,
+            filled: row.rate_dps.is_none(),
+        });
+        self.previous = Some(*row);
+    }
+
+    /// Stage 2: trim slots without a rate at the start (and, in `finish`, at the end);
+    /// interpolate the rate across the runs between (bounded by `max_gap_s`).
+    fn rate(&mut self, slot: Slot) {
+        if self.fill_error.is_some() {
+            return;
+        }
+        if slot.rate_dps.is_nan() {
+            if self.last_rate.is_none() {
+                self.leading_missing += 1;
+            } else {
+                self.missing_count += 1;
+                if self.missing.len() < self.max_run {
+                    self.missing.push(slot);
+                }
+            }
+            return;
+        }
+        if let Some(before) = self.last_rate {
+            if self.missing_count > self.max_run as u64 {
+                self.fill_error = Some(LogError::Gap {
+                    path: self.path.to_path_buf(),
+                    line: slot.line,
+                    previous_line: before.line,
+                    gap_s: slot.time_s - before.time_s,
+                    max_gap_s: self.max_gap_s,
+                });
+                self.missing.clear();
+                return;
+            }
+            let (previous, value) = (before.rate_dps, slot.rate_dps);
+            let span = (self.missing.len() + 1) as f64;
+            for (k, mut filled) in std::mem::take(&mut self.missing).into_iter().enumerate() {
+                let w = (k + 1) as f64 / span;
+                filled.rate_dps = previous + w * (value - previous);
+                self.channels(filled);
+            }
+            self.missing_count = 0;
+        }
+        self.last_rate = Some(slot);
+        self.channels(slot);
+    }
+
+    /// Stage 3: interpolate the reference and the temperature across runs up to
+    /// `max_gap_s` (else leave them missing); deliver the slots that cannot change.
+    fn channels(&mut self, slot: Slot) {
+        let index = self.next_index;
+        self.next_index += 1;
+        self.pending.push_back(slot);
+        let max_run = self.max_run;
+        let start = self.pending_start;
+        let pending = &mut self.pending;
+        interpolate(
+            &mut self.reference,
+            index,
+            slot.reference_deg,
+            max_run,
+            |k, v| {
+                if let Some(s) = slot_at(pending, start, k) {
+                    s.reference_deg = Some(v);
+                }
+            },
+        );
+        interpolate(
+            &mut self.temperature,
+            index,
+            slot.temperature_c,
+            max_run,
+            |k, v| {
+                if let Some(s) = slot_at(pending, start, k) {
+                    s.temperature_c = Some(v);
+                }
+            },
+        );
+        self.deliver(false);
+    }
+
+    /// Hand the final slots at the front of `pending` to the sink (all at the end).
+    fn deliver(&mut self, all: bool) {
+        let latest = self.next_index.saturating_sub(1);
+        while let Some(front) = self.pending.front() {
+            let index = self.pending_start;
+            let done = all
+                || (self
+                    .reference
+                    .is_final(index, front.reference_deg, latest, self.max_run)
+                    && self
+                        .temperature
+                        .is_final(index, front.temperature_c, latest, self.max_run));
+            if !done {
+                break;
+            }
+            let Some(slot) = self.pending.pop_front() else {
+                break;
+            };
+            self.pending_start += 1;
+            self.quality.slots += 1;
+            if slot.filled {
+                self.quality.filled_slots += 1;
+            }
+            if self.reference.enabled && slot.reference_deg.is_none() {
+                self.quality.missing_reference_slots += 1;
+            }
+            if self.first_time_s.is_none() {
+                self.first_time_s = Some(slot.time_s);
+            }
+            self.last_time_s = slot.time_s;
+            self.sink.slot(&slot);
+        }
+    }
+
+    /// The end of the rows: trim the trailing slots without a rate, deliver the rest, and
+    /// return the report or the first error (in the order of the passes over a whole log).
+    fn finish(mut self) -> Result<Quality, LogError> {
+        if let Some(e) = self.row_error.take() {
+            return Err(e);
+        }
+        if self.last_rate.is_none() {
+            return Err(LogError::NoData {
+                path: self.path.to_path_buf(),
+                what: "no row has a rate value".into(),
+            });
+        }
+        if let Some(e) = self.fill_error.take() {
+            return Err(e);
+        }
+        self.quality.trimmed_slots = self.leading_missing + self.missing_count;
+        self.deliver(true);
+        let mut quality = self.quality;
+        let first_time_s = self.first_time_s.unwrap_or(self.last_time_s);
+        let span_s = self.last_time_s - first_time_s;
+        quality.effective_rate_hz = if span_s > 0.0 {
+            (quality.slots - 1) as f64 / span_s
+        } else {
+            quality.sample_rate_hz
+        };
+        Ok(quality)
+    }
+}
+
+/// The pending slot of index `index` (`start`: the index of the first pending slot).
+fn slot_at(
+    pending: &mut std::collections::VecDeque<Slot>,
+    start: u64,
+    index: u64,
+) -> Option<&mut Slot> {
+    let offset = usize::try_from(index.checked_sub(start)?).ok()?;
+    pending.get_mut(offset)
+}
+
+/// Stage 3 for one channel: a slot at `index` with `value`; if it ends a run of missing
+/// values no longer than `max_run`, `set(k, v)` for each slot `k` of the run.
+fn interpolate(
+    channel: &mut Channel,
+    index: u64,
+    value: Option<f64>,
+    max_run: usize,
+    mut set: impl FnMut(u64, f64),
+) {
+    if !channel.enabled {
+        return;
+    }
+    let Some(value) = value else {
+        return;
+    };
+    if let Some((j, previous)) = channel.last_known {
+        if index - j > 1 && index - j - 1 <= max_run as u64 {
+            for k in j + 1..index {
+                let w = (k - j) as f64 / (index - j) as f64;
+                set(k, previous + w * (value - previous));
+            }
+        }
+    }
+    channel.last_known = Some((index, value));
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use std::collections::BTreeMap;
+
+    mod whole {
+        //! The whole-log passes that [`super::super::place`] streams.
+        use super::super::{GridOptions, Quality, RegularLog, Slot};
+        use crate::{Log, LogError, Row};
+
+        fn same_row_whole(a: &Row, b: &Row) -> bool {
+            a.time_s == b.time_s
+                && a.rate_dps == b.rate_dps
+                && a.reference_deg == b.reference_deg
+                && a.temperature_c == b.temperature_c
+        }
+
+        /// The grid rate and where it came from.
+        fn sample_rate(log: &Log, options: &GridOptions) -> Result<(f64, &'static str), LogError> {
+            let bad = |message: String| LogError::SampleRate {
+                path: log.path.clone(),
+                message,
+            };
+            if let Some(rate) = options.sample_rate_hz {
+                if !(rate.is_finite() && rate > 0.0) {
+                    return Err(bad(format!(
+                        "--sample-rate-hz {rate} is not a positive number"
+                    )));
+                }
+                return Ok((rate, "option"));
+            }
+            if let Some(rate) = log.metadata_rate_hz() {
+                return Ok((rate, "metadata"));
+            }
+            let mut steps: Vec<f64> = log
+                .rows
+                .windows(2)
+                .take(100_000)
+                .map(|w| w[1].time_s - w[0].time_s)
+                .filter(|dt| *dt > 0.0)
+                .collect();
+            if steps.is_empty() {
+                return Err(bad(
+                "cannot estimate the sample rate (fewer than two distinct time stamps); pass --sample-rate-hz".into(),
+            ));
+            }
+            steps.sort_by(f64::total_cmp);
+            Ok((1.0 / steps[steps.len() / 2], "median_step"))
+        }
+
+        /// The whole-log implementation `place` replaced, kept verbatim as the oracle.
+        pub fn regularize_whole(log: &Log, options: &GridOptions) -> Result<RegularLog, LogError> {
+            if log.rows.is_empty() {
+                return Err(LogError::NoData {
+                    path: log.path.clone(),
+                    what: "no data rows after the header".into(),
+                });
+            }
+            let (rate_hz, source) = sample_rate(log, options)?;
+            let period_s = 1.0 / rate_hz;
+            let mut quality = Quality {
+                rows: log.rows.len() as u64,
+                sample_rate_hz: rate_hz,
+                sample_rate_source: source,
+                ..Quality::default()
+            };
+
+            // Pass 1: assign slots; a missing rate is NaN (and `filled`) for now.
+            let mut slots: Vec<Slot> = Vec::with_capacity(log.rows.len() + 16);
+            let mut previous: Option<&Row> = None;
+            for row in &log.rows {
+                if let Some(prev) = previous {
+                    if same_row_whole(prev, row) {
+                        quality.duplicate_rows += 1;
+                        quality.note("duplicate row dropped", row.line);
+                        continue;
+                    }
+                    let dt = row.time_s - prev.time_s;
+                    quality.longest_step_s = quality.longest_step_s.max(dt);
+                    if dt < 0.0 {
+                        if -dt > options.max_gap_s {
+                            return Err(LogError::TimeBackwards {
+                                path: log.path.clone(),
+                                line: row.line,
+                                previous_line: prev.line,
+                                previous_s: prev.time_s,
+                                time_s: row.time_s,
+                                back_s: -dt,
+                            });
+                        }
+                        quality.backward_steps += 1;
+                        quality.note("time stamp before the previous row", row.line);
+                    } else if dt == 0.0 {
+                        quality.same_time_rows += 1;
+                        quality.note("same time stamp as the previous row", row.line);
+                    }
+                    let steps = if dt <= 0.0 {
+                        1
+                    } else {
+                        ((dt / period_s).round() as u64).max(1)
+                    };
+                    if steps > 1 {
+                        if dt > options.max_gap_s {
+                            return Err(LogError::Gap {
+                                path: log.path.clone(),
+                                line: row.line,
+                                previous_line: prev.line,
+                                gap_s: dt,
+                                max_gap_s: options.max_gap_s,
+                            });
+                        }
+                        quality.gaps += 1;
+                        quality.note("gap filled by interpolation", row.line);
+                        for j in 1..steps {
+                            let time_s = prev.time_s + dt * j as f64 / steps as f64;
+                            slots.push(Slot {
+                                time_s,
+                                rate_dps: f64::NAN,
+                                reference_deg: None,
+                                temperature_c: None,
+                                line: 0,
+                                filled: true,
+                            });
+                        }
+                    } else if dt > 0.0 && (dt - period_s).abs() > 0.05 * period_s {
+                        quality.jittered_steps += 1;
+                    }
+                }
+                if row.rate_dps.is_none() {
+                    quality.missing_rate_rows += 1;
+                    quality.note("missing rate interpolated", row.line);
+                }
+                slots.push(Slot {
+                    time_s: row.time_s,
+                    rate_dps: row.rate_dps.unwrap_or(f64::NAN),
+                    reference_deg: row.reference_deg,
+                    temperature_c: row.temperature_c,
+                    line: row.line,
+                    filled: row.rate_dps.is_none(),
+                });
+                previous = Some(row);
+            }
+
+            // Trim slots without a rate at both ends.
+            let first = slots.iter().position(|s| !s.rate_dps.is_nan());
+            let last = slots.iter().rposition(|s| !s.rate_dps.is_nan());
+            let (Some(first), Some(last)) = (first, last) else {
+                return Err(LogError::NoData {
+                    path: log.path.clone(),
+                    what: "no row has a rate value".into(),
+                });
+            };
+            quality.trimmed_slots = (slots.len() - 1 - last + first) as u64;
+            slots.truncate(last + 1);
+            slots.drain(..first);
+
+            // Pass 2: interpolate the rate across missing slots (runs bounded by max_gap_s).
+            let max_run = ((options.max_gap_s / period_s).floor() as usize).max(1);
+            fill_runs(
+                &mut slots,
+                |s| (!s.rate_dps.is_nan()).then_some(s.rate_dps),
+                |s, v| s.rate_dps = v,
+                |before, after| {
+                    if after - before - 1 > max_run {
+                        Err((before, after))
+                    } else {
+                        Ok(true)
+                    }
+                },
+            )
+            .map_err(|(before, after)| LogError::Gap {
+                path: log.path.clone(),
+                line: slots[after].line,
+                previous_line: slots[before].line,
+                gap_s: slots[after].time_s - slots[before].time_s,
+                max_gap_s: options.max_gap_s,
+            })?;
+            quality.filled_slots = slots.iter().filter(|s| s.filled).count() as u64;
+
+            // Pass 3: reference and temperature, interpolated within max_gap_s, else missing.
+            let within = |before: usize, after: usize| -> Result<bool, LogError> {
+                Ok(after - before - 1 <= max_run)
+            };
+            if log.has_reference {
+                fill_runs(
+                    &mut slots,
+                    |s| s.reference_deg,
+                    |s, v| s.reference_deg = Some(v),
+                    within,
+                )?;
+                quality.missing_reference_slots =
+                    slots.iter().filter(|s| s.reference_deg.is_none()).count() as u64;
+            }
+            if log.has_temperature {
+                fill_runs(
+                    &mut slots,
+                    |s| s.temperature_c,
+                    |s, v| s.temperature_c = Some(v),
+                    within,
+                )?;
+            }
+
+            quality.slots = slots.len() as u64;
+            let span_s = slots.last().map_or(0.0, |s| s.time_s) - slots[0].time_s;
+            quality.effective_rate_hz = if span_s > 0.0 {
+                (slots.len() - 1) as f64 / span_s
+            } else {
+                rate_hz
+            };
+            Ok(RegularLog {
+                slots,
+                sample_rate_hz: rate_hz,
+                has_reference: log.has_reference,
+                has_temperature: log.has_temperature,
+                quality,
+            })
+        }
+
+        /// Fill interior runs of missing values by linear interpolation over the slot index.
+        /// `decide(before, after)`, the indices of the known values around a run, says whether to
+        /// fill it (`Ok(true)`), leave it (`Ok(false)`) or fail.
+        fn fill_runs<E>(
+            slots: &mut [Slot],
+            get: impl Fn(&Slot) -> Option<f64>,
+            set: impl Fn(&mut Slot, f64),
+            decide: impl Fn(usize, usize) -> Result<bool, E>,
+        ) -> Result<(), E> {
+            let mut last_known: Option<(usize, f64)> = None;
+            for i in 0..slots.len() {
+                let Some(value) = get(&slots[i]) else {
+                    continue;
+                };
+                if let Some((j, previous)) = last_known {
+                    if i - j > 1 && decide(j, i)? {
+                        for (k, slot) in slots.iter_mut().enumerate().take(i).skip(j + 1) {
+                            let w = (k - j) as f64 / (i - j) as f64;
+                            set(slot, previous + w * (value - previous));
+                        }
+                    }
+                }
+                last_known = Some((i, value));
+            }
+            Ok(())
+        }
+    }
+
+    /// One step of a generated log.
+    #[derive(Clone, Copy, Debug)]
+    enum Step {
+        Regular,
+        Jitter(f64),
+        Same,
+        Back(f64),
+        Gap(u32),
+        LongGap,
+        LongBack,
+        Duplicate,
+    }
+
+    fn step() -> impl Strategy<Value = Step> {
+        prop_oneof![
+            40 => Just(Step::Regular),
+            8 => (-0.4..0.4_f64).prop_map(Step::Jitter),
+            2 => Just(Step::Same),
+            2 => (0.01..1.5_f64).prop_map(Step::Back),
+            4 => (2_u32..12).prop_map(Step::Gap),
+            3 => Just(Step::Duplicate),
+        ]
+    }
+
+    /// A row's fields: rate, reference, temperature, each possibly missing.
+    type Fields = (Option<f64>, Option<f64>, Option<f64>);
+
+    fn fields() -> impl Strategy<Value = Fields> {
+        let value = |missing: u32| {
+            prop_oneof![
+                missing => Just(None),
+                20 => (-100.0..100.0_f64).prop_map(Some),
+            ]
+        };
+        (value(3), value(4), value(3))
+    }
+
+    /// Rows at a nominal 100 Hz with the generated irregularities; runs of missing values
+    /// come from `missing_runs` (start, length, which field).
+    fn make_log(
+        steps: &[(Step, Fields)],
+        missing_runs: &[(usize, usize, u8)],
+        metadata_rate: bool,
+        has_reference: bool,
+        has_temperature: bool,
+    ) -> Log {
+        let period = 0.01;
+        let mut rows: Vec<Row> = Vec::new();
+        let mut time_s = 12.5;
+        for (i, (step, (rate, reference, temperature))) in steps.iter().enumerate() {
+            let line = i as u64 + 3;
+            let mut row = Row {
+                line,
+                time_s,
+                rate_dps: *rate,
+                reference_deg: if has_reference { *reference } else { None },
+                temperature_c: if has_temperature { *temperature } else { None },
+            };
+            if let Some(previous) = rows.last() {
+                time_s = previous.time_s
+                    + match step {
+                        Step::Regular | Step::Duplicate => period,
+                        Step::Jitter(j) => period * (1.0 + j),
+                        Step::Same => 0.0,
+                        Step::Back(b) => -period * b,
+                        Step::Gap(n) => period * f64::from(*n),
+                        Step::LongGap => 0.3,
+                        Step::LongBack => -0.3,
+                    };
+                row.time_s = time_s;
+                if matches!(step, Step::Duplicate) {
+                    row = Row { line, ..*previous };
+                }
+            }
+            rows.push(row);
+        }
+        for &(start, len, which) in missing_runs {
+            for row in rows.iter_mut().skip(start).take(len) {
+                match which % 3 {
+                    0 => row.rate_dps = None,
+                    1 => row.reference_deg = None,
+                    _ => row.temperature_c = None,
+                }
+            }
+        }
+        let mut metadata = BTreeMap::new();
+        if metadata_rate {
+            metadata.insert("sample_rate_hz".to_string(), "100".to_string());
+        }
+        Log {
+            path: "generated.csv".into(),
+            metadata,
+            has_reference,
+            has_temperature,
+            rows,
+        }
+    }
+
+    fn outcome(result: Result<RegularLog, LogError>) -> String {
+        match result {
+            Ok(log) => format!("{log:?}"),
+            Err(e) => format!("error: {e}"),
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(600))]
+        /// The streaming placer gives what the whole-log passes gave: slots, quality
+        /// report, or the same error.
+        #[test]
+        fn streaming_placement_equals_whole_log_passes(
+            mut steps in proptest::collection::vec((step(), fields()), 0..300),
+            // At most one step too long to bridge, forward or back.
+            long_step in proptest::option::weighted(0.2, (0_usize..300, any::<bool>())),
+            missing_runs in proptest::collection::vec((0_usize..300, 1_usize..30, 0_u8..3), 0..4),
+            metadata_rate: bool,
+            option_rate in prop_oneof![4 => Just(None), 1 => Just(Some(100.0)), 1 => Just(Some(-1.0))],
+            max_gap_s in prop_oneof![Just(0.05), Just(0.12), Just(0.5)],
+            has_reference: bool,
+            has_temperature: bool,
+        ) {
+            if let Some((at, forward)) = long_step {
+                if let Some(step) = steps.get_mut(at) {
+                    step.0 = if forward { Step::LongGap } else { Step::LongBack };
+                }
+            }
+            let log = make_log(&steps, &missing_runs, metadata_rate, has_reference, has_temperature);
+            let options = GridOptions { sample_rate_hz: option_rate, max_gap_s };
+            prop_assert_eq!(
+                outcome(regularize(&log, &options)),
+                outcome(whole::regularize_whole(&log, &options))
+            );
+        }
+    }
+
+    /// A read error anywhere wins over any placement error, as when the log was read whole
+    /// before being placed.
+    #[test]
+    fn read_errors_come_before_placement_errors() {
+        let path = Path::new("x.csv");
+        let info = LogInfo {
+            path,
+            metadata_rate_hz: Some(100.0),
+            has_reference: false,
+            has_temperature: false,
+        };
+        let row = |line: u64, time_s: f64| Row {
+            line,
+            time_s,
+            rate_dps: Some(1.0),
+            reference_deg: None,
+            temperature_c: None,
+        };
+        let bad = || LogError::BadTime {
+            path: path.to_path_buf(),
+            line: 9,
+            column: "time_s".into(),
+        };
+        struct Count(usize);
+        impl SlotSink for Count {
+            fn start(&mut self, _: f64) {}
+            fn slot(&mut self, _: &Slot) {
+                self.0 += 1;
+            }
+        }
+        // A gap (line 2), then a read error (line 9).
+        let rows = vec![
+            Ok(row(1, 0.0)),
+            Ok(row(2, 5.0)),
+            Ok(row(3, 5.01)),
+            Err(bad()),
+        ];
+        let err = place(&info, rows, &GridOptions::default(), &mut Count(0)).unwrap_err();
+        assert!(
+            err.to_string().contains("x.csv:9: missing or non-finite"),
+            "{err}"
+        );
+        // A bad --sample-rate-hz, then a read error.
+        let options = GridOptions {
+            sample_rate_hz: Some(0.0),
+            ..GridOptions::default()
+        };
+        let rows = vec![Ok(row(1, 0.0)), Err(bad())];
+        let err = place(&info, rows, &options, &mut Count(0)).unwrap_err();
+        assert!(err.to_string().contains("x.csv:9:"), "{err}");
+        // Without a rate: the read error is inside the look-ahead.
+        let info = LogInfo {
+            metadata_rate_hz: None,
+            ..info
+        };
+        let rows = vec![Ok(row(1, 0.0)), Err(bad())];
+        let err = place(&info, rows, &GridOptions::default(), &mut Count(0)).unwrap_err();
+        assert!(err.to_string().contains("x.csv:9:"), "{err}");
+    }
+
+    /// The look-ahead for the rate holds RATE_WINDOW_STEPS + 1 rows and no more; the
+    /// estimate ignores what comes after (as it always did).
+    #[test]
+    fn rate_estimate_uses_the_first_window_only() {
+        let n = RATE_WINDOW_STEPS + 50_000;
+        let rows: Vec<Row> = (0..n)
+            .map(|i| {
+                // 100 Hz for the window, then 50 Hz.
+                let time_s = if i <= RATE_WINDOW_STEPS {
+                    i as f64 * 0.01
+                } else {
+                    RATE_WINDOW_STEPS as f64 * 0.01 + (i - RATE_WINDOW_STEPS) as f64 * 0.02
+                };
+                Row {
+                    line: i as u64 + 2,
+                    time_s,
+                    rate_dps: Some(0.5),
+                    reference_deg: None,
+                    temperature_c: None,
+                }
+            })
+            .collect();
+        let log = Log {
+            path: "window.csv".into(),
+            rows,
+            ..Log::default()
+        };
+        let options = GridOptions::default();
+        let streamed = regularize(&log, &options).unwrap();
+        assert_eq!(streamed.quality.sample_rate_source, "median_step");
+        assert!((streamed.sample_rate_hz - 100.0).abs() < 1e-6);
+        assert_eq!(streamed.quality.gaps, 50_000 - 1);
+        assert_eq!(
+            outcome(Ok(streamed)),
+            outcome(whole::regularize_whole(&log, &options))
+        );
+    }
+}

@@ -1,0 +1,189 @@
+//! Rendering a [`Characterization`]: a human-readable table, and the PSD as CSV.
+
+use gyro_analysis::noise::{Characterization, FitTerm, NoiseType};
+use std::fmt::Write as _;
+use std::io::{self, Write};
+
+fn mark(term: &FitTerm) -> &'static str {
+    if term.significant {
+        "*"
+    } else {
+        " "
+    }
+}
+
+/// The Allan table, the fitted terms and the PSD summary of one data set, titled `label`.
+pub fn table(label: &str, c: &Characterization) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "== {label}: {} samples at {} Hz ({:.1} s) in {} stretch{}; mean {:.5} deg/s, sd {:.5} deg/s{}",
+        c.samples,
+        c.sample_rate_hz,
+        c.duration_s,
+        c.segments,
+        if c.segments == 1 { "" } else { "es" },
+        c.mean_rate_dps,
+        c.std_rate_dps,
+        c.rate_step_dps
+            .map_or(String::new(), |v| format!(", output step {v:.6} deg/s"))
+    );
+    let _ = writeln!(
+        s,
+        "Allan deviation (overlapping; {:.1}% chi-squared bounds, EDF by the fitted model's noise type):",
+        100.0 * c.allan.confidence
+    );
+    let _ = writeln!(
+        s,
+        "  {:>10} {:>12} {:>12} {:>12} {:>14} {:>12}",
+        "tau_s", "adev_dps", "lower_dps", "upper_dps", "noise", "model_dps"
+    );
+    for p in &c.allan.points {
+        let noise = match p.noise {
+            NoiseType::WhitePm => "white_pm",
+            NoiseType::WhiteFm => "white_fm",
+            NoiseType::FlickerFm => "flicker_fm",
+            NoiseType::RandomWalkFm => "random_walk_fm",
+        };
+        let _ = writeln!(
+            s,
+            "  {:>10.4} {:>12.4e} {:>12.4e} {:>12.4e} {:>14} {:>12.4e}",
+            p.tau_s,
+            p.adev_dps,
+            p.lower_dps,
+            p.upper_dps,
+            noise,
+            c.fit.adev(p.tau_s)
+        );
+    }
+    let f = &c.fit;
+    let _ = writeln!(
+        s,
+        "Fit (weighted non-negative least squares on the Allan variance; * significant, Δ = misfit increase without the term):"
+    );
+    let n = &f.arw_dps_per_rt_hz;
+    let _ = writeln!(
+        s,
+        "  {} angle random walk N  {:.4e} deg/s/√Hz = {:.4} deg/√h  (Δ {:.1})",
+        mark(n),
+        n.value,
+        f.arw_deg_per_rt_h,
+        n.delta_cost
+    );
+    let q = &f.quantization_deg;
+    let _ = writeln!(
+        s,
+        "  {} quantisation Q       {:.4e} deg  (Δ {:.1})",
+        mark(q),
+        q.value,
+        q.delta_cost
+    );
+    let b = &f.bias_instability_dps;
+    let _ = writeln!(
+        s,
+        "  {} bias instability B   {:.4e} deg/s  (Δ {:.1})",
+        mark(b),
+        b.value,
+        b.delta_cost
+    );
+    let k = &f.rate_random_walk_dps_per_rt_s;
+    let _ = writeln!(
+        s,
+        "  {} rate random walk K   {:.4e} deg/s/√s  (Δ {:.1})",
+        mark(k),
+        k.value,
+        k.delta_cost
+    );
+    let gm = &f.gauss_markov;
+    let _ = writeln!(
+        s,
+        "  {} Gauss-Markov bias    σ {:.4e} deg/s, T {}  (Δ {:.1})",
+        if gm.significant { "*" } else { " " },
+        gm.sigma_dps,
+        gm.corr_time_s
+            .map_or_else(|| "-".to_string(), |t| format!("{t:.4} s")),
+        gm.delta_cost
+    );
+    let _ = writeln!(
+        s,
+        "  floor: min adev {:.4e} deg/s at τ {:.4} s -> B = min/0.664 = {:.4e} deg/s{}",
+        f.floor.adev_dps,
+        f.floor.tau_s,
+        f.floor.bias_instability_dps,
+        if f.floor.at_longest_tau {
+            " (at the longest τ: an upper bound)"
+        } else {
+            ""
+        }
+    );
+    let _ = writeln!(s, "  misfit {:.1} over {} τ points", f.cost, f.points);
+    match &c.psd {
+        Some(psd) => {
+            let _ = writeln!(
+                s,
+                "PSD (Welch, Hann, 50% overlap, {} samples per segment, {} averaged, {:.4} Hz resolution):",
+                psd.segment_len, psd.segments, psd.resolution_hz
+            );
+            let _ = writeln!(
+                s,
+                "  white density {:.4e} deg/s/√Hz = {:.4} deg/√h (over {:.3}–{:.3} Hz)",
+                psd.white_density_dps_per_rt_hz,
+                psd.white_arw_deg_per_rt_h,
+                psd.white_band_hz.0,
+                psd.white_band_hz.1
+            );
+            let _ = writeln!(s, "  {:>22} {:>16}", "band_hz", "psd_dps2_per_hz");
+            // One line per half decade of the ten-per-decade bands.
+            for chunk in psd.bands.chunks(5) {
+                let bins: usize = chunk.iter().map(|b| b.bins).sum();
+                let mean = chunk
+                    .iter()
+                    .map(|b| b.psd_dps2_per_hz * b.bins as f64)
+                    .sum::<f64>()
+                    / bins.max(1) as f64;
+                if let (Some(first), Some(last)) = (chunk.first(), chunk.last()) {
+                    let _ = writeln!(
+                        s,
+                        "  {:>10.4}–{:<11.4} {:>16.4e}",
+                        first.low_hz, last.high_hz, mean
+                    );
+                }
+            }
+        }
+        None => {
+            let _ = writeln!(s, "PSD: no stretch long enough for a window");
+        }
+    }
+    if !c.suggested_effects.is_empty() {
+        let specs: Vec<String> = c
+            .suggested_effects
+            .iter()
+            .map(|e| {
+                let params: Vec<String> = e
+                    .info()
+                    .params
+                    .iter()
+                    .zip(e.params())
+                    .map(|((name, _), v)| format!("{name}={v:.4e}"))
+                    .collect();
+                format!("--effect {}:{}", e.id(), params.join(","))
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "Not in the sensor model; to simulate: {}",
+            specs.join(" ")
+        );
+    }
+    s
+}
+
+/// The full PSD as CSV rows `label,frequency_hz,psd_dps2_per_hz` (no header).
+pub fn psd_csv(out: &mut impl Write, label: &str, c: &Characterization) -> io::Result<()> {
+    if let Some(psd) = &c.psd {
+        for (f, p) in psd.frequency_hz.iter().zip(&psd.psd_dps2_per_hz) {
+            writeln!(out, "{label},{f},{p:e}")?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,212 @@
+//! Rendering a [`RunReport`]: a human table, JSON, or CSV; and the 50 Hz series as CSV.
+
+use gyro_analysis::replay::{MovementResult, RunReport};
+use std::fmt::Write as _;
+use std::io::{self, Write};
+
+fn opt(value: Option<f64>, decimals: usize) -> String {
+    value.map_or_else(|| "-".to_string(), |v| format!("{v:.decimals$}"))
+}
+
+/// A human-readable report.
+pub fn table(file: &str, report: &RunReport) -> String {
+    let mut s = String::new();
+    let q = &report.input;
+    let c = &report.config;
+    let _ = writeln!(s, "file: {file}");
+    let _ = writeln!(
+        s,
+        "input: {} rows -> {} samples at {} Hz ({}), effective {:.3} Hz",
+        q.rows, q.slots, q.sample_rate_hz, q.sample_rate_source, q.effective_rate_hz
+    );
+    let issues: Vec<String> = [
+        (q.duplicate_rows, "duplicate rows dropped"),
+        (q.same_time_rows, "rows with a repeated time stamp"),
+        (q.backward_steps, "steps back in time"),
+        (q.jittered_steps, "jittered steps"),
+        (q.gaps, "gaps"),
+        (q.missing_rate_rows, "missing rates"),
+        (q.filled_slots, "samples interpolated"),
+        (q.trimmed_slots, "samples trimmed at the ends"),
+        (q.missing_reference_slots, "samples without reference"),
+    ]
+    .iter()
+    .filter(|(n, _)| *n > 0)
+    .map(|(n, what)| format!("{n} {what}"))
+    .collect();
+    if !issues.is_empty() {
+        let _ = writeln!(
+            s,
+            "  irregular: {} (longest step {:.3} s)",
+            issues.join(", "),
+            q.longest_step_s
+        );
+        for (what, line) in q.examples.iter().take(5) {
+            let _ = writeln!(s, "    line {line}: {what}");
+        }
+    }
+    let _ = writeln!(
+        s,
+        "pipeline: decimate x{} -> {} Hz, Butterworth order {} at {} Hz, compensation {}",
+        report.decimation_factor,
+        report.output_rate_hz,
+        c.filter.order,
+        c.filter.cutoff_hz,
+        match c.compensation {
+            gyro_core::Compensation::None => "none",
+            gyro_core::Compensation::Paper => "paper",
+            gyro_core::Compensation::Kalman => "kalman",
+        }
+    );
+    let k = &c.correction;
+    if !k.is_identity() {
+        let temperature = match report.temperature_reference_c {
+            Some(t) => format!("ΔT from {t:.2} °C"),
+            None => "no temperature: temperature terms not applied".into(),
+        };
+        let _ = writeln!(
+            s,
+            "correction: scale {:+.5}, asymmetry {:+.5}, {:+.5} deg/s/°C, scale {:+.3e} /°C ({temperature})",
+            k.scale_k, k.asymmetry_k, k.bias_dps_per_c, k.scale_per_c
+        );
+    }
+    if report.reference_delay_s != 0.0 {
+        let _ = writeln!(
+            s,
+            "reference shifted by the gyro's latency, {:.4} s",
+            report.reference_delay_s
+        );
+    }
+    if report.summary.rejected_samples > 0 {
+        let _ = writeln!(
+            s,
+            "  rejected input samples: {}",
+            report.summary.rejected_samples
+        );
+    }
+    let _ = writeln!(s, "movements: {}", report.movements.len());
+    if !report.movements.is_empty() {
+        let _ = writeln!(
+            s,
+            "  {:>4} {:>10} {:>10} {:>8} {:>11} {:>11} {:>11} {:>10} {:>10}",
+            "#",
+            "start_s",
+            "end_s",
+            "dur_s",
+            "angle_deg",
+            "raw_deg",
+            "ref_deg",
+            "error_deg",
+            "raw_err"
+        );
+        for m in &report.movements {
+            let _ = writeln!(
+                s,
+                "  {:>4} {:>10.3} {:>10.3} {:>8.3} {:>11.3} {:>11.3} {:>11} {:>10} {:>10}{}",
+                m.index,
+                m.start_time_s,
+                m.end_time_s,
+                m.duration_s,
+                m.angle_deg,
+                m.raw_angle_deg,
+                opt(m.reference_deg, 3),
+                opt(m.error_deg, 3),
+                opt(m.raw_error_deg, 3),
+                if m.complete {
+                    ""
+                } else {
+                    "  (log ends while moving)"
+                }
+            );
+        }
+    }
+    let sm = &report.summary;
+    let _ = writeln!(
+        s,
+        "summary: {:.1} s, final angle {:.3} deg (uncompensated {:.3} deg)",
+        sm.duration_s, sm.final_angle_deg, sm.final_raw_angle_deg
+    );
+    if sm.max_abs_error_deg.is_some() {
+        let _ = writeln!(
+            s,
+            "  error vs reference: max abs {} deg, RMS {} deg, final {} deg",
+            opt(sm.max_abs_error_deg, 4),
+            opt(sm.rms_error_deg, 4),
+            opt(sm.final_error_deg, 4)
+        );
+        let _ = writeln!(
+            s,
+            "  uncompensated:      max abs {} deg, RMS {} deg, final {} deg",
+            opt(sm.raw_max_abs_error_deg, 4),
+            opt(sm.raw_rms_error_deg, 4),
+            opt(sm.raw_final_error_deg, 4)
+        );
+    } else {
+        let _ = writeln!(s, "  no reference_deg column: no error figures");
+    }
+    s
+}
+
+/// JSON: `{"file", "input", "config", "summary", "movements", ...}`.
+pub fn json(file: &str, report: &RunReport) -> serde_json::Result<String> {
+    #[derive(serde::Serialize)]
+    struct WithFile<'a> {
+        file: &'a str,
+        #[serde(flatten)]
+        report: &'a RunReport,
+    }
+    serde_json::to_string_pretty(&WithFile { file, report })
+}
+
+/// CSV of the movements.
+pub fn movements_csv(out: &mut impl Write, movements: &[MovementResult]) -> io::Result<()> {
+    writeln!(
+        out,
+        "index,start_time_s,end_time_s,duration_s,complete,angle_deg,raw_angle_deg,reference_deg,error_deg,raw_error_deg"
+    )?;
+    for m in movements {
+        writeln!(
+            out,
+            "{},{:.6},{:.6},{:.6},{},{:.6},{:.6},{},{},{}",
+            m.index,
+            m.start_time_s,
+            m.end_time_s,
+            m.duration_s,
+            m.complete,
+            m.angle_deg,
+            m.raw_angle_deg,
+            m.reference_deg.map_or(String::new(), |v| format!("{v:.6}")),
+            m.error_deg.map_or(String::new(), |v| format!("{v:.6}")),
+            m.raw_error_deg.map_or(String::new(), |v| format!("{v:.6}")),
+        )?;
+    }
+    Ok(())
+}
+
+/// CSV of the output series (the `--out` file).
+pub fn series_csv(out: &mut impl Write, report: &RunReport) -> io::Result<()> {
+    writeln!(out, "# output_rate_hz: {}", report.output_rate_hz)?;
+    writeln!(
+        out,
+        "time_s,rate_dps,motion,angle_deg,raw_angle_deg,angle_std_deg,bias_dps,reference_deg,error_deg"
+    )?;
+    for p in &report.series {
+        writeln!(
+            out,
+            "{:.6},{:.5},{},{:.6},{:.6},{},{:.6},{},{}",
+            p.time_s,
+            p.rate_dps,
+            match p.motion {
+                gyro_core::MotionState::Static => "static",
+                gyro_core::MotionState::Dynamic => "dynamic",
+            },
+            p.angle_deg,
+            p.raw_angle_deg,
+            p.angle_std_deg.map_or(String::new(), |v| format!("{v:.6}")),
+            p.bias_dps,
+            p.reference_deg.map_or(String::new(), |v| format!("{v:.6}")),
+            p.error_deg().map_or(String::new(), |v| format!("{v:.6}")),
+        )?;
+    }
+    Ok(())
+}
