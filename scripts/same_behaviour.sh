@@ -5,8 +5,8 @@
 #
 # Inputs: every fixture log, every real recording under ../shared/data/real (ssong and
 # rasteiro), six simulated bench runs (simulate is itself compared), noise on the
-# simulated runs' rests and on rasteiro, calibrate on the simulated runs, and one diagnose
-# self-test case.
+# simulated runs' rests and on rasteiro, calibrate on the simulated runs, diagnose with its
+# HTML report on the simulated runs, and one diagnose self-test case.
 #
 # Usage: scripts/same_behaviour.sh [REV]      exit 0 when every output is equal
 #        OLD_BIN=path/to/old/gyro-cli scripts/same_behaviour.sh   (skip building REV)
@@ -53,6 +53,9 @@ snapshot() {
         -o "$out/model.json" --format json >"$out/calibrate.json" 2>"$out/calibrate.err"
     "$bin" run "$out/sim/run105.csv" --model "$out/model.json" --format json >"$out/run-model.json" 2>&1
     "$bin" convert "$top/fixtures/logs/bench_run.csv" "$out/bench.mcap" >/dev/null 2>&1
+    "$bin" diagnose --train "$out"/sim/run10[1-3].csv --holdout "$out"/sim/run10[4-6].csv \
+        --members 12 --candidate-members 6 --format json --report "$out/report" \
+        >"$out/diagnose-sim.json" 2>/dev/null
     "$bin" diagnose --self-test --seed 8 --only scale_factor --format json >"$out/diagnose.json" \
         2>/dev/null
     # Paths differ between the two runs: compare names relative to the snapshot.

@@ -30,7 +30,7 @@
 //!   fallible objective ([`NelderMead::try_minimize`]) aborts the run with that error.
 //!
 //! ```
-//! use gyro_host::nelder_mead::{NelderMead, Termination};
+//! use nelder_mead::{NelderMead, Termination};
 //! let rosenbrock = |x: &[f64]| 100.0 * (x[1] - x[0] * x[0]).powi(2) + (1.0 - x[0]).powi(2);
 //! let outcome = NelderMead::new()
 //!     .with_x_tolerance(1e-8)?
@@ -235,7 +235,7 @@ impl NelderMead {
     /// [`Start::Simplex`]); the dimension is the start's.
     ///
     /// ```
-    /// use gyro_host::nelder_mead::{Bounds, NelderMead};
+    /// use nelder_mead::{Bounds, NelderMead};
     /// // (x − 3)² is smallest at 3, but x must stay in [−1, 2]: the answer is the bound.
     /// let settings = NelderMead::new()
     ///     .with_bounds(Bounds::new(vec![-1.0], vec![2.0])?)

@@ -2,7 +2,8 @@
 //! bounds, the IEEE 952 noise terms and a Gauss-Markov bias fitted to it, and a Welch PSD.
 //!
 //! ```no_run
-//! use gyro_host::{log, noise};
+//! use gyro_analysis::noise;
+//! use gyro_log as log;
 //! let raw = log::read_csv("static.csv".as_ref(), &log::ColumnOptions::default())?;
 //! let regular = log::regularize(&raw, &log::GridOptions::default())?;
 //! let rate: Vec<f64> = regular.slots.iter().map(|s| s.rate_dps).collect();

@@ -110,13 +110,13 @@ struct RawMessage<'a> {
 /// process leaves every closed chunk readable.
 ///
 /// ```no_run
-/// use gyro_host::log::{McapLogWriter, Row};
+/// use gyro_log::{McapLogWriter, Row};
 /// let mut w = McapLogWriter::create("run.mcap".as_ref())?;
 /// w.write_metadata(&[("sample_rate_hz".to_string(), "1000".to_string())].into())?;
 /// w.write_row(&Row { line: 1, time_s: 0.0, rate_dps: Some(0.1), reference_deg: None, temperature_c: Some(25.0) })?;
 /// w.write_raw(0, &[0x00, 0x01, 0x02])?;
 /// w.finish()?;
-/// # Ok::<(), gyro_host::log::LogError>(())
+/// # Ok::<(), gyro_log::LogError>(())
 /// ```
 pub struct McapLogWriter {
     path: PathBuf,
