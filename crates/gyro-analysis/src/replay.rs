@@ -12,10 +12,7 @@
 
 use crate::model::ModelFile;
 use gyro_core::{Compensation, Config, Decimator, Event, MotionState, Pipeline, Sos, SosState};
-use gyro_log::{
-    metadata_rate_hz, place, read_ahead, read_log_with_warnings, read_mcap, regularize, CsvRows,
-    GridOptions, LogError, LogFormat, LogInfo, LogOptions, Quality, RegularLog, Slot, SlotSink,
-};
+use gyro_log::{GridOptions, LogError, LogOptions, Quality, RegularLog, Slot, SlotSink};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -217,13 +214,12 @@ pub enum ReplayFileError {
     },
 }
 
-/// Read, place on the grid and replay a log: what [`read_log_with_warnings`],
-/// [`regularize`] and [`replay_with`] do, with the same result and the same errors, in
-/// one pass without holding the log: a CSV log is streamed row by row (memory: the rate
-/// look-ahead, the output series); an MCAP log is read whole, then streamed from its rows.
-/// Scoring against a reference shifted by a delay needs the reference ahead: then the log
-/// is placed whole and replayed by [`replay_with`]. MCAP warnings go to `warn` before
-/// anything else is reported.
+/// Read, place on the grid and replay a log: what [`gyro_log::load`] and [`replay_with`]
+/// do, with the same result and the same errors, in one pass without holding the log
+/// ([`gyro_log::stream`]; memory: the rate look-ahead, the output series). Scoring against
+/// a reference shifted by a delay needs the reference ahead: then the log is loaded whole
+/// and replayed by [`replay_with`]. MCAP warnings go to `warn` before anything else is
+/// reported.
 pub fn replay_file(
     path: &Path,
     options: &LogOptions,
@@ -238,12 +234,7 @@ pub fn replay_file(
     };
     let delay = replay_options.reference_delay_s;
     if delay.is_finite() && delay != 0.0 {
-        let (raw, warnings) = read_log_with_warnings(path, options)?;
-        for warning in &warnings {
-            warn(warning);
-        }
-        let regular = regularize(&raw, grid)?;
-        drop(raw);
+        let regular = gyro_log::load(path, options, grid, warn)?;
         return replay_with(&regular, config, replay_options).map_err(config_error);
     }
     let mut sink = ReplaySink {
@@ -252,33 +243,7 @@ pub fn replay_file(
         has_temperature: false,
         replayer: None,
     };
-    let quality = match LogFormat::detect(path) {
-        LogFormat::Csv => {
-            let rows = CsvRows::open(path, &options.columns)?;
-            let info = LogInfo {
-                path,
-                metadata_rate_hz: metadata_rate_hz(rows.metadata()),
-                has_reference: rows.has_reference(),
-                has_temperature: rows.has_temperature(),
-            };
-            sink.has_temperature = info.has_temperature;
-            // Parsing on a second thread, the grid and the pipeline on this one.
-            read_ahead(rows, |rows| place(&info, rows, grid, &mut sink))?
-        }
-        LogFormat::Mcap => {
-            let read = read_mcap(path, &options.mcap)?;
-            for warning in &read.warnings {
-                warn(warning);
-            }
-            sink.has_temperature = read.log.has_temperature;
-            place(
-                &LogInfo::of(&read.log),
-                read.log.rows.iter().copied().map(Ok),
-                grid,
-                &mut sink,
-            )?
-        }
-    };
+    let quality = gyro_log::stream(path, options, grid, &mut sink, warn)?;
     match sink.replayer {
         Some(Ok(replayer)) => Ok(replayer.finish(quality)),
         Some(Err(cause)) => Err(config_error(cause)),
@@ -304,6 +269,10 @@ struct ReplaySink<'c> {
 }
 
 impl SlotSink for ReplaySink<'_> {
+    fn columns(&mut self, _has_reference: bool, has_temperature: bool) {
+        self.has_temperature = has_temperature;
+    }
+
     fn start(&mut self, sample_rate_hz: f64) {
         self.replayer = Some(Replayer::new(
             sample_rate_hz,

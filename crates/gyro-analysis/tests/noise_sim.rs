@@ -165,7 +165,7 @@ fn white_noise_alone_gives_only_arw() {
     assert!(c.sensor_model().gm_sigma_dps == 0.0);
 }
 
-/// DESIGN.md: rate random walk makes the long-τ slope +½, bias instability ~0. Four
+/// docs/effects.md: rate random walk makes the long-τ slope +½, bias instability ~0. Four
 /// static runs of 2000 s at 20 Hz (seeds 1–4) pooled; the same runs without the effect
 /// have slope −½ there. (Single runs scatter: over seeds 1–8 at 100 Hz the RRW slope on
 /// 10–100 s was 0.23–0.56, the BI slope −0.05…+0.10.)

@@ -1,4 +1,4 @@
-//! Each effect of the simulator changes the statistic its signature names (DESIGN.md).
+//! Each effect of the simulator changes the statistic its signature names (docs/effects.md).
 //!
 //! Every run is compared with the same seed without the effect: the random streams are
 //! per source, so the difference between the two is the effect's own term (plus rounding

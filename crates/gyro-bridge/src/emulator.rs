@@ -144,7 +144,7 @@ impl FaultSpec {
     /// preset: `typical,seed=7`, `drop=0.001,bit_flip=1e-4,stall=1e-4,stall_ms=80`. Keys:
     /// `drop`, `byte_loss`, `bit_flip`, `checksum`, `status`, `stall` (probabilities per
     /// frame, 0..=1), `stall_ms`, `seed`.
-    pub fn parse(spec: &str) -> Result<FaultSpec, String> {
+    pub fn parse(spec: &str) -> Result<FaultSpec, FaultSpecError> {
         let mut faults = FaultSpec::NONE;
         for (i, item) in spec.split(',').map(str::trim).enumerate() {
             match item {
@@ -158,21 +158,25 @@ impl FaultSpec {
             }
             let (key, value) = item
                 .split_once('=')
-                .ok_or_else(|| format!("fault `{item}`: expected key=value"))?;
+                .ok_or_else(|| FaultSpecError::NotKeyValue { item: item.into() })?;
             let (key, value) = (key.trim(), value.trim());
-            let probability = || -> Result<f64, String> {
+            let probability = || -> Result<f64, FaultSpecError> {
                 value
                     .parse::<f64>()
                     .ok()
                     .filter(|p| (0.0..=1.0).contains(p))
-                    .ok_or_else(|| {
-                        format!("fault `{key}`: `{value}` is not a probability in [0, 1]")
+                    .ok_or_else(|| FaultSpecError::NotProbability {
+                        key: key.into(),
+                        value: value.into(),
                     })
             };
-            let integer = || -> Result<u64, String> {
+            let integer = || -> Result<u64, FaultSpecError> {
                 value
                     .parse::<u64>()
-                    .map_err(|_| format!("fault `{key}`: `{value}` is not a whole number"))
+                    .map_err(|_| FaultSpecError::NotWholeNumber {
+                        key: key.into(),
+                        value: value.into(),
+                    })
             };
             match key {
                 "drop" => faults.drop = probability()?,
@@ -183,15 +187,44 @@ impl FaultSpec {
                 "stall" => faults.stall = probability()?,
                 "stall_ms" => faults.stall_ms = integer()?,
                 "seed" => faults.seed = integer()?,
-                _ => {
-                    return Err(format!(
-                        "unknown fault `{key}` (known: drop, byte_loss, bit_flip, checksum, status, stall, stall_ms, seed)"
-                    ))
-                }
+                _ => return Err(FaultSpecError::UnknownKey { key: key.into() }),
             }
         }
         Ok(faults)
     }
+}
+
+/// Why a fault specification ([`FaultSpec::parse`]) was refused.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum FaultSpecError {
+    /// An item is not `key=value`.
+    #[error("fault `{item}`: expected key=value")]
+    NotKeyValue {
+        /// The item as written.
+        item: String,
+    },
+    /// A probability outside [0, 1] or not a number.
+    #[error("fault `{key}`: `{value}` is not a probability in [0, 1]")]
+    NotProbability {
+        /// The key.
+        key: String,
+        /// The value as written.
+        value: String,
+    },
+    /// A count that is not a whole number.
+    #[error("fault `{key}`: `{value}` is not a whole number")]
+    NotWholeNumber {
+        /// The key.
+        key: String,
+        /// The value as written.
+        value: String,
+    },
+    /// A key that names no fault.
+    #[error("unknown fault `{key}` (known: drop, byte_loss, bit_flip, checksum, status, stall, stall_ms, seed)")]
+    UnknownKey {
+        /// The key.
+        key: String,
+    },
 }
 
 /// What happens to a frame on the wire.

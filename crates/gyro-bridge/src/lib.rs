@@ -7,8 +7,8 @@ pub mod emulator;
 pub mod record;
 
 pub use emulator::{
-    simulated_samples, stream, Emulator, EmulatorConfig, EmulatorReport, FaultSpec, Pacing,
-    PlannedFrame, Sample, SensorFault, WireFault,
+    simulated_samples, stream, Emulator, EmulatorConfig, EmulatorReport, FaultSpec, FaultSpecError,
+    Pacing, PlannedFrame, Sample, SensorFault, WireFault,
 };
 pub use record::{
     record, CsvSink, DecodedFrame, LiveStatus, McapSink, RecordEvent, RecordOptions, RecordSink,
@@ -17,15 +17,32 @@ pub use record::{
 
 use crm100_driver::Range;
 
-/// The range with this full scale (°/s): 75, 150, 300 or 900; for `--range`.
-pub fn parse_range(text: &str) -> Result<Range, String> {
+/// Why a range ([`parse_range`]) was refused.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum RangeError {
+    /// Not a whole number of °/s.
+    #[error("`{text}` is not a range in °/s (75, 150, 300 or 900)")]
+    NotANumber {
+        /// The text as written.
+        text: String,
+    },
+    /// A full scale the CRM100 does not have.
+    #[error("no CRM100 range of ±{dps} °/s (75, 150, 300 or 900)")]
+    NoSuchRange {
+        /// The full scale asked for (°/s).
+        dps: u16,
+    },
+}
+
+/// The CRM100 range with this full scale (°/s): 75, 150, 300 or 900, optionally after `±`.
+pub fn parse_range(text: &str) -> Result<Range, RangeError> {
     let dps: u16 = text
         .trim()
         .trim_start_matches('±')
         .parse()
-        .map_err(|_| format!("`{text}` is not a range in °/s (75, 150, 300 or 900)"))?;
+        .map_err(|_| RangeError::NotANumber { text: text.into() })?;
     Range::ALL
         .into_iter()
         .find(|r| r.full_scale_dps() == dps)
-        .ok_or_else(|| format!("no CRM100 range of ±{dps} °/s (75, 150, 300 or 900)"))
+        .ok_or(RangeError::NoSuchRange { dps })
 }

@@ -55,9 +55,49 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // A reader that stopped reading (`| head`) is not an error: end quietly.
+        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            let hint = flag_hint(&e).map_or(String::new(), |h| format!(" ({h})"));
+            eprintln!("error: {}{hint}", one_line(&format!("{e:#}")));
             ExitCode::FAILURE
         }
     }
+}
+
+/// True if the error comes from writing to a pipe whose reader has gone.
+fn is_broken_pipe(error: &anyhow::Error) -> bool {
+    error.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}
+
+/// The option that settles a library error, named as this command line spells it (the
+/// libraries name no flags).
+fn flag_hint(error: &anyhow::Error) -> Option<&'static str> {
+    use gyro_log::LogError;
+    error
+        .chain()
+        .find_map(|cause| cause.downcast_ref::<LogError>())
+        .and_then(|e| match e {
+            LogError::SampleRateInvalid { .. } | LogError::SampleRateUnknown { .. } => {
+                Some("--sample-rate-hz")
+            }
+            LogError::Gap { .. } => Some("--max-gap-s"),
+            LogError::McapSecondRate { .. } => Some("--topic"),
+            LogError::McapZeroStamp { .. } => Some("--time-source log-time"),
+            _ => None,
+        })
+}
+
+/// An error message on one line (a cause that spans lines is joined with "; ").
+fn one_line(message: &str) -> String {
+    message
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
 }

@@ -156,6 +156,16 @@ fn bad_input_is_a_clear_error_naming_file_and_line() {
             "gap.csv:5: gap of 1.999 s",
         ),
         (
+            "gap_hint.csv",
+            "# sample_rate_hz: 1000\ntime_s,rate_dps\n0.000,1.0\n0.001,1.0\n2.000,1.0\n",
+            "the longest gap bridged, 0.5 s; the rotation during it cannot be recovered (--max-gap-s)",
+        ),
+        (
+            "one_stamp.csv",
+            "time_s,rate_dps\n0.000,1.0\n0.000,1.0\n",
+            "fewer than two distinct time stamps); give the sample rate (--sample-rate-hz)",
+        ),
+        (
             "backwards.csv",
             "time_s,rate_dps\n10.000,1.0\n10.001,1.0\n3.000,1.0\n",
             "backwards.csv:4: time goes back by 7.001000 s",

@@ -301,11 +301,6 @@ impl CsvRows {
         })
     }
 
-    /// The file.
-    pub fn path(&self) -> &Path {
-        &self.columns.path
-    }
-
     /// The `# key: value` metadata lines before the header.
     pub fn metadata(&self) -> &BTreeMap<String, String> {
         &self.metadata

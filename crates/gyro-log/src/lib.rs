@@ -1,16 +1,21 @@
-//! Gyro logs: the shared CSV and MCAP contract (DESIGN.md "Log formats"), read into rows,
+//! Gyro logs: the shared CSV and MCAP contract (docs/log-formats.md), read into rows,
 //! then put on a regular time grid with every irregularity counted.
 //!
-//! [`read_log`] reads either format (by content, else by extension); [`write_log`] writes
-//! either by extension.
+//! [`load`] is the one way in for a command: read either format (by content, else by
+//! extension), pass on the warnings, place the rows on the grid; [`stream`] does the same
+//! slot by slot. [`read_log`] reads without placing; [`write_log`] writes either format by
+//! extension.
 
 mod ahead;
 mod csv_log;
+mod load;
 pub mod mcap;
 mod regular;
 
-pub use ahead::read_ahead;
-pub use csv_log::{read_csv, write_csv, ColumnOptions, CsvRows, RateUnit, TimeUnit};
+pub(crate) use ahead::read_ahead;
+pub(crate) use csv_log::CsvRows;
+pub use csv_log::{read_csv, write_csv, ColumnOptions, RateUnit, TimeUnit};
+pub use load::{load, stream};
 pub use mcap::{
     read_mcap, write_mcap, Axis, JsonChannel, McapLogWriter, McapOptions, McapRead,
     McapWriteOptions, TimeSource,
@@ -233,13 +238,21 @@ pub enum LogError {
         /// What is missing.
         what: String,
     },
-    /// The sample rate could not be determined or is invalid.
-    #[error("{path}: {message}")]
-    SampleRate {
+    /// The sample rate given ([`GridOptions::sample_rate_hz`]) is not a positive number.
+    #[error("{path}: the sample rate {rate_hz} Hz is not a positive number")]
+    SampleRateInvalid {
         /// File.
         path: PathBuf,
-        /// What is wrong.
-        message: String,
+        /// The rate given (Hz).
+        rate_hz: f64,
+    },
+    /// No sample rate given, none in the metadata, and the stamps cannot give one.
+    #[error(
+        "{path}: cannot estimate the sample rate (fewer than two distinct time stamps); give the sample rate"
+    )]
+    SampleRateUnknown {
+        /// File.
+        path: PathBuf,
     },
     /// Time runs backwards by more than the tolerated amount.
     #[error(
@@ -261,7 +274,7 @@ pub enum LogError {
     },
     /// A gap in time longer than the longest one bridged by interpolation.
     #[error(
-        "{path}:{line}: gap of {gap_s:.3} s in the data (after line {previous_line}) exceeds --max-gap-s {max_gap_s} s; the rotation during it cannot be recovered"
+        "{path}:{line}: gap of {gap_s:.3} s in the data (after line {previous_line}) exceeds the longest gap bridged, {max_gap_s} s; the rotation during it cannot be recovered"
     )]
     Gap {
         /// File.
@@ -292,6 +305,28 @@ pub enum LogError {
         channel: String,
         /// What is wrong.
         message: String,
+    },
+    /// Two channels carry rates; which one is the gyro must be chosen
+    /// ([`McapOptions::topic`]).
+    #[error("{path}: channel `{channel}`: a second rate channel besides `{first}`; choose one")]
+    McapSecondRate {
+        /// File.
+        path: PathBuf,
+        /// The second rate channel.
+        channel: String,
+        /// The first rate channel.
+        first: String,
+    },
+    /// A ROS 2 message's header stamp is zero: the publisher did not set it; its log time
+    /// can be used instead ([`McapOptions::time_source`]).
+    #[error("{path}: channel `{channel}` message {index}: header stamp is zero (unset); use the log time")]
+    McapZeroStamp {
+        /// File.
+        path: PathBuf,
+        /// Topic.
+        channel: String,
+        /// 1-based index of the message on its channel.
+        index: u64,
     },
     /// An MCAP message cannot be decoded.
     #[error("{path}: channel `{channel}` message {index}: {message}")]

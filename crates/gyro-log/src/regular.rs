@@ -154,6 +154,8 @@ impl<'a> LogInfo<'a> {
 
 /// Where [`place`] delivers the slots, in order, as soon as each is final.
 pub trait SlotSink {
+    /// Called first, with the columns the log has.
+    fn columns(&mut self, _has_reference: bool, _has_temperature: bool) {}
     /// Called once with the grid rate (Hz), before the first slot.
     fn start(&mut self, sample_rate_hz: f64);
     /// One slot of the grid.
@@ -174,9 +176,9 @@ fn given_rate(
 ) -> Option<Result<(f64, &'static str), LogError>> {
     if let Some(rate) = options.sample_rate_hz {
         if !(rate.is_finite() && rate > 0.0) {
-            return Some(Err(LogError::SampleRate {
+            return Some(Err(LogError::SampleRateInvalid {
                 path: info.path.to_path_buf(),
-                message: format!("--sample-rate-hz {rate} is not a positive number"),
+                rate_hz: rate,
             }));
         }
         return Some(Ok((rate, "option")));
@@ -193,9 +195,8 @@ fn median_step_rate(path: &Path, rows: &[Row]) -> Result<(f64, &'static str), Lo
         .filter(|dt| *dt > 0.0)
         .collect();
     if steps.is_empty() {
-        return Err(LogError::SampleRate {
+        return Err(LogError::SampleRateUnknown {
             path: path.to_path_buf(),
-            message: "cannot estimate the sample rate (fewer than two distinct time stamps); pass --sample-rate-hz".into(),
         });
     }
     steps.sort_by(f64::total_cmp);
@@ -248,6 +249,7 @@ pub fn place<S: SlotSink + ?Sized>(
     options: &GridOptions,
     sink: &mut S,
 ) -> Result<Quality, LogError> {
+    sink.columns(info.has_reference, info.has_temperature);
     let mut rows = rows.into_iter();
     // Rows held back while the rate is estimated.
     let mut ahead: Vec<Row> = Vec::new();
@@ -685,15 +687,12 @@ mod tests {
 
         /// The grid rate and where it came from.
         fn sample_rate(log: &Log, options: &GridOptions) -> Result<(f64, &'static str), LogError> {
-            let bad = |message: String| LogError::SampleRate {
-                path: log.path.clone(),
-                message,
-            };
             if let Some(rate) = options.sample_rate_hz {
                 if !(rate.is_finite() && rate > 0.0) {
-                    return Err(bad(format!(
-                        "--sample-rate-hz {rate} is not a positive number"
-                    )));
+                    return Err(LogError::SampleRateInvalid {
+                        path: log.path.clone(),
+                        rate_hz: rate,
+                    });
                 }
                 return Ok((rate, "option"));
             }
@@ -708,9 +707,9 @@ mod tests {
                 .filter(|dt| *dt > 0.0)
                 .collect();
             if steps.is_empty() {
-                return Err(bad(
-                "cannot estimate the sample rate (fewer than two distinct time stamps); pass --sample-rate-hz".into(),
-            ));
+                return Err(LogError::SampleRateUnknown {
+                    path: log.path.clone(),
+                });
             }
             steps.sort_by(f64::total_cmp);
             Ok((1.0 / steps[steps.len() / 2], "median_step"))

@@ -25,10 +25,7 @@ pub fn run(args: &Args) -> Result<()> {
             args.input.display()
         );
     }
-    let (log, warnings) = log::read_log_with_warnings(&args.input, &args.input_options)?;
-    for warning in &warnings {
-        eprintln!("warning: {warning}");
-    }
+    let log = super::read(&args.input, &args.input_options)?;
     log::write_log(&args.output, &log, args.to)?;
     let yes_no = |b: bool| if b { "yes" } else { "no" };
     eprintln!(

@@ -97,12 +97,7 @@ fn progress_bar() -> Bar {
 fn load(paths: &[PathBuf], args: &Args, role: &str) -> Result<Vec<RealRun>> {
     let mut runs = Vec::new();
     for path in paths {
-        let (raw, warnings) = log::read_log_with_warnings(path, &args.input)?;
-        for warning in &warnings {
-            eprintln!("warning: {warning}");
-        }
-        let regular = log::regularize(&raw, &args.grid)?;
-        drop(raw);
+        let regular = super::load(path, &args.input, &args.grid)?;
         if !regular.has_reference {
             bail!(
                 "{}: no reference_deg column; diagnose compares the gyro with an encoder reference, so every {role} run needs one",

@@ -61,10 +61,7 @@ pub struct Args {
 
 fn samples(args: &Args) -> Result<(Vec<Sample>, String)> {
     if let Some(path) = &args.log {
-        let (log, warnings) = log::read_log_with_warnings(path, &log::LogOptions::default())?;
-        for warning in warnings {
-            eprintln!("warning: {warning}");
-        }
+        let log = super::read(path, &log::LogOptions::default())?;
         let samples = log.rows.iter().map(Sample::from).collect();
         return Ok((samples, format!("log {}", path.display())));
     }
@@ -222,7 +219,7 @@ fn open_pty(keep: &mut Option<PtySlave>) -> Result<Box<dyn serialport::SerialPor
     let (master, slave) =
         serialport::TTYPort::pair().context("cannot create a pseudo-terminal pair")?;
     let name = slave.name().context("the pseudo-terminal has no name")?;
-    println!("{name}");
+    writeln!(std::io::stdout().lock(), "{name}")?;
     eprintln!("record from {name}, e.g.: gyro-cli record --port {name} -o run.mcap");
     *keep = Some(slave);
     Ok(Box::new(master))

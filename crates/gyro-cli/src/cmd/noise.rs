@@ -117,11 +117,7 @@ struct Output<'a> {
 }
 
 fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<Loaded> {
-    let (raw, warnings) = log::read_log_with_warnings(path, &args.input)?;
-    for warning in &warnings {
-        eprintln!("warning: {warning}");
-    }
-    let regular = log::regularize(&raw, &args.grid)?;
+    let regular = super::load(path, &args.input, &args.grid)?;
     let rate: Vec<f64> = regular.slots.iter().map(|s| s.rate_dps).collect();
     let segments = if args.static_only {
         let segments = noise::rest_segments(&regular, config, args.margin_s, args.min_rest_s)

@@ -80,7 +80,7 @@ pub fn run(args: &Args) -> Result<()> {
         &args.grid,
         &config,
         &options,
-        &mut |warning| eprintln!("warning: {warning}"),
+        &mut super::warn,
     )
     .map_err(|e| match e {
         replay::ReplayFileError::Log(e) => anyhow::Error::new(e),

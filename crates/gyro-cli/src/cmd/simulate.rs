@@ -43,8 +43,8 @@ pub struct Args {
     encoder_counts: Option<u32>,
 }
 
-fn list_effects() {
-    println!("{:<18} {:<36} signature", "id", "parameters (typical)");
+fn list_effects(out: &mut impl Write) -> std::io::Result<()> {
+    writeln!(out, "{:<18} {:<36} signature", "id", "parameters (typical)")?;
     for info in sim::EFFECTS {
         let params: Vec<String> = info
             .params
@@ -52,19 +52,21 @@ fn list_effects() {
             .zip(info.typical.params())
             .map(|((name, unit), v)| format!("{name}={v} {unit}"))
             .collect();
-        println!(
+        writeln!(
+            out,
             "{:<18} {:<36} {}",
             info.id,
             params.join(", "),
             info.signature
-        );
+        )?;
     }
+    Ok(())
 }
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
     if args.list_effects {
-        list_effects();
+        list_effects(&mut std::io::stdout().lock())?;
         return Ok(());
     }
     let mut sensor = match &args.model {
@@ -82,17 +84,17 @@ pub fn run(args: &Args) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let motion = match &args.motion_from {
         Some(path) => {
-            let (raw, warnings) = log::read_log_with_warnings(path, &log::LogOptions::default())?;
-            for warning in &warnings {
-                eprintln!("warning: {warning}");
-            }
-            if !raw.has_reference {
+            let regular = super::load(
+                path,
+                &log::LogOptions::default(),
+                &log::GridOptions::default(),
+            )?;
+            if !regular.has_reference {
                 anyhow::bail!(
                     "{}: no reference_deg column to take the motion from",
                     path.display()
                 );
             }
-            let regular = log::regularize(&raw, &log::GridOptions::default())?;
             let period_s = 1.0 / regular.sample_rate_hz;
             let reference: Vec<f64> = regular
                 .slots

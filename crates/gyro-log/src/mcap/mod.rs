@@ -1,4 +1,4 @@
-//! MCAP logs (DESIGN.md "Log formats"): JSON channels Foxglove plots directly, written
+//! MCAP logs (docs/log-formats.md, "MCAP"): JSON channels Foxglove plots directly, written
 //! incrementally in small zstd chunks, read as a stream; ROS 2 bags (`sensor_msgs/msg/Imu`
 //! in CDR) are read too.
 //!

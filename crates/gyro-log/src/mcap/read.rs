@@ -432,12 +432,10 @@ impl State<'_> {
                     None => self.rate_topic = Some((channel.topic.clone(), channel.kind.clone())),
                     Some((topic, _)) if *topic == channel.topic => {}
                     Some((topic, _)) => {
-                        return Err(LogError::McapChannel {
+                        return Err(LogError::McapSecondRate {
                             path: self.path.to_path_buf(),
                             channel: channel.topic.clone(),
-                            message: format!(
-                                "a second rate channel besides `{topic}`; choose one with --topic"
-                            ),
+                            first: topic.clone(),
                         })
                     }
                 }
@@ -446,9 +444,13 @@ impl State<'_> {
                         decode_imu(data, self.options.axis, self.options.flip).map_err(fail)?;
                     let time_ns = match self.options.time_source {
                         TimeSource::LogTime => header.log_time,
-                        TimeSource::Header => sample.stamp_ns.ok_or_else(|| {
-                            fail("header stamp is zero (unset); use --time-source log-time".into())
-                        })?,
+                        TimeSource::Header => {
+                            sample.stamp_ns.ok_or_else(|| LogError::McapZeroStamp {
+                                path: self.path.to_path_buf(),
+                                channel: channel.topic.clone(),
+                                index,
+                            })?
+                        }
                     };
                     (time_ns, sample.rate_dps, None)
                 } else {

@@ -61,9 +61,9 @@ impl ImageFormat {
 
 /// A command-line value parser for a plot file: the path, if its extension names a
 /// format (so a typo fails before any work is done).
-pub fn parse_plot_path(value: &str) -> Result<PathBuf, String> {
+pub fn parse_plot_path(value: &str) -> Result<PathBuf, PlotError> {
     let path = PathBuf::from(value);
-    ImageFormat::from_path(&path).map_err(|e| e.to_string())?;
+    ImageFormat::from_path(&path)?;
     Ok(path)
 }
 
