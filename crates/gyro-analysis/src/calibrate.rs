@@ -15,7 +15,7 @@
 //! data's correlation estimate (or 0.01 1/s), b0 = the median rest bias, o0 = 0.
 
 use crate::replay::{replay, RunReport, Summary};
-use gyro_core::{Compensation, Config, GaussMarkov, MotionState, Pipeline};
+use gyro_core::{Compensation, Config, GaussMarkov, MotionState};
 use gyro_log::RegularLog;
 use nelder_mead::{Bounds, InitialSteps, NelderMead, Termination};
 use serde::Serialize;
@@ -114,37 +114,23 @@ impl Trace {
             ..*config
         };
         let report = replay(log, &none)?;
-        let delay_s = Pipeline::try_new(&report.config)?.filter_delay_s();
-        Ok(Self::from_report(&report, delay_s))
+        Ok(Self::from_report(&report))
     }
 
-    /// `delay_s`: the pipeline's filter delay, which it subtracts from movement times.
-    fn from_report(report: &RunReport, delay_s: f64) -> Self {
+    fn from_report(report: &RunReport) -> Self {
         let series = &report.series;
         let output_period_s = 1.0 / f64::from(report.output_rate_hz);
-        // The output sample a movement boundary belongs to: nearest to time + delay.
-        let index_of = |time_s: f64| -> usize {
-            let t = time_s + delay_s;
-            let i = series.partition_point(|p| p.time_s < t);
-            let i = if i > 0
-                && (i >= series.len() || (t - series[i - 1].time_s) < (series[i].time_s - t))
-            {
-                i - 1
-            } else {
-                i
-            };
-            i.min(series.len().saturating_sub(1))
-        };
+        // The output samples that bound each movement, as the core published them.
         let spans = report
             .movements
             .iter()
             .map(|m| {
-                let start = index_of(m.start_time_s);
+                let start = m.samples.0;
                 let confirmed = (start + 1..series.len())
                     .find(|&k| series[k].motion == MotionState::Dynamic)
                     .unwrap_or(series.len());
                 let end = m.complete.then(|| {
-                    let end = index_of(m.end_time_s);
+                    let end = m.samples.1;
                     let ended = (confirmed..series.len())
                         .find(|&k| series[k].motion == MotionState::Static)
                         .unwrap_or(series.len());

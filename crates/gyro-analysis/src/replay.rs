@@ -67,6 +67,11 @@ pub struct MovementResult {
     pub error_deg: Option<f64>,
     /// `raw_angle_deg − reference_deg`.
     pub raw_error_deg: Option<f64>,
+    /// The output samples (indices into [`RunReport::series`]) that bound the movement, as
+    /// the core published them: its last quiet sample before and first quiet sample after
+    /// (the last sample if the log ends while moving). Not in the JSON.
+    #[serde(skip)]
+    pub samples: (usize, usize),
 }
 
 /// Error statistics over the run.
@@ -412,21 +417,26 @@ impl Replayer {
             reference_deg,
         });
         match out.event {
-            Some(Event::MovementStarted { start_time_s }) => {
-                self.open = Some((start_time_s, index_at(series, start_time_s)));
+            Some(Event::MovementStarted {
+                start_time_s,
+                start_index,
+            }) => {
+                self.open = Some((start_time_s, start_index as usize));
             }
             Some(Event::MovementEnded(m)) => {
-                let start = self
-                    .open
-                    .take()
-                    .map_or(index_at(series, m.start_time_s), |o| o.1);
-                let end = index_at(series, m.end_time_s);
+                self.open = None;
+                let samples = (m.start_index as usize, m.end_index as usize);
+                let at_times = (
+                    index_at(series, m.start_time_s),
+                    index_at(series, m.end_time_s),
+                );
                 self.movements.push(movement_result(
                     self.movements.len() + 1,
                     (m.start_time_s, m.end_time_s),
                     true,
                     (m.angle_deg, m.raw_angle_deg),
-                    reference_change(series, start, end),
+                    samples,
+                    reference_change(series, at_times),
                 ));
             }
             None => {}
@@ -449,6 +459,8 @@ impl Replayer {
         } = self;
         if let (Some((start_time_s, start)), Some(last)) = (open, series.last()) {
             let first = &series[start];
+            let samples = (start, series.len() - 1);
+            let at_times = (index_at(&series, start_time_s), series.len() - 1);
             movements.push(movement_result(
                 movements.len() + 1,
                 (start_time_s, last.time_s),
@@ -457,7 +469,8 @@ impl Replayer {
                     last.angle_deg - first.angle_deg,
                     last.raw_angle_deg - first.raw_angle_deg,
                 ),
-                reference_change(&series, start, series.len() - 1),
+                samples,
+                reference_change(&series, at_times),
             ));
         }
 
@@ -523,7 +536,9 @@ fn shifted_reference(slots: &[Slot], i: usize, shift_slots: f64) -> Option<f64> 
     Some(a + fraction * (b - a))
 }
 
-/// Index of the output sample nearest to `time_s`.
+/// The output sample nearest to `time_s`: where the reference is read at a movement's time
+/// on the input's time line (the filtered reference at the movement's own samples,
+/// [`MovementResult::samples`], is a filter delay later: see `docs/log-formats.md`).
 fn index_at(series: &[SeriesPoint], time_s: f64) -> usize {
     let i = series.partition_point(|p| p.time_s < time_s);
     if i == 0 {
@@ -539,7 +554,8 @@ fn index_at(series: &[SeriesPoint], time_s: f64) -> usize {
     }
 }
 
-fn reference_change(series: &[SeriesPoint], start: usize, end: usize) -> Option<f64> {
+/// The reference's change between two output samples.
+fn reference_change(series: &[SeriesPoint], (start, end): (usize, usize)) -> Option<f64> {
     Some(series.get(end)?.reference_deg? - series.get(start)?.reference_deg?)
 }
 
@@ -548,6 +564,7 @@ fn movement_result(
     (start_time_s, end_time_s): (f64, f64),
     complete: bool,
     (angle_deg, raw_angle_deg): (f32, f32),
+    samples: (usize, usize),
     reference_deg: Option<f64>,
 ) -> MovementResult {
     MovementResult {
@@ -561,6 +578,7 @@ fn movement_result(
         reference_deg,
         error_deg: reference_deg.map(|r| f64::from(angle_deg) - r),
         raw_error_deg: reference_deg.map(|r| f64::from(raw_angle_deg) - r),
+        samples,
     }
 }
 
@@ -602,5 +620,36 @@ mod tests {
         assert_eq!(shifted_reference(&s, 0, f64::MAX), None);
         assert_eq!(shifted_reference(&s, 0, -f64::MAX), None);
         assert_eq!(shifted_reference(&s, 0, f64::NAN), None);
+    }
+
+    /// The samples each movement carries are the core's: the raw angle between them is the
+    /// movement's raw angle (held at rest), and their times less the filter delay are the
+    /// movement's times.
+    #[test]
+    fn movements_carry_the_core_samples_that_bound_them() {
+        use gyro_sim::{simulate, BenchProfile, Motion, SensorModel, SimOptions};
+        let mut checked = 0;
+        for seed in 1..=3 {
+            let motion = Motion::bench(&BenchProfile::default(), seed);
+            let log = simulate(
+                &SensorModel::default(),
+                &[],
+                &motion,
+                &SimOptions::default(),
+            );
+            let regular = gyro_log::regularize(&log, &GridOptions::default()).expect("grid");
+            let report = replay(&regular, &Config::default()).expect("replay");
+            let delay_s = Pipeline::try_new(&report.config)
+                .expect("config")
+                .filter_delay_s();
+            for m in report.movements.iter().filter(|m| m.complete) {
+                let (a, b) = (&report.series[m.samples.0], &report.series[m.samples.1]);
+                assert!((b.raw_angle_deg - a.raw_angle_deg - m.raw_angle_deg).abs() < 1e-3);
+                assert!((a.time_s - delay_s - m.start_time_s).abs() < 1e-6, "{m:?}");
+                assert!((b.time_s - delay_s - m.end_time_s).abs() < 1e-6, "{m:?}");
+                checked += 1;
+            }
+        }
+        assert!(checked >= 10, "{checked}");
     }
 }

@@ -58,7 +58,7 @@ fn main() -> ExitCode {
         // A reader that stopped reading (`| head`) is not an error: end quietly.
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            let hint = flag_hint(&e).map_or(String::new(), |h| format!(" ({h})"));
+            let hint = flag_hint(&e).unwrap_or_default();
             eprintln!("error: {}{hint}", one_line(&format!("{e:#}")));
             ExitCode::FAILURE
         }
@@ -75,19 +75,18 @@ fn is_broken_pipe(error: &anyhow::Error) -> bool {
 }
 
 /// The option that settles a library error, named as this command line spells it (the
-/// libraries name no flags).
+/// libraries name no flags), to append to its message.
 fn flag_hint(error: &anyhow::Error) -> Option<&'static str> {
     use gyro_log::LogError;
     error
         .chain()
         .find_map(|cause| cause.downcast_ref::<LogError>())
         .and_then(|e| match e {
-            LogError::SampleRateInvalid { .. } | LogError::SampleRateUnknown { .. } => {
-                Some("--sample-rate-hz")
-            }
-            LogError::Gap { .. } => Some("--max-gap-s"),
-            LogError::McapSecondRate { .. } => Some("--topic"),
-            LogError::McapZeroStamp { .. } => Some("--time-source log-time"),
+            LogError::SampleRateInvalid { .. } => Some(" (--sample-rate-hz)"),
+            LogError::SampleRateUnknown { .. } => Some(" with --sample-rate-hz"),
+            LogError::Gap { .. } => Some(" (--max-gap-s)"),
+            LogError::McapSecondRate { .. } => Some(" with --topic"),
+            LogError::McapZeroStamp { .. } => Some(": --time-source log-time"),
             _ => None,
         })
 }

@@ -163,7 +163,7 @@ fn bad_input_is_a_clear_error_naming_file_and_line() {
         (
             "one_stamp.csv",
             "time_s,rate_dps\n0.000,1.0\n0.000,1.0\n",
-            "fewer than two distinct time stamps); give the sample rate (--sample-rate-hz)",
+            "fewer than two distinct time stamps); give the sample rate with --sample-rate-hz",
         ),
         (
             "backwards.csv",

@@ -112,13 +112,18 @@ impl Config {
 ///
 /// Movement times are on the input's time line: the time of the output sample that
 /// bounds the movement minus the low-pass filter's group delay at DC
-/// ([`Pipeline::filter_delay_s`]), by which the filtered rate lags the input.
+/// ([`Pipeline::filter_delay_s`]), by which the filtered rate lags the input. Movement
+/// indices are those output samples themselves, counted from 0 at the pipeline's first
+/// output: the samples whose angles bound the movement, so that a host holding the output
+/// series needs no search by time.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Event {
     /// A movement was confirmed; it started at `start_time_s` (its last quiet sample).
     MovementStarted {
         /// Time of the movement's start (s), on the input's time line.
         start_time_s: f64,
+        /// Index of the output sample the movement starts at (its last quiet sample).
+        start_index: u32,
     },
     /// A rest was confirmed after a movement.
     MovementEnded(Movement),
@@ -131,6 +136,10 @@ pub struct Movement {
     pub start_time_s: f64,
     /// End time (s), on the input's time line (see [`Event`]).
     pub end_time_s: f64,
+    /// Index of the output sample the movement starts at (its last quiet sample).
+    pub start_index: u32,
+    /// Index of the output sample the movement ends at (its first quiet sample).
+    pub end_index: u32,
     /// Angle turned, with the configured compensation (deg).
     pub angle_deg: f32,
     /// Angle turned, uncompensated (deg).
@@ -492,7 +501,10 @@ impl Pipeline {
                     settle_index: None,
                 });
                 self.commit();
-                Some(Event::MovementStarted { start_time_s })
+                Some(Event::MovementStarted {
+                    start_time_s,
+                    start_index,
+                })
             }
             Phase::Moving => {
                 self.commit();
@@ -560,6 +572,8 @@ impl Pipeline {
         Some(Movement {
             start_time_s: track.start_time_s,
             end_time_s: end_time_s - self.filter_delay_s,
+            start_index: track.start_index,
+            end_index,
             angle_deg: self.angle_deg() - track.angle_at_start_deg,
             raw_angle_deg,
         })

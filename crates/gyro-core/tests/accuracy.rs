@@ -98,7 +98,7 @@ fn compare_with_reference(samples: &[f32]) -> Deviation {
     let mut spans: Vec<Span> = Vec::new();
     for (k, o) in out.iter().enumerate() {
         match o.event {
-            Some(Event::MovementStarted { start_time_s }) => spans.push(Span {
+            Some(Event::MovementStarted { start_time_s, .. }) => spans.push(Span {
                 start: index_of(start_time_s),
                 end: None,
             }),

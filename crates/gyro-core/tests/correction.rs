@@ -36,7 +36,7 @@ impl Digest {
         self.bytes(format!("{:?}", out.motion).as_bytes());
         match out.event {
             None => self.bytes(b"-"),
-            Some(Event::MovementStarted { start_time_s }) => {
+            Some(Event::MovementStarted { start_time_s, .. }) => {
                 self.bytes(b"S");
                 self.bytes(&start_time_s.to_bits().to_le_bytes());
             }

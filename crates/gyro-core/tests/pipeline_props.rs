@@ -100,7 +100,7 @@ fn assert_output_finite(out: &Output) {
     assert!(out.bias_dps.is_finite(), "{out:?}");
     assert!(out.angle_std_deg.is_none_or(f32::is_finite), "{out:?}");
     match out.event {
-        Some(Event::MovementStarted { start_time_s }) => assert!(start_time_s.is_finite()),
+        Some(Event::MovementStarted { start_time_s, .. }) => assert!(start_time_s.is_finite()),
         Some(Event::MovementEnded(m)) => {
             assert!(
                 m.start_time_s.is_finite() && m.end_time_s.is_finite(),

@@ -5,6 +5,18 @@
 //! extension), pass on the warnings, place the rows on the grid; [`stream`] does the same
 //! slot by slot. [`read_log`] reads without placing; [`write_log`] writes either format by
 //! extension.
+//!
+//! ```
+//! let regular = gyro_log::load(
+//!     "../../fixtures/logs/bench_run.csv".as_ref(),
+//!     &gyro_log::LogOptions::default(),
+//!     &gyro_log::GridOptions::default(),
+//!     &mut |warning| eprintln!("warning: {warning}"),
+//! )?;
+//! assert_eq!(regular.sample_rate_hz, 1000.0);
+//! assert!(regular.has_reference && regular.quality.duplicate_rows == 0);
+//! # Ok::<(), gyro_log::LogError>(())
+//! ```
 
 mod ahead;
 mod csv_log;

@@ -1,4 +1,17 @@
-//! The sensor simulator: nominal model, the effect terms, true motion.
+//! The sensor simulator: the nominal sensor model ([`SensorModel`]: bias, Gauss-Markov bias,
+//! white noise, output step and range), the effect table ([`EFFECTS`], [`Effect`]) that the
+//! simulator, the diagnosis and the docs all read, and the true motion ([`Motion`]: bench-like
+//! hand rotations, or the motion of a log's reference). `docs/effects.md` defines each term.
+//! Same seed, same log.
+//!
+//! ```
+//! use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+//! let motion = Motion::bench(&BenchProfile { duration_s: 20.0, ..BenchProfile::default() }, 7);
+//! let effects = [Effect::parse("scale_factor:k=0.01")?];
+//! let log = simulate(&SensorModel::default(), &effects, &motion, &SimOptions::default());
+//! assert!(log.has_reference && log.rows.len() > 19_000);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 mod effects;
 mod motion;

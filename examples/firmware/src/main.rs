@@ -78,7 +78,7 @@ impl Channel {
         };
         self.outputs += 1;
         match output.event {
-            Some(Event::MovementStarted { start_time_s }) => {
+            Some(Event::MovementStarted { start_time_s, .. }) => {
                 // Confirmed 60 ms or so after it began; the start is back-dated.
                 hprintln!(
                     "started  compensation={} index={} start_time_s={} confirmed_at_s={}",

@@ -32,7 +32,7 @@ pub fn rest_segments(
             continue;
         };
         match out.event {
-            Some(Event::MovementStarted { start_time_s }) => open = Some(start_time_s),
+            Some(Event::MovementStarted { start_time_s, .. }) => open = Some(start_time_s),
             Some(Event::MovementEnded(m)) => {
                 open = None;
                 moves.push((m.start_time_s, m.end_time_s));

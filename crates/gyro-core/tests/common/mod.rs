@@ -211,7 +211,7 @@ pub fn run(config: &Config, samples: &[f32], sample_rate_hz: f64) -> Run {
     for (i, &rate) in samples.iter().enumerate() {
         if let Some(out) = pipeline.push(i as f64 / sample_rate_hz, rate) {
             match out.event {
-                Some(Event::MovementStarted { start_time_s }) => {
+                Some(Event::MovementStarted { start_time_s, .. }) => {
                     starts.push((outputs.len(), start_time_s))
                 }
                 Some(Event::MovementEnded(m)) => movements.push((outputs.len(), m)),
