@@ -538,7 +538,7 @@ fn shifted_reference(slots: &[Slot], i: usize, shift_slots: f64) -> Option<f64> 
 
 /// The output sample nearest to `time_s`: where the reference is read at a movement's time
 /// on the input's time line (the filtered reference at the movement's own samples,
-/// [`MovementResult::samples`], is a filter delay later: see `docs/log-formats.md`).
+/// [`MovementResult::samples`], is a filter delay later: see [`gyro_core::Event`]).
 fn index_at(series: &[SeriesPoint], time_s: f64) -> usize {
     let i = series.partition_point(|p| p.time_s < time_s);
     if i == 0 {
