@@ -1,6 +1,8 @@
-//! Rendering a [`Characterization`]: a human-readable table, and the PSD as CSV.
+//! Rendering a [`Characterization`]: a human-readable table, the JSON of `noise`, and the
+//! PSD as CSV.
 
-use gyro_analysis::noise::{Characterization, FitTerm, NoiseType};
+use gyro_analysis::noise::{Characterization, FitTerm, NoiseLog, NoiseRun, NoiseType};
+use serde::Serialize;
 use std::fmt::Write as _;
 use std::io::{self, Write};
 
@@ -186,4 +188,68 @@ pub fn psd_csv(out: &mut impl Write, label: &str, c: &Characterization) -> io::R
         }
     }
     Ok(())
+}
+
+/// The tables of every log (labelled with what was irregular in it) and of all pooled.
+pub fn tables(logs: &[NoiseLog], run: &NoiseRun) -> String {
+    let mut s = String::new();
+    for (l, r) in logs.iter().zip(&run.results) {
+        let irregular = l.input.filled_slots + l.input.duplicate_rows;
+        let label = if irregular > 0 {
+            format!(
+                "{} ({} samples interpolated, {} duplicates dropped)",
+                l.file, l.input.filled_slots, l.input.duplicate_rows
+            )
+        } else {
+            l.file.clone()
+        };
+        let _ = writeln!(s, "{}", table(&label, r));
+    }
+    if let Some(c) = &run.combined {
+        let label = format!("all {} logs pooled", logs.len());
+        let _ = writeln!(s, "{}", table(&label, c));
+    }
+    s
+}
+
+#[derive(Serialize)]
+struct LogJson<'a> {
+    file: &'a str,
+    /// Rest stretches used (s from the log's start), when only rests were used.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rest_stretches_s: Option<Vec<(f64, f64)>>,
+    input: &'a gyro_log::Quality,
+    #[serde(flatten)]
+    result: &'a Characterization,
+}
+
+#[derive(Serialize)]
+struct RunJson<'a> {
+    logs: Vec<LogJson<'a>>,
+    combined: Option<&'a Characterization>,
+    model_out: Option<&'a str>,
+}
+
+/// The JSON of `noise`: each log (with its rest stretches when `rests_only`), the pooled
+/// result, and the model file written (if any).
+pub fn json(
+    logs: &[NoiseLog],
+    run: &NoiseRun,
+    rests_only: bool,
+    model_out: Option<&str>,
+) -> serde_json::Result<String> {
+    serde_json::to_string_pretty(&RunJson {
+        logs: logs
+            .iter()
+            .zip(&run.results)
+            .map(|(l, r)| LogJson {
+                file: &l.file,
+                rest_stretches_s: rests_only.then(|| l.stretches_s()),
+                input: &l.input,
+                result: r,
+            })
+            .collect(),
+        combined: run.combined.as_ref(),
+        model_out,
+    })
 }

@@ -20,7 +20,9 @@
 //!   bounds then use the noise type the fitted model has at each τ.
 //! - [`psd`]: Welch PSD (Hann, 50% overlap, one-sided) and the white density.
 //! - [`rest`]: rest stretches found by the gyro-core motion detector (`--static-only`).
-//! - [`report`]: the human-readable table.
+//! - [`characterize_logs`]: several logs, each and pooled.
+//!
+//! The table, the JSON and the PSD CSV are rendered by `gyro_report::noise`.
 //!
 //! Data comes in *segments* (contiguous runs of samples at one rate): a whole static log
 //! is one segment; rest stretches of a log with motion, or several logs, are several.
@@ -30,12 +32,14 @@ pub mod allan;
 mod chi2;
 mod fft;
 pub mod fit;
+mod logs;
 pub mod psd;
 pub mod rest;
 
 pub use allan::{AllanDeviation, AllanPoint, NoiseType, TauGrid, ONE_SIGMA};
 pub use chi2::chi2_quantile;
 pub use fit::{fit, AllanFloor, FitOptions, FitTerm, GaussMarkovFit, NoiseFit};
+pub use logs::{characterize_logs, NoiseLog, NoiseLogsError, NoiseRun};
 pub use psd::{welch, Psd, PsdBand, PsdOptions};
 pub use rest::rest_segments;
 

@@ -3,9 +3,8 @@
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 use gyro_analysis::model;
-use gyro_analysis::noise::{self, Characterization, NoiseOptions, PsdOptions, TauGrid};
+use gyro_analysis::noise::{self, NoiseLog, NoiseOptions, PsdOptions, TauGrid};
 use gyro_log as log;
-use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -80,43 +79,7 @@ pub struct Args {
     input: log::LogOptions,
 }
 
-/// One log's data, ready to characterise.
-struct Loaded {
-    file: String,
-    rate: Vec<f64>,
-    sample_rate_hz: f64,
-    segments: Vec<std::ops::Range<usize>>,
-    input: log::Quality,
-}
-
-impl Loaded {
-    fn parts(&self) -> Vec<&[f64]> {
-        self.segments
-            .iter()
-            .map(|r| &self.rate[r.clone()])
-            .collect()
-    }
-}
-
-#[derive(Serialize)]
-struct LogResult<'a> {
-    file: &'a str,
-    /// Rest stretches used (s from the log's start), with --static-only.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    rest_stretches_s: Option<Vec<(f64, f64)>>,
-    input: &'a log::Quality,
-    #[serde(flatten)]
-    result: &'a Characterization,
-}
-
-#[derive(Serialize)]
-struct Output<'a> {
-    logs: Vec<LogResult<'a>>,
-    combined: Option<&'a Characterization>,
-    model_out: Option<String>,
-}
-
-fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<Loaded> {
+fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<NoiseLog> {
     let regular = super::load(path, &args.input, &args.grid)?;
     let rate: Vec<f64> = regular.slots.iter().map(|s| s.rate_dps).collect();
     let segments = if args.static_only {
@@ -138,9 +101,9 @@ fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<Loaded> 
     } else {
         std::iter::once(0..rate.len()).collect()
     };
-    Ok(Loaded {
+    Ok(NoiseLog {
         file: path.display().to_string(),
-        rate,
+        rate_dps: rate,
         sample_rate_hz: regular.sample_rate_hz,
         segments,
         input: regular.quality,
@@ -186,35 +149,14 @@ pub fn run(args: &Args) -> Result<()> {
         .iter()
         .map(|path| load(path, args, &config))
         .collect::<Result<Vec<_>>>()?;
-    let results = loaded
-        .iter()
-        .map(|l| {
-            noise::characterize(&l.parts(), l.sample_rate_hz, &options)
-                .with_context(|| l.file.clone())
-        })
-        .collect::<Result<Vec<_>>>()?;
-
-    let combined = if loaded.len() > 1 {
-        let rate = loaded[0].sample_rate_hz;
-        if loaded
-            .iter()
-            .all(|l| (l.sample_rate_hz / rate - 1.0).abs() < 1e-9)
-        {
-            let parts: Vec<&[f64]> = loaded.iter().flat_map(|l| l.parts()).collect();
-            Some(noise::characterize(&parts, rate, &options).context("all logs pooled")?)
-        } else {
-            eprintln!("note: the logs differ in sample rate; no pooled result");
-            None
-        }
-    } else {
-        None
-    };
+    let run = noise::characterize_logs(&loaded, &options)?;
+    if run.rates_differ {
+        eprintln!("note: the logs differ in sample rate; no pooled result");
+    }
 
     if let Some(out) = &args.model_out {
-        let source = match (&combined, results.as_slice()) {
-            (Some(c), _) => c,
-            (None, [only]) => only,
-            (None, _) => bail!("--model-out needs one log, or logs of one sample rate to pool"),
+        let Some(source) = run.single() else {
+            bail!("--model-out needs one log, or logs of one sample rate to pool")
         };
         let file = match base {
             Some(base) => model::ModelFile {
@@ -244,10 +186,10 @@ pub fn run(args: &Args) -> Result<()> {
         let write = || -> std::io::Result<()> {
             let mut w = std::io::BufWriter::new(std::fs::File::create(out)?);
             writeln!(w, "log,frequency_hz,psd_dps2_per_hz")?;
-            for (l, r) in loaded.iter().zip(&results) {
+            for (l, r) in loaded.iter().zip(&run.results) {
                 gyro_report::noise::psd_csv(&mut w, &l.file, r)?;
             }
-            if let Some(c) = &combined {
+            if let Some(c) = &run.combined {
                 gyro_report::noise::psd_csv(&mut w, "combined", c)?;
             }
             w.flush()
@@ -256,7 +198,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
 
     if let Some(path) = &args.plot {
-        let (title, result) = match (&combined, loaded.as_slice(), results.as_slice()) {
+        let (title, result) = match (&run.combined, loaded.as_slice(), run.results.as_slice()) {
             (Some(c), ..) => (format!("all {} logs pooled", loaded.len()), c),
             (None, [l, ..], [r, ..]) => (l.file.clone(), r),
             _ => bail!("no result to plot"),
@@ -266,48 +208,12 @@ pub fn run(args: &Args) -> Result<()> {
 
     let mut stdout = std::io::stdout().lock();
     match args.format {
-        Format::Table => {
-            for (l, r) in loaded.iter().zip(&results) {
-                let irregular = l.input.filled_slots + l.input.duplicate_rows;
-                let label = if irregular > 0 {
-                    format!(
-                        "{} ({} samples interpolated, {} duplicates dropped)",
-                        l.file, l.input.filled_slots, l.input.duplicate_rows
-                    )
-                } else {
-                    l.file.clone()
-                };
-                writeln!(stdout, "{}", gyro_report::noise::table(&label, r))?;
-            }
-            if let Some(c) = &combined {
-                let label = format!("all {} logs pooled", loaded.len());
-                writeln!(stdout, "{}", gyro_report::noise::table(&label, c))?;
-            }
-        }
+        Format::Table => write!(stdout, "{}", gyro_report::noise::tables(&loaded, &run))?,
         Format::Json => {
-            let output = Output {
-                logs: loaded
-                    .iter()
-                    .zip(&results)
-                    .map(|(l, r)| LogResult {
-                        file: &l.file,
-                        rest_stretches_s: args.static_only.then(|| {
-                            l.segments
-                                .iter()
-                                .map(|s| {
-                                    let dt = 1.0 / l.sample_rate_hz;
-                                    (s.start as f64 * dt, s.end as f64 * dt)
-                                })
-                                .collect()
-                        }),
-                        input: &l.input,
-                        result: r,
-                    })
-                    .collect(),
-                combined: combined.as_ref(),
-                model_out: args.model_out.as_ref().map(|p| p.display().to_string()),
-            };
-            writeln!(stdout, "{}", serde_json::to_string_pretty(&output)?)?;
+            let model_out = args.model_out.as_ref().map(|p| p.display().to_string());
+            let json =
+                gyro_report::noise::json(&loaded, &run, args.static_only, model_out.as_deref())?;
+            writeln!(stdout, "{json}")?;
         }
     }
     Ok(())
