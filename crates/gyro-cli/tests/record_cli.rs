@@ -5,10 +5,13 @@
 #![cfg(unix)]
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+mod common;
+
 use crm100_driver::serial::serialport::{SerialPort, TTYPort};
 use gyro_bridge::{self as bridge, Emulator, EmulatorConfig, Pacing, Sample};
 use gyro_log::{self as log, McapOptions};
-use std::io::{BufRead, BufReader};
+use std::ffi::OsStr;
+
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -177,36 +180,21 @@ fn emulate_and_record_commands_agree() {
     let dir = temp_dir("cli");
     let out = dir.join("cli.mcap");
     let fault_log = dir.join("faults.json");
-    let mut emulate = Command::new(BIN)
-        .args([
-            "emulate",
-            "--create-pty",
-            "--seed",
-            "5",
-            "--duration-s",
-            "10",
-            "--as-fast-as-possible",
-            "--faults",
-            "typical,stall=0,seed=3",
-            "--fault-log",
-        ])
-        .arg(&fault_log)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut port = String::new();
-    BufReader::new(emulate.stdout.take().unwrap())
-        .read_line(&mut port)
-        .unwrap();
-    let record = Command::new(BIN)
-        .args(["record", "--port", port.trim(), "--idle-stop", "1", "-o"])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let args = [
+        "--seed",
+        "5",
+        "--duration-s",
+        "10",
+        "--as-fast-as-possible",
+        "--faults",
+        "typical,stall=0,seed=3",
+        "--fault-log",
+    ];
+    let mut args: Vec<&OsStr> = args.iter().map(OsStr::new).collect();
+    args.push(fault_log.as_os_str());
+    let (emulated, record) = common::emulate_into_record(&args, &out);
     let stderr = String::from_utf8_lossy(&record.stderr);
     assert!(record.status.success(), "{stderr}");
-    let emulated = emulate.wait_with_output().unwrap();
     assert!(emulated.status.success());
     let faults: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&fault_log).unwrap()).unwrap();

@@ -6,7 +6,7 @@
 mod common;
 
 use common::{gyro, ok, temp_dir};
-use std::io::{BufRead, BufReader};
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
@@ -76,16 +76,14 @@ fn run_noise_convert_take_non_ascii_paths() {
 fn calibrate_and_diagnose_take_non_ascii_paths() {
     let (dir, runs) = bench("unicode-calibrate");
     let model = dir.join("Modell_ö.json");
-    let out = gyro(&[
-        "calibrate",
+    let split = [
         s(&runs[0]),
         s(&runs[1]),
         "--holdout",
         s(&runs[2]),
         s(&runs[3]),
-        "-o",
-        s(&model),
-    ]);
+    ];
+    let out = gyro(&[&["calibrate"], &split[..], &["-o", s(&model)]].concat());
     let table = ok(&out);
     // The table shows the last 40 characters of each run's name.
     let tail: String = s(&runs[0])
@@ -102,23 +100,16 @@ fn calibrate_and_diagnose_take_non_ascii_paths() {
 
     let diagnosed = dir.join("Diagnose_ä.json");
     let report = dir.join("Bericht_ü");
-    let out = gyro(&[
+    let diagnose = [
         "diagnose",
         "--members",
         "8",
         "--candidate-members",
         "4",
         "--train",
-        s(&runs[0]),
-        s(&runs[1]),
-        "--holdout",
-        s(&runs[2]),
-        s(&runs[3]),
-        "-o",
-        s(&diagnosed),
-        "--report",
-        s(&report),
-    ]);
+    ];
+    let outputs = ["-o", s(&diagnosed), "--report", s(&report)];
+    let out = gyro(&[&diagnose[..], &split[..], &outputs[..]].concat());
     ok(&out);
     assert!(report.join("index.html").exists());
     let html = std::fs::read_to_string(report.join("index.html")).unwrap();
@@ -131,30 +122,20 @@ fn emulate_and_record_take_non_ascii_paths() {
     let (dir, runs) = bench("unicode-bridge");
     let recording = dir.join("Mitschnitt_ö.mcap");
     let fault_log = dir.join("Fehler_ä.json");
-    let mut emulate = Command::new(BIN)
-        .args(["emulate", "--create-pty", "--as-fast-as-possible", "--log"])
-        .arg(&runs[0])
-        .arg("--fault-log")
-        .arg(&fault_log)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut port = String::new();
-    BufReader::new(emulate.stdout.take().unwrap())
-        .read_line(&mut port)
-        .unwrap();
-    let record = Command::new(BIN)
-        .args(["record", "--port", port.trim(), "--idle-stop", "1", "-o"])
-        .arg(&recording)
-        .output()
-        .unwrap();
+    let args: Vec<&OsStr> = vec![
+        "--as-fast-as-possible".as_ref(),
+        "--log".as_ref(),
+        runs[0].as_os_str(),
+        "--fault-log".as_ref(),
+        fault_log.as_os_str(),
+    ];
+    let (emulated, record) = common::emulate_into_record(&args, &recording);
     assert!(
         record.status.success(),
         "{}",
         String::from_utf8_lossy(&record.stderr)
     );
-    assert!(emulate.wait_with_output().unwrap().status.success());
+    assert!(emulated.status.success());
     assert!(fault_log.exists());
     let json: serde_json::Value =
         serde_json::from_str(&ok(&gyro(&["run", s(&recording), "--format", "json"]))).unwrap();

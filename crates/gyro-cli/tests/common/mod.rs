@@ -36,6 +36,32 @@ pub fn write(dir: &Path, name: &str, text: &str) -> String {
     path.to_string_lossy().into_owned()
 }
 
+/// `gyro-cli emulate --create-pty ARGS` feeding `gyro-cli record --idle-stop 1 -o out`, as
+/// a user runs them: the emulator prints the port, the recorder reads it until it goes
+/// quiet. Returns (emulate, record) as they ended.
+#[cfg(unix)]
+pub fn emulate_into_record(emulate_args: &[&std::ffi::OsStr], out: &Path) -> (Output, Output) {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let mut emulate = Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
+        .args(["emulate", "--create-pty"])
+        .args(emulate_args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut port = String::new();
+    BufReader::new(emulate.stdout.take().unwrap())
+        .read_line(&mut port)
+        .unwrap();
+    let record = Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
+        .args(["record", "--port", port.trim(), "--idle-stop", "1", "-o"])
+        .arg(out)
+        .output()
+        .unwrap();
+    (emulate.wait_with_output().unwrap(), record)
+}
+
 /// Assert success; stdout as text.
 pub fn ok(out: &Output) -> String {
     assert!(
