@@ -1310,13 +1310,13 @@ Effects are fitted on the training runs only and scored on the held-out runs.</p
                 .params
                 .iter()
                 .zip(e.params())
-                .map(|((name, unit), v)| {
-                    let unit = if *unit == "1" {
+                .map(|(spec, v)| {
+                    let unit = if spec.unit == "1" {
                         String::new()
                     } else {
-                        format!(" {}", esc(unit))
+                        format!(" {}", esc(spec.unit))
                     };
-                    format!("{}&nbsp;=&nbsp;{}{unit}", esc(name), short(v, 4))
+                    format!("{}&nbsp;=&nbsp;{}{unit}", esc(spec.name), short(v, 4))
                 })
                 .collect();
             let _ = writeln!(

@@ -464,7 +464,7 @@ pub fn diagnose(
     let eval_set = |set: &[Effect]| -> Vec<RunScore> {
         let set = &joint.effects(set);
         let model = fit::model_with(&nominal, set, white_target);
-        if set.iter().all(|e| fit::is_identity(e, &nominal)) && model == nominal {
+        if set.iter().all(|e| e.is_neutral(&nominal)) && model == nominal {
             (0..mc * holdout.len()).for_each(|_| progress.tick());
             return before_c.clone();
         }
@@ -747,11 +747,11 @@ pub fn diagnose(
         .map(|(i, c)| {
             let info = c.fit.effect.info();
             let values = c.fit.effect.params();
-            let params = info.params.iter().map(|p| p.0).zip(values).collect();
+            let params = info.params.iter().map(|p| p.name).zip(values).collect();
             let ci95 = info
                 .params
                 .iter()
-                .map(|p| p.0)
+                .map(|p| p.name)
                 .zip(c.fit.ci95.iter().map(|(a, b)| [*a, *b]))
                 .collect();
             let mut with = partners.get(&i).cloned().unwrap_or_default();

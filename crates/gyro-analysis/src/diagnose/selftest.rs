@@ -45,16 +45,7 @@ pub const CONFOUND_GROUPS: [(&str, &str); 1] = [("latency", "bandwidth")];
 
 /// The magnitudes injected by the self-check.
 pub fn magnitudes() -> Vec<Effect> {
-    EFFECTS
-        .iter()
-        .map(|info| match info.typical {
-            Effect::RateRandomWalk { .. } => Effect::RateRandomWalk {
-                k_dps_per_rt_s: 0.02,
-            },
-            Effect::TemperatureScale { .. } => Effect::TemperatureScale { per_c: 2e-3 },
-            other => other,
-        })
-        .collect()
+    EFFECTS.iter().map(|info| info.self_test).collect()
 }
 
 fn magnitude(id: &str) -> Option<Effect> {
@@ -172,7 +163,8 @@ fn score_case(kind: &'static str, injected: Vec<Effect>, d: &Diagnosis) -> CaseR
     let mut covered = Vec::new();
     for t in &injected {
         if let Some(e) = d.effects.iter().find(|e| e.id == t.id()) {
-            for ((name, _), value) in t.info().params.iter().zip(t.params()) {
+            for (spec, value) in t.info().params.iter().zip(t.params()) {
+                let name = spec.name;
                 if let Some([lo, hi]) = e.ci95.get(name) {
                     let inside = lo.is_none_or(|l| value >= l) && hi.is_none_or(|h| value <= h);
                     covered.push((format!("{}.{name}", t.id()), inside));
