@@ -64,6 +64,23 @@ pub fn corrected_model(base: &ModelFile, effects: &[Effect]) -> (ModelFile, Vec<
     (model, ids)
 }
 
+/// Stage 5: the base model with the corrections of the selected effects and its
+/// held-out angle errors, when any selected effect is correctable.
+pub(crate) fn compensate(
+    holdout: &[RealRun],
+    base: &ModelFile,
+    selected: &[Effect],
+    progress: &dyn super::Progress,
+) -> (Option<CompensationSummary>, Option<ModelFile>) {
+    let (corrected, ids) = corrected_model(base, selected);
+    if ids.is_empty() {
+        return (None, None);
+    }
+    progress.stage("compensated replays of held-out runs", 0);
+    let summary = score(holdout, base, &corrected, ids);
+    (Some(summary), Some(corrected))
+}
+
 /// Max abs angle error of every held-out run with `base` and with `corrected`.
 pub fn score(
     holdout: &[RealRun],
