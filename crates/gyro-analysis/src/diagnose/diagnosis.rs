@@ -102,6 +102,10 @@ pub struct Diagnosis {
     /// The model file with those corrections (`--out`).
     #[serde(skip)]
     pub corrected_model: Option<ModelFile>,
+    /// The sensor model simulated with the selected effects (the nominal one, with the
+    /// white noise matched again under an extra output rounding); for the report.
+    #[serde(skip)]
+    pub selected_sensor: SensorModel,
 }
 
 /// The nominal model.

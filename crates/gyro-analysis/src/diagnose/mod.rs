@@ -32,6 +32,7 @@ mod baseline;
 pub mod compensate;
 mod diagnosis;
 pub mod ensemble;
+pub mod envelopes;
 pub mod features;
 pub mod fit;
 mod locate;
@@ -215,6 +216,7 @@ pub fn diagnose(
         candidates,
         selection,
         selected_effects,
+        selected_sensor,
         train_after,
         compensation,
         corrected_model,

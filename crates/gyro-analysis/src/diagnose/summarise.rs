@@ -156,6 +156,7 @@ pub(crate) struct Findings<'a> {
     pub(crate) candidates: Vec<Candidate>,
     pub(crate) selection: Selection,
     pub(crate) selected_effects: Vec<Effect>,
+    pub(crate) selected_sensor: SensorModel,
     pub(crate) train_after: (Vec<RunScore>, f64),
     pub(crate) compensation: Option<CompensationSummary>,
     pub(crate) corrected_model: Option<ModelFile>,
@@ -203,5 +204,6 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         runs,
         compensation: f.compensation,
         corrected_model: f.corrected_model,
+        selected_sensor: f.selected_sensor,
     }
 }

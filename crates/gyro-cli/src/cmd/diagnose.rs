@@ -337,7 +337,8 @@ fn write_report(
     holdout: &[RealRun],
     options: &Options,
 ) -> Result<()> {
-    gyro_report::diagnose::write_report(dir, result, train, holdout, options)?;
+    let envelopes = diagnose::envelopes::envelopes(result, train, holdout, options);
+    gyro_report::diagnose::write_report(dir, result, envelopes.as_ref(), options)?;
     eprintln!("wrote {}", dir.join("index.html").display());
     Ok(())
 }
