@@ -110,12 +110,36 @@ pub enum DiagnoseError {
         /// What is wrong.
         message: String,
     },
-    /// Not enough runs.
-    #[error("{0}")]
-    TooFewRuns(String),
+    /// Fewer than 2 training runs.
+    #[error(
+        "{found} training run(s): at least 2 are needed (3 to test turn-on bias), each a log with reference_deg"
+    )]
+    TooFewTrainingRuns {
+        /// Training runs given.
+        found: usize,
+    },
+    /// Fewer than 2 held-out runs.
+    #[error(
+        "{found} held-out run(s): at least 2 are needed to score effects on runs not used to fit them"
+    )]
+    TooFewHeldOutRuns {
+        /// Held-out runs given.
+        found: usize,
+    },
     /// Runs at different sample rates.
-    #[error("{0}")]
-    MismatchedRates(String),
+    #[error(
+        "sample rates differ: {first} is at {first_hz} Hz, {other} at {other_hz} Hz; diagnose compares runs of one sensor setup"
+    )]
+    MismatchedRates {
+        /// The first training run.
+        first: String,
+        /// Its sample rate (Hz).
+        first_hz: f64,
+        /// A run at another rate.
+        other: String,
+        /// That run's sample rate (Hz).
+        other_hz: f64,
+    },
 }
 
 /// Progress reports.
@@ -137,25 +161,23 @@ impl Progress for Silent {
 /// Check the runs can be diagnosed together.
 pub fn check_runs(train: &[RealRun], holdout: &[RealRun]) -> Result<(), DiagnoseError> {
     if train.len() < 2 {
-        return Err(DiagnoseError::TooFewRuns(format!(
-            "{} training run(s): at least 2 are needed (3 to test turn-on bias), each a log with reference_deg",
-            train.len()
-        )));
+        return Err(DiagnoseError::TooFewTrainingRuns { found: train.len() });
     }
     if holdout.len() < 2 {
-        return Err(DiagnoseError::TooFewRuns(format!(
-            "{} held-out run(s): at least 2 are needed to score effects on runs not used to fit them (pass --holdout, or --split-s to cut logs into windows)",
-            holdout.len()
-        )));
+        return Err(DiagnoseError::TooFewHeldOutRuns {
+            found: holdout.len(),
+        });
     }
     let first = &train[0];
     for run in train.iter().chain(holdout) {
         let ratio = run.sample_rate_hz / first.sample_rate_hz;
         if (ratio - 1.0).abs() > 1e-3 {
-            return Err(DiagnoseError::MismatchedRates(format!(
-                "sample rates differ: {} is at {} Hz, {} at {} Hz; diagnose compares runs of one sensor setup (resample, or pass --sample-rate-hz to place all on one grid)",
-                first.name, first.sample_rate_hz, run.name, run.sample_rate_hz
-            )));
+            return Err(DiagnoseError::MismatchedRates {
+                first: first.name.clone(),
+                first_hz: first.sample_rate_hz,
+                other: run.name.clone(),
+                other_hz: run.sample_rate_hz,
+            });
         }
     }
     Ok(())

@@ -4,7 +4,7 @@
 use anyhow::{bail, Result};
 use clap::ValueEnum;
 use gyro_analysis::diagnose::ensemble::{split, RealRun};
-use gyro_analysis::diagnose::{self, selftest, Diagnosis, Options, Progress};
+use gyro_analysis::diagnose::{self, selftest, DiagnoseError, Diagnosis, Options, Progress};
 use gyro_analysis::model;
 use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -162,11 +162,11 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let train = load(&args.train, args, "training")?;
     let holdout = load(&args.holdout, args, "held-out")?;
-    diagnose::check_runs(&train, &holdout)?;
+    diagnose::check_runs(&train, &holdout).map_err(with_advice)?;
     let bar = progress_bar();
     let result = diagnose::diagnose(&train, &holdout, &options, &bar);
     bar.0.finish_and_clear();
-    let result = result?;
+    let result = result.map_err(with_advice)?;
     let mut stdout = std::io::stdout().lock();
     match args.format {
         Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
@@ -222,7 +222,7 @@ fn self_test(args: &Args) -> Result<()> {
         },
     );
     bar.finish_and_clear();
-    let result = result?;
+    let result = result.map_err(with_advice)?;
     let mut stdout = std::io::stdout().lock();
     match args.format {
         Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
@@ -328,6 +328,22 @@ top-1 accuracy (single effects): {} strict, {} counting confounded pairs ({}) as
         pct(t.mean_fraction_closed)
     );
     s
+}
+
+/// `e` with what to pass on the command line to get past it, where there is advice.
+fn with_advice(e: DiagnoseError) -> anyhow::Error {
+    let advice = match &e {
+        DiagnoseError::TooFewHeldOutRuns { .. } => {
+            "pass --holdout, or --split-s to cut logs into windows"
+        }
+        DiagnoseError::MismatchedRates { .. } => {
+            "resample, or pass --sample-rate-hz to place all on one grid"
+        }
+        DiagnoseError::Run { .. } | DiagnoseError::TooFewTrainingRuns { .. } => {
+            return e.into();
+        }
+    };
+    anyhow::anyhow!("{e} ({advice})")
 }
 
 fn write_report(
