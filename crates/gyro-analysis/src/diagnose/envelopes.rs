@@ -190,7 +190,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 impl Measures {
     /// Empty measures for `setup`.
-    pub fn new(setup: &Setup) -> Self {
+    pub(crate) fn new(setup: &Setup) -> Self {
         Self {
             allan: BTreeMap::new(),
             psd: vec![0.0; setup.psd_len / 2 + 1],
@@ -205,7 +205,7 @@ impl Measures {
     }
 
     /// Pool another run's measures into these.
-    pub fn merge(&mut self, o: &Measures) {
+    pub(crate) fn merge(&mut self, o: &Measures) {
         for (m, (a, t)) in &o.allan {
             let e = self.allan.entry(*m).or_insert((0.0, 0.0));
             e.0 += a;
@@ -229,7 +229,7 @@ impl Measures {
     }
 
     /// The measures of one run's residuals.
-    pub fn of(r: &Residuals, setup: &Setup) -> Self {
+    pub(crate) fn of(r: &Residuals, setup: &Setup) -> Self {
         let mut out = Self::new(setup);
         let n = r.residual_dps.len();
         let res = &r.residual_dps;

@@ -570,7 +570,7 @@ fn clock_fit(input: &FitInput) -> Result<Fit, FitError> {
 
 /// Why an effect cannot be fitted on these training runs.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum FitError {
+pub(crate) enum FitError {
     /// No nominal sample rate to compare the time stamps with.
     #[error(
         "needs the nominal sample rate (`# sample_rate_hz` metadata or \
