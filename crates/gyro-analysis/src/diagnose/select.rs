@@ -5,6 +5,7 @@ use super::baseline::{evaluate, Baseline, Runs};
 use super::fit::{self, Fit, Joint};
 use super::score::{bootstrap_p, gap, RunScore};
 use super::{Options, Progress, CONFOUND_COSINE, MAX_EFFECTS, TIE_BIC};
+use crate::seed::derive_seed;
 use gyro_sim::{Effect, SensorModel};
 use std::collections::BTreeMap;
 
@@ -82,15 +83,20 @@ impl<'a> Scorer<'a> {
         self.baseline.candidate_members * self.runs.holdout.len()
     }
 
+    /// The seed of the bootstrap stream `name`, number `index`.
+    fn seed(&self, name: &str, index: usize) -> u64 {
+        derive_seed(self.options.seed, name, index as u64)
+    }
+
     /// `after` against `before`, for an effect of `params` parameters; the bootstrap
-    /// draws with `salt`.
-    fn step_of(&self, after: &[RunScore], before: &[RunScore], params: usize, salt: u64) -> Step {
+    /// draws with `seed`.
+    fn step_of(&self, after: &[RunScore], before: &[RunScore], params: usize, seed: u64) -> Step {
         let diffs = loglik_diffs(after, before);
         Step {
             gap_before: gap(before),
             gap_after: gap(after),
             delta_bic: delta_bic(&diffs, params, self.observations),
-            p: bootstrap_p(&diffs, self.options.bootstrap, self.options.seed ^ salt),
+            p: bootstrap_p(&diffs, self.options.bootstrap, seed),
         }
     }
 
@@ -153,7 +159,12 @@ pub(crate) fn score_alone(scorer: &Scorer, fits: Vec<Fit>) -> Vec<Candidate> {
     let mut candidates = Vec::new();
     for (i, f) in fits.into_iter().enumerate() {
         let scores = scorer.eval_set(&[f.effect]);
-        let alone = scorer.step_of(&scores, &scorer.before, f.effect.params().len(), i as u64);
+        let alone = scorer.step_of(
+            &scores,
+            &scorer.before,
+            f.effect.params().len(),
+            scorer.seed("alone", i),
+        );
         let alone_ok = scorer.qualifies(&f, &alone);
         candidates.push(Candidate {
             fit: f,
@@ -210,7 +221,7 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
                     &c.alone_scores,
                     &current,
                     c.fit.effect.params().len(),
-                    i as u64,
+                    scorer.seed("alone", i),
                 );
                 tried.push((i, st, c.alone_scores.clone()));
             }
@@ -228,7 +239,7 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
                     &scores,
                     &current,
                     candidates[i].fit.effect.params().len(),
-                    (1000 * step + i) as u64,
+                    derive_seed(scorer.seed("forward step", step), "added", i as u64),
                 );
                 tried.push((i, st, scores));
             }
@@ -253,7 +264,7 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
                 let d: Vec<f64> = lead_ll.iter().zip(&ll).map(|(a, b)| a - b).collect();
                 t.0 == lead
                     || ok[0].1.delta_bic - t.1.delta_bic < TIE_BIC
-                    || bootstrap_p(&d, scorer.options.bootstrap, scorer.options.seed ^ 77) > 0.05
+                    || bootstrap_p(&d, scorer.options.bootstrap, scorer.seed("tie", step)) > 0.05
             })
             .map(|t| t.0)
             .min()
@@ -312,7 +323,7 @@ fn swaps(
                 && bootstrap_p(
                     &diffs,
                     scorer.options.bootstrap,
-                    scorer.options.seed ^ (200_000 + a) as u64,
+                    scorer.seed("swap test", a),
                 ) < 0.05;
             if better {
                 let out = selected[slot];
@@ -320,7 +331,7 @@ fn swaps(
                     &scores,
                     &current,
                     candidates[a].fit.effect.params().len(),
-                    (300_000 + a) as u64,
+                    scorer.seed("swap step", a),
                 );
                 candidates[a].added = Some(st);
                 candidates[out].added = None;
@@ -363,7 +374,7 @@ fn leave_one_out(
             &current,
             &without,
             candidates[i].fit.effect.params().len(),
-            (100_000 + i) as u64,
+            scorer.seed("leave one out", i),
         );
         if !(st.delta_bic > 0.0 && st.p < 0.05) {
             selected.retain(|&j| j != i);
