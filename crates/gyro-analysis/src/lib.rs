@@ -16,3 +16,4 @@ pub mod diagnose;
 pub mod model;
 pub mod noise;
 pub mod replay;
+pub mod seed;

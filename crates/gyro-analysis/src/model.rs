@@ -108,12 +108,12 @@ pub enum ModelError {
         version: u32,
     },
     /// The sensor model is invalid.
-    #[error("{path}: {message}")]
+    #[error("{path}: {problem}")]
     Sensor {
         /// File.
         path: PathBuf,
-        /// What is wrong.
-        message: String,
+        /// What is wrong (part of this message, not a separate cause).
+        problem: gyro_sim::InvalidSensorModel,
     },
     /// `reference_delay_s` is not finite or beyond ±[`MAX_REFERENCE_DELAY_S`].
     #[error("{path}: reference_delay_s must be within ±{MAX_REFERENCE_DELAY_S} s, found {value}")]
@@ -159,9 +159,9 @@ pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
     model
         .sensor
         .validate()
-        .map_err(|message| ModelError::Sensor {
+        .map_err(|problem| ModelError::Sensor {
             path: path.to_path_buf(),
-            message,
+            problem,
         })?;
     // (JSON has no NaN or infinity; the check keeps the bound honest for any caller.)
     let delay_ok = model.reference_delay_s.is_finite()

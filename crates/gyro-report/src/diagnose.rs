@@ -6,56 +6,32 @@
 //! the ranked effects, the largest "where" z-scores, the per-run gaps, and figures of real
 //! data against simulated envelopes, each with a note on how to read it.
 //!
-//! **Envelopes.** The runs are re-simulated with the nominal model (and, when effects
-//! were selected, with the model holding them) with the seeds of the diagnosis' baseline
-//! ensemble ([`member_seed`] of run and member), [`REPORT_MEMBERS`] members each, so the
-//! nominal band is drawn from the very ensemble the z-scores were computed against. Every
-//! real and simulated run goes through the same residuals ([`residuals`]). A figure
-//! pools its statistic over the runs (like [`gyro_analysis::noise`] pools segments) for the real
-//! runs and, member by member, for the simulated ones; a band spans the members' minimum
-//! to maximum with their median dashed (the cross-correlation's: a 95% band, mean ± 1.96
-//! sd of the members). When the runs hold more than [`SAMPLE_BUDGET`] samples, an evenly
-//! spaced subset of training and held-out runs is used for the figures (real and
-//! simulated alike; the page says which). The gap map and the tables use every run.
+//! **Envelopes.** The figures draw [`Envelopes`], which the analysis computes
+//! ([`gyro_analysis::diagnose::envelopes`]): real data against the same statistics of
+//! simulated runs, a band spanning the members' minimum to maximum with their median
+//! dashed (the cross-correlation's: a 95% band, mean ± 1.96 sd of the members). The gap
+//! map and the tables use every run. The page renders; it computes nothing.
 
 use crate::plot::diagnose_plot::{
     AngleErrorPlot, AngleErrorRow, Band, EnvelopePlot, GapMapPlot, Measured, Panel,
 };
 use crate::plot::{render, sig, Figure, ImageFormat, RenderError};
-use gyro_analysis::diagnose::ensemble::{member_seed, simulate_residuals, RealRun};
+use gyro_analysis::diagnose::envelopes::{
+    quantile, Bins, Envelopes, Measures, Moments, SimModel, PSD_BANDS_PER_DECADE,
+};
 use gyro_analysis::diagnose::features::MIN_TEMPERATURE_RANGE_C;
-use gyro_analysis::diagnose::fit::{model_with, nominal_model};
-use gyro_analysis::diagnose::stats::{residuals, stretches, Residuals, MAX_LAG_S};
 use gyro_analysis::diagnose::{Diagnosis, EffectResult, Options};
-use gyro_analysis::noise::{welch, AllanDeviation, PsdOptions, TauGrid, ONE_SIGMA};
-use gyro_sim::{Effect, SensorModel, EFFECTS};
-use rayon::prelude::*;
+use gyro_sim::EFFECTS;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Simulated members per run for the envelopes (at most the diagnosis' members).
-pub const REPORT_MEMBERS: usize = 12;
-/// Samples of real runs the figures use at most (each simulated [`REPORT_MEMBERS`]
-/// times per model): 11 of 20 runs of 90 s at 1 kHz, about 7 s of CPU with one set of
-/// selected effects.
-pub const SAMPLE_BUDGET: usize = 1_000_000;
 /// Colours of the gap map saturate at this |z|.
 pub const GAP_MAP_CLIP: f64 = 10.0;
 /// Most statistics (columns) in the gap map, by combined |z|.
 pub const GAP_MAP_COLUMNS: usize = 120;
 /// Rows of the "where" table.
 pub const WHERE_ROWS: usize = 20;
-/// Bins of the reference rate and of the angular acceleration.
-const SIGNED_BINS: usize = 24;
-/// Bins of the temperature change.
-const TEMPERATURE_BINS: usize = 12;
-/// Fewest real samples for a bin to be shown.
-const MIN_BIN_SAMPLES: f64 = 20.0;
-/// Welch segment length (s), rounded down to a power of two of samples.
-const PSD_SEGMENT_S: f64 = 4.0;
-/// Bands per decade of the PSD.
-const PSD_BANDS_PER_DECADE: f64 = 10.0;
 
 /// Why the report could not be written; every variant names the file.
 #[derive(Debug, thiserror::Error)]
@@ -100,13 +76,16 @@ pub enum ReportError {
     },
 }
 
-/// Write `dir/diagnosis.json` and `dir/index.html` for the diagnosis `d` of `train` and
-/// `holdout` (the runs it was computed from, in the same order) with `options`.
+/// Fewest real samples for a bin to be shown.
+pub const MIN_BIN_SAMPLES: f64 = 20.0;
+
+/// Write `dir/diagnosis.json` and `dir/index.html` for the diagnosis `d` computed with
+/// `options`, its figures drawn from `envelopes` (none: the page says there is no run
+/// to draw).
 pub fn write_report(
     dir: &Path,
     d: &Diagnosis,
-    train: &[RealRun],
-    holdout: &[RealRun],
+    envelopes: Option<&Envelopes>,
     options: &Options,
 ) -> Result<(), ReportError> {
     std::fs::create_dir_all(dir).map_err(|source| ReportError::CreateDir {
@@ -123,7 +102,7 @@ pub fn write_report(
         source,
     })?;
     let html_path = dir.join("index.html");
-    let html = page(d, train, holdout, options, &html_path)?;
+    let html = page(d, envelopes, options, &html_path)?;
     std::fs::write(&html_path, html).map_err(|source| ReportError::Write {
         path: html_path.clone(),
         source,
@@ -131,470 +110,7 @@ pub fn write_report(
 }
 
 // ---------------------------------------------------------------------------------------
-// Measures of one run, poolable over runs.
-
-/// Count, sum and sum of squares.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct Moments {
-    n: f64,
-    sum: f64,
-    sum_sq: f64,
-}
-
-impl Moments {
-    fn add(&mut self, v: f64) {
-        self.n += 1.0;
-        self.sum += v;
-        self.sum_sq += v * v;
-    }
-
-    fn merge(&mut self, o: &Moments) {
-        self.n += o.n;
-        self.sum += o.sum;
-        self.sum_sq += o.sum_sq;
-    }
-
-    fn mean(&self) -> f64 {
-        if self.n > 0.0 {
-            self.sum / self.n
-        } else {
-            f64::NAN
-        }
-    }
-
-    fn std(&self) -> f64 {
-        if self.n > 1.0 {
-            let m = self.mean();
-            ((self.sum_sq - self.n * m * m) / (self.n - 1.0))
-                .max(0.0)
-                .sqrt()
-        } else {
-            f64::NAN
-        }
-    }
-}
-
-/// Fixed bins `[edges[i], edges[i+1])`.
-#[derive(Clone, Debug, PartialEq)]
-struct Bins {
-    edges: Vec<f64>,
-}
-
-impl Bins {
-    fn linear(lo: f64, hi: f64, n: usize) -> Self {
-        Self {
-            edges: (0..=n)
-                .map(|i| lo + (hi - lo) * i as f64 / n as f64)
-                .collect(),
-        }
-    }
-
-    fn len(&self) -> usize {
-        self.edges.len().saturating_sub(1)
-    }
-
-    fn index(&self, v: f64) -> Option<usize> {
-        let (lo, hi) = (*self.edges.first()?, *self.edges.last()?);
-        if !(v.is_finite() && v >= lo && v <= hi && hi > lo) {
-            return None;
-        }
-        let k = ((v - lo) / (hi - lo) * self.len() as f64).floor() as usize;
-        Some(k.min(self.len() - 1))
-    }
-
-    fn centres(&self) -> Vec<f64> {
-        self.edges.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect()
-    }
-}
-
-/// What every run is measured with (fixed from the real runs before any simulation).
-#[derive(Clone, Debug)]
-struct Setup {
-    fs: f64,
-    allan_factors: Vec<usize>,
-    psd_len: usize,
-    rate: Bins,
-    acceleration: Bins,
-    temperature: Option<Bins>,
-    /// Lags of the cross-correlation (samples).
-    lags: Vec<i64>,
-}
-
-/// A run's (or pooled runs') figure statistics.
-#[derive(Clone, Debug, Default)]
-struct Measures {
-    /// Per averaging factor: Σ avar·terms and Σ terms of the static residual.
-    allan: BTreeMap<usize, (f64, f64)>,
-    /// Σ PSD·segments per bin, and Σ segments.
-    psd: Vec<f64>,
-    psd_segments: f64,
-    rate: Vec<Moments>,
-    acceleration: Vec<Moments>,
-    temperature: Vec<Moments>,
-    /// Σ g[i+lag]·r[i] per lag, Σ g², Σ r² (means removed per run).
-    xcorr: Vec<f64>,
-    g2: f64,
-    r2: f64,
-}
-
-/// Σ a·b, in four independent sums (so the compiler can vectorise it).
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0f64; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = ca
-        .remainder()
-        .iter()
-        .zip(cb.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in ca.zip(cb) {
-        for j in 0..4 {
-            acc[j] += x[j] * y[j];
-        }
-    }
-    acc.iter().sum::<f64>() + tail
-}
-
-impl Measures {
-    fn new(setup: &Setup) -> Self {
-        Self {
-            allan: BTreeMap::new(),
-            psd: vec![0.0; setup.psd_len / 2 + 1],
-            psd_segments: 0.0,
-            rate: vec![Moments::default(); setup.rate.len()],
-            acceleration: vec![Moments::default(); setup.acceleration.len()],
-            temperature: vec![Moments::default(); setup.temperature.as_ref().map_or(0, Bins::len)],
-            xcorr: vec![0.0; setup.lags.len()],
-            g2: 0.0,
-            r2: 0.0,
-        }
-    }
-
-    fn merge(&mut self, o: &Measures) {
-        for (m, (a, t)) in &o.allan {
-            let e = self.allan.entry(*m).or_insert((0.0, 0.0));
-            e.0 += a;
-            e.1 += t;
-        }
-        self.psd.iter_mut().zip(&o.psd).for_each(|(a, b)| *a += b);
-        self.psd_segments += o.psd_segments;
-        for (mine, theirs) in [
-            (&mut self.rate, &o.rate),
-            (&mut self.acceleration, &o.acceleration),
-            (&mut self.temperature, &o.temperature),
-        ] {
-            mine.iter_mut().zip(theirs).for_each(|(a, b)| a.merge(b));
-        }
-        self.xcorr
-            .iter_mut()
-            .zip(&o.xcorr)
-            .for_each(|(a, b)| *a += b);
-        self.g2 += o.g2;
-        self.r2 += o.r2;
-    }
-
-    fn of(r: &Residuals, setup: &Setup) -> Self {
-        let mut out = Self::new(setup);
-        let n = r.residual_dps.len();
-        let res = &r.residual_dps;
-
-        // Allan deviation of the static residual, each static stretch a segment.
-        let statics: Vec<&[f64]> = stretches(n, |i| r.is_static[i] && res[i].is_finite())
-            .into_iter()
-            .map(|s| &res[s])
-            .collect();
-        if !statics.is_empty() {
-            let allan =
-                AllanDeviation::compute(&statics, setup.fs, &setup.allan_factors, ONE_SIGMA);
-            for p in &allan.points {
-                out.allan
-                    .insert(p.m, (p.avar() * p.terms as f64, p.terms as f64));
-            }
-        }
-
-        // Welch PSD of the residual over every stretch with one.
-        let all: Vec<&[f64]> = stretches(n, |i| res[i].is_finite())
-            .into_iter()
-            .filter(|s| s.len() >= setup.psd_len)
-            .map(|s| &res[s])
-            .collect();
-        let psd_options = PsdOptions {
-            segment_len: Some(setup.psd_len),
-            ..PsdOptions::default()
-        };
-        if let Some(psd) = welch(&all, setup.fs, &psd_options) {
-            let k = psd.segments as f64;
-            out.psd
-                .iter_mut()
-                .zip(&psd.psd_dps2_per_hz)
-                .for_each(|(a, p)| *a += p * k);
-            out.psd_segments += k;
-        }
-
-        // Binned residuals.
-        let t0 = r.temperature_c.iter().copied().find(|t| t.is_finite());
-        for (i, &v) in res.iter().enumerate() {
-            if !v.is_finite() {
-                continue;
-            }
-            if let Some(k) = setup.rate.index(r.reference_rate_dps[i]) {
-                out.rate[k].add(v);
-            }
-            if !r.is_static[i] {
-                if let Some(k) = setup.acceleration.index(r.reference_acceleration_dps2[i]) {
-                    out.acceleration[k].add(v);
-                }
-            } else if let (Some(bins), Some(t0)) = (&setup.temperature, t0) {
-                if let Some(k) = bins.index(r.temperature_c[i] - t0) {
-                    out.temperature[k].add(v);
-                }
-            }
-        }
-
-        // Cross-correlation of gyro and reference rate, means removed.
-        let both = |i: usize| r.rate_dps[i].is_finite() && r.reference_rate_dps[i].is_finite();
-        let count = (0..n).filter(|&i| both(i)).count();
-        if count >= 3 {
-            let mean =
-                |x: &[f64]| (0..n).filter(|&i| both(i)).map(|i| x[i]).sum::<f64>() / count as f64;
-            let (mg, mr) = (mean(&r.rate_dps), mean(&r.reference_rate_dps));
-            let g: Vec<f64> = (0..n)
-                .map(|i| if both(i) { r.rate_dps[i] - mg } else { 0.0 })
-                .collect();
-            let rr: Vec<f64> = (0..n)
-                .map(|i| {
-                    if both(i) {
-                        r.reference_rate_dps[i] - mr
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
-            out.g2 = g.iter().map(|v| v * v).sum();
-            out.r2 = rr.iter().map(|v| v * v).sum();
-            for (c, &lag) in out.xcorr.iter_mut().zip(&setup.lags) {
-                let l = lag.unsigned_abs() as usize;
-                if l >= n {
-                    continue;
-                }
-                let (a, b) = if lag >= 0 {
-                    (&g[l..], &rr[..n - l])
-                } else {
-                    (&g[..n - l], &rr[l..])
-                };
-                *c = dot(a, b);
-            }
-        }
-        out
-    }
-
-    /// Pooled Allan deviation: (τ, σ).
-    fn allan_curve(&self, fs: f64) -> Vec<(f64, f64)> {
-        self.allan
-            .iter()
-            .filter(|(_, (_, t))| *t >= 2.0)
-            .map(|(m, (a, t))| (*m as f64 / fs, (a / t).sqrt()))
-            .collect()
-    }
-
-    /// PSD averaged over log bands: (centre frequency, PSD).
-    fn psd_bands(&self, setup: &Setup) -> Vec<(f64, f64)> {
-        if self.psd_segments <= 0.0 {
-            return Vec::new();
-        }
-        let df = setup.fs / setup.psd_len as f64;
-        let mut bands: BTreeMap<i64, (f64, f64, f64)> = BTreeMap::new();
-        for (k, p) in self.psd.iter().enumerate().skip(1) {
-            let f = k as f64 * df;
-            let band = ((f / df).log10() * PSD_BANDS_PER_DECADE).floor() as i64;
-            let e = bands.entry(band).or_insert((0.0, 0.0, 0.0));
-            e.0 += p / self.psd_segments;
-            e.1 += 1.0;
-            e.2 += f.ln();
-        }
-        bands
-            .values()
-            .map(|(sum, count, log_f)| ((log_f / count).exp(), sum / count))
-            .collect()
-    }
-
-    /// Normalised cross-correlation per lag.
-    fn xcorr_curve(&self) -> Vec<f64> {
-        let norm = (self.g2 * self.r2).sqrt();
-        self.xcorr
-            .iter()
-            .map(|c| if norm > 0.0 { c / norm } else { f64::NAN })
-            .collect()
-    }
-}
-
-/// Quantile `q` of the finite `values` (nearest rank).
-fn quantile(values: &mut [f64], q: f64) -> Option<f64> {
-    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return None;
-    }
-    let k = ((q * (v.len() - 1) as f64).round() as usize).min(v.len() - 1);
-    Some(*v.select_nth_unstable_by(k, f64::total_cmp).1)
-}
-
-/// The measurement set-up from the real runs' residuals.
-fn setup(real: &[Residuals], fs: f64) -> Setup {
-    let longest_static = real
-        .iter()
-        .flat_map(|r| {
-            stretches(r.residual_dps.len(), |i| {
-                r.is_static[i] && r.residual_dps[i].is_finite()
-            })
-        })
-        .map(|s| s.len())
-        .max()
-        .unwrap_or(0);
-    let allan_factors = TauGrid::PerDecade(8).factors(longest_static);
-    let longest = real
-        .iter()
-        .flat_map(|r| stretches(r.residual_dps.len(), |i| r.residual_dps[i].is_finite()))
-        .map(|s| s.len())
-        .max()
-        .unwrap_or(0);
-    let target = ((PSD_SEGMENT_S * fs) as usize).min(longest).max(16);
-    let psd_len = 1usize << (usize::BITS - 1 - target.leading_zeros());
-
-    let mut abs_rate: Vec<f64> = Vec::new();
-    let mut abs_acc: Vec<f64> = Vec::new();
-    let mut delta_t: Vec<f64> = Vec::new();
-    for r in real {
-        let t0 = r.temperature_c.iter().copied().find(|t| t.is_finite());
-        for i in 0..r.residual_dps.len() {
-            if !r.residual_dps[i].is_finite() {
-                continue;
-            }
-            abs_rate.push(r.reference_rate_dps[i].abs());
-            if r.is_static[i] {
-                if let Some(t0) = t0 {
-                    delta_t.push(r.temperature_c[i] - t0);
-                }
-            } else {
-                abs_acc.push(r.reference_acceleration_dps2[i].abs());
-            }
-        }
-    }
-    let span = |v: &mut [f64], q: f64| quantile(v, q).filter(|x| *x > 0.0).unwrap_or(1.0);
-    let rate_max = span(&mut abs_rate, 0.995);
-    let acc_max = span(&mut abs_acc, 0.99);
-    let temperature = {
-        let lo = delta_t
-            .iter()
-            .copied()
-            .filter(|v| v.is_finite())
-            .fold(f64::INFINITY, f64::min);
-        let hi = delta_t
-            .iter()
-            .copied()
-            .filter(|v| v.is_finite())
-            .fold(f64::NEG_INFINITY, f64::max);
-        (hi - lo >= MIN_TEMPERATURE_RANGE_C).then(|| Bins::linear(lo, hi, TEMPERATURE_BINS))
-    };
-    let max_lag = ((MAX_LAG_S * fs).round() as i64).max(1);
-    let step = ((fs / 1000.0).round() as i64).max(1);
-    let lags = (-max_lag / step..=max_lag / step)
-        .map(|k| k * step)
-        .collect();
-    Setup {
-        fs,
-        allan_factors,
-        psd_len,
-        rate: Bins::linear(-rate_max, rate_max, SIGNED_BINS),
-        acceleration: Bins::linear(-acc_max, acc_max, SIGNED_BINS),
-        temperature,
-        lags,
-    }
-}
-
-// ---------------------------------------------------------------------------------------
-// Runs, simulations and envelopes.
-
-/// A run used by the figures, with its seed index in the diagnosis.
-struct FigureRun<'a> {
-    id: usize,
-    run: &'a RealRun,
-}
-
-/// The runs the figures use: all of them if they fit [`SAMPLE_BUDGET`], else an evenly
-/// spaced subset taking held-out and training runs in turn (at least one of each).
-fn figure_runs<'a>(train: &'a [RealRun], holdout: &'a [RealRun]) -> Vec<FigureRun<'a>> {
-    let all: Vec<FigureRun> = train
-        .iter()
-        .enumerate()
-        .map(|(i, run)| FigureRun { id: i, run })
-        .chain(holdout.iter().enumerate().map(|(i, run)| FigureRun {
-            id: train.len() + i,
-            run,
-        }))
-        .collect();
-    let total: usize = all.iter().map(|f| f.run.len()).sum();
-    if total <= SAMPLE_BUDGET || all.len() <= 2 {
-        return all;
-    }
-    let mean_len = (total / all.len()).max(1);
-    let k = (SAMPLE_BUDGET / mean_len).clamp(2, all.len());
-    let k_hold = (k / 2).clamp(1, holdout.len().max(1));
-    let k_train = (k - k_hold).clamp(1, train.len().max(1));
-    // m of n indices, evenly spaced (the middle of m equal parts).
-    let spaced = |n: usize, m: usize| -> Vec<usize> {
-        let m = m.min(n);
-        (0..m).map(|i| ((2 * i + 1) * n) / (2 * m)).collect()
-    };
-    let mut chosen: Vec<usize> = spaced(train.len(), k_train);
-    chosen.extend(
-        spaced(holdout.len(), k_hold)
-            .iter()
-            .map(|i| train.len() + i),
-    );
-    all.into_iter().filter(|f| chosen.contains(&f.id)).collect()
-}
-
-/// One simulated model for the envelopes.
-struct SimModel {
-    label: String,
-    model: SensorModel,
-    effects: Vec<Effect>,
-}
-
-/// The pooled measures of every member of every model (`[model][member]`).
-fn simulate_all(
-    runs: &[FigureRun],
-    models: &[SimModel],
-    members: usize,
-    seed: u64,
-    setup: &Setup,
-) -> Vec<Vec<Measures>> {
-    let jobs: Vec<(usize, usize, usize)> = (0..models.len())
-        .flat_map(|m| (0..members).flat_map(move |j| (0..runs.len()).map(move |r| (m, j, r))))
-        .collect();
-    let done: Vec<((usize, usize), Measures)> = jobs
-        .par_iter()
-        .filter_map(|&(m, j, r)| {
-            let f = &runs[r];
-            let model = &models[m];
-            simulate_residuals(
-                f.run,
-                &model.model,
-                &model.effects,
-                member_seed(seed, f.id, j),
-            )
-            .ok()
-            .map(|res| ((m, j), Measures::of(&res, setup)))
-        })
-        .collect();
-    let mut out: Vec<Vec<Measures>> = (0..models.len())
-        .map(|_| (0..members).map(|_| Measures::new(setup)).collect())
-        .collect();
-    for ((m, j), measures) in done {
-        out[m][j].merge(&measures);
-    }
-    out
-}
+// Envelopes.
 
 /// Band over members of `values[member][point]` at `x`.
 fn band_of(label: &str, x: &[f64], values: &[Vec<f64>]) -> Band {
@@ -658,75 +174,6 @@ fn at_x(curve: &[(f64, f64)], x: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Everything the figures need.
-struct FigureData {
-    setup: Setup,
-    real: Measures,
-    models: Vec<SimModel>,
-    sims: Vec<Vec<Measures>>,
-    members: usize,
-    runs_used: usize,
-    runs_total: usize,
-    real_errors: Vec<String>,
-}
-
-fn figure_data(
-    d: &Diagnosis,
-    train: &[RealRun],
-    holdout: &[RealRun],
-    options: &Options,
-) -> Option<FigureData> {
-    let runs = figure_runs(train, holdout);
-    let computed: Vec<_> = runs.par_iter().map(|f| residuals(&f.run.log)).collect();
-    let mut real_errors = Vec::new();
-    let mut real_res: Vec<Residuals> = Vec::new();
-    for (f, r) in runs.iter().zip(computed) {
-        match r {
-            Ok(r) => real_res.push(r),
-            Err(e) => real_errors.push(format!("{}: {e}", f.run.name)),
-        }
-    }
-    let fs = runs.first()?.run.sample_rate_hz;
-    let setup = setup(&real_res, fs);
-    let mut real = Measures::new(&setup);
-    for r in &real_res {
-        real.merge(&Measures::of(r, &setup));
-    }
-    drop(real_res);
-    // The white-noise target the diagnosis matched (it matters with quantisation only).
-    let white_target = if options.fixed_model || d.model.effects.is_empty() {
-        None
-    } else {
-        let train_refs: Vec<&RealRun> = train.iter().collect();
-        nominal_model(&train_refs, &options.prior).2
-    };
-    let mut models = vec![SimModel {
-        label: "nominal model".to_string(),
-        model: d.model.sensor,
-        effects: Vec::new(),
-    }];
-    if !d.model.effects.is_empty() {
-        let ids: Vec<&str> = d.model.effects.iter().map(Effect::id).collect();
-        models.push(SimModel {
-            label: format!("nominal + {}", ids.join(" + ")),
-            model: model_with(&d.model.sensor, &d.model.effects, white_target),
-            effects: d.model.effects.clone(),
-        });
-    }
-    let members = REPORT_MEMBERS.min(options.members).max(2);
-    let sims = simulate_all(&runs, &models, members, options.seed, &setup);
-    Some(FigureData {
-        setup,
-        real,
-        models,
-        sims,
-        members,
-        runs_used: runs.len(),
-        runs_total: train.len() + holdout.len(),
-        real_errors,
-    })
-}
-
 fn band_label(model: &SimModel, members: usize) -> String {
     format!(
         "{}: range of {members} simulated sets, median dashed",
@@ -734,7 +181,7 @@ fn band_label(model: &SimModel, members: usize) -> String {
     )
 }
 
-fn allan_plot(f: &FigureData) -> EnvelopePlot {
+fn allan_plot(f: &Envelopes) -> EnvelopePlot {
     let real = f.real.allan_curve(f.setup.fs);
     let x: Vec<f64> = real.iter().map(|p| p.0).collect();
     let bands = f
@@ -774,7 +221,7 @@ fn allan_plot(f: &FigureData) -> EnvelopePlot {
     }
 }
 
-fn psd_plot(f: &FigureData) -> EnvelopePlot {
+fn psd_plot(f: &Envelopes) -> EnvelopePlot {
     let real = f.real.psd_bands(&f.setup);
     let x: Vec<f64> = real.iter().map(|p| p.0).collect();
     let bands = f
@@ -822,7 +269,7 @@ fn psd_plot(f: &FigureData) -> EnvelopePlot {
 
 /// A binned-residual panel from `pick` (which bins of a `Measures`).
 fn binned_panel(
-    f: &FigureData,
+    f: &Envelopes,
     bins: &Bins,
     pick: &dyn Fn(&Measures) -> &Vec<Moments>,
     x_desc: &str,
@@ -881,7 +328,7 @@ fn binned_panel(
     }
 }
 
-fn residual_plot(f: &FigureData) -> EnvelopePlot {
+fn residual_plot(f: &Envelopes) -> EnvelopePlot {
     let rate = binned_panel(
         f,
         &f.setup.rate,
@@ -940,7 +387,7 @@ fn peak_lag(c: &[f64], lags_s: &[f64]) -> Option<f64> {
 type Curves = Vec<Vec<f64>>;
 
 /// The cross-correlation figure, and a sentence on the peak lags.
-fn xcorr_plot(f: &FigureData) -> (EnvelopePlot, String) {
+fn xcorr_plot(f: &Envelopes) -> (EnvelopePlot, String) {
     let lags_s: Vec<f64> = f
         .setup
         .lags
@@ -1310,13 +757,13 @@ Effects are fitted on the training runs only and scored on the held-out runs.</p
                 .params
                 .iter()
                 .zip(e.params())
-                .map(|((name, unit), v)| {
-                    let unit = if *unit == "1" {
+                .map(|(spec, v)| {
+                    let unit = if spec.unit == "1" {
                         String::new()
                     } else {
-                        format!(" {}", esc(unit))
+                        format!(" {}", esc(spec.unit))
                     };
-                    format!("{}&nbsp;=&nbsp;{}{unit}", esc(name), short(v, 4))
+                    format!("{}&nbsp;=&nbsp;{}{unit}", esc(spec.name), short(v, 4))
                 })
                 .collect();
             let _ = writeln!(
@@ -1409,13 +856,11 @@ fn read(s: &mut String, text: &str) {
 fn figures(
     s: &mut String,
     d: &Diagnosis,
-    train: &[RealRun],
-    holdout: &[RealRun],
-    options: &Options,
+    envelopes: Option<&Envelopes>,
     page: &Path,
 ) -> Result<(), ReportError> {
     let _ = writeln!(s, "<h2>Figures</h2>");
-    match figure_data(d, train, holdout, options) {
+    match envelopes {
         None => {
             let _ = writeln!(s, "<p>No run to draw.</p>");
         }
@@ -1442,7 +887,7 @@ fn figures(
                 let _ = writeln!(s, "<p class=\"warn\">left out: {}</p>", esc(e));
             }
             let _ = writeln!(s, "<h3>Allan deviation</h3>");
-            s.push_str(&inline_svg(&allan_plot(&f), "Allan deviation", page)?);
+            s.push_str(&inline_svg(&allan_plot(f), "Allan deviation", page)?);
             read(
                 s,
                 &format!(
@@ -1456,7 +901,7 @@ model's noise is too large.",
                 ),
             );
             let _ = writeln!(s, "<h3>Power spectral density</h3>");
-            s.push_str(&inline_svg(&psd_plot(&f), "PSD", page)?);
+            s.push_str(&inline_svg(&psd_plot(f), "PSD", page)?);
             read(
                 s,
                 &format!(
@@ -1474,7 +919,7 @@ an error that scales with the motion — {}; {}.",
                 "<h3>Residual against rate, temperature and acceleration</h3>"
             );
             s.push_str(&inline_svg(
-                &residual_plot(&f),
+                &residual_plot(f),
                 "residual vs rate, temperature, acceleration",
                 page,
             )?);
@@ -1497,7 +942,7 @@ see the “where” statistics by temperature tercile). Bottom: a slope against 
                 ),
             );
             let _ = writeln!(s, "<h3>Cross-correlation</h3>");
-            let (plot, peaks) = xcorr_plot(&f);
+            let (plot, peaks) = xcorr_plot(f);
             s.push_str(&inline_svg(&plot, "cross-correlation", page)?);
             let _ = writeln!(s, "<p>{peaks}</p>");
             read(
@@ -1574,8 +1019,7 @@ Errors that grow with the total angle turned point to {}; angle lost in motion t
 /// The whole page.
 fn page(
     d: &Diagnosis,
-    train: &[RealRun],
-    holdout: &[RealRun],
+    envelopes: Option<&Envelopes>,
     options: &Options,
     path: &Path,
 ) -> Result<String, ReportError> {
@@ -1591,7 +1035,7 @@ fn page(
     );
     header(&mut s, d, options);
     tables(&mut s, d);
-    figures(&mut s, d, train, holdout, options, path)?;
+    figures(&mut s, d, envelopes, path)?;
     let _ = writeln!(
         s,
         "<p><small>Written by gyro-cli diagnose {}; the machine-readable result is <code>diagnosis.json</code> beside this page.</small></p>\n</body>\n</html>",
@@ -1603,6 +1047,8 @@ fn page(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    use gyro_sim::{Effect, SensorModel};
 
     use gyro_analysis::diagnose::{
         CompensationRun, CompensationSummary, GapSummary, ModelSummary, RunSummary, Verdict,
@@ -1650,6 +1096,7 @@ mod tests {
                 }],
             }),
             corrected_model: None,
+            selected_sensor: SensorModel::default(),
         }
     }
 
@@ -1663,7 +1110,7 @@ mod tests {
     #[test]
     fn page_without_runs_has_the_gap_map_and_the_angle_error_bars() {
         let dir = temp("no-runs");
-        write_report(&dir, &diagnosis(), &[], &[], &Options::default()).unwrap();
+        write_report(&dir, &diagnosis(), None, &Options::default()).unwrap();
         let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
         assert_eq!(html.matches("<svg").count(), 2, "gap map and bars");
         assert!(html.contains("No run to draw."));
@@ -1685,14 +1132,13 @@ mod tests {
         let err = write_report(
             &file.join("report"),
             &diagnosis(),
-            &[],
-            &[],
+            None,
             &Options::default(),
         )
         .unwrap_err();
         assert!(matches!(err, ReportError::CreateDir { .. }));
         assert!(err.to_string().contains("not-a-dir"), "{err}");
-        let err = write_report(&file, &diagnosis(), &[], &[], &Options::default()).unwrap_err();
+        let err = write_report(&file, &diagnosis(), None, &Options::default()).unwrap_err();
         assert!(err.to_string().contains("not-a-dir"), "{err}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
@@ -1700,21 +1146,6 @@ mod tests {
     #[test]
     fn escapes_html() {
         assert_eq!(esc("a<b & \"c\">"), "a&lt;b &amp; &quot;c&quot;&gt;");
-    }
-
-    #[test]
-    fn bins_and_moments() {
-        let b = Bins::linear(-1.0, 1.0, 4);
-        assert_eq!(b.index(-1.0), Some(0));
-        assert_eq!(b.index(1.0), Some(3));
-        assert_eq!(b.index(0.1), Some(2));
-        assert_eq!(b.index(1.5), None);
-        assert_eq!(b.index(f64::NAN), None);
-        assert_eq!(b.centres(), vec![-0.75, -0.25, 0.25, 0.75]);
-        let mut m = Moments::default();
-        [1.0, 2.0, 3.0].iter().for_each(|v| m.add(*v));
-        assert_eq!(m.mean(), 2.0);
-        assert!((m.std() - 1.0).abs() < 1e-12);
     }
 
     #[test]

@@ -166,7 +166,7 @@ pub fn table(label: &str, c: &Characterization) -> String {
                     .params
                     .iter()
                     .zip(e.params())
-                    .map(|((name, _), v)| format!("{name}={v:.4e}"))
+                    .map(|(spec, v)| format!("{}={v:.4e}", spec.name))
                     .collect();
                 format!("--effect {}:{}", e.id(), params.join(","))
             })

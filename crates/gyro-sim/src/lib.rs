@@ -17,6 +17,11 @@ mod effects;
 mod motion;
 mod sensor;
 
-pub use effects::{Effect, EffectInfo, EFFECTS};
+pub use effects::{
+    effect_info, Bound, CoreCorrection, Effect, EffectError, EffectInfo, FitProcedure, ParamRange,
+    ParamSpec, Reading, Regressor, WanderShape, EFFECTS, LOW_PASS_POLE_RATIO,
+};
 pub use motion::{BenchProfile, Motion, Rotation};
-pub use sensor::{simulate, simulate_series, SensorModel, SimOptions, SimSeries};
+pub use sensor::{
+    simulate, simulate_series, InvalidSensorModel, SensorModel, SimOptions, SimSeries,
+};

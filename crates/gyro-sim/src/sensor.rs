@@ -1,11 +1,12 @@
 //! The nominal sensor model and the generator of simulated logs.
 //!
-//! Nominal (DESIGN.md): `rate_meas = rate_true + b_const + b_gm(t) + white noise`,
-//! quantised to the output word and clipped to the range. Each [`Effect`] adds its term.
+//! Nominal: `rate_meas = rate_true + b_const + b_gm(t) + white noise`,
+//! quantised to the output word and clipped to the range. Each [`Effect`] adds its term
+//! (its table entry's, summed in [`SimTerms`]).
 //! Every noise source draws from its own random stream of the seed, so switching an
 //! effect on or off leaves the other sources' sequences unchanged.
 
-use super::effects::Effect;
+use super::effects::{Effect, SimTerms};
 use super::motion::Motion;
 use gyro_log::{Log, Row};
 use rand::{Rng, SeedableRng};
@@ -55,7 +56,7 @@ impl SensorModel {
     }
 
     /// Check the parameters.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidSensorModel> {
         let checks = [
             (
                 self.sample_rate_hz > 0.0 && self.sample_rate_hz <= 1e6,
@@ -72,10 +73,18 @@ impl SensorModel {
             (self.bias_dps.is_finite(), "bias_dps must be finite"),
         ];
         match checks.iter().find(|(ok, _)| !ok) {
-            Some((_, why)) => Err(format!("sensor model: {why}")),
+            Some((_, why)) => Err(InvalidSensorModel { reason: why }),
             None => Ok(()),
         }
     }
+}
+
+/// A sensor model parameter out of its range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("sensor model: {reason}")]
+pub struct InvalidSensorModel {
+    /// Which parameter, and the condition it must meet.
+    pub reason: &'static str,
 }
 
 /// Conditions of a simulated run.
@@ -177,7 +186,7 @@ pub fn simulate(
     let fs = series.sample_rate_hz;
     // Samples are stamped when they are taken, by the logger's (accurate) clock: a
     // sensor clock error shows as stamps that drift from the nominal k / fs.
-    let clock = 1.0 + clock_ppm(effects) * 1e-6;
+    let clock = 1.0 + SimTerms::of(effects).clock_ppm * 1e-6;
     // Rounded to what a logger would keep (and what reads back short from CSV).
     let round = |x: f64, step: f64| (x / step).round() * step;
     let rows = (0..series.rate_dps.len())
@@ -209,17 +218,6 @@ pub fn simulate(
         has_temperature: true,
         rows,
     }
-}
-
-/// The clock error of `effects` (ppm; 0 without one).
-fn clock_ppm(effects: &[Effect]) -> f64 {
-    effects
-        .iter()
-        .map(|e| match *e {
-            Effect::ClockError { ppm } => ppm,
-            _ => 0.0,
-        })
-        .sum()
 }
 
 /// Simulate `motion` as seen by `model` with `effects`, as columns.
@@ -254,53 +252,42 @@ pub fn simulate_series(
     let mut gm = GaussMarkovProcess::new(model.gm_sigma_dps, model.gm_tau_s, dt, &mut gm_rng);
 
     // Effect terms (identity unless present).
-    let (mut scale_k, mut asym_k, mut k3, mut temp_bias, mut temp_scale) =
-        (0.0, 0.0, 0.0, 0.0, 0.0);
-    let (mut delay_s, mut clock_ppm, mut turn_on_sigma, mut walk_k) = (0.0, 0.0, 0.0, 0.0);
-    let mut limit = model.range_dps;
-    let mut extra_lsb = 0.0;
-    let mut dropout: Option<(f64, f64)> = None;
-    let mut flicker: Vec<GaussMarkovProcess> = Vec::new();
-    let mut bandwidth_alpha: Option<f64> = None;
-    for effect in effects {
-        match *effect {
-            Effect::ScaleFactor { k } => scale_k += k,
-            Effect::ScaleAsymmetry { k } => asym_k += k,
-            Effect::Nonlinearity { k3_per_dps2 } => k3 += k3_per_dps2,
-            Effect::Saturation { limit_dps } => limit = limit.min(limit_dps),
-            Effect::Quantization { lsb_dps } => extra_lsb = lsb_dps,
-            Effect::Latency { delay_s: d } => delay_s += d,
-            Effect::ClockError { ppm } => clock_ppm += ppm,
-            Effect::Dropouts {
-                rate_per_s,
-                mean_samples,
-            } => dropout = Some((rate_per_s / fs, 1.0 - 1.0 / mean_samples)),
-            Effect::TemperatureBias { dps_per_c } => temp_bias += dps_per_c,
-            Effect::TemperatureScale { per_c } => temp_scale += per_c,
-            Effect::BiasInstability { sigma_dps } => {
-                // Six processes, τ from 1 s to 1000 s (half-decade steps): a flat floor.
-                let count = 6;
-                flicker = (0..count)
-                    .map(|i| {
-                        let tau_s = 10f64.powf(i as f64 * 0.6);
-                        GaussMarkovProcess::new(
-                            sigma_dps / (count as f64).sqrt(),
-                            tau_s,
-                            dt,
-                            &mut flicker_rng,
-                        )
-                    })
-                    .collect();
-            }
-            Effect::RateRandomWalk { k_dps_per_rt_s } => walk_k += k_dps_per_rt_s,
-            Effect::TurnOnBias { sigma_dps } => turn_on_sigma += sigma_dps,
-            Effect::Bandwidth { cutoff_hz } => {
-                // Two equal first-order stages, -3 dB at cutoff_hz overall.
-                let pole_hz = cutoff_hz / (2f64.sqrt() - 1.0).sqrt();
-                bandwidth_alpha = Some(1.0 - (-2.0 * std::f64::consts::PI * pole_hz * dt).exp());
-            }
-        }
-    }
+    let terms = SimTerms::of(effects);
+    let limit = model.range_dps.min(terms.limit_dps);
+    let dropout = terms
+        .dropouts
+        .map(|(rate_per_s, mean_samples)| (rate_per_s / fs, 1.0 - 1.0 / mean_samples));
+    // Six processes, τ from 1 s to 1000 s (half-decade steps): a flat floor.
+    let flicker_count = 6;
+    let mut flicker: Vec<GaussMarkovProcess> = terms
+        .flicker_sigma_dps
+        .map(|sigma_dps| {
+            (0..flicker_count)
+                .map(|i| {
+                    let tau_s = 10f64.powf(i as f64 * 0.6);
+                    GaussMarkovProcess::new(
+                        sigma_dps / (flicker_count as f64).sqrt(),
+                        tau_s,
+                        dt,
+                        &mut flicker_rng,
+                    )
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    // Two equal first-order stages, -3 dB at the cutoff overall.
+    let bandwidth_alpha = terms.bandwidth_hz.map(|cutoff_hz| {
+        let pole_hz = cutoff_hz / (2f64.sqrt() - 1.0).sqrt();
+        1.0 - (-2.0 * std::f64::consts::PI * pole_hz * dt).exp()
+    });
+    let (scale_k, asym_k, k3) = (terms.scale_k, terms.asymmetry_k, terms.k3_per_dps2);
+    let (temp_bias, temp_scale) = (terms.bias_dps_per_c, terms.scale_per_c);
+    let (delay_s, clock_ppm) = (terms.delay_s, terms.clock_ppm);
+    let (turn_on_sigma, walk_k, extra_lsb) = (
+        terms.turn_on_sigma_dps,
+        terms.walk_dps_per_rt_s,
+        terms.extra_lsb_dps,
+    );
     let turn_on_draw: f64 = StandardNormal.sample(&mut turn_on_rng);
     let turn_on = turn_on_sigma * turn_on_draw;
     let clock = 1.0 + clock_ppm * 1e-6;

@@ -2,23 +2,18 @@
 //! `run --model`, and scored on the held-out runs (the pipeline's max abs angle error
 //! without and with it).
 //!
-//! What the core corrects, per effect: `scale_factor` → `correction.scale_k`;
-//! `clock_error` → `correction.scale_k` too (integrated over nominal periods, the samples
-//! of a clock fast by ε give 1 + ε times the angle, exactly like a scale factor); `scale_asymmetry` →
-//! `correction.asymmetry_k`; `temperature_bias` → `correction.bias_dps_per_c` and
-//! `temperature_scale` → `correction.scale_per_c` (ΔT from the first temperature of the
-//! run, as the simulator defines them); `latency` → `reference_delay_s`; `bandwidth` →
-//! `reference_delay_s` of its low-frequency delay (2 / (2π · 1.554 f_c) for the two-pole
-//! response); `turn_on_bias` → Kalman compensation (the bias estimated at every rest).
-//! The others (nonlinearity, saturation, quantisation, dropouts, bias wander) have no
-//! correction in the core.
+//! What the core corrects is each effect's [`CoreCorrection`] in the effect table
+//! (`gyro_sim::EFFECTS`): a scale, asymmetry or temperature coefficient of the core's
+//! correction (ΔT from the first temperature of the run, as the simulator defines it),
+//! the model file's reference delay (a low-pass: its low-frequency delay
+//! 2 / (2π · 1.554 f_c)), or Kalman compensation of the bias at every rest.
 
 use super::ensemble::RealRun;
 use super::{CompensationRun, CompensationSummary};
 use crate::model::ModelFile;
 use crate::replay::{replay_with, ReplayOptions};
 use gyro_core::Compensation;
-use gyro_sim::Effect;
+use gyro_sim::{CoreCorrection, Effect, LOW_PASS_POLE_RATIO};
 use rayon::prelude::*;
 
 /// `base` with the corrections of `effects`, and the ids corrected.
@@ -27,46 +22,63 @@ pub fn corrected_model(base: &ModelFile, effects: &[Effect]) -> (ModelFile, Vec<
     let mut ids = Vec::new();
     let c = &mut model.config.correction;
     for effect in effects {
-        let used = match *effect {
-            Effect::ScaleFactor { k } => {
-                c.scale_k += k as f32;
+        let Some(&value) = effect.params().first() else {
+            continue;
+        };
+        let used = match effect.info().correction {
+            CoreCorrection::None => false,
+            CoreCorrection::ScaleK { per_unit } => {
+                c.scale_k += (value * per_unit) as f32;
                 true
             }
-            Effect::ClockError { ppm } => {
-                c.scale_k += (ppm * 1e-6) as f32;
+            CoreCorrection::AsymmetryK => {
+                c.asymmetry_k += value as f32;
                 true
             }
-            Effect::ScaleAsymmetry { k } => {
-                c.asymmetry_k += k as f32;
+            CoreCorrection::BiasPerC => {
+                c.bias_dps_per_c += value as f32;
                 true
             }
-            Effect::TemperatureBias { dps_per_c } => {
-                c.bias_dps_per_c += dps_per_c as f32;
+            CoreCorrection::ScalePerC => {
+                c.scale_per_c += value as f32;
                 true
             }
-            Effect::TemperatureScale { per_c } => {
-                c.scale_per_c += per_c as f32;
+            CoreCorrection::ReferenceDelay => {
+                model.reference_delay_s += value;
                 true
             }
-            Effect::Latency { delay_s } => {
-                model.reference_delay_s += delay_s;
+            CoreCorrection::LowPassReferenceDelay => {
+                model.reference_delay_s +=
+                    1.0 / (std::f64::consts::PI * LOW_PASS_POLE_RATIO * value);
                 true
             }
-            Effect::Bandwidth { cutoff_hz } => {
-                model.reference_delay_s += 1.0 / (std::f64::consts::PI * 1.5538 * cutoff_hz);
-                true
-            }
-            Effect::TurnOnBias { .. } => {
+            CoreCorrection::KalmanBias => {
                 model.config.compensation = Compensation::Kalman;
                 true
             }
-            _ => false,
         };
         if used {
             ids.push(effect.id());
         }
     }
     (model, ids)
+}
+
+/// Stage 5: the base model with the corrections of the selected effects and its
+/// held-out angle errors, when any selected effect is correctable.
+pub(crate) fn compensate(
+    holdout: &[RealRun],
+    base: &ModelFile,
+    selected: &[Effect],
+    progress: &dyn super::Progress,
+) -> (Option<CompensationSummary>, Option<ModelFile>) {
+    let (corrected, ids) = corrected_model(base, selected);
+    if ids.is_empty() {
+        return (None, None);
+    }
+    progress.stage("compensated replays of held-out runs", 0);
+    let summary = score(holdout, base, &corrected, ids);
+    (Some(summary), Some(corrected))
 }
 
 /// Max abs angle error of every held-out run with `base` and with `corrected`.

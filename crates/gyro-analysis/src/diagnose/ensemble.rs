@@ -8,6 +8,7 @@
 
 use super::features::{features, Features, REGRESSORS, WANDER_TAUS_S};
 use super::stats::{residuals, residuals_of, stats_of, Residuals, Stat, StatsError};
+use crate::seed::derive_seed;
 use gyro_log::RegularLog;
 use gyro_sim::{simulate_series, Effect, Motion, SensorModel, SimOptions};
 use rayon::prelude::*;
@@ -298,14 +299,9 @@ pub struct Member {
     pub features: Features,
 }
 
-/// Seed of member `j` of run `run` (SplitMix64 of the three).
+/// Seed of member `j` of the ensemble of run `run` (its seed index) under `base`.
 pub fn member_seed(base: u64, run: usize, j: usize) -> u64 {
-    let mut z = base
-        ^ (run as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        ^ (j as u64).wrapping_mul(0xD1B5_4A32_D192_ED69);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+    derive_seed(derive_seed(base, "run", run as u64), "member", j as u64)
 }
 
 /// Simulate `run` with `model` and `effects` and `seed` (its motion, temperatures and
@@ -495,10 +491,9 @@ mod tests {
             duration_s: 60.0,
             ..Default::default()
         };
-        // The first is the self-test's run that showed it (seed 6, turn-on case, run 9).
-        let seeds = [member_seed(member_seed(6, 7_000_012, 0), 1009, 0)]
-            .into_iter()
-            .chain(0..10);
+        // The first is the self-test's run that showed it (seed 6, turn-on case, run 9,
+        // under the self-test's earlier seed derivation).
+        let seeds = [14_163_778_728_719_377_083].into_iter().chain(0..10);
         for seed in seeds {
             let motion = Motion::bench(&profile, seed);
             let reference: Vec<f64> = (0..60_000)

@@ -14,7 +14,10 @@ use super::ensemble::{simulate_features, simulate_member, Member, RealRun, Stamp
 use super::features::{reg, CUBIC_SCALE_DPS, WANDER_TAUS_S};
 use crate::noise::fit::gauss_markov_avar_continuous;
 use crate::noise::{chi2_quantile, rate_step};
-use gyro_sim::{Effect, SensorModel, EFFECTS};
+use gyro_sim::{
+    Effect, EffectInfo, FitProcedure, Reading, Regressor, SensorModel, WanderShape, EFFECTS,
+    LOW_PASS_POLE_RATIO,
+};
 use rayon::prelude::*;
 
 /// |z| of the parameter test above which an effect is a candidate (Bonferroni over the
@@ -63,23 +66,27 @@ pub fn direct_evidence(
     null: &[Vec<Member>],
     model: &SensorModel,
 ) -> bool {
-    match effect {
-        Effect::TurnOnBias { .. } => runs.len() >= 3 && bias_spread(runs, null).0 >= Z_CRITICAL,
-        Effect::Saturation { .. } => {
+    match effect.info().fit {
+        FitProcedure::BetweenRunSpread => {
+            runs.len() >= 3 && bias_spread(runs, null).0 >= Z_CRITICAL
+        }
+        FitProcedure::Plateau => {
             runs.iter()
                 .map(|r| r.features.plateau_samples)
                 .sum::<usize>()
                 >= MIN_CLIPPED
         }
-        Effect::Quantization { .. } => {
+        FitProcedure::OutputGrid => {
             let values: Vec<f64> = runs
                 .iter()
                 .flat_map(|r| r.measured_rates_dps.iter().copied())
                 .collect();
             rate_step(&values).is_some_and(|s| s >= QUANT_RATIO * model.lsb_dps && s > 0.0)
         }
-        Effect::Dropouts { .. } => runs.iter().map(|r| r.gaps).sum::<u64>() >= MIN_GAPS,
-        _ => false,
+        FitProcedure::Gaps => runs.iter().map(|r| r.gaps).sum::<u64>() >= MIN_GAPS,
+        FitProcedure::Regression { .. } | FitProcedure::StampedClock | FitProcedure::Wander(_) => {
+            false
+        }
     }
 }
 
@@ -257,39 +264,15 @@ pub fn model_with(
 ) -> SensorModel {
     let mut model = *nominal;
     if let Some(target) = white_target {
-        for e in effects.iter().filter(|e| !is_identity(e, nominal)) {
-            if let Effect::Quantization { lsb_dps } = *e {
-                let sigma = solve_white_sigma(target, nominal, &[nominal.lsb_dps, lsb_dps]);
+        // An effect read from the output grid is an extra rounding of the output.
+        for e in effects.iter().filter(|e| !e.is_neutral(nominal)) {
+            if let (FitProcedure::OutputGrid, [lsb_dps]) = (e.info().fit, e.params().as_slice()) {
+                let sigma = solve_white_sigma(target, nominal, &[nominal.lsb_dps, *lsb_dps]);
                 model.arw_deg_per_rt_h = sigma * 60.0 / model.sample_rate_hz.sqrt();
             }
         }
     }
     model
-}
-
-/// True if adding `effect` to `model` changes no simulated sample (a zero-size wander,
-/// no dropouts, the nominal grid again, a clip above the range): its ensemble is the
-/// baseline's, seed for seed, so it need not be simulated.
-pub fn is_identity(effect: &Effect, model: &SensorModel) -> bool {
-    match *effect {
-        Effect::BiasInstability { sigma_dps } | Effect::TurnOnBias { sigma_dps } => {
-            sigma_dps == 0.0
-        }
-        Effect::RateRandomWalk { k_dps_per_rt_s } => k_dps_per_rt_s == 0.0,
-        Effect::Dropouts { rate_per_s, .. } => rate_per_s == 0.0,
-        Effect::Quantization { lsb_dps } => {
-            lsb_dps == 0.0 || (lsb_dps - model.lsb_dps).abs() <= 1e-3 * model.lsb_dps
-        }
-        Effect::Saturation { limit_dps } => limit_dps >= model.range_dps,
-        Effect::ScaleFactor { k } | Effect::ScaleAsymmetry { k } => k == 0.0,
-        Effect::Nonlinearity { k3_per_dps2 } => k3_per_dps2 == 0.0,
-        Effect::Latency { delay_s } => delay_s == 0.0,
-        Effect::ClockError { ppm } => ppm == 0.0,
-        Effect::TemperatureBias { dps_per_c } => dps_per_c == 0.0,
-        Effect::TemperatureScale { per_c } => per_c == 0.0,
-        // The fit's stand-in for "no limit".
-        Effect::Bandwidth { cutoff_hz } => cutoff_hz >= 0.5 * model.sample_rate_hz,
-    }
 }
 
 fn mean(v: impl Iterator<Item = f64>) -> f64 {
@@ -390,25 +373,15 @@ impl Known {
 
 /// Effects fitted from the joint regression, which [`Joint`] refits given the others.
 fn conditional(effect: &Effect) -> bool {
-    matches!(
-        effect,
-        Effect::ScaleFactor { .. }
-            | Effect::ScaleAsymmetry { .. }
-            | Effect::Nonlinearity { .. }
-            | Effect::Latency { .. }
-            | Effect::Bandwidth { .. }
-            | Effect::TemperatureBias { .. }
-            | Effect::TemperatureScale { .. }
-    )
+    matches!(effect.info().fit, FitProcedure::Regression { .. })
 }
 
 /// Deterministic effects, which a noise-free calibration can hold as known.
 fn deterministic(effect: &Effect) -> bool {
-    conditional(effect)
-        || matches!(
-            effect,
-            Effect::ClockError { .. } | Effect::Saturation { .. }
-        )
+    matches!(
+        effect.info().fit,
+        FitProcedure::Regression { .. } | FitProcedure::StampedClock | FitProcedure::Plateau
+    )
 }
 
 /// Joint fits of a set of effects: each regression-based effect refitted with the others
@@ -456,7 +429,7 @@ impl Joint<'_> {
                 continue;
             }
             let known = Known::new(self.input, self.quiet, others);
-            if let Ok(f) = fit_one(self.input, &known, set[i]) {
+            if let Ok(f) = fit_one(self.input, &known, set[i].info()) {
                 current[i] = f.effect;
                 out[i] = Some(f);
             }
@@ -493,11 +466,11 @@ pub fn fit_all<'a>(input: &'a FitInput<'a>) -> (Vec<Fit>, Vec<Untestable>, Joint
         .collect();
     let known = Known::new(input, quiet, clock.clone());
     for info in EFFECTS {
-        match fit_one(input, &known, info.typical) {
+        match fit_one(input, &known, info) {
             Ok(f) => fits.push(f),
             Err(reason) => untestable.push(Untestable {
                 id: info.id,
-                reason,
+                reason: reason.to_string(),
             }),
         }
     }
@@ -572,14 +545,10 @@ fn regression_fit(
 /// Clock error from the time stamps ([`StampedClock`]): the training runs' mean ppm,
 /// tested against its standard error (between-run scatter and each run's stamp
 /// scatter; at least 0.01 ppm).
-fn clock_fit(input: &FitInput) -> Result<Fit, String> {
+fn clock_fit(input: &FitInput) -> Result<Fit, FitError> {
     let clocks: Option<Vec<StampedClock>> = input.train.iter().map(|r| r.clock).collect();
     let Some(clocks) = clocks else {
-        return Err(
-            "needs the nominal sample rate (`# sample_rate_hz` metadata or \
-                    --sample-rate-hz): a clock error shows as time stamps drifting from it"
-                .into(),
-        );
+        return Err(FitError::NoNominalRate);
     };
     let ppm: Vec<f64> = clocks.iter().map(|c| c.ppm).collect();
     let n = ppm.len() as f64;
@@ -599,108 +568,150 @@ fn clock_fit(input: &FitInput) -> Result<Fit, String> {
     })
 }
 
-fn fit_one(input: &FitInput, known: &Known, typical: Effect) -> Result<Fit, String> {
-    let exact = f64::NAN;
-    let temperature = || -> Result<(), String> {
-        if input.temperature_ok {
-            Ok(())
-        } else {
-            Err(format!(
-                "needs a temperature column that varies by at least {} degC in every training run",
-                super::features::MIN_TEMPERATURE_RANGE_C
-            ))
-        }
+/// Why an effect cannot be fitted on these training runs.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub(crate) enum FitError {
+    /// No nominal sample rate to compare the time stamps with.
+    #[error(
+        "needs the nominal sample rate (`# sample_rate_hz` metadata or \
+         --sample-rate-hz): a clock error shows as time stamps drifting from it"
+    )]
+    NoNominalRate,
+    /// The temperature does not vary enough.
+    #[error(
+        "needs a temperature column that varies by at least {min} degC in every training run",
+        min = super::features::MIN_TEMPERATURE_RANGE_C
+    )]
+    NoTemperatureChange,
+    /// Fewer than 3 training runs for a between-run spread.
+    #[error("needs at least 3 training runs (between-run spread of the bias)")]
+    TooFewRunsForSpread,
+    /// Fewer than 2 training runs long enough for the wander's Allan variance.
+    #[error("needs at least 2 training runs longer than {min_s} s")]
+    TooShortForWander {
+        /// Shortest usable run (s).
+        min_s: f64,
+    },
+    /// The table pairs the effect with a procedure for another number of parameters.
+    #[error("effect `{id}`: its fitting procedure fits {expected} parameter(s)")]
+    ParamCount {
+        /// Effect id.
+        id: &'static str,
+        /// Parameters the procedure fits.
+        expected: usize,
+    },
+}
+
+/// The z-score of a test whose outcome is exact (no null distribution).
+const EXACT: f64 = f64::NAN;
+
+/// A fit judged by its z-score: passes when |z| (two-sided) or z (one-sided) reaches
+/// [`Z_CRITICAL`].
+fn judged(
+    effect: Effect,
+    z: f64,
+    ci95: Vec<(Option<f64>, Option<f64>)>,
+    two_sided: bool,
+    test: &str,
+) -> Fit {
+    let passes = if two_sided {
+        z.abs() >= Z_CRITICAL
+    } else {
+        z >= Z_CRITICAL
     };
-    let fit = |effect, z: f64, ci: Vec<(Option<f64>, Option<f64>)>, two_sided: bool, test: &str| {
-        let passes = if two_sided {
-            z.abs() >= Z_CRITICAL
-        } else {
-            z >= Z_CRITICAL
-        };
-        Fit {
-            effect,
-            ci95: ci,
-            z,
-            passes,
-            test: test.to_string(),
-            direct: false,
+    Fit {
+        effect,
+        ci95,
+        z,
+        passes,
+        test: test.to_string(),
+        direct: false,
+    }
+}
+
+/// An ordered interval of two bounds.
+fn ordered((a, b): (f64, f64)) -> Vec<(Option<f64>, Option<f64>)> {
+    vec![(Some(a.min(b)), Some(a.max(b)))]
+}
+
+/// `info`'s effect from its single parameter (for the procedures that fit one).
+fn single_param(info: &'static EffectInfo) -> Result<impl Fn(f64) -> Effect, FitError> {
+    if info.params.len() != 1 {
+        return Err(FitError::ParamCount {
+            id: info.id,
+            expected: 1,
+        });
+    }
+    Ok(move |v: f64| info.typical.with_params(&[v]).unwrap_or(info.typical))
+}
+
+/// The column of the residual regression for `regressor`.
+fn regressor_index(regressor: Regressor) -> usize {
+    match regressor {
+        Regressor::Rate => reg::RATE,
+        Regressor::AbsRate => reg::ABS_RATE,
+        Regressor::RateCubed => reg::RATE_CUBED,
+        Regressor::Acceleration => reg::ACCELERATION,
+        Regressor::DeltaT => reg::DELTA_T,
+        Regressor::RateDeltaT => reg::RATE_DELTA_T,
+    }
+}
+
+/// Fit the effect of table entry `info` with its procedure.
+fn fit_one(input: &FitInput, known: &Known, info: &'static EffectInfo) -> Result<Fit, FitError> {
+    match info.fit {
+        FitProcedure::Regression {
+            regressor,
+            reading,
+            needs_temperature,
+            test,
+        } => {
+            if needs_temperature && !input.temperature_ok {
+                return Err(FitError::NoTemperatureChange);
+            }
+            let index = regressor_index(regressor);
+            regression_procedure(input, known, info, index, reading, test)
         }
-    };
-    let some = |(a, b): (f64, f64)| vec![(Some(a.min(b)), Some(a.max(b)))];
-    Ok(match typical {
-        Effect::ScaleFactor { .. } => {
-            let (e, z, ci) = regression_fit(
-                input,
-                known,
-                reg::RATE,
-                &|k| Effect::ScaleFactor { k },
-                &|x| x,
-            );
-            fit(
-                e,
-                z,
-                some(ci),
-                true,
-                "regression slope on rate vs null replicas",
-            )
+        FitProcedure::StampedClock => clock_fit(input),
+        FitProcedure::BetweenRunSpread => between_run_fit(input, info),
+        FitProcedure::Wander(shape) => wander_fit(input, info, shape),
+        FitProcedure::Plateau => plateau_fit(input, info),
+        FitProcedure::OutputGrid => grid_fit(input, info),
+        FitProcedure::Gaps => gaps_fit(input, info),
+    }
+}
+
+/// A parameter read from the regression coefficient of column `index`
+/// ([`regression_fit`]).
+fn regression_procedure(
+    input: &FitInput,
+    known: &Known,
+    info: &'static EffectInfo,
+    index: usize,
+    reading: Reading,
+    test: &str,
+) -> Result<Fit, FitError> {
+    let make = single_param(info)?;
+    Ok(match reading {
+        Reading::Coefficient => {
+            let (e, z, ci) = regression_fit(input, known, index, &make, &|x| x);
+            judged(e, z, ordered(ci), true, test)
         }
-        Effect::ClockError { .. } => clock_fit(input)?,
-        Effect::ScaleAsymmetry { .. } => {
-            let (e, z, ci) = regression_fit(
-                input,
-                known,
-                reg::ABS_RATE,
-                &|k| Effect::ScaleAsymmetry { k },
-                &|x| x,
-            );
-            fit(
-                e,
-                z,
-                some(ci),
-                true,
-                "regression slope on |rate| vs null replicas",
-            )
-        }
-        Effect::Nonlinearity { .. } => {
+        Reading::CubicCoefficient => {
             let scale = CUBIC_SCALE_DPS.powi(3);
-            let (e, z, ci) = regression_fit(
-                input,
-                known,
-                reg::RATE_CUBED,
-                &|k3_per_dps2| Effect::Nonlinearity { k3_per_dps2 },
-                &|x| x / scale,
-            );
-            fit(
-                e,
-                z,
-                some(ci),
-                true,
-                "regression on rate^3 vs null replicas",
-            )
+            let (e, z, ci) = regression_fit(input, known, index, &make, &|x| x / scale);
+            judged(e, z, ordered(ci), true, test)
         }
-        Effect::Latency { .. } => {
-            let (e, z, ci) = regression_fit(
-                input,
-                known,
-                reg::ACCELERATION,
-                &|d| Effect::Latency {
-                    delay_s: d.clamp(0.0, 1.0),
-                },
-                &|x| -x,
-            );
-            let ci = vec![(Some(ci.0.min(ci.1)), Some(ci.0.max(ci.1)))];
-            fit(
-                e,
-                -z,
-                ci,
-                false,
-                "regression on angular acceleration vs null replicas (one-sided)",
-            )
+        Reading::Delay => {
+            let range = info.params[0].range;
+            let make = |d: f64| make(range.clamp(d));
+            let (e, z, ci) = regression_fit(input, known, index, &make, &|x| -x);
+            judged(e, -z, ordered(ci), false, test)
         }
-        Effect::Bandwidth { .. } => {
+        Reading::LowPassDelay => {
             // A two-pole low-pass delays slow motion by 2/(2π f_pole), f_pole = 1.554 f_c:
             // fitted as a delay (its first-order parameter), calibrated as a low-pass.
-            let per_delay = 1.0 / (std::f64::consts::PI * 1.5538);
+            let per_delay = 1.0 / (std::f64::consts::PI * LOW_PASS_POLE_RATIO);
             let nyquist = 0.5 * input.model.sample_rate_hz;
             let to_cutoff = |d: f64| -> f64 {
                 if d > 0.0 {
@@ -709,300 +720,263 @@ fn fit_one(input: &FitInput, known: &Known, typical: Effect) -> Result<Fit, Stri
                     nyquist
                 }
             };
-            let (e, z, (d_lo, d_hi)) = regression_fit(
-                input,
-                known,
-                reg::ACCELERATION,
-                &|d| Effect::Bandwidth {
-                    cutoff_hz: to_cutoff(d),
-                },
-                &|x| -x,
-            );
+            let make = |d: f64| make(to_cutoff(d));
+            let (e, z, (d_lo, d_hi)) = regression_fit(input, known, index, &make, &|x| -x);
             // Interval: the (calibrated) delay's, mapped like the estimate.
             let (d_lo, d_hi) = (d_lo.min(d_hi), d_lo.max(d_hi));
             let bound = |dd: f64| (dd > 0.0).then(|| to_cutoff(dd));
-            fit(
-                e,
-                -z,
-                vec![(bound(d_hi), bound(d_lo))],
-                false,
-                "delay from the acceleration regression vs null replicas (one-sided)",
-            )
+            judged(e, -z, vec![(bound(d_hi), bound(d_lo))], false, test)
         }
-        Effect::TemperatureBias { .. } => {
-            temperature()?;
-            let (e, z, ci) = regression_fit(
-                input,
-                known,
-                reg::DELTA_T,
-                &|dps_per_c| Effect::TemperatureBias { dps_per_c },
-                &|x| x,
-            );
-            fit(
-                e,
-                z,
-                some(ci),
-                true,
-                "regression on temperature change vs null replicas",
-            )
+    })
+}
+
+/// A between-run spread of the bias: σ² is the runs' variance less the replicas'
+/// ([`bias_spread`]), with χ² bounds.
+fn between_run_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError> {
+    let single = single_param(info)?;
+    if input.train.len() < 3 {
+        return Err(FitError::TooFewRunsForSpread);
+    }
+    let (z, s2, v0, k) = bias_spread(input.train, input.null);
+    let sigma = (s2 - v0).max(0.0).sqrt();
+    let lo = (k * s2 / chi2_quantile(0.975, k) - v0).max(0.0).sqrt();
+    let hi = (k * s2 / chi2_quantile(0.025, k) - v0).max(0.0).sqrt();
+    Ok(Fit {
+        direct: true,
+        ..judged(
+            single(sigma),
+            z,
+            vec![(Some(lo), Some(hi))],
+            false,
+            "between-run variance of the bias vs null replicas (chi-square, one-sided; \
+             replicated on the held-out runs)",
+        )
+    })
+}
+
+/// A bias wander of `shape` from the Allan variance of the residual at long τ.
+fn wander_fit(
+    input: &FitInput,
+    info: &'static EffectInfo,
+    shape: WanderShape,
+) -> Result<Fit, FitError> {
+    let single = single_param(info)?;
+    let shape_at = |tau: f64| -> f64 {
+        match shape {
+            WanderShape::RandomWalk => tau / 3.0,
+            WanderShape::Flicker => (0..6)
+                .map(|i| gauss_markov_avar_continuous(tau, 1.0, 10f64.powf(0.6 * i as f64)) / 6.0)
+                .sum(),
         }
-        Effect::TemperatureScale { .. } => {
-            temperature()?;
-            let (e, z, ci) = regression_fit(
-                input,
-                known,
-                reg::RATE_DELTA_T,
-                &|per_c| Effect::TemperatureScale { per_c },
-                &|x| x,
-            );
-            fit(
-                e,
-                z,
-                some(ci),
-                true,
-                "regression on rate x temperature change vs null replicas",
-            )
+    };
+    let usable = input
+        .train
+        .iter()
+        .filter(|r| r.features.wander_avar[2].is_finite())
+        .count();
+    if usable < 2 {
+        return Err(FitError::TooShortForWander {
+            min_s: 2.0 * WANDER_TAUS_S[2],
+        });
+    }
+    let mut per_tau = Vec::new();
+    for (k, &tau) in WANDER_TAUS_S.iter().enumerate() {
+        let (real, replicas) = input.pooled(&|f| f.wander_avar[k]);
+        let (m0, s0) = mean_sd(&replicas);
+        per_tau.push((real, replicas, m0, s0, shape_at(tau)));
+    }
+    // Weighted least squares of the excess on the shape: θ = σ² or K².
+    let solve = |excess: &dyn Fn(usize) -> f64| -> f64 {
+        let (mut num, mut den) = (0.0, 0.0);
+        for (k, (_, _, _, s0, f)) in per_tau.iter().enumerate() {
+            let w = 1.0 / (s0 * s0).max(1e-30);
+            num += w * f * excess(k);
+            den += w * f * f;
         }
-        Effect::TurnOnBias { .. } => {
-            let n = input.train.len();
-            if n < 3 {
-                return Err(
-                    "needs at least 3 training runs (between-run spread of the bias)".into(),
+        num / den
+    };
+    let null_thetas: Vec<f64> = (0..input.members())
+        .map(|j| solve(&|k| per_tau[k].1[j] - per_tau[k].2))
+        .collect();
+    let (_, s_theta) = mean_sd(&null_thetas);
+    // Per run: the excess over that run's own ensemble mean.
+    let per_run = |f: &dyn Fn(usize, usize) -> f64, r: usize, members: &[Member]| {
+        solve(&|k| f(r, k) - mean(members.iter().map(|m| m.features.wander_avar[k])))
+    };
+    let thetas: Vec<f64> = (0..input.train.len())
+        .map(|r| {
+            per_run(
+                &|r, k| input.train[r].features.wander_avar[k],
+                r,
+                &input.null[r],
+            )
+        })
+        .filter(|t| t.is_finite())
+        .collect();
+    let (mut theta, sd) = mean_sd(&thetas);
+    let z = theta / s_theta;
+    let mut half = t95(thetas.len().saturating_sub(1)) * sd / (thetas.len() as f64).sqrt();
+    let make = |theta: f64| single(theta.max(0.0).sqrt());
+    if z >= Z_CRITICAL && theta > 0.0 {
+        // Gain: the same estimator on the training runs simulated with the
+        // effect, against the same seeds without it.
+        const GAIN_MEMBERS: usize = 8;
+        let effect = [make(theta)];
+        let sims: Vec<Vec<Member>> = (0..input.train.len())
+            .into_par_iter()
+            .map(|r| {
+                (0..GAIN_MEMBERS.min(input.null[r].len()))
+                    .map(|j| {
+                        simulate_member(
+                            input.train[r],
+                            input.model,
+                            &effect,
+                            super::ensemble::member_seed(input.seed, r, j),
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
+        let gains: Vec<f64> = (0..input.train.len())
+            .flat_map(|r| {
+                let sims = &sims[r];
+                (0..sims.len()).map(move |j| (r, j))
+            })
+            .map(|(r, j)| {
+                let k_sim = per_run(
+                    &|r, k| sims[r][j].features.wander_avar[k],
+                    r,
+                    &input.null[r],
                 );
-            }
-            let (z, s2, v0, k) = bias_spread(input.train, input.null);
-            let sigma = (s2 - v0).max(0.0).sqrt();
-            let lo = (k * s2 / chi2_quantile(0.975, k) - v0).max(0.0).sqrt();
-            let hi = (k * s2 / chi2_quantile(0.025, k) - v0).max(0.0).sqrt();
+                let k_null = per_run(
+                    &|r, k| input.null[r][j].features.wander_avar[k],
+                    r,
+                    &input.null[r],
+                );
+                k_sim - k_null
+            })
+            .collect();
+        let gain = mean(gains.into_iter()) / theta;
+        if gain.is_finite() && gain > 0.1 && gain < 10.0 {
+            theta /= gain;
+            half /= gain;
+        }
+    }
+    let lo = (theta - half).max(0.0).sqrt();
+    let hi = (theta + half).max(0.0).sqrt();
+    Ok(judged(
+        make(theta),
+        z,
+        vec![(Some(lo), Some(hi))],
+        false,
+        "Allan variance of the regression residual at 1/4/16 s vs null replicas (one-sided)",
+    ))
+}
+
+/// A clip level from samples on a plateau at the largest |rate|.
+fn plateau_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError> {
+    let single = single_param(info)?;
+    let clipped: usize = input.train.iter().map(|r| r.features.plateau_samples).sum();
+    let limit = input
+        .train
+        .iter()
+        .map(|r| r.features.max_abs_rate_dps)
+        .fold(0.0f64, f64::max);
+    let null: Vec<f64> = (0..input.members())
+        .map(|j| {
+            input
+                .null
+                .iter()
+                .map(|m| m[j].features.plateau_samples as f64)
+                .sum()
+        })
+        .collect();
+    let (m0, s0) = mean_sd(&null);
+    let z = (clipped as f64 - m0) / s0.max(1.0);
+    let tol = input.model.lsb_dps.max(1e-6);
+    // No plateau: no clip seen below the range.
+    let limit = if clipped >= MIN_CLIPPED {
+        limit
+    } else {
+        input.model.range_dps
+    };
+    let mut f = judged(
+        single(limit.max(1e-3)),
+        z,
+        vec![(Some(limit - tol), Some(limit + tol))],
+        false,
+        "samples on a plateau at the largest |rate| while the reference is faster, vs null replicas",
+    );
+    f.passes = f.passes && clipped >= MIN_CLIPPED;
+    f.direct = true;
+    Ok(f)
+}
+
+/// An output grid step coarser than the nominal one.
+fn grid_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError> {
+    let single = single_param(info)?;
+    let values: Vec<f64> = input
+        .train
+        .iter()
+        .flat_map(|r| r.measured_rates_dps.iter().copied())
+        .collect();
+    let nominal = input.model.lsb_dps;
+    Ok(match rate_step(&values) {
+        Some(step) => {
+            let passes = step >= QUANT_RATIO * nominal && step > 0.0;
             Fit {
+                effect: single(step),
+                ci95: vec![(Some(step * 0.999), Some(step * 1.001))],
+                z: EXACT,
+                passes,
                 direct: true,
-                ..fit(
-                    Effect::TurnOnBias { sigma_dps: sigma },
-                    z,
-                    vec![(Some(lo), Some(hi))],
-                    false,
-                    "between-run variance of the bias vs null replicas (chi-square, one-sided; \
-                     replicated on the held-out runs)",
-                )
+                test: format!(
+                    "output grid step {step:.6} deg/s vs nominal {nominal:.6} (named above {QUANT_RATIO}x)"
+                ),
             }
         }
-        Effect::BiasInstability { .. } | Effect::RateRandomWalk { .. } => {
-            let shape = |tau: f64| -> f64 {
-                match typical {
-                    Effect::RateRandomWalk { .. } => tau / 3.0,
-                    _ => (0..6)
-                        .map(|i| {
-                            gauss_markov_avar_continuous(tau, 1.0, 10f64.powf(0.6 * i as f64)) / 6.0
-                        })
-                        .sum(),
-                }
-            };
-            let usable = input
-                .train
-                .iter()
-                .filter(|r| r.features.wander_avar[2].is_finite())
-                .count();
-            if usable < 2 {
-                return Err(format!(
-                    "needs at least 2 training runs longer than {} s",
-                    2.0 * WANDER_TAUS_S[2]
-                ));
-            }
-            let mut per_tau = Vec::new();
-            for (k, &tau) in WANDER_TAUS_S.iter().enumerate() {
-                let (real, replicas) = input.pooled(&|f| f.wander_avar[k]);
-                let (m0, s0) = mean_sd(&replicas);
-                per_tau.push((real, replicas, m0, s0, shape(tau)));
-            }
-            // Weighted least squares of the excess on the shape: θ = σ² or K².
-            let solve = |excess: &dyn Fn(usize) -> f64| -> f64 {
-                let (mut num, mut den) = (0.0, 0.0);
-                for (k, (_, _, _, s0, f)) in per_tau.iter().enumerate() {
-                    let w = 1.0 / (s0 * s0).max(1e-30);
-                    num += w * f * excess(k);
-                    den += w * f * f;
-                }
-                num / den
-            };
-            let null_thetas: Vec<f64> = (0..input.members())
-                .map(|j| solve(&|k| per_tau[k].1[j] - per_tau[k].2))
-                .collect();
-            let (_, s_theta) = mean_sd(&null_thetas);
-            // Per run: the excess over that run's own ensemble mean.
-            let per_run = |f: &dyn Fn(usize, usize) -> f64, r: usize, members: &[Member]| {
-                solve(&|k| f(r, k) - mean(members.iter().map(|m| m.features.wander_avar[k])))
-            };
-            let thetas: Vec<f64> = (0..input.train.len())
-                .map(|r| {
-                    per_run(
-                        &|r, k| input.train[r].features.wander_avar[k],
-                        r,
-                        &input.null[r],
-                    )
-                })
-                .filter(|t| t.is_finite())
-                .collect();
-            let (mut theta, sd) = mean_sd(&thetas);
-            let z = theta / s_theta;
-            let mut half = t95(thetas.len().saturating_sub(1)) * sd / (thetas.len() as f64).sqrt();
-            let make = |theta: f64| match typical {
-                Effect::RateRandomWalk { .. } => Effect::RateRandomWalk {
-                    k_dps_per_rt_s: theta.max(0.0).sqrt(),
-                },
-                _ => Effect::BiasInstability {
-                    sigma_dps: theta.max(0.0).sqrt(),
-                },
-            };
-            if z >= Z_CRITICAL && theta > 0.0 {
-                // Gain: the same estimator on the training runs simulated with the
-                // effect, against the same seeds without it.
-                const GAIN_MEMBERS: usize = 8;
-                let effect = [make(theta)];
-                let sims: Vec<Vec<Member>> = (0..input.train.len())
-                    .into_par_iter()
-                    .map(|r| {
-                        (0..GAIN_MEMBERS.min(input.null[r].len()))
-                            .map(|j| {
-                                simulate_member(
-                                    input.train[r],
-                                    input.model,
-                                    &effect,
-                                    super::ensemble::member_seed(input.seed, r, j),
-                                )
-                            })
-                            .collect()
-                    })
-                    .collect();
-                let gains: Vec<f64> = (0..input.train.len())
-                    .flat_map(|r| {
-                        let sims = &sims[r];
-                        (0..sims.len()).map(move |j| (r, j))
-                    })
-                    .map(|(r, j)| {
-                        let k_sim = per_run(
-                            &|r, k| sims[r][j].features.wander_avar[k],
-                            r,
-                            &input.null[r],
-                        );
-                        let k_null = per_run(
-                            &|r, k| input.null[r][j].features.wander_avar[k],
-                            r,
-                            &input.null[r],
-                        );
-                        k_sim - k_null
-                    })
-                    .collect();
-                let gain = mean(gains.into_iter()) / theta;
-                if gain.is_finite() && gain > 0.1 && gain < 10.0 {
-                    theta /= gain;
-                    half /= gain;
-                }
-            }
-            let lo = (theta - half).max(0.0).sqrt();
-            let hi = (theta + half).max(0.0).sqrt();
-            fit(
-                make(theta),
-                z,
-                vec![(Some(lo), Some(hi))],
-                false,
-                "Allan variance of the regression residual at 1/4/16 s vs null replicas (one-sided)",
-            )
-        }
-        Effect::Saturation { .. } => {
-            let clipped: usize = input.train.iter().map(|r| r.features.plateau_samples).sum();
-            let limit = input
-                .train
-                .iter()
-                .map(|r| r.features.max_abs_rate_dps)
-                .fold(0.0f64, f64::max);
-            let null: Vec<f64> = (0..input.members())
-                .map(|j| {
-                    input
-                        .null
-                        .iter()
-                        .map(|m| m[j].features.plateau_samples as f64)
-                        .sum()
-                })
-                .collect();
-            let (m0, s0) = mean_sd(&null);
-            let z = (clipped as f64 - m0) / s0.max(1.0);
-            let tol = input.model.lsb_dps.max(1e-6);
-            // No plateau: no clip seen below the range.
-            let limit = if clipped >= MIN_CLIPPED {
-                limit
-            } else {
-                input.model.range_dps
-            };
-            let mut f = fit(
-                Effect::Saturation { limit_dps: limit.max(1e-3) },
-                z,
-                vec![(Some(limit - tol), Some(limit + tol))],
-                false,
-                "samples on a plateau at the largest |rate| while the reference is faster, vs null replicas",
-            );
-            f.passes = f.passes && clipped >= MIN_CLIPPED;
-            f.direct = true;
-            f
-        }
-        Effect::Quantization { .. } => {
-            let values: Vec<f64> = input
-                .train
-                .iter()
-                .flat_map(|r| r.measured_rates_dps.iter().copied())
-                .collect();
-            let nominal = input.model.lsb_dps;
-            match rate_step(&values) {
-                Some(step) => {
-                    let passes = step >= QUANT_RATIO * nominal && step > 0.0;
-                    Fit {
-                        effect: Effect::Quantization { lsb_dps: step },
-                        ci95: vec![(Some(step * 0.999), Some(step * 1.001))],
-                        z: exact,
-                        passes,
-                        direct: true,
-                        test: format!(
-                            "output grid step {step:.6} deg/s vs nominal {nominal:.6} (named above {QUANT_RATIO}x)"
-                        ),
-                    }
-                }
-                None => Fit {
-                    effect: Effect::Quantization { lsb_dps: nominal },
-                    ci95: vec![(Some(0.0), Some(QUANT_RATIO * nominal))],
-                    z: exact,
-                    passes: false,
-                    direct: true,
-                    test: "no output grid coarser than the nominal step".into(),
-                },
-            }
-        }
-        Effect::Dropouts { .. } => {
-            let gaps: u64 = input.train.iter().map(|r| r.gaps).sum();
-            let filled: u64 = input.train.iter().map(|r| r.filled_slots).sum();
-            let duration: f64 = input.train.iter().map(|r| r.duration_s).sum();
-            let g = gaps as f64;
-            let rate = g / duration.max(1e-9);
-            let mean_samples = if gaps > 0 {
-                (filled as f64 / g).max(1.0)
-            } else {
-                1.0
-            };
-            let rate_half = 1.96 * g.sqrt() / duration.max(1e-9);
-            let sd = (mean_samples * (mean_samples - 1.0)).sqrt();
-            let len_half = 1.96 * sd / g.max(1.0).sqrt();
-            Fit {
-                effect: Effect::Dropouts {
-                    rate_per_s: rate,
-                    mean_samples,
-                },
-                ci95: vec![
-                    (Some((rate - rate_half).max(0.0)), Some(rate + rate_half)),
-                    (Some((mean_samples - len_half).max(1.0)), Some(mean_samples + len_half)),
-                ],
-                z: exact,
-                passes: gaps >= MIN_GAPS,
-                direct: true,
-                test: format!("{gaps} gaps ({filled} samples filled) in the training runs; the nominal model has none (named from {MIN_GAPS})"),
-            }
-        }
+        None => Fit {
+            effect: single(nominal),
+            ci95: vec![(Some(0.0), Some(QUANT_RATIO * nominal))],
+            z: EXACT,
+            passes: false,
+            direct: true,
+            test: "no output grid coarser than the nominal step".into(),
+        },
+    })
+}
+
+/// Dropouts from the gaps in the time stamps: their rate and mean length.
+fn gaps_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError> {
+    let gaps: u64 = input.train.iter().map(|r| r.gaps).sum();
+    let filled: u64 = input.train.iter().map(|r| r.filled_slots).sum();
+    let duration: f64 = input.train.iter().map(|r| r.duration_s).sum();
+    let g = gaps as f64;
+    let rate = g / duration.max(1e-9);
+    let mean_samples = if gaps > 0 {
+        (filled as f64 / g).max(1.0)
+    } else {
+        1.0
+    };
+    let rate_half = 1.96 * g.sqrt() / duration.max(1e-9);
+    let sd = (mean_samples * (mean_samples - 1.0)).sqrt();
+    let len_half = 1.96 * sd / g.max(1.0).sqrt();
+    let effect = info
+        .typical
+        .with_params(&[rate, mean_samples])
+        .ok_or(FitError::ParamCount {
+            id: info.id,
+            expected: 2,
+        })?;
+    Ok(Fit {
+        effect,
+        ci95: vec![
+            (Some((rate - rate_half).max(0.0)), Some(rate + rate_half)),
+            (Some((mean_samples - len_half).max(1.0)), Some(mean_samples + len_half)),
+        ],
+        z: EXACT,
+        passes: gaps >= MIN_GAPS,
+        direct: true,
+        test: format!("{gaps} gaps ({filled} samples filled) in the training runs; the nominal model has none (named from {MIN_GAPS})"),
     })
 }

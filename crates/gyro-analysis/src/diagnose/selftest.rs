@@ -16,6 +16,7 @@
 
 use super::ensemble::RealRun;
 use super::{diagnose, Diagnosis, Options, Silent};
+use crate::seed::derive_seed;
 use gyro_log::{regularize, GridOptions};
 use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions, EFFECTS};
 use serde::Serialize;
@@ -45,16 +46,7 @@ pub const CONFOUND_GROUPS: [(&str, &str); 1] = [("latency", "bandwidth")];
 
 /// The magnitudes injected by the self-check.
 pub fn magnitudes() -> Vec<Effect> {
-    EFFECTS
-        .iter()
-        .map(|info| match info.typical {
-            Effect::RateRandomWalk { .. } => Effect::RateRandomWalk {
-                k_dps_per_rt_s: 0.02,
-            },
-            Effect::TemperatureScale { .. } => Effect::TemperatureScale { per_c: 2e-3 },
-            other => other,
-        })
-        .collect()
+    EFFECTS.iter().map(|info| info.self_test).collect()
 }
 
 fn magnitude(id: &str) -> Option<Effect> {
@@ -130,10 +122,9 @@ pub fn case_runs(effects: &[Effect], seed: u64) -> (Vec<RealRun>, Vec<RealRun>) 
         ..BenchProfile::default()
     };
     let make = |i: usize| -> Option<RealRun> {
-        let s = super::ensemble::member_seed(seed, 1000 + i, 0);
-        let motion = Motion::bench(&profile, s);
+        let motion = Motion::bench(&profile, derive_seed(seed, "case run motion", i as u64));
         let options = SimOptions {
-            seed: s ^ 0x5EED,
+            seed: derive_seed(seed, "case run sensor", i as u64),
             ..SimOptions::default()
         };
         let log = simulate(&model, effects, &motion, &options);
@@ -172,7 +163,8 @@ fn score_case(kind: &'static str, injected: Vec<Effect>, d: &Diagnosis) -> CaseR
     let mut covered = Vec::new();
     for t in &injected {
         if let Some(e) = d.effects.iter().find(|e| e.id == t.id()) {
-            for ((name, _), value) in t.info().params.iter().zip(t.params()) {
+            for (spec, value) in t.info().params.iter().zip(t.params()) {
+                let name = spec.name;
                 if let Some([lo, hi]) = e.ci95.get(name) {
                     let inside = lo.is_none_or(|l| value >= l) && hi.is_none_or(|h| value <= h);
                     covered.push((format!("{}.{name}", t.id()), inside));
@@ -234,10 +226,10 @@ pub fn run(
             effects.iter().map(|e| e.id()).collect::<Vec<_>>().join("+")
         };
         progress(n, total, &label);
-        let case_seed = super::ensemble::member_seed(seed, 7_000_000 + k, 0);
+        let case_seed = derive_seed(seed, "self-test case", k as u64);
         let (train, holdout) = case_runs(&effects, case_seed);
         let options = Options {
-            seed: case_seed ^ 0xD1A6,
+            seed: derive_seed(case_seed, "diagnosis", 0),
             ..options.clone()
         };
         let d = diagnose(&train, &holdout, &options, &Silent)?;

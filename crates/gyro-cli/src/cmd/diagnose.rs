@@ -4,7 +4,7 @@
 use anyhow::{bail, Result};
 use clap::ValueEnum;
 use gyro_analysis::diagnose::ensemble::{split, RealRun};
-use gyro_analysis::diagnose::{self, selftest, Diagnosis, Options, Progress};
+use gyro_analysis::diagnose::{self, selftest, DiagnoseError, Diagnosis, Options, Progress};
 use gyro_analysis::model;
 use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -157,11 +157,11 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let train = load(&args.train, args, "training")?;
     let holdout = load(&args.holdout, args, "held-out")?;
-    diagnose::check_runs(&train, &holdout)?;
+    diagnose::check_runs(&train, &holdout).map_err(with_advice)?;
     let bar = progress_bar();
     let result = diagnose::diagnose(&train, &holdout, &options, &bar);
     bar.0.finish_and_clear();
-    let result = result?;
+    let result = result.map_err(with_advice)?;
     let mut stdout = std::io::stdout().lock();
     match args.format {
         Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
@@ -217,7 +217,7 @@ fn self_test(args: &Args) -> Result<()> {
         },
     );
     bar.finish_and_clear();
-    let result = result?;
+    let result = result.map_err(with_advice)?;
     let mut stdout = std::io::stdout().lock();
     match args.format {
         Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
@@ -325,6 +325,22 @@ top-1 accuracy (single effects): {} strict, {} counting confounded pairs ({}) as
     s
 }
 
+/// `e` with what to pass on the command line to get past it, where there is advice.
+fn with_advice(e: DiagnoseError) -> anyhow::Error {
+    let advice = match &e {
+        DiagnoseError::TooFewHeldOutRuns { .. } => {
+            "pass --holdout, or --split-s to cut logs into windows"
+        }
+        DiagnoseError::MismatchedRates { .. } => {
+            "resample, or pass --sample-rate-hz to place all on one grid"
+        }
+        DiagnoseError::Run { .. } | DiagnoseError::TooFewTrainingRuns { .. } => {
+            return e.into();
+        }
+    };
+    anyhow::anyhow!("{e} ({advice})")
+}
+
 fn write_report(
     dir: &Path,
     result: &Diagnosis,
@@ -332,7 +348,8 @@ fn write_report(
     holdout: &[RealRun],
     options: &Options,
 ) -> Result<()> {
-    gyro_report::diagnose::write_report(dir, result, train, holdout, options)?;
+    let envelopes = diagnose::envelopes::envelopes(result, train, holdout, options);
+    gyro_report::diagnose::write_report(dir, result, envelopes.as_ref(), options)?;
     eprintln!("wrote {}", dir.join("index.html").display());
     Ok(())
 }

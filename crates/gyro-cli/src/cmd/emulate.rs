@@ -77,7 +77,7 @@ fn samples(args: &Args) -> Result<(Vec<Sample>, String)> {
         range_dps: f64::from(range.full_scale_dps()),
         ..SensorModel::default()
     };
-    sensor.validate().map_err(anyhow::Error::msg)?;
+    sensor.validate()?;
     let samples = bridge::simulated_samples(&sensor, duration_s, seed);
     Ok((
         samples,

@@ -50,7 +50,7 @@ fn list_effects(out: &mut impl Write) -> std::io::Result<()> {
             .params
             .iter()
             .zip(info.typical.params())
-            .map(|((name, unit), v)| format!("{name}={v} {unit}"))
+            .map(|(spec, v)| format!("{}={v} {}", spec.name, spec.unit))
             .collect();
         writeln!(
             out,
@@ -76,11 +76,11 @@ pub fn run(args: &Args) -> Result<()> {
     if let Some(rate) = args.sample_rate_hz {
         sensor.sample_rate_hz = rate;
     }
-    sensor.validate().map_err(anyhow::Error::msg)?;
+    sensor.validate()?;
     let effects = args
         .effects
         .iter()
-        .map(|spec| Effect::parse(spec).map_err(anyhow::Error::msg))
+        .map(|spec| Effect::parse(spec).map_err(anyhow::Error::from))
         .collect::<Result<Vec<_>>>()?;
     let motion = match &args.motion_from {
         Some(path) => {

@@ -1,0 +1,155 @@
+//! Stage 1, baseline: the nominal model, and every run re-simulated with it as an
+//! ensemble scored against the run; the floor of the gap between simulated ensembles.
+
+use super::ensemble::{ensembles, Member, RealRun};
+use super::score::{self, gap, score, RunScore};
+use super::{fit, Options, Progress};
+use gyro_sim::{Effect, SensorModel};
+
+/// The training and held-out runs with their seed indices in the ensembles (training
+/// runs first, then the held-out runs).
+pub(crate) struct Runs<'a> {
+    /// Training runs.
+    pub(crate) train: Vec<&'a RealRun>,
+    /// Held-out runs.
+    pub(crate) holdout: Vec<&'a RealRun>,
+    /// Seed index of each training run.
+    pub(crate) train_ids: Vec<usize>,
+    /// Seed index of each held-out run.
+    pub(crate) holdout_ids: Vec<usize>,
+}
+
+impl<'a> Runs<'a> {
+    pub(crate) fn new(train: &'a [RealRun], holdout: &'a [RealRun]) -> Self {
+        Self {
+            train: train.iter().collect(),
+            holdout: holdout.iter().collect(),
+            train_ids: (0..train.len()).collect(),
+            holdout_ids: (train.len()..train.len() + holdout.len()).collect(),
+        }
+    }
+}
+
+/// Runs scored against their ensembles.
+pub(crate) struct Evaluation {
+    /// Each run's score.
+    pub(crate) scores: Vec<RunScore>,
+    /// Each run's ensemble.
+    pub(crate) members: Vec<Vec<Member>>,
+}
+
+/// Simulate `members` members of every run with `model` and `effects`, and score each
+/// run against its ensemble.
+pub(crate) fn evaluate(
+    runs: &[&RealRun],
+    ids: &[usize],
+    model: &SensorModel,
+    effects: &[Effect],
+    options: &Options,
+    members: usize,
+    progress: &dyn Progress,
+) -> Evaluation {
+    let tick = || progress.tick();
+    let ens = ensembles(runs, ids, model, effects, options.seed, members, &tick);
+    let scores = runs
+        .iter()
+        .zip(&ens)
+        .map(|(r, m)| score(&r.stats, m))
+        .collect();
+    Evaluation {
+        scores,
+        members: ens,
+    }
+}
+
+/// Scores against only the first `k` members of each ensemble.
+pub(crate) fn rescore(runs: &[&RealRun], members: &[Vec<Member>], k: usize) -> Vec<RunScore> {
+    runs.iter()
+        .zip(members)
+        .map(|(r, m)| score(&r.stats, &m[..k.min(m.len())]))
+        .collect()
+}
+
+/// The baseline stage's result.
+pub(crate) struct Baseline {
+    /// The nominal model.
+    pub(crate) nominal: SensorModel,
+    /// Where its values came from.
+    pub(crate) notes: Vec<String>,
+    /// The static first-difference variance the white noise was matched to (if fitted).
+    pub(crate) white_target: Option<f64>,
+    /// Members of each candidate's ensemble (the baseline's first seeds).
+    pub(crate) candidate_members: usize,
+    /// Training runs against the nominal model.
+    pub(crate) train: Evaluation,
+    /// Held-out runs against the nominal model.
+    pub(crate) holdout: Evaluation,
+    /// G between independent simulated ensembles.
+    pub(crate) floor: f64,
+    /// G of the training runs, nominal.
+    pub(crate) train_gap: f64,
+    /// G of the held-out runs, nominal.
+    pub(crate) holdout_gap: f64,
+}
+
+/// Stage 1: the nominal model (fitted on the training runs, or the given one) and the
+/// baseline ensembles of every run.
+pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) -> Baseline {
+    let (nominal, notes, white_target) = if options.fixed_model {
+        let mut m = options.prior;
+        if let Some(first) = runs.train.first() {
+            m.sample_rate_hz = first.sample_rate_hz;
+        }
+        (
+            m,
+            vec!["the --model sensor model as given".to_string()],
+            None,
+        )
+    } else {
+        fit::nominal_model(&runs.train, &options.prior)
+    };
+    let m = options.members.max(4);
+    let mc = options.candidate_members.clamp(2, m);
+    progress.stage(
+        "baseline ensembles",
+        (m * (runs.train.len() + runs.holdout.len())) as u64,
+    );
+    let train = evaluate(
+        &runs.train,
+        &runs.train_ids,
+        &nominal,
+        &[],
+        options,
+        m,
+        progress,
+    );
+    let holdout = evaluate(
+        &runs.holdout,
+        &runs.holdout_ids,
+        &nominal,
+        &[],
+        options,
+        m,
+        progress,
+    );
+    let floor = {
+        let all: Vec<Vec<Member>> = train
+            .members
+            .iter()
+            .chain(&holdout.members)
+            .cloned()
+            .collect();
+        score::floor(&all)
+    };
+    Baseline {
+        nominal,
+        notes,
+        white_target,
+        candidate_members: mc,
+        train_gap: gap(&train.scores),
+        holdout_gap: gap(&holdout.scores),
+        train,
+        holdout,
+        floor,
+    }
+}

@@ -1,0 +1,160 @@
+//! The diagnosis: the JSON contract of `diagnose --format json`, plus what the report
+//! and `--out` need (not serialised).
+
+use crate::model::ModelFile;
+use gyro_sim::{Effect, SensorModel};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// The gap figures of the JSON contract.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GapSummary {
+    /// G of the training runs, nominal model.
+    pub train_before: f64,
+    /// G of the training runs, with the selected effects.
+    pub train_after: f64,
+    /// G of the held-out runs, nominal model.
+    pub holdout_before: f64,
+    /// G of the held-out runs, with the selected effects.
+    pub holdout_after: f64,
+    /// G between independent simulated ensembles.
+    pub floor: f64,
+}
+
+/// One "where" entry.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Where {
+    /// Segment or stratum.
+    pub segment: String,
+    /// Statistic.
+    pub statistic: String,
+    /// Combined z over all runs (Σz/√n).
+    pub z: f64,
+}
+
+/// One candidate effect's result.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EffectResult {
+    /// Effect id.
+    pub id: &'static str,
+    /// Fitted parameters by name.
+    pub params: BTreeMap<&'static str, f64>,
+    /// BIC(nominal) − BIC(nominal + effect) on the held-out runs (positive favours it).
+    pub delta_bic: f64,
+    /// G of the held-out runs, nominal (the candidate ensemble's seeds).
+    pub holdout_gap_before: f64,
+    /// G of the held-out runs with this effect added.
+    pub holdout_gap_after: f64,
+    /// (before − after) / (before − floor); 0 when before is within 10% of the floor
+    /// (no gap to close).
+    pub fraction_closed: f64,
+    /// Named in the verdict.
+    pub significant: bool,
+    /// 95% intervals of the parameters (null: unbounded).
+    pub ci95: BTreeMap<&'static str, [Option<f64>; 2]>,
+    /// Parameter test z on the training runs (null where the test is exact).
+    pub z: Option<f64>,
+    /// The parameter test and its outcome.
+    pub test: String,
+    /// Bootstrap over held-out runs: P(no likelihood improvement).
+    pub bootstrap_p: f64,
+    /// Effects it is confounded with (indistinguishable on these runs).
+    pub confounded_with: Vec<&'static str>,
+}
+
+/// The verdict.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Verdict {
+    /// Significant effects, best first.
+    pub unmodelled: Vec<&'static str>,
+    /// Fraction of the held-out gap closed by them, relative to the floor.
+    pub fraction_closed_holdout: f64,
+}
+
+/// An untestable effect.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct UntestableEntry {
+    /// Effect id.
+    pub id: &'static str,
+    /// Why.
+    pub reason: String,
+}
+
+/// The whole diagnosis (the JSON contract, with `untestable`, `model` and `runs`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Diagnosis {
+    /// Gap figures.
+    pub gap: GapSummary,
+    /// Statistics by |z|, largest first.
+    pub r#where: Vec<Where>,
+    /// Candidate effects, best first.
+    pub effects: Vec<EffectResult>,
+    /// Verdict.
+    pub verdict: Verdict,
+    /// Effects that could not be tested, and why.
+    pub untestable: Vec<UntestableEntry>,
+    /// The nominal model used, and where its values came from.
+    pub model: ModelSummary,
+    /// Per run figures.
+    pub runs: Vec<RunSummary>,
+    /// Angle error with the correctable effects compensated, if any were selected.
+    pub compensation: Option<CompensationSummary>,
+    /// The model file with those corrections (`--out`).
+    #[serde(skip)]
+    pub corrected_model: Option<ModelFile>,
+    /// The sensor model simulated with the selected effects (the nominal one, with the
+    /// white noise matched again under an extra output rounding); for the report.
+    #[serde(skip)]
+    pub selected_sensor: SensorModel,
+}
+
+/// The nominal model.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ModelSummary {
+    /// The sensor model.
+    pub sensor: SensorModel,
+    /// Provenance of its values.
+    pub notes: Vec<String>,
+    /// The selected effects with their parameters.
+    pub effects: Vec<Effect>,
+}
+
+/// One run's figures.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunSummary {
+    /// Name.
+    pub name: String,
+    /// Training or held-out.
+    pub role: &'static str,
+    /// Duration (s).
+    pub duration_s: f64,
+    /// G of this run, nominal.
+    pub gap_before: f64,
+    /// G of this run with the selected effects.
+    pub gap_after: f64,
+    /// Its z-scores against the nominal ensemble, `(segment/statistic, z)` (for the
+    /// report's gap map; not in the JSON).
+    #[serde(skip)]
+    pub z: Vec<(String, f64)>,
+}
+
+/// The pipeline's angle error on the held-out runs without and with the correctable
+/// effects compensated (`run --model`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CompensationSummary {
+    /// The model file's corrections, as written.
+    pub corrected: Vec<&'static str>,
+    /// Per held-out run.
+    pub runs: Vec<CompensationRun>,
+}
+
+/// One run's angle error without and with compensation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CompensationRun {
+    /// Run name.
+    pub name: String,
+    /// Max abs angle error of `run` with the nominal configuration (deg).
+    pub max_abs_error_before_deg: f64,
+    /// Max abs angle error of `run --model` with the corrections (deg).
+    pub max_abs_error_after_deg: f64,
+}

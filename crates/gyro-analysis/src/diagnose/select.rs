@@ -1,0 +1,468 @@
+//! Stage 4, select: every fitted candidate scored alone on the held-out runs, then
+//! forward selection, swaps, leave-one-out ablations and confounds.
+
+use super::baseline::{evaluate, Baseline, Runs};
+use super::fit::{self, Fit, Joint};
+use super::score::{bootstrap_p, gap, RunScore};
+use super::{Options, Progress, CONFOUND_COSINE, MAX_EFFECTS, TIE_BIC};
+use crate::seed::derive_seed;
+use gyro_sim::{Effect, SensorModel};
+use std::collections::BTreeMap;
+
+/// The held-out comparison of one model with another.
+pub(crate) struct Step {
+    /// G before (the model compared against).
+    pub(crate) gap_before: f64,
+    /// G after.
+    pub(crate) gap_after: f64,
+    /// ΔBIC (positive favours "after").
+    pub(crate) delta_bic: f64,
+    /// Bootstrap over runs: P(no likelihood improvement).
+    pub(crate) p: f64,
+}
+
+/// A fitted effect and how it scored on the held-out runs.
+pub(crate) struct Candidate {
+    /// The fit on the training runs.
+    pub(crate) fit: Fit,
+    /// Added alone to the nominal model.
+    pub(crate) alone: Step,
+    /// The held-out scores with it alone.
+    pub(crate) alone_scores: Vec<RunScore>,
+    /// Qualified when added alone.
+    pub(crate) alone_ok: bool,
+    /// Added on top of the effects selected before it (selected effects only).
+    pub(crate) added: Option<Step>,
+}
+
+/// Scores sets of effects on the held-out runs against the nominal model, with the
+/// candidate ensembles' seeds.
+pub(crate) struct Scorer<'a> {
+    runs: &'a Runs<'a>,
+    baseline: &'a Baseline,
+    options: &'a Options,
+    progress: &'a dyn Progress,
+    joint: &'a Joint<'a>,
+    /// Held-out scores of the nominal model with the candidate members.
+    pub(crate) before: Vec<RunScore>,
+    /// Statistics scored over the held-out runs (the BIC's observation count).
+    observations: usize,
+}
+
+impl<'a> Scorer<'a> {
+    pub(crate) fn new(
+        runs: &'a Runs<'a>,
+        baseline: &'a Baseline,
+        options: &'a Options,
+        progress: &'a dyn Progress,
+        joint: &'a Joint<'a>,
+    ) -> Self {
+        let before = super::baseline::rescore(
+            &runs.holdout,
+            &baseline.holdout.members,
+            baseline.candidate_members,
+        );
+        let observations = before.iter().map(|s| s.count).sum();
+        Self {
+            runs,
+            baseline,
+            options,
+            progress,
+            joint,
+            before,
+            observations,
+        }
+    }
+
+    fn nominal(&self) -> &SensorModel {
+        &self.baseline.nominal
+    }
+
+    /// Simulations per evaluated set (for progress totals).
+    fn per_set(&self) -> usize {
+        self.baseline.candidate_members * self.runs.holdout.len()
+    }
+
+    /// The seed of the bootstrap stream `name`, number `index`.
+    fn seed(&self, name: &str, index: usize) -> u64 {
+        derive_seed(self.options.seed, name, index as u64)
+    }
+
+    /// `after` against `before`, for an effect of `params` parameters; the bootstrap
+    /// draws with `seed`.
+    fn step_of(&self, after: &[RunScore], before: &[RunScore], params: usize, seed: u64) -> Step {
+        let diffs = loglik_diffs(after, before);
+        Step {
+            gap_before: gap(before),
+            gap_after: gap(after),
+            delta_bic: delta_bic(&diffs, params, self.observations),
+            p: bootstrap_p(&diffs, self.options.bootstrap, seed),
+        }
+    }
+
+    /// The fit is significant given its held-out step: its direct evidence replicates
+    /// on the held-out runs, or its ΔBIC is positive with bootstrap P < 5%.
+    fn qualifies(&self, f: &Fit, st: &Step) -> bool {
+        if f.direct {
+            f.passes
+                && fit::direct_evidence(
+                    &f.effect,
+                    &self.runs.holdout,
+                    &self.baseline.holdout.members,
+                    self.nominal(),
+                )
+        } else {
+            f.passes && st.delta_bic > 0.0 && st.p < 0.05
+        }
+    }
+
+    /// The held-out scores of the nominal model with `set` (joint fits).
+    fn eval_set(&self, set: &[Effect]) -> Vec<RunScore> {
+        let set = &self.joint.effects(set);
+        let nominal = self.nominal();
+        let model = fit::model_with(nominal, set, self.baseline.white_target);
+        if set.iter().all(|e| e.is_neutral(nominal)) && model == *nominal {
+            (0..self.per_set()).for_each(|_| self.progress.tick());
+            return self.before.clone();
+        }
+        evaluate(
+            &self.runs.holdout,
+            &self.runs.holdout_ids,
+            &model,
+            set,
+            self.options,
+            self.baseline.candidate_members,
+            self.progress,
+        )
+        .scores
+    }
+}
+
+fn loglik_diffs(after: &[RunScore], before: &[RunScore]) -> Vec<f64> {
+    after
+        .iter()
+        .zip(before)
+        .map(|(a, b)| a.loglik - b.loglik)
+        .collect()
+}
+
+fn delta_bic(diffs: &[f64], params: usize, observations: usize) -> f64 {
+    2.0 * diffs.iter().sum::<f64>() - params as f64 * (observations.max(1) as f64).ln()
+}
+
+/// Every fit added alone to the nominal model and scored on the held-out runs.
+pub(crate) fn score_alone(scorer: &Scorer, fits: Vec<Fit>) -> Vec<Candidate> {
+    scorer.progress.stage(
+        "candidate effects on held-out runs",
+        (fits.len() * scorer.per_set()) as u64,
+    );
+    let mut candidates = Vec::new();
+    for (i, f) in fits.into_iter().enumerate() {
+        let scores = scorer.eval_set(&[f.effect]);
+        let alone = scorer.step_of(
+            &scores,
+            &scorer.before,
+            f.effect.params().len(),
+            scorer.seed("alone", i),
+        );
+        let alone_ok = scorer.qualifies(&f, &alone);
+        candidates.push(Candidate {
+            fit: f,
+            alone,
+            alone_scores: scores,
+            alone_ok,
+            added: None,
+        });
+    }
+    candidates
+}
+
+/// The selection stage's result.
+pub(crate) struct Selection {
+    /// Indices of the selected candidates, in the order they were added.
+    pub(crate) selected: Vec<usize>,
+    /// Effects each candidate is confounded with.
+    pub(crate) partners: BTreeMap<usize, Vec<&'static str>>,
+    /// Held-out scores with the selected set.
+    pub(crate) holdout_scores: Vec<RunScore>,
+}
+
+/// Stage 4: forward selection, swaps and leave-one-out over `candidates` (whose `added`
+/// steps it sets), and the confounds.
+pub(crate) fn select(scorer: &Scorer, candidates: &mut [Candidate]) -> Selection {
+    let (mut selected, current) = forward(scorer, candidates);
+    let current = swaps(scorer, candidates, &mut selected, current);
+    let (dropped, current) = leave_one_out(scorer, candidates, &mut selected, current);
+    let partners = confounds(scorer, candidates, &selected, &dropped);
+    Selection {
+        selected,
+        partners,
+        holdout_scores: current,
+    }
+}
+
+/// Forward selection: add the best qualifying effect on top of those already chosen,
+/// until none qualifies. Returns the selected indices and their held-out scores.
+fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<RunScore>) {
+    let mut selected: Vec<usize> = Vec::new();
+    let mut current = scorer.before.clone();
+    for step in 0..MAX_EFFECTS {
+        let pool: Vec<usize> = (0..candidates.len())
+            .filter(|i| !selected.contains(i) && candidates[*i].fit.passes)
+            .collect();
+        if pool.is_empty() {
+            break;
+        }
+        let mut tried: Vec<(usize, Step, Vec<RunScore>)> = Vec::new();
+        if step == 0 {
+            for &i in &pool {
+                let c = &candidates[i];
+                let st = scorer.step_of(
+                    &c.alone_scores,
+                    &current,
+                    c.fit.effect.params().len(),
+                    scorer.seed("alone", i),
+                );
+                tried.push((i, st, c.alone_scores.clone()));
+            }
+        } else {
+            scorer.progress.stage(
+                &format!("effects on top of {} selected", selected.len()),
+                (pool.len() * scorer.per_set()) as u64,
+            );
+            for &i in &pool {
+                let mut set: Vec<Effect> =
+                    selected.iter().map(|&j| candidates[j].fit.effect).collect();
+                set.push(candidates[i].fit.effect);
+                let scores = scorer.eval_set(&set);
+                let st = scorer.step_of(
+                    &scores,
+                    &current,
+                    candidates[i].fit.effect.params().len(),
+                    derive_seed(scorer.seed("forward step", step), "added", i as u64),
+                );
+                tried.push((i, st, scores));
+            }
+        }
+        let mut ok: Vec<(usize, Step, Vec<RunScore>)> = tried
+            .into_iter()
+            .filter(|(i, st, _)| scorer.qualifies(&candidates[*i].fit, st))
+            .collect();
+        // Best ΔBIC; an earlier effect of the vocabulary (the simpler, more common
+        // explanation of a shared signature) is preferred unless the best one is
+        // significantly better on the held-out runs (bootstrap of the per-run difference).
+        ok.sort_by(|a, b| b.1.delta_bic.total_cmp(&a.1.delta_bic));
+        if ok.is_empty() {
+            break;
+        }
+        let lead = ok[0].0;
+        let lead_ll = loglik_diffs(&ok[0].2, &current);
+        let best = ok
+            .iter()
+            .filter(|t| {
+                let ll = loglik_diffs(&t.2, &current);
+                let d: Vec<f64> = lead_ll.iter().zip(&ll).map(|(a, b)| a - b).collect();
+                t.0 == lead
+                    || ok[0].1.delta_bic - t.1.delta_bic < TIE_BIC
+                    || bootstrap_p(&d, scorer.options.bootstrap, scorer.seed("tie", step)) > 0.05
+            })
+            .map(|t| t.0)
+            .min()
+            .unwrap_or(lead);
+        let Some(pos) = ok.iter().position(|t| t.0 == best) else {
+            break;
+        };
+        let (i, st, scores) = ok.swap_remove(pos);
+        candidates[i].added = Some(st);
+        selected.push(i);
+        current = scores;
+    }
+    (selected, current)
+}
+
+/// Swaps: a selected effect replaced by another that passed its parameter test, kept
+/// when the held-out likelihood improves significantly (greedy selection can take a
+/// look-alike first, e.g. a bandwidth for a latency while a scale error is unmodelled).
+fn swaps(
+    scorer: &Scorer,
+    candidates: &mut [Candidate],
+    selected: &mut [usize],
+    mut current: Vec<RunScore>,
+) -> Vec<RunScore> {
+    if selected.is_empty() {
+        return current;
+    }
+    let alternatives: Vec<usize> = (0..candidates.len())
+        .filter(|i| {
+            !selected.contains(i) && candidates[*i].fit.passes && !candidates[*i].fit.direct
+        })
+        .collect();
+    scorer.progress.stage(
+        "swaps",
+        (selected.len() * alternatives.len() * scorer.per_set()) as u64,
+    );
+    for slot in 0..selected.len() {
+        for &a in &alternatives {
+            if selected.contains(&a) || candidates[selected[slot]].fit.direct {
+                continue;
+            }
+            let set: Vec<Effect> = selected
+                .iter()
+                .enumerate()
+                .map(|(k, &j)| {
+                    if k == slot {
+                        candidates[a].fit.effect
+                    } else {
+                        candidates[j].fit.effect
+                    }
+                })
+                .collect();
+            let scores = scorer.eval_set(&set);
+            let diffs = loglik_diffs(&scores, &current);
+            let better = diffs.iter().sum::<f64>() > 0.0
+                && bootstrap_p(
+                    &diffs,
+                    scorer.options.bootstrap,
+                    scorer.seed("swap test", a),
+                ) < 0.05;
+            if better {
+                let out = selected[slot];
+                let st = scorer.step_of(
+                    &scores,
+                    &current,
+                    candidates[a].fit.effect.params().len(),
+                    scorer.seed("swap step", a),
+                );
+                candidates[a].added = Some(st);
+                candidates[out].added = None;
+                selected[slot] = a;
+                current = scores;
+            }
+        }
+    }
+    current
+}
+
+/// Leave-one-out: an effect whose removal from the selected set costs nothing
+/// significant is redundant given the others. Returns the dropped indices and the
+/// held-out scores of what remains.
+fn leave_one_out(
+    scorer: &Scorer,
+    candidates: &mut [Candidate],
+    selected: &mut Vec<usize>,
+    mut current: Vec<RunScore>,
+) -> (Vec<usize>, Vec<RunScore>) {
+    let mut dropped: Vec<usize> = Vec::new();
+    if selected.len() < 2 {
+        return (dropped, current);
+    }
+    scorer.progress.stage(
+        "leave-one-out ablations",
+        (selected.len() * scorer.per_set()) as u64,
+    );
+    for &i in selected.clone().iter().rev() {
+        if selected.len() < 2 || candidates[i].fit.direct {
+            continue;
+        }
+        let rest: Vec<Effect> = selected
+            .iter()
+            .filter(|&&j| j != i)
+            .map(|&j| candidates[j].fit.effect)
+            .collect();
+        let without = scorer.eval_set(&rest);
+        let st = scorer.step_of(
+            &current,
+            &without,
+            candidates[i].fit.effect.params().len(),
+            scorer.seed("leave one out", i),
+        );
+        if !(st.delta_bic > 0.0 && st.p < 0.05) {
+            selected.retain(|&j| j != i);
+            candidates[i].added = None;
+            dropped.push(i);
+            current = without;
+        }
+    }
+    (dropped, current)
+}
+
+/// Confounds: an effect that qualified alone but is not selected, and the selected
+/// effect whose signature (the shift it gives the held-out z-scores) is most alike.
+fn confounds(
+    scorer: &Scorer,
+    candidates: &[Candidate],
+    selected: &[usize],
+    dropped: &[usize],
+) -> BTreeMap<usize, Vec<&'static str>> {
+    let shift = |scores: &[RunScore]| -> Vec<f64> {
+        scores
+            .iter()
+            .zip(&scorer.before)
+            .flat_map(|(a, b)| {
+                a.z.iter().zip(&b.z).map(|((_, za), (_, zb))| {
+                    if za.is_finite() && zb.is_finite() {
+                        za - zb
+                    } else {
+                        0.0
+                    }
+                })
+            })
+            .collect()
+    };
+    let mut partners: BTreeMap<usize, Vec<&'static str>> = BTreeMap::new();
+    for i in 0..candidates.len() {
+        if selected.contains(&i) || !candidates[i].alone_ok {
+            continue;
+        }
+        let si = shift(&candidates[i].alone_scores);
+        let best = selected
+            .iter()
+            .map(|&j| (j, cosine(&si, &shift(&candidates[j].alone_scores))))
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((j, c)) = best {
+            if c > CONFOUND_COSINE || dropped.contains(&i) {
+                partners
+                    .entry(i)
+                    .or_default()
+                    .push(candidates[j].fit.effect.id());
+                partners
+                    .entry(j)
+                    .or_default()
+                    .push(candidates[i].fit.effect.id());
+            }
+        }
+    }
+    partners
+}
+
+/// The selected effects with their joint fits (as they were scored); each selected
+/// candidate's fit is replaced by its joint refit.
+pub(crate) fn joint_refit(
+    joint: &Joint,
+    candidates: &mut [Candidate],
+    selected: &[usize],
+) -> Vec<Effect> {
+    let alone: Vec<Effect> = selected.iter().map(|&i| candidates[i].fit.effect).collect();
+    for (&i, refit) in selected.iter().zip(joint.fits(&alone)) {
+        if let Some(f) = refit {
+            candidates[i].fit.effect = f.effect;
+            candidates[i].fit.ci95 = f.ci95;
+        }
+    }
+    selected.iter().map(|&i| candidates[i].fit.effect).collect()
+}
+
+/// Cosine similarity of two vectors (0 when either is zero).
+fn cosine(a: &[f64], b: &[f64]) -> f64 {
+    let (mut ab, mut aa, mut bb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        ab += x * y;
+        aa += x * x;
+        bb += y * y;
+    }
+    if aa > 0.0 && bb > 0.0 {
+        ab / (aa * bb).sqrt()
+    } else {
+        0.0
+    }
+}

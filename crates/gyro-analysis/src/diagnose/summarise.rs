@@ -1,0 +1,209 @@
+//! Stage 6, summarise: how far the selected effects close the gap on the training and
+//! held-out runs, and the [`Diagnosis`] of the JSON contract.
+
+use super::baseline::{evaluate, Baseline, Runs};
+use super::fit::Untestable;
+use super::score::{gap, RunScore};
+use super::select::{Candidate, Selection};
+use super::{
+    CompensationSummary, Diagnosis, EffectResult, GapSummary, ModelSummary, Options, Progress,
+    RunSummary, UntestableEntry, Verdict, Where,
+};
+use crate::model::ModelFile;
+use gyro_sim::{Effect, SensorModel};
+
+/// The training runs with the selected effects: their scores and G.
+pub(crate) fn train_after(
+    runs: &Runs,
+    baseline: &Baseline,
+    selected_model: &SensorModel,
+    selected_effects: &[Effect],
+    options: &Options,
+    progress: &dyn Progress,
+) -> (Vec<RunScore>, f64) {
+    if selected_effects.is_empty() {
+        return (baseline.train.scores.clone(), baseline.train_gap);
+    }
+    let mc = baseline.candidate_members;
+    progress.stage(
+        "selected model on training runs",
+        (mc * runs.train.len()) as u64,
+    );
+    let e = evaluate(
+        &runs.train,
+        &runs.train_ids,
+        selected_model,
+        selected_effects,
+        options,
+        mc,
+        progress,
+    );
+    let g = gap(&e.scores);
+    (e.scores, g)
+}
+
+/// (before − after) / (before − floor); 0 with no gap above the floor (within 10% of it).
+fn closed(floor: f64, before: f64, after: f64) -> f64 {
+    let span = before - floor;
+    if span <= 0.1 * floor {
+        0.0
+    } else {
+        (before - after) / span
+    }
+}
+
+/// Each candidate's result: the selected ones in the order they were added, then the
+/// rest by held-out gap reduction when added alone.
+fn effect_results(
+    floor: f64,
+    candidates: &[Candidate],
+    selection: &Selection,
+) -> Vec<EffectResult> {
+    let selected = &selection.selected;
+    let mut effects: Vec<(Option<usize>, EffectResult)> = candidates
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let info = c.fit.effect.info();
+            let values = c.fit.effect.params();
+            let params = info.params.iter().map(|p| p.name).zip(values).collect();
+            let ci95 = info
+                .params
+                .iter()
+                .map(|p| p.name)
+                .zip(c.fit.ci95.iter().map(|(a, b)| [*a, *b]))
+                .collect();
+            let mut with = selection.partners.get(&i).cloned().unwrap_or_default();
+            with.sort_unstable();
+            with.dedup();
+            let st = c.added.as_ref().unwrap_or(&c.alone);
+            let order = selected.iter().position(|&j| j == i);
+            (
+                order,
+                EffectResult {
+                    id: info.id,
+                    params,
+                    delta_bic: st.delta_bic,
+                    holdout_gap_before: st.gap_before,
+                    holdout_gap_after: st.gap_after,
+                    fraction_closed: closed(floor, st.gap_before, st.gap_after),
+                    significant: order.is_some(),
+                    ci95,
+                    z: c.fit.z.is_finite().then_some(c.fit.z),
+                    test: format!(
+                        "{}: {}",
+                        c.fit.test,
+                        if c.fit.passes {
+                            "passes"
+                        } else {
+                            "does not pass"
+                        }
+                    ),
+                    bootstrap_p: st.p,
+                    confounded_with: with,
+                },
+            )
+        })
+        .collect();
+    effects.sort_by(|(oa, a), (ob, b)| match (oa, ob) {
+        (Some(x), Some(y)) => x.cmp(y),
+        (Some(_), None) => std::cmp::Ordering::Less,
+        (None, Some(_)) => std::cmp::Ordering::Greater,
+        (None, None) => (a.holdout_gap_after - a.holdout_gap_before)
+            .total_cmp(&(b.holdout_gap_after - b.holdout_gap_before)),
+    });
+    effects.into_iter().map(|(_, e)| e).collect()
+}
+
+/// Each run's gap before and after, training runs first.
+fn run_summaries(
+    runs: &Runs,
+    train: (&[RunScore], &[RunScore]),
+    holdout: (&[RunScore], &[RunScore]),
+) -> Vec<RunSummary> {
+    runs.train
+        .iter()
+        .zip(train.0.iter().zip(train.1))
+        .map(|(r, (b, a))| (r, "train", b, a))
+        .chain(
+            runs.holdout
+                .iter()
+                .zip(holdout.0.iter().zip(holdout.1))
+                .map(|(r, (b, a))| (r, "holdout", b, a)),
+        )
+        .map(|(r, role, b, a)| RunSummary {
+            name: r.name.clone(),
+            role,
+            duration_s: r.duration_s,
+            gap_before: gap(std::slice::from_ref(b)),
+            gap_after: gap(std::slice::from_ref(a)),
+            z: b.z
+                .iter()
+                .map(|(s, z)| (format!("{}/{}", s.segment, s.statistic), *z))
+                .collect(),
+        })
+        .collect()
+}
+
+/// Everything the diagnosis reports, from the stages before.
+pub(crate) struct Findings<'a> {
+    pub(crate) runs: &'a Runs<'a>,
+    pub(crate) baseline: Baseline,
+    pub(crate) r#where: Vec<Where>,
+    pub(crate) untestable: Vec<Untestable>,
+    /// Held-out scores of the nominal model with the candidate members.
+    pub(crate) holdout_before: Vec<RunScore>,
+    pub(crate) candidates: Vec<Candidate>,
+    pub(crate) selection: Selection,
+    pub(crate) selected_effects: Vec<Effect>,
+    pub(crate) selected_sensor: SensorModel,
+    pub(crate) train_after: (Vec<RunScore>, f64),
+    pub(crate) compensation: Option<CompensationSummary>,
+    pub(crate) corrected_model: Option<ModelFile>,
+}
+
+/// Stage 6: the diagnosis.
+pub(crate) fn summarise(f: Findings) -> Diagnosis {
+    let floor = f.baseline.floor;
+    let effects = effect_results(floor, &f.candidates, &f.selection);
+    let unmodelled: Vec<&'static str> = effects
+        .iter()
+        .filter(|e| e.significant)
+        .map(|e| e.id)
+        .collect();
+    let holdout_after = gap(&f.selection.holdout_scores);
+    let runs = run_summaries(
+        f.runs,
+        (&f.baseline.train.scores, &f.train_after.0),
+        (&f.holdout_before, &f.selection.holdout_scores),
+    );
+    Diagnosis {
+        gap: GapSummary {
+            train_before: f.baseline.train_gap,
+            train_after: f.train_after.1,
+            holdout_before: f.baseline.holdout_gap,
+            holdout_after,
+            floor,
+        },
+        r#where: f.r#where,
+        effects,
+        verdict: Verdict {
+            unmodelled,
+            fraction_closed_holdout: closed(floor, gap(&f.holdout_before), holdout_after),
+        },
+        untestable: f
+            .untestable
+            .into_iter()
+            .map(|Untestable { id, reason }| UntestableEntry { id, reason })
+            .collect(),
+        model: ModelSummary {
+            sensor: f.baseline.nominal,
+            notes: f.baseline.notes,
+            effects: f.selected_effects,
+        },
+        runs,
+        compensation: f.compensation,
+        corrected_model: f.corrected_model,
+        selected_sensor: f.selected_sensor,
+    }
+}
