@@ -1,0 +1,10 @@
+//! The diagnosis rendered: the HTML report of `diagnose --report DIR` ([`write_report`]) and
+//! the text summary ([`table`], [`self_test_table`]).
+
+mod html;
+mod text;
+
+pub use html::{
+    write_report, ReportError, GAP_MAP_CLIP, GAP_MAP_COLUMNS, MIN_BIN_SAMPLES, WHERE_ROWS,
+};
+pub use text::{self_test_table, table};
