@@ -2,9 +2,9 @@
 //!
 //! The runs are re-simulated with the nominal model (and, when effects were selected,
 //! with the model holding them) with the seeds of the diagnosis' baseline ensemble
-//! ([`member_seed`] of run and member), [`REPORT_MEMBERS`] members each, so the nominal
+//! (`member_seed` of run and member), [`REPORT_MEMBERS`] members each, so the nominal
 //! band is drawn from the very ensemble the z-scores were computed against. Every real
-//! and simulated run goes through the same residuals ([`residuals`]) and [`Measures`],
+//! and simulated run goes through the same residuals (`residuals`) and [`Measures`],
 //! pooled over the runs (like [`crate::noise`] pools segments) for the real runs and,
 //! member by member, for the simulated ones. When the runs hold more than
 //! [`SAMPLE_BUDGET`] samples, an evenly spaced subset of training and held-out runs is
@@ -162,7 +162,7 @@ pub struct Measures {
     pub acceleration: Vec<Moments>,
     /// Residual (deg/s) per temperature-change bin, at rest.
     pub temperature: Vec<Moments>,
-    /// Σ g[i+lag]·r[i] per lag, Σ g², Σ r² (means removed per run).
+    /// `Σ g[i+lag]·r[i]` per lag, `Σ g²`, `Σ r²` (means removed per run).
     pub xcorr: Vec<f64>,
     /// Σ g² (gyro rate, mean removed).
     pub g2: f64,

@@ -52,6 +52,7 @@ pub mod reg {
     /// α (s).
     pub const ACCELERATION: usize = 4;
     /// dα/dt (s²).
+    #[allow(dead_code)] // no fit reads this column alone; it names the layout's sixth column
     pub const JERK: usize = 5;
     /// ΔT (deg/s/°C).
     pub const DELTA_T: usize = 6;

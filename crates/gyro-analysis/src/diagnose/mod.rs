@@ -3,14 +3,14 @@
 //! effect closes the gap on runs not used to fit it.
 //!
 //! Method, fixed before looking at any data:
-//! 1. **Baseline**: the nominal model ([`fit::nominal_model`]; or `--model`) re-simulates
+//! 1. **Baseline**: the nominal model (`fit::nominal_model`; or `--model`) re-simulates
 //!    every run with its own reference motion and temperatures as an ensemble of
 //!    [`Options::members`] seeds; every run, real or simulated, goes through the same
-//!    statistics ([`stats`]) and features ([`features`]).
+//!    statistics (`stats`) and features (`features`).
 //! 2. **Where**: z-scores of each statistic against the run's ensemble, combined over runs
-//!    (Stouffer: Σz/√n); the gap G and its floor ([`score`]).
+//!    (Stouffer: Σz/√n); the gap G and its floor (`score`).
 //! 3. **Which**: every effect of the vocabulary is fitted on the training runs
-//!    ([`fit`]); each testable one is added to the nominal model and the held-out runs are
+//!    (`fit`); each testable one is added to the nominal model and the held-out runs are
 //!    re-simulated with the same seeds ([`Options::candidate_members`] of them). An effect
 //!    is significant when its parameter test passes on the training runs, its held-out
 //!    ΔBIC is positive and the bootstrap over held-out runs gives P(no improvement) < 5%.
@@ -18,37 +18,39 @@
 //!    dropped in turn from the model holding all of them (leave-one-out); one whose
 //!    removal costs nothing significant is redundant: it is confounded with the others
 //!    (e.g. a latency next to a bandwidth) and not named. A clock error is measured from
-//!    the time stamps against the nominal sample rate ([`ensemble::StampedClock`]); the
+//!    the time stamps against the nominal sample rate (`ensemble::StampedClock`); the
 //!    regression-based effects are fitted on top of it (on the nominal grid the pipeline
 //!    integrates on, a fast clock scales the rate like a scale factor).
 //! 4. **How far**: the gap with the selected effects on the training and held-out runs,
 //!    and the fraction of the held-out gap closed relative to the floor.
 //!
 //! [`diagnose`] runs this as stages, one module each: `baseline` (1), `locate` (2),
-//! [`fit`] and `select` (3), [`compensate`] (the correctable effects replayed through
+//! `fit` and `select` (3), `compensate` (the correctable effects replayed through
 //! the core) and `summarise` (4, and the [`Diagnosis`]).
 
 mod baseline;
-pub mod compensate;
+pub(crate) mod compensate;
 mod diagnosis;
-pub mod ensemble;
+pub(crate) mod ensemble;
 pub mod envelopes;
-pub mod features;
-pub mod fit;
+pub(crate) mod features;
+pub(crate) mod fit;
 mod locate;
-pub mod score;
+pub(crate) mod score;
 mod select;
 pub mod selftest;
-pub mod stats;
+pub(crate) mod stats;
 mod summarise;
 
 pub use diagnosis::{
     CompensationRun, CompensationSummary, Diagnosis, EffectResult, GapSummary, ModelSummary,
     RunSummary, UntestableEntry, Verdict, Where,
 };
+pub use ensemble::{split, RealRun};
+pub use features::MIN_TEMPERATURE_RANGE_C;
+pub use stats::stretches;
 
 use baseline::Runs;
-use ensemble::RealRun;
 use fit::FitInput;
 use select::Scorer;
 

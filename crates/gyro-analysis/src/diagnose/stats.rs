@@ -234,6 +234,7 @@ pub fn stretches(n: usize, ok: impl Fn(usize) -> bool) -> Vec<std::ops::Range<us
 }
 
 /// The "where" statistics of `log` (see the module documentation).
+#[cfg(test)]
 pub fn where_stats(log: &RegularLog) -> Result<Vec<Stat>, StatsError> {
     Ok(stats_of(&residuals(log)?))
 }

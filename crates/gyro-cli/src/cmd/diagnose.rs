@@ -3,8 +3,8 @@
 
 use anyhow::{bail, Result};
 use clap::ValueEnum;
-use gyro_analysis::diagnose::ensemble::{split, RealRun};
 use gyro_analysis::diagnose::{self, selftest, DiagnoseError, Diagnosis, Options, Progress};
+use gyro_analysis::diagnose::{split, RealRun};
 use gyro_analysis::model;
 use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};

@@ -19,7 +19,7 @@ use crate::plot::{render, sig, Figure, ImageFormat, RenderError};
 use gyro_analysis::diagnose::envelopes::{
     quantile, Bins, Envelopes, Measures, Moments, SimModel, PSD_BANDS_PER_DECADE,
 };
-use gyro_analysis::diagnose::features::MIN_TEMPERATURE_RANGE_C;
+use gyro_analysis::diagnose::MIN_TEMPERATURE_RANGE_C;
 use gyro_analysis::diagnose::{Diagnosis, EffectResult, Options};
 use gyro_sim::EFFECTS;
 use std::collections::BTreeMap;
