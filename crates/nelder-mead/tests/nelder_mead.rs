@@ -2,7 +2,7 @@
 //! (`fixtures/nelder_mead/nm_reference.json`, made by `make_nm_reference.py` in that folder),
 //! bounds, NaN regions, errors, limits, settings validation and Lagarias' tie-breaking.
 //!
-//! `cargo test -p gyro-cli --test nelder_mead -- --nocapture` prints the evaluation counts
+//! `cargo test -p nelder-mead --test nelder_mead -- --nocapture` prints the evaluation counts
 //! side by side with scipy's.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
