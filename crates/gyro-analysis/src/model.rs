@@ -257,5 +257,10 @@ mod tests {
         std::fs::write(&path, r#"{"format":"gyro-model","version":1,"config":{"filter":{"order":12,"cutoff_hz":10}}}"#).unwrap();
         let err = load(&path).unwrap_err().to_string();
         assert!(err.contains("filter.order"), "{err}");
+
+        // A typo in the filter section is an error like in every other section.
+        std::fs::write(&path, r#"{"format":"gyro-model","version":1,"config":{"filter":{"order":2,"cutoff_hz":12.5,"cutof_hz":10}}}"#).unwrap();
+        let err = load(&path).unwrap_err().to_string();
+        assert!(err.contains("cutof_hz"), "{err}");
     }
 }

@@ -18,6 +18,7 @@ pub const MAX_ORDER: u8 = 2 * MAX_SECTIONS as u8;
 /// Settings of a Butterworth low-pass.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Butterworth {
     /// Filter order, 1 to [`MAX_ORDER`].
     pub order: u8,
