@@ -27,12 +27,7 @@ the central part of each rest (0.25 s trimmed at each end).
 Prints one line per file, then the median and 90th percentile of |error| per sensor and
 speed for both estimators and their ratio (run / plain).
 
-With `--resampled`, each recording is first put on a regular grid by the integral-preserving
-rule `run` does not yet follow: the cumulative angle (trapezoid on the stamps) is
-interpolated onto a grid at the mean row rate and differenced, and `gyro-cli run` reads that
-(what integral-preserving placement would give, measured before building it).
-
-Usage: python3 scripts/rasteiro_turns.py [DATA_DIR] [--gyro target/release/gyro-cli] [--resampled]
+Usage: python3 scripts/rasteiro_turns.py [DATA_DIR] [--gyro target/release/gyro-cli]
 """
 import glob
 import os
@@ -149,31 +144,12 @@ def turns(path, gyro):
     return out
 
 
-def resample(path, out_dir):
-    """`path` on a regular grid at its mean row rate, preserving the integral of the rate."""
-    d = pd.read_csv(path, comment="#")
-    t, w, ref = (d[c].to_numpy() for c in ("time_s", "rate_dps", "reference_deg"))
-    angle = np.concatenate([[0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * np.diff(t))])
-    rate_hz = (len(t) - 1) / (t[-1] - t[0])
-    grid = np.arange(t[0], t[-1], 1.0 / rate_hz)
-    rate = np.diff(np.interp(grid, t, angle)) * rate_hz
-    out = os.path.join(out_dir, os.path.basename(path))
-    with open(out, "w") as f:
-        f.write(f"# sample_rate_hz: {rate_hz:.6f}\ntime_s,rate_dps,reference_deg\n")
-        for row in zip(grid[:-1], rate, np.interp(grid[:-1], t, ref)):
-            f.write("%.6f,%.6f,%.6f\n" % row)
-    return out
-
-
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     data = args[0] if args else os.path.join(os.path.dirname(__file__), "../../shared/data/real/rasteiro")
     gyro = sys.argv[sys.argv.index("--gyro") + 1] if "--gyro" in sys.argv else "target/release/gyro-cli"
     groups = {}
-    tmp = tempfile.TemporaryDirectory()
     for path in sorted(glob.glob(os.path.join(data, "rasteiro_*.csv"))):
-        if "--resampled" in sys.argv:
-            path = resample(path, tmp.name)
         name = os.path.basename(path)[len("rasteiro_") : -len(".csv")]
         sensor, speed = name.split("RM3100_")[0], name.split("RM3100_")[1].rsplit("_", 1)[0]
         found = turns(path, gyro)

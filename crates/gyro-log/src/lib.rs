@@ -19,12 +19,14 @@
 //! ```
 
 mod ahead;
+pub mod bursts;
 mod csv_log;
 mod load;
 pub mod mcap;
 mod regular;
 
 pub(crate) use ahead::read_ahead;
+pub use bursts::Bursts;
 pub(crate) use csv_log::CsvRows;
 pub use csv_log::{read_csv, write_csv, ColumnOptions, RateUnit, TimeUnit};
 pub use load::{load, stream};

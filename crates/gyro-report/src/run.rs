@@ -8,6 +8,12 @@ fn opt(value: Option<f64>, decimals: usize) -> String {
     value.map_or_else(|| "-".to_string(), |v| format!("{v:.decimals$}"))
 }
 
+/// A rate in Hz to at most three decimals, without trailing zeros (`1000`, `108.509`).
+fn hz(rate_hz: f64) -> String {
+    let text = format!("{rate_hz:.3}");
+    text.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 /// A human-readable report.
 pub fn table(file: &str, report: &RunReport) -> String {
     let mut s = String::new();
@@ -17,8 +23,23 @@ pub fn table(file: &str, report: &RunReport) -> String {
     let _ = writeln!(
         s,
         "input: {} rows -> {} samples at {} Hz ({}), effective {:.3} Hz",
-        q.rows, q.slots, q.sample_rate_hz, q.sample_rate_source, q.effective_rate_hz
+        q.rows,
+        q.slots,
+        hz(q.sample_rate_hz),
+        q.sample_rate_source,
+        q.effective_rate_hz
     );
+    if let Some(b) = &q.bursts {
+        let _ = writeln!(
+            s,
+            "  rows arrive in bursts: {:.0}% of steps off the grid of the median step {:.1} ms \
+             (mean {:.2} ms); the integral of the rate was resampled onto the grid, not placed \
+             row by row",
+            100.0 * b.off_grid_share,
+            1e3 * b.median_step_s,
+            1e3 * b.mean_step_s
+        );
+    }
     let issues: Vec<String> = [
         (q.duplicate_rows, "duplicate rows dropped"),
         (q.same_time_rows, "rows with a repeated time stamp"),

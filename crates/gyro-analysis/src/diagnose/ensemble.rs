@@ -58,10 +58,11 @@ pub struct StampedClock {
 
 impl StampedClock {
     /// The clock of `log`, if its grid rate is the nominal one (metadata or option, not
-    /// the median step, which would make the stamps agree by construction) and it has at
-    /// least three stamped samples.
+    /// the median step, which would make the stamps agree by construction), its slots carry
+    /// the rows' stamps (not a log resampled for arriving in bursts, whose slot times are
+    /// the grid's) and it has at least three stamped samples.
     pub fn of(log: &RegularLog) -> Option<Self> {
-        if log.quality.sample_rate_source == "median_step" {
+        if log.quality.sample_rate_source == "median_step" || log.quality.bursts.is_some() {
             return None;
         }
         let points: Vec<(f64, f64)> = log

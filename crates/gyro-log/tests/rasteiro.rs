@@ -1,0 +1,84 @@
+//! The rasteiro recordings (../shared/data/real/rasteiro beside the workspace, when
+//! present): rows stamped on arrival at a PC, in bursts. They are recognised as such, and
+//! the grid keeps the integral of the rate the stamps say.
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+use gyro_log::{load, read_log, GridOptions, LogOptions};
+use std::path::PathBuf;
+
+fn recordings() -> Vec<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/real/rasteiro");
+    let mut found: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "csv"))
+                .collect()
+        })
+        .unwrap_or_default();
+    found.sort();
+    if found.is_empty() {
+        eprintln!("skipped: no recordings in {}", dir.display());
+    }
+    found
+}
+
+#[test]
+fn bursts_are_recognised_and_the_integral_is_kept() {
+    for path in recordings() {
+        let raw = read_log(&path, &LogOptions::default()).unwrap();
+        let placed = load(
+            &path,
+            &LogOptions::default(),
+            &GridOptions::default(),
+            &mut |_| {},
+        )
+        .unwrap();
+        let bursts = placed
+            .quality
+            .bursts
+            .unwrap_or_else(|| panic!("{}: not bursts", path.display()));
+        assert!(
+            bursts.off_grid_share > 0.5,
+            "{}: {bursts:?}",
+            path.display()
+        );
+        assert_eq!(placed.quality.sample_rate_source, "mean_step");
+        // About 100 Hz sensors, 101-111 rows per second.
+        assert!(
+            (95.0..120.0).contains(&placed.sample_rate_hz),
+            "{}",
+            placed.sample_rate_hz
+        );
+        // The integral on the grid is the trapezoid on the stamps up to the last grid time.
+        let end_s = placed.slots.last().unwrap().time_s;
+        let mut on_stamps = 0.0;
+        for w in raw.rows.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            let (ra, rb) = (a.rate_dps.unwrap(), b.rate_dps.unwrap());
+            let until = b.time_s.min(end_s);
+            if until > a.time_s {
+                let r_until = ra + (rb - ra) * (until - a.time_s) / (b.time_s - a.time_s);
+                on_stamps += 0.5 * (ra + r_until) * (until - a.time_s);
+            }
+        }
+        let period_s = 1.0 / placed.sample_rate_hz;
+        let on_grid: f64 = placed.slots[1..]
+            .iter()
+            .map(|s| s.rate_dps * period_s)
+            .sum();
+        assert!(
+            (on_grid - on_stamps).abs() < 1e-6 * (1.0 + on_stamps.abs()),
+            "{}: {on_grid} on the grid, {on_stamps} on the stamps",
+            path.display()
+        );
+        // One slot per period of the stamps' span: no time invented.
+        let span_s = raw.rows.last().unwrap().time_s - raw.rows[0].time_s;
+        let expected = span_s * placed.sample_rate_hz;
+        assert!(
+            (placed.slots.len() as f64 - expected).abs() < 2.0,
+            "{} slots, {expected}",
+            placed.slots.len()
+        );
+    }
+}
