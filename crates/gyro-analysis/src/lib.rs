@@ -16,4 +16,5 @@ pub mod diagnose;
 pub mod model;
 pub mod noise;
 pub mod replay;
+pub mod rest_mean;
 pub mod seed;

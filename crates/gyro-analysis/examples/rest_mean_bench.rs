@@ -1,0 +1,102 @@
+//! The default pipeline beside the per-rest estimator on simulated CRM100 bench runs, one
+//! scenario per line: median over runs of the max |accumulated angle error| at the rests,
+//! and the median |error| per movement.
+//!
+//! `cargo run --release -p gyro-analysis --example rest_mean_bench [RUNS]` (default 20 runs
+//! of 90 s at 1 kHz per scenario, seeds 1..=RUNS).
+use gyro_analysis::rest_mean::score;
+use gyro_core::Config;
+use gyro_log::{regularize, GridOptions};
+use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        v[v.len() / 2]
+    }
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let runs: u64 = std::env::args().nth(1).map_or(Ok(20), |a| a.parse())?;
+    let scenarios: [(&str, &[&str]); 6] = [
+        ("nominal model", &[]),
+        ("turn-on bias 0.3 deg/s", &["turn_on_bias:sigma_dps=0.3"]),
+        (
+            "bias instability 0.05 deg/s",
+            &["bias_instability:sigma_dps=0.05"],
+        ),
+        ("output step 0.2 deg/s", &["quantization:lsb_dps=0.2"]),
+        (
+            "rate random walk 0.005",
+            &["rate_random_walk:k_dps_per_rt_s=0.005"],
+        ),
+        (
+            "turn-on bias + random walk",
+            &[
+                "turn_on_bias:sigma_dps=0.3",
+                "rate_random_walk:k_dps_per_rt_s=0.005",
+            ],
+        ),
+    ];
+    println!(
+        "{:<30} {:>5} {:>10} {:>10} {:>6}   {:>10} {:>10} {:>6}",
+        "scenario", "runs", "run max", "oracle", "ratio", "run/move", "oracle", "ratio"
+    );
+    for (name, specs) in scenarios {
+        let effects = specs
+            .iter()
+            .map(|s| Effect::parse(s))
+            .collect::<Result<Vec<_>, _>>()?;
+        let (mut max_run, mut max_oracle, mut move_run, mut move_oracle) =
+            (vec![], vec![], vec![], vec![]);
+        let mut events = vec![];
+        for seed in 1..=runs {
+            let motion = Motion::bench(&BenchProfile::default(), seed);
+            let rotations: Vec<(f64, f64)> = motion
+                .rotations()
+                .iter()
+                .map(|r| (r.start_s, r.start_s + r.duration_s))
+                .collect();
+            let options = SimOptions {
+                seed,
+                ..SimOptions::default()
+            };
+            let log = simulate(&SensorModel::default(), &effects, &motion, &options);
+            let regular = regularize(&log, &GridOptions::default())?;
+            let errors = score(&regular, &rotations, &Config::default())?;
+            let report = gyro_analysis::replay::replay(&regular, &Config::default())?;
+            for r in motion.rotations() {
+                let mid = r.start_s + 0.5 * r.duration_s;
+                let found = report
+                    .movements
+                    .iter()
+                    .find(|m| m.start_time_s <= mid && mid <= m.end_time_s);
+                events.push(found.map_or(f64::INFINITY, |m| {
+                    (f64::from(m.angle_deg) - r.angle_deg).abs()
+                }));
+            }
+            let (p, o) = errors.max_abs();
+            max_run.push(p);
+            max_oracle.push(o);
+            for (p, o) in errors.per_movement() {
+                move_run.push(p.abs());
+                move_oracle.push(o.abs());
+            }
+        }
+        let (a, b) = (median(max_run), median(max_oracle));
+        let (c, d) = (median(move_run), median(move_oracle));
+        let missed = events.iter().filter(|e| e.is_infinite()).count();
+        events.sort_by(f64::total_cmp);
+        println!(
+            "{name:<30} {runs:>5} {a:>9.3}° {b:>9.3}° {:>6.2}   {c:>9.3}° {d:>9.3}° {:>6.2}   \
+             event {:>7.3}° p90 {:>7.3}° missed {missed}",
+            a / b,
+            c / d,
+            events[events.len() / 2],
+            events[events.len() * 9 / 10],
+        );
+    }
+    Ok(())
+}
