@@ -137,12 +137,29 @@ pub struct MotionDetector {
     run_reached_enter: bool,
     rest: Mean,
     run_mean: Mean,
-    /// The latest stretch of the run within `2 × exit_dps` (a candidate new rest level).
+    /// The latest stretch of the run within the level band (a candidate new rest level).
     level: Mean,
     level_min: f32,
     level_max: f32,
     bias_dps: f32,
+    /// Mean |difference| of successive samples near the bias (deg/s): the rest noise the
+    /// level band scales with (exponential average over about `1/NOISE_WEIGHT` samples).
+    noise_dps: f32,
+    /// The previous sample (deg/s), for `noise_dps`.
+    previous_dps: f32,
 }
+
+/// Weight of one sample in the running `noise_dps`.
+const NOISE_WEIGHT: f32 = 1.0 / 32.0;
+/// The level band is at least this many `noise_dps` wide (for white noise low-passed like
+/// the default pipeline, about 3.5 standard deviations each side).
+const BAND_PER_NOISE: f32 = 8.0;
+/// A level is never steady in fewer samples than this (a one-sample `min_rest` says
+/// nothing about steadiness).
+const MIN_LEVEL_SAMPLES: u16 = 3;
+/// Before any rest has been seen, a steady level up to this many `enter_dps` from zero is
+/// taken for the power-up bias rather than a movement.
+const POWER_UP_BIAS_PER_ENTER: f32 = 5.0;
 
 /// Whole samples covering `seconds` at `rate_hz`, at least 1.
 fn samples(seconds: f32, rate_hz: f32) -> u16 {
@@ -184,6 +201,8 @@ impl MotionDetector {
             level_min: 0.0,
             level_max: 0.0,
             bias_dps: config.initial_bias_dps,
+            noise_dps: 0.0,
+            previous_dps: f32::NAN,
         })
     }
 
@@ -205,6 +224,7 @@ impl MotionDetector {
     /// True if the state is finite (it always is for finite input).
     pub fn is_finite(&self) -> bool {
         self.bias_dps.is_finite()
+            && self.noise_dps.is_finite()
             && self.rest.sum.is_finite()
             && self.run_mean.sum.is_finite()
             && self.level.sum.is_finite()
@@ -219,9 +239,24 @@ impl MotionDetector {
     }
 
     /// Classify one (finite) sample.
+    ///
+    /// Besides the thresholds around the bias reference: a *level* (a stretch whose samples
+    /// all lie within a band of `max(2 × exit_dps, 8 × noise)`) lasting `min_rest` samples
+    /// (at least 3) is a rest if its mean is within `near` (`max(enter_dps / 4,
+    /// 2 × exit_dps)`, at most `enter_dps`) of the
+    /// bias (a bias that moved, or a noisier sensor than `exit_dps` allows for) and a slow
+    /// movement if it is further (1–3 deg/s at the end of a tightening); before the first
+    /// rest the bias is unknown, so a steady level up to `5 × enter_dps` is the rest (the
+    /// power-up bias), not a movement.
     pub fn update(&mut self, rate_dps: f32) -> Phase {
         let deviation = libm::fabsf(rate_dps - self.bias_dps);
         let quiet = deviation <= self.exit_dps;
+        let near_dps = self.near_dps();
+        if deviation <= near_dps {
+            self.observe_noise(rate_dps);
+        }
+        self.previous_dps = rate_dps;
+        let bias_known = self.rest.count >= u32::from(self.min_rest);
         match self.state {
             MotionState::Static if quiet => {
                 let aborted = self.run > 0;
@@ -240,17 +275,28 @@ impl MotionDetector {
                 self.run_reached_enter |= deviation > self.enter_dps;
                 self.run_mean.add(rate_dps);
                 self.track_level(rate_dps);
-                if self.run >= self.min_motion && self.run_reached_enter {
-                    let run = self.run;
-                    self.state = MotionState::Dynamic;
-                    self.clear_run();
-                    Phase::Started { run }
-                } else if !self.run_reached_enter && self.level.count >= u32::from(self.min_rest) {
-                    // A bias change, not a movement: the new level is the rest.
+                let steady = self.level.count >= self.steady_samples();
+                let level_dps = self.level.mean().unwrap_or(rate_dps);
+                let level_near = libm::fabsf(level_dps - self.bias_dps) <= near_dps;
+                let power_up = !bias_known
+                    && libm::fabsf(level_dps) <= POWER_UP_BIAS_PER_ENTER * self.enter_dps;
+                // Before the first rest a run that is one steady level so far may still be
+                // the power-up bias: it is not confirmed as a movement yet.
+                let may_be_bias = power_up && self.level.count == u32::from(self.run);
+                if steady && (level_near && !self.run_reached_enter || power_up) {
+                    // A bias change (or the power-up bias), not a movement: the new level
+                    // is the rest.
                     self.rest = self.level;
                     self.clear_run();
                     self.refresh_bias();
                     Phase::Aborted
+                } else if self.run >= self.min_motion
+                    && (self.run_reached_enter && !may_be_bias || steady && !level_near)
+                {
+                    let run = self.run;
+                    self.state = MotionState::Dynamic;
+                    self.clear_run();
+                    Phase::Started { run }
                 } else {
                     Phase::Onset
                 }
@@ -258,6 +304,7 @@ impl MotionDetector {
             MotionState::Dynamic if quiet => {
                 self.run = self.run.saturating_add(1);
                 self.run_mean.add(rate_dps);
+                self.track_level(rate_dps);
                 if self.run >= self.min_rest {
                     let quiet = self.run;
                     self.state = MotionState::Static;
@@ -272,9 +319,53 @@ impl MotionDetector {
                 }
             }
             MotionState::Dynamic => {
-                self.clear_run();
-                Phase::Moving
+                self.run = 0;
+                self.run_mean = Mean::default();
+                self.track_level(rate_dps);
+                let level_dps = self.level.mean().unwrap_or(rate_dps);
+                if self.level.count >= self.steady_samples()
+                    && libm::fabsf(level_dps - self.bias_dps) <= near_dps
+                {
+                    // A steady level near the bias, though not within `exit_dps` of it:
+                    // the rest after the movement, on a bias that moved or a noisy sensor.
+                    // This sample is the movement's end (the level was integrated: its
+                    // residual is small by `near`).
+                    self.state = MotionState::Static;
+                    self.rest = self.level;
+                    self.clear_run();
+                    self.refresh_bias();
+                    Phase::Ended { quiet: 1 }
+                } else {
+                    Phase::Moving
+                }
             }
+        }
+    }
+
+    /// How far from the bias a steady level is still a rest (deg/s).
+    fn near_dps(&self) -> f32 {
+        (0.25 * self.enter_dps)
+            .max(2.0 * self.exit_dps)
+            .min(self.enter_dps)
+    }
+
+    /// Samples a level must last to count as steady: `min_rest`, and at least a few.
+    fn steady_samples(&self) -> u32 {
+        u32::from(self.min_rest.max(MIN_LEVEL_SAMPLES))
+    }
+
+    /// Width of the level band (deg/s).
+    fn band_dps(&self) -> f32 {
+        (2.0 * self.exit_dps).max(BAND_PER_NOISE * self.noise_dps)
+    }
+
+    /// Update the running rest noise with a sample near the bias.
+    fn observe_noise(&mut self, rate_dps: f32) {
+        let step = libm::fabsf(rate_dps - self.previous_dps);
+        if step.is_finite() {
+            // One outlier (a knock) moves the average by a bounded amount.
+            let step = step.min(4.0 * self.near_dps());
+            self.noise_dps += NOISE_WEIGHT * (step - self.noise_dps);
         }
     }
 
@@ -300,11 +391,11 @@ impl MotionDetector {
     }
 
     /// Extend the current level by `rate_dps`, or start a new one if it would span more
-    /// than `2 × exit_dps`.
+    /// than the band.
     fn track_level(&mut self, rate_dps: f32) {
         let low = self.level_min.min(rate_dps);
         let high = self.level_max.max(rate_dps);
-        if self.level.count == 0 || high - low > 2.0 * self.exit_dps {
+        if self.level.count == 0 || high - low > self.band_dps() {
             self.level = Mean::default();
             self.level_min = rate_dps;
             self.level_max = rate_dps;
@@ -463,6 +554,109 @@ mod tests {
             d.update(0.0);
         }
         assert_eq!(d.state(), MotionState::Static);
+    }
+
+    /// Deterministic noise in [-amplitude, amplitude] (a fixed pseudo-random sequence).
+    fn noise(k: u32, amplitude: f32) -> f32 {
+        let x = k.wrapping_mul(2_654_435_761) >> 8;
+        amplitude * ((x % 2001) as f32 / 1000.0 - 1.0)
+    }
+
+    /// The default thresholds (exit 0.08, enter 2.0 deg/s) at 50 Hz.
+    fn default_detector() -> MotionDetector {
+        MotionDetector::try_new(&MotionConfig::default(), 50.0).unwrap()
+    }
+
+    #[test]
+    fn slow_turns_are_movements_not_bias() {
+        for slow_dps in [1.0_f32, 1.5, 3.0, -1.0, -3.0] {
+            let mut d = default_detector();
+            for k in 0..100 {
+                d.update(0.1 + noise(k, 0.02));
+            }
+            assert!((d.bias_dps() - 0.1).abs() < 0.01);
+            // The last degrees of a tightening: a steady slow rate for 2 s.
+            let mut started = false;
+            for k in 0..100 {
+                started |= matches!(
+                    d.update(0.1 + slow_dps + noise(k, 0.02)),
+                    Phase::Started { .. }
+                );
+            }
+            assert!(started, "{slow_dps} deg/s");
+            assert_eq!(d.state(), MotionState::Dynamic, "{slow_dps} deg/s");
+            assert!(
+                (d.bias_dps() - 0.1).abs() < 0.01,
+                "{slow_dps}: bias {}",
+                d.bias_dps()
+            );
+            // And it ends at the rest after it.
+            for k in 0..30 {
+                d.update(0.1 + noise(k, 0.02));
+            }
+            assert_eq!(d.state(), MotionState::Static, "{slow_dps} deg/s");
+        }
+    }
+
+    #[test]
+    fn a_power_up_bias_of_a_few_deg_per_s_is_the_rest() {
+        for bias in [3.0_f32, -4.0, 8.0] {
+            let mut d = default_detector();
+            for k in 0..50 {
+                let phase = d.update(bias + noise(k, 0.02));
+                assert!(
+                    !matches!(phase, Phase::Started { .. }),
+                    "{bias}: sample {k}"
+                );
+            }
+            assert_eq!(d.state(), MotionState::Static);
+            assert!(
+                (d.bias_dps() - bias).abs() < 0.02,
+                "{bias}: {}",
+                d.bias_dps()
+            );
+            // A movement is then found and ends.
+            for _ in 0..20 {
+                d.update(bias + 50.0);
+            }
+            assert_eq!(d.state(), MotionState::Dynamic);
+            for k in 0..20 {
+                d.update(bias + noise(k, 0.02));
+            }
+            assert_eq!(d.state(), MotionState::Static);
+        }
+        // Far beyond a plausible bias, a steady rate at power-up is a movement.
+        let mut d = default_detector();
+        for _ in 0..50 {
+            d.update(40.0);
+        }
+        assert_eq!(d.state(), MotionState::Dynamic);
+    }
+
+    /// A sensor noisier than `exit_dps` allows for, whose rest after a movement sits 0.1
+    /// deg/s off the rest before it (as on the rasteiro MPU6500 recordings): the movement
+    /// still ends.
+    #[test]
+    fn a_noisy_rest_off_the_old_bias_ends_the_movement() {
+        let mut d = default_detector();
+        for k in 0..100 {
+            d.update(noise(k, 0.07));
+        }
+        assert_eq!(d.state(), MotionState::Static);
+        for _ in 0..30 {
+            d.update(150.0);
+        }
+        assert_eq!(d.state(), MotionState::Dynamic);
+        let mut ended = None;
+        for k in 0..60 {
+            if let Phase::Ended { quiet } = d.update(0.1 + noise(k + 7, 0.07)) {
+                ended = Some((k, quiet));
+                break;
+            }
+        }
+        let (k, _) = ended.expect("the movement ends");
+        assert!(k < 20, "ended after {k} samples");
+        assert!((d.bias_dps() - 0.1).abs() < 0.05, "{}", d.bias_dps());
     }
 
     #[test]

@@ -269,7 +269,6 @@ pub struct Pipeline {
     corrector: Corrector,
     compensation: Compensation,
     paper: GaussMarkov,
-    input_period_s: f64,
     output_period_s: f32,
     filter_delay_s: f64,
     decimator: Decimator,
@@ -312,7 +311,6 @@ impl Pipeline {
             corrector: Corrector::try_new(&config.correction)?,
             compensation: config.compensation,
             paper: config.paper,
-            input_period_s: 1.0 / f64::from(config.sample_rate_hz),
             output_period_s,
             filter_delay_s: dc_group_delay_samples(&design) * f64::from(output_period_s),
             decimator: Decimator::try_new(factor)?,
@@ -411,7 +409,8 @@ impl Pipeline {
         let time_s = if time_s.is_finite() {
             time_s
         } else if self.last_time_s.is_finite() {
-            self.last_time_s + self.input_period_s
+            // One input period on from the last time (the output period over the factor).
+            self.last_time_s + f64::from(self.output_period_s) / f64::from(self.decimator.factor())
         } else {
             0.0
         };
