@@ -38,6 +38,7 @@
 mod butterworth;
 mod correction;
 mod decimator;
+mod decision;
 mod error;
 mod gauss_markov;
 mod integrator;
@@ -50,6 +51,7 @@ mod sos;
 pub use butterworth::{Butterworth, SosDesign, MAX_ORDER};
 pub use correction::{Correction, Corrector, MAX_DELTA_C, MIN_SCALE, TEMPERATURE_RANGE_C};
 pub use decimator::Decimator;
+pub use decision::{decide, Direction, Tightening, Verdict};
 pub use error::Error;
 pub use gauss_markov::GaussMarkov;
 pub use integrator::Integrator;
