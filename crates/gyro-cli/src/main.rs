@@ -84,6 +84,9 @@ fn flag_hint(error: &anyhow::Error) -> Option<&'static str> {
         .and_then(|e| match e {
             LogError::SampleRateInvalid { .. } => Some(" (--sample-rate-hz)"),
             LogError::SampleRateUnknown { .. } => Some(" with --sample-rate-hz"),
+            LogError::SampleRateDisagrees { .. } => {
+                Some(" (fix --sample-rate-hz or the metadata, or leave it out)")
+            }
             LogError::Gap { .. } => Some(" (--max-gap-s)"),
             LogError::McapSecondRate { .. } => Some(" with --topic"),
             LogError::McapZeroStamp { .. } => Some(": --time-source log-time"),

@@ -274,3 +274,25 @@ fn calibrate_and_noise_take_mcap_and_refuse_logs_without_reference() {
         "{stderr}"
     );
 }
+
+/// A declared rate the stamps contradict is refused, not turned into angles off by the
+/// ratio (100 Hz declared on the 1 kHz bench log: a 90° turn would read 900°).
+#[test]
+fn a_declared_rate_the_stamps_contradict_is_refused() {
+    let log = bench_log();
+    let log = log.to_str().unwrap();
+    for rate in ["100", "1e9"] {
+        let out = gyro(&["run", log, "--sample-rate-hz", rate]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{rate}: {stderr}");
+        assert!(stderr.contains("time stamps say 1000"), "{rate}: {stderr}");
+        assert!(stderr.contains("--sample-rate-hz"), "{rate}: {stderr}");
+    }
+    // Within 20% of the stamps: accepted.
+    let out = gyro(&["run", log, "--sample-rate-hz", "990"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -383,11 +383,11 @@ mod tests {
             "{}",
             on_grid - bias_deg
         );
-        // The same rows placed one per slot at the median step invent rotation.
+        // A given rate (within what the stamps allow) keeps the resampling.
         let per_row = regularize(
             &log,
             &GridOptions {
-                sample_rate_hz: Some(1.0 / 0.0025),
+                sample_rate_hz: Some(110.0),
                 ..GridOptions::default()
             },
         )
@@ -398,6 +398,40 @@ mod tests {
         );
         let end_s = per_row.slots.last().unwrap().time_s;
         assert!((integral_deg(&per_row) - on_stamps_deg(&log, end_s)).abs() < 1e-9);
+    }
+
+    /// A rate the stamps contradict (here 4x) is refused, naming both.
+    #[test]
+    fn a_given_rate_the_stamps_contradict_is_refused() {
+        let log = turn_log(|_, t| t);
+        let err = regularize(
+            &log,
+            &GridOptions {
+                sample_rate_hz: Some(400.0),
+                ..GridOptions::default()
+            },
+        )
+        .unwrap_err();
+        let text = err.to_string();
+        assert!(
+            text.contains("400 Hz") && text.contains("say 100.0"),
+            "{text}"
+        );
+        let mut with_metadata = log.clone();
+        with_metadata
+            .metadata
+            .insert("sample_rate_hz".into(), "1000".into());
+        let err = regularize(&with_metadata, &GridOptions::default()).unwrap_err();
+        assert!(err.to_string().contains("sample_rate_hz metadata"), "{err}");
+        // Within 20%: accepted (a logger clock a few percent off is not a wrong rate).
+        assert!(regularize(
+            &log,
+            &GridOptions {
+                sample_rate_hz: Some(95.0),
+                ..GridOptions::default()
+            }
+        )
+        .is_ok());
     }
 
     #[test]

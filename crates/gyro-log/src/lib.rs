@@ -260,6 +260,23 @@ pub enum LogError {
         /// The rate given (Hz).
         rate_hz: f64,
     },
+    /// The sample rate given (option or metadata) disagrees with the time stamps.
+    #[error(
+        "{path}: the {source_name} gives {rate_hz} Hz but the time stamps say {measured_hz:.6} Hz ({ratio:.4} times that); on the given rate every angle would be off by that factor"
+    )]
+    SampleRateDisagrees {
+        /// File.
+        path: PathBuf,
+        /// The rate given (Hz).
+        rate_hz: f64,
+        /// Where it came from: "option" or "metadata" (printed as a phrase).
+        source_name: &'static str,
+        /// The rate of the stamps (Hz): the median step's, or the mean row rate for rows
+        /// arriving in bursts.
+        measured_hz: f64,
+        /// `measured_hz / rate_hz`.
+        ratio: f64,
+    },
     /// No sample rate given, none in the metadata, and the stamps cannot give one.
     #[error(
         "{path}: cannot estimate the sample rate (fewer than two distinct time stamps); give the sample rate"

@@ -192,6 +192,58 @@ fn given_rate(
     info.metadata_rate_hz.map(|rate| Ok((rate, "metadata")))
 }
 
+/// A given rate further than this factor from the rate the stamps measure is refused.
+pub const RATE_DISAGREEMENT: f64 = 1.2;
+
+/// Positive steps needed before a given rate is checked against the stamps.
+pub const RATE_CHECK_MIN_STEPS: usize = 20;
+
+/// Refuse a given rate (option or metadata) that the first rows' stamps contradict by more
+/// than [`RATE_DISAGREEMENT`]: the stamps' rate is the mean row rate for rows arriving in
+/// bursts, else the median step's. (Nothing to check with fewer than
+/// [`RATE_CHECK_MIN_STEPS`] positive steps: a median of a few steps says little.)
+pub(crate) fn check_given_rate(
+    path: &Path,
+    rows: &[Row],
+    arrival: Option<Bursts>,
+    rate_hz: f64,
+    source: &'static str,
+) -> Result<(), LogError> {
+    if source != "option" && source != "metadata" {
+        return Ok(());
+    }
+    let positive = rows
+        .windows(2)
+        .take(RATE_WINDOW_STEPS)
+        .filter(|w| w[1].time_s > w[0].time_s)
+        .count();
+    if positive < RATE_CHECK_MIN_STEPS {
+        return Ok(());
+    }
+    let measured_hz = match arrival {
+        Some(b) => 1.0 / b.mean_step_s,
+        None => match median_step_rate(path, rows) {
+            Ok((hz, _)) => hz,
+            Err(_) => return Ok(()),
+        },
+    };
+    let ratio = measured_hz / rate_hz;
+    if ratio > RATE_DISAGREEMENT || ratio < 1.0 / RATE_DISAGREEMENT {
+        return Err(LogError::SampleRateDisagrees {
+            path: path.to_path_buf(),
+            rate_hz,
+            source_name: if source == "option" {
+                "--sample-rate-hz option"
+            } else {
+                "sample_rate_hz metadata"
+            },
+            measured_hz,
+            ratio,
+        });
+    }
+    Ok(())
+}
+
 /// The rate from the median positive step of the first [`RATE_WINDOW_STEPS`] steps.
 fn median_step_rate(path: &Path, rows: &[Row]) -> Result<(f64, &'static str), LogError> {
     let mut steps: Vec<f64> = rows
@@ -278,6 +330,9 @@ pub fn place<S: SlotSink + ?Sized>(
         (None, Some(b)) => Ok((1.0 / b.mean_step_s, "mean_step")),
         (None, None) => median_step_rate(info.path, &ahead),
     };
+    let rate = rate.and_then(|(rate_hz, source)| {
+        check_given_rate(info.path, &ahead, arrival, rate_hz, source).map(|()| (rate_hz, source))
+    });
     let (rate_hz, source) = match rate {
         Ok(rate) => rate,
         Err(e) => {
@@ -781,6 +836,7 @@ mod tests {
             }
             let arrival = crate::bursts::classify(&log.rows, 100_000);
             let (rate_hz, source) = sample_rate(log, options, arrival)?;
+            super::super::check_given_rate(&log.path, &log.rows, arrival, rate_hz, source)?;
             if let Some(b) = arrival {
                 return resample_whole(log, options, rate_hz, source, b);
             }
