@@ -228,7 +228,7 @@ pub(crate) fn check_given_rate(
         },
     };
     let ratio = measured_hz / rate_hz;
-    if ratio > RATE_DISAGREEMENT || ratio < 1.0 / RATE_DISAGREEMENT {
+    if !(1.0 / RATE_DISAGREEMENT..=RATE_DISAGREEMENT).contains(&ratio) {
         return Err(LogError::SampleRateDisagrees {
             path: path.to_path_buf(),
             rate_hz,
