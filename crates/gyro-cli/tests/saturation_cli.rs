@@ -89,7 +89,14 @@ fn table_marks_and_warns_and_csv_has_a_column() {
         "{plain}"
     );
 
-    let csv = ok(&gyro(&["run", log, "--format", "csv", "--range-dps", "120"]));
+    let csv = ok(&gyro(&[
+        "run",
+        log,
+        "--format",
+        "csv",
+        "--range-dps",
+        "120",
+    ]));
     let mut lines = csv.lines();
     assert!(lines.next().unwrap().ends_with(",saturated"));
     let rows: Vec<&str> = lines.collect();

@@ -94,7 +94,7 @@ fn rests_on_a_quantised_output_are_not_flagged() {
     let profile = one_turn();
     for (bias_dps, lsb_dps) in [(0.0, 1.0), (5.0, 1.0), (-20.0, 2.0), (0.25, LSB_DPS)] {
         // At rest the output repeats the bias on the output grid; the turn is read finely.
-        let rest_value = ((bias_dps / lsb_dps as f64).round() * lsb_dps) as f32;
+        let rest_value = ((bias_dps / lsb_dps).round() * lsb_dps) as f32;
         let mut samples = readings(&profile, bias_dps, LSB_DPS, 300.0, 2);
         for (i, sample) in samples.iter_mut().enumerate() {
             if profile.rate_dps(i as f64 / FS_HZ) == 0.0 {
