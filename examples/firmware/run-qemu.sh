@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Boot the firmware example on an emulated Cortex-M4F (QEMU mps2-an386) and check that it
 # computes exactly what the host computes: the same rate words go through `gyro-cli run`
-# (paper and kalman compensation), and every movement (start, end, angle, raw angle) and the
-# final angles must be the same numbers, bit for bit.
+# (paper and kalman compensation), and every movement (start, end, angle, raw angle, the
+# saturated flag) and the final angles must be the same numbers, bit for bit.
 #
 # Needs: cargo with the thumbv7em-none-eabihf target, qemu-system-arm, jq, od, awk.
 #   apt-get install -y --no-install-recommends qemu-system-arm jq
@@ -57,12 +57,12 @@ csv=$work/bench_run_20s.csv
 } >"$csv"
 for compensation in paper kalman; do
     (cd "$root" && cargo run -q -p gyro-cli -- run "$csv" --compensation "$compensation" \
-        --format json) >"$work/host-$compensation.json"
-    # One "compensation what key value" line per figure.
+        --range-dps 300 --format json) >"$work/host-$compensation.json"
+    # One "compensation what key value" line per figure (the saturated flag as 0 or 1).
     jq -r --arg c "$compensation" '
         (.movements[] | select(.complete) | . as $m
-            | ("start_time_s", "end_time_s", "angle_deg", "raw_angle_deg")
-            | "\($c) movement_\($m.index) \(.) \($m[.])"),
+            | ("start_time_s", "end_time_s", "angle_deg", "raw_angle_deg", "saturated")
+            | "\($c) movement_\($m.index) \(.) \($m[.] | if type == "boolean" then (if . then 1 else 0 end) else . end)"),
         (.summary | . as $s
             | ("outputs", "rejected_samples", "movements", "final_angle_deg", "final_raw_angle_deg")
             | "\($c) summary \(.) \($s[.])")' "$work/host-$compensation.json"
@@ -74,7 +74,7 @@ awk '
         delete f
         for (i = 2; i <= NF; i++) { split($i, kv, "="); f[kv[1]] = kv[2] }
         if ($1 == "movement") {
-            n = split("start_time_s end_time_s angle_deg raw_angle_deg", keys, " ")
+            n = split("start_time_s end_time_s angle_deg raw_angle_deg saturated", keys, " ")
             what = "movement_" f["index"]
         } else {
             n = split("outputs rejected_samples movements final_angle_deg final_raw_angle_deg", keys, " ")

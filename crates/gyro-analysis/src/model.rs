@@ -70,6 +70,15 @@ impl ModelFile {
             reference_delay_s: 0.0,
         }
     }
+
+    /// The sensor's full-scale range (deg/s) the pipeline flags saturation at:
+    /// `config.range_dps` if set, else the sensor section's `range_dps` (whose default is
+    /// the CRM100's ±300 deg/s, like the rest of the section).
+    pub fn range_dps(&self) -> f32 {
+        self.config
+            .range_dps
+            .unwrap_or(self.sensor.range_dps as f32)
+    }
 }
 
 /// Why a model file could not be used.

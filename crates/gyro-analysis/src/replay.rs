@@ -67,6 +67,9 @@ pub struct MovementResult {
     pub error_deg: Option<f64>,
     /// `raw_angle_deg − reference_deg`.
     pub raw_error_deg: Option<f64>,
+    /// A reading reached the sensor's range or a clip plateau during the movement (the
+    /// core's [`gyro_core::Movement::saturated`]): the angle is a lower bound.
+    pub saturated: bool,
     /// The output samples (indices into [`RunReport::series`]) that bound the movement, as
     /// the core published them: its last quiet sample before and first quiet sample after
     /// (the last sample if the log ends while moving). Not in the JSON.
@@ -435,6 +438,7 @@ impl Replayer {
                     (m.start_time_s, m.end_time_s),
                     true,
                     (m.angle_deg, m.raw_angle_deg),
+                    m.saturated,
                     samples,
                     reference_change(series, at_times),
                 ));
@@ -469,6 +473,7 @@ impl Replayer {
                     last.angle_deg - first.angle_deg,
                     last.raw_angle_deg - first.raw_angle_deg,
                 ),
+                pipeline.movement_saturated(),
                 samples,
                 reference_change(&series, at_times),
             ));
@@ -564,6 +569,7 @@ fn movement_result(
     (start_time_s, end_time_s): (f64, f64),
     complete: bool,
     (angle_deg, raw_angle_deg): (f32, f32),
+    saturated: bool,
     samples: (usize, usize),
     reference_deg: Option<f64>,
 ) -> MovementResult {
@@ -578,6 +584,7 @@ fn movement_result(
         reference_deg,
         error_deg: reference_deg.map(|r| f64::from(angle_deg) - r),
         raw_error_deg: reference_deg.map(|r| f64::from(raw_angle_deg) - r),
+        saturated,
         samples,
     }
 }

@@ -56,7 +56,29 @@ pub struct Config {
         serde(skip_serializing_if = "Correction::is_exactly_identity")
     )]
     pub correction: Correction,
+    /// The sensor's full-scale range (deg/s), if known: a movement during which a reading
+    /// reaches it (within [`RANGE_MARGIN`]) is flagged [`Movement::saturated`]. Unknown by
+    /// default (then only a clip plateau flags one; see [`Movement::saturated`]). Left out
+    /// when serialized as unknown.
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    pub range_dps: Option<f32>,
 }
+
+/// A reading within this fraction of [`Config::range_dps`] counts as reaching the range
+/// (0.5%: 36 of the CRM100's 7200 full-scale counts, far above its noise).
+pub const RANGE_MARGIN: f32 = 0.005;
+
+/// Consecutive identical readings, at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`], that make a clip
+/// plateau. On the nominal CRM100 (white noise 0.15 deg/s per sample, step 1/24 deg/s) two
+/// readings of a steady rate are equal with probability about 0.08, and with a 0.2 deg/s
+/// step about 0.4; 16 in a row then happen about 0.4^15 ≈ 1e-6 of the time at a steady
+/// peak. An output step much coarser than the noise makes a slow peak flat: set
+/// [`Config::range_dps`] for such a sensor rather than rely on the plateau.
+pub const CLIP_PLATEAU_SAMPLES: u8 = 16;
+
+/// The least |rate| (deg/s) a clip plateau sits at: far above any gyro's bias, so that a
+/// rest on a quantised output (the same reading again and again) is never one.
+pub const CLIP_PLATEAU_MIN_DPS: f32 = 30.0;
 
 impl Default for Config {
     /// 1 kHz in, 50 Hz out, 2nd-order Butterworth at 12.5 Hz, Kalman compensation.
@@ -86,6 +108,7 @@ impl Default for Config {
             paper: GaussMarkov::default(),
             kalman: KalmanConfig::default(),
             correction: Correction::IDENTITY,
+            range_dps: None,
         }
     }
 }
@@ -144,6 +167,11 @@ pub struct Movement {
     pub angle_deg: f32,
     /// Angle turned, uncompensated (deg).
     pub raw_angle_deg: f32,
+    /// A reading during the movement (its confirming run included) reached the sensor's
+    /// range ([`Config::range_dps`], within [`RANGE_MARGIN`]) or sat on a clip plateau
+    /// ([`CLIP_PLATEAU_SAMPLES`] identical readings at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`]):
+    /// the angle is then a lower bound of the turn.
+    pub saturated: bool,
 }
 
 /// One output sample, at the decimated rate.
@@ -181,6 +209,8 @@ struct Track {
     settle_index: Option<u32>,
     raw_at_start_deg: f32,
     angle_at_start_deg: f32,
+    /// A reading reached the range or a clip plateau (in the struct's padding).
+    saturated: bool,
 }
 
 impl Track {
@@ -208,40 +238,46 @@ impl Track {
 /// pipeline's state small.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct RestBlocks {
+    fresh_sum: KahanSum,
+    aged_sum: KahanSum,
+    // The counts side by side: 4 bytes less than (sum, count) pairs with their padding.
+    fresh_count: u16,
+    aged_count: u16,
     block: u16,
-    fresh: (KahanSum, u16),
-    aged: (KahanSum, u16),
 }
 
 impl RestBlocks {
     fn new(block: u16) -> Self {
         Self {
+            fresh_sum: KahanSum::ZERO,
+            aged_sum: KahanSum::ZERO,
+            fresh_count: 0,
+            aged_count: 0,
             block,
-            fresh: (KahanSum::ZERO, 0),
-            aged: (KahanSum::ZERO, 0),
         }
     }
 
     /// Add a rest sample; returns a released block's (mean, count).
     fn push(&mut self, rate_dps: f32) -> Option<(f32, u16)> {
-        self.fresh.0.add(rate_dps);
-        self.fresh.1 += 1;
-        if self.fresh.1 < self.block.max(1) {
+        self.fresh_sum.add(rate_dps);
+        self.fresh_count += 1;
+        if self.fresh_count < self.block.max(1) {
             return None;
         }
-        let (sum, count) = core::mem::replace(&mut self.aged, self.fresh);
-        self.fresh = (KahanSum::ZERO, 0);
+        let sum = core::mem::replace(&mut self.aged_sum, self.fresh_sum);
+        let count = core::mem::replace(&mut self.aged_count, self.fresh_count);
+        self.fresh_sum = KahanSum::ZERO;
+        self.fresh_count = 0;
         (count > 0).then(|| (sum.value() / f32::from(count), count))
     }
 
     /// Drop the pending blocks (a movement starts).
     fn clear(&mut self) {
-        self.fresh = (KahanSum::ZERO, 0);
-        self.aged = (KahanSum::ZERO, 0);
+        *self = Self::new(self.block);
     }
 
     fn is_finite(&self) -> bool {
-        self.fresh.0.is_finite() && self.aged.0.is_finite()
+        self.fresh_sum.is_finite() && self.aged_sum.is_finite()
     }
 }
 
@@ -266,6 +302,14 @@ fn dc_group_delay_samples(design: &SosDesign) -> f64 {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pipeline {
     max_abs_rate_dps: f32,
+    /// |reading| at which the range counts as reached (infinite if unknown).
+    clip_level_dps: f32,
+    /// The last accepted reading and how many times in a row it came (up to the plateau).
+    clip_last_dps: f32,
+    clip_run: u8,
+    /// A reading reached the range or a plateau since the last output step, or during the
+    /// run that may become a movement.
+    clip_pending: bool,
     corrector: Corrector,
     compensation: Compensation,
     paper: GaussMarkov,
@@ -285,7 +329,9 @@ pub struct Pipeline {
     block_start_time_s: f64,
     last_time_s: f64,
     last_valid_rate_dps: f32,
-    previous: Option<(f32, f32)>,
+    /// The previous output step's rate and corrected rate; meaningful from index 1 on
+    /// (a tuple rather than an `Option`, whose tag costs 4 bytes of the state budget).
+    previous: (f32, f32),
     index: u32,
     rejected: u32,
 }
@@ -306,8 +352,19 @@ impl Pipeline {
         config.paper.validate()?;
         let output_period_s = 1.0 / output_rate_hz;
         let detector = MotionDetector::try_new(&config.motion, output_rate_hz)?;
+        let clip_level_dps = match config.range_dps {
+            Some(range_dps) => {
+                check_range("range_dps", range_dps.into(), 1e-3, 1e30)?;
+                range_dps * (1.0 - RANGE_MARGIN)
+            }
+            None => f32::INFINITY,
+        };
         Ok(Self {
             max_abs_rate_dps: config.max_abs_rate_dps,
+            clip_level_dps,
+            clip_last_dps: f32::NAN,
+            clip_run: 0,
+            clip_pending: false,
             corrector: Corrector::try_new(&config.correction)?,
             compensation: config.compensation,
             paper: config.paper,
@@ -327,7 +384,7 @@ impl Pipeline {
             block_start_time_s: f64::NAN,
             last_time_s: f64::NAN,
             last_valid_rate_dps: 0.0,
-            previous: None,
+            previous: (0.0, 0.0),
             index: 0,
             rejected: 0,
         })
@@ -417,6 +474,7 @@ impl Pipeline {
         // Plausibility is judged on the reading; a rejected sample is replaced by the last
         // valid one, corrected as it was then.
         let rate_dps = if rate_dps.is_finite() && libm::fabsf(rate_dps) <= self.max_abs_rate_dps {
+            self.observe_clip(rate_dps);
             let corrected = if with_temperature {
                 self.corrector.correct_at_temperature(rate_dps)
             } else {
@@ -436,6 +494,29 @@ impl Pipeline {
         // Halves first: the sum of two huge times would overflow.
         let centre_s = 0.5 * self.block_start_time_s + 0.5 * time_s;
         Some(self.step(centre_s, mean_dps))
+    }
+
+    /// Flag a reading that reaches the range or completes a clip plateau (see
+    /// [`Movement::saturated`]). Judged on the reading, before correction.
+    fn observe_clip(&mut self, reading_dps: f32) {
+        self.clip_run = if reading_dps == self.clip_last_dps {
+            self.clip_run.saturating_add(1)
+        } else {
+            1
+        };
+        self.clip_last_dps = reading_dps;
+        let magnitude = libm::fabsf(reading_dps);
+        if magnitude >= self.clip_level_dps
+            || (self.clip_run >= CLIP_PLATEAU_SAMPLES && magnitude >= CLIP_PLATEAU_MIN_DPS)
+        {
+            self.clip_pending = true;
+        }
+    }
+
+    /// Whether the movement in progress (its confirming run included) is saturated so far;
+    /// `false` at rest. For a host whose log ends while moving.
+    pub fn movement_saturated(&self) -> bool {
+        self.clip_pending || self.track.as_ref().is_some_and(|track| track.saturated)
     }
 
     /// One step at the output rate.
@@ -463,11 +544,21 @@ impl Pipeline {
         let corrected_dps = rate_dps - self.kalman.bias_dps();
         // The first sample has no interval before it: nothing to integrate (a log that starts
         // in motion would otherwise gain a whole step of T × rate).
-        if let (true, Some((previous_rate, previous_corrected))) = (integrates, self.previous) {
+        if integrates && self.index > 0 {
+            let (previous_rate, previous_corrected) = self.previous;
             self.raw.step(previous_rate, rate_dps);
             self.corrected.step(previous_corrected, corrected_dps);
         }
-        self.previous = Some((rate_dps, corrected_dps));
+        self.previous = (rate_dps, corrected_dps);
+
+        // Saturation seen in this block goes to the movement in progress; during a run that
+        // may become one it waits; at rest, or when the run is dropped, it is forgotten.
+        match (phase, self.track.as_mut()) {
+            (Phase::Rest | Phase::Aborted, _) => self.clip_pending = false,
+            (Phase::Onset | Phase::Started { .. }, _) => {}
+            (_, Some(track)) => track.saturated |= core::mem::take(&mut self.clip_pending),
+            (_, None) => self.clip_pending = false,
+        }
 
         let event = match phase {
             Phase::Rest => {
@@ -498,6 +589,7 @@ impl Pipeline {
                     angle_at_start_deg: self.committed_angle_deg(),
                     settle_time_s: 0.0,
                     settle_index: None,
+                    saturated: core::mem::take(&mut self.clip_pending),
                 });
                 self.commit();
                 Some(Event::MovementStarted {
@@ -575,6 +667,7 @@ impl Pipeline {
             end_index,
             angle_deg: self.angle_deg() - track.angle_at_start_deg,
             raw_angle_deg,
+            saturated: track.saturated,
         })
     }
 
@@ -613,9 +706,10 @@ impl Pipeline {
 mod size_tests {
     use super::Pipeline;
 
-    /// The firmware budget: the whole pipeline state in 512 bytes at most. With the
-    /// corrector (24 bytes) it is exactly 512: `Track` gave up 8 bytes of `Option` padding
-    /// to make room (see its documentation).
+    /// The firmware budget: the whole pipeline state in 512 bytes at most. It is exactly
+    /// 512 (511 of fields): `Track` gave up 8 bytes of `Option` padding for the corrector,
+    /// and the saturation state (10 bytes) is paid for by `previous` without an `Option` tag
+    /// and the sample rate kept as f32 instead of the period as f64.
     #[test]
     fn pipeline_state_fits_in_512_bytes() {
         use core::mem::size_of;

@@ -224,6 +224,7 @@ fn any_valid_config() -> impl Strategy<Value = Config> {
         kalman,
         10.0..1e6_f32,
         any_valid_correction(),
+        proptest::option::of(1.0..1e4_f32),
     )
         .prop_map(
             |(
@@ -235,6 +236,7 @@ fn any_valid_config() -> impl Strategy<Value = Config> {
                 (kalman_beta, bias_sigma_dps, bias_mean_dps, rate_noise_dps, initial_sigma),
                 max_abs_rate_dps,
                 correction,
+                range_dps,
             )| {
                 let factor = factor.min(sample_rate_hz as u16);
                 let output_rate_hz = sample_rate_hz / f32::from(factor);
@@ -267,6 +269,7 @@ fn any_valid_config() -> impl Strategy<Value = Config> {
                         initial_bias_sigma_dps: initial_sigma,
                     },
                     correction,
+                    range_dps,
                 }
             },
         )

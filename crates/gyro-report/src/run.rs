@@ -68,7 +68,7 @@ pub fn table(file: &str, report: &RunReport) -> String {
     }
     let _ = writeln!(
         s,
-        "pipeline: decimate x{} -> {} Hz, Butterworth order {} at {} Hz, compensation {}",
+        "pipeline: decimate x{} -> {} Hz, Butterworth order {} at {} Hz, compensation {}{}",
         report.decimation_factor,
         report.output_rate_hz,
         c.filter.order,
@@ -77,7 +77,9 @@ pub fn table(file: &str, report: &RunReport) -> String {
             gyro_core::Compensation::None => "none",
             gyro_core::Compensation::Paper => "paper",
             gyro_core::Compensation::Kalman => "kalman",
-        }
+        },
+        c.range_dps
+            .map_or(String::new(), |r| format!(", sensor range ±{r} deg/s"))
     );
     let k = &c.correction;
     if !k.is_identity() {
@@ -133,12 +135,16 @@ pub fn table(file: &str, report: &RunReport) -> String {
                 opt(m.reference_deg, 3),
                 opt(m.error_deg, 3),
                 opt(m.raw_error_deg, 3),
-                if m.complete {
-                    ""
-                } else {
-                    "  (log ends while moving)"
+                match (m.saturated, m.complete) {
+                    (false, true) => "",
+                    (false, false) => "  (log ends while moving)",
+                    (true, true) => "  SATURATED",
+                    (true, false) => "  SATURATED (log ends while moving)",
                 }
             );
+        }
+        for m in report.movements.iter().filter(|m| m.saturated) {
+            let _ = writeln!(s, "warning: {}", saturation_warning(m.index, c.range_dps));
         }
     }
     let sm = &report.summary;
@@ -168,6 +174,19 @@ pub fn table(file: &str, report: &RunReport) -> String {
     s
 }
 
+/// Why movement `index` is flagged saturated, and what that means for its angle.
+fn saturation_warning(index: usize, range_dps: Option<f32>) -> String {
+    let what = match range_dps {
+        Some(r) => format!("reached the sensor range ({r} deg/s) or clipped below it"),
+        None => format!(
+            "clipped ({} identical readings at >= {} deg/s; sensor range unknown)",
+            gyro_core::CLIP_PLATEAU_SAMPLES,
+            gyro_core::CLIP_PLATEAU_MIN_DPS
+        ),
+    };
+    format!("movement {index} {what}: its angle is a lower bound")
+}
+
 /// JSON: `{"file", "input", "config", "summary", "movements", ...}`.
 pub fn json(file: &str, report: &RunReport) -> serde_json::Result<String> {
     #[derive(serde::Serialize)]
@@ -183,12 +202,12 @@ pub fn json(file: &str, report: &RunReport) -> serde_json::Result<String> {
 pub fn movements_csv(out: &mut impl Write, movements: &[MovementResult]) -> io::Result<()> {
     writeln!(
         out,
-        "index,start_time_s,end_time_s,duration_s,complete,angle_deg,raw_angle_deg,reference_deg,error_deg,raw_error_deg"
+        "index,start_time_s,end_time_s,duration_s,complete,angle_deg,raw_angle_deg,reference_deg,error_deg,raw_error_deg,saturated"
     )?;
     for m in movements {
         writeln!(
             out,
-            "{},{:.6},{:.6},{:.6},{},{:.6},{:.6},{},{},{}",
+            "{},{:.6},{:.6},{:.6},{},{:.6},{:.6},{},{},{},{}",
             m.index,
             m.start_time_s,
             m.end_time_s,
@@ -199,6 +218,7 @@ pub fn movements_csv(out: &mut impl Write, movements: &[MovementResult]) -> io::
             m.reference_deg.map_or(String::new(), |v| format!("{v:.6}")),
             m.error_deg.map_or(String::new(), |v| format!("{v:.6}")),
             m.raw_error_deg.map_or(String::new(), |v| format!("{v:.6}")),
+            m.saturated,
         )?;
     }
     Ok(())

@@ -22,7 +22,9 @@ use core::mem::size_of;
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
-use crm100_driver::{temperature_c_to_word, Crm100, Range, Settings, DEFAULT_CS_LEAD_NS};
+use crm100_driver::{
+    temperature_c_to_word, Crm100, Error, FrameError, Range, Settings, DEFAULT_CS_LEAD_NS,
+};
 use gyro_core::{Compensation, Config, Event, Output, Pipeline};
 use panic_semihosting as _; // a panic prints its message and exits QEMU with a failure
 
@@ -91,14 +93,16 @@ impl Channel {
             Some(Event::MovementEnded(movement)) => {
                 self.movements += 1;
                 // On the wrench: this is where the turned angle goes to the tightening logic.
+                // A saturated movement's angle is a lower bound: not a tightening to accept.
                 hprintln!(
-                    "movement compensation={} index={} start_time_s={} end_time_s={} angle_deg={} raw_angle_deg={}",
+                    "movement compensation={} index={} start_time_s={} end_time_s={} angle_deg={} raw_angle_deg={} saturated={}",
                     self.name,
                     self.movements,
                     movement.start_time_s,
                     movement.end_time_s,
                     movement.angle_deg,
-                    movement.raw_angle_deg
+                    movement.raw_angle_deg,
+                    u8::from(movement.saturated)
                 );
             }
             None => {}
@@ -137,7 +141,12 @@ impl Channel {
 
 /// The whole run; `true` if it was clean.
 fn run() -> bool {
-    let config = Config::default(); // 1 kHz in, 50 Hz out; on the wrench: the calibrated model
+    // 1 kHz in, 50 Hz out; on the wrench: the calibrated model. The range is the one the
+    // driver commands: a movement whose readings reach it is flagged saturated.
+    let config = Config {
+        range_dps: Some(f32::from(RANGE.full_scale_dps())),
+        ..Config::default()
+    };
     let mut channels = COMPENSATIONS.map(|(name, compensation)| {
         let config = Config {
             compensation,
@@ -178,6 +187,7 @@ fn run() -> bool {
     );
 
     let (mut read_errors, mut status_faults, mut temperature_c) = (0_u32, 0_u32, f32::NAN);
+    let mut beyond_full_scale = 0_u32;
     for n in 0..samples {
         // One iteration per sample clock tick. On the wrench a timer fires at 1 kHz and this
         // body runs in its interrupt handler (or in the main loop after `wfi()` wakes on it):
@@ -192,6 +202,17 @@ fn run() -> bool {
                 status_faults += u32::from(measurement.status.is_fault());
                 temperature_c = measurement.temperature_c;
                 measurement.rate_dps
+            }
+            // A rate word beyond full scale: the sensor is saturated. Its reading is the
+            // range (a lower bound of the rate), which flags the movement.
+            Err(Error::Frame(FrameError::Saturated { counts })) => {
+                beyond_full_scale += 1;
+                let range_dps = f32::from(RANGE.full_scale_dps());
+                if counts < 0 {
+                    -range_dps
+                } else {
+                    range_dps
+                }
             }
             Err(error) => {
                 // Never skip a tick: a NaN keeps the timing, and the pipeline replaces it by
@@ -210,11 +231,12 @@ fn run() -> bool {
 
     let sensor = gyro.release();
     hprintln!(
-        "sensor   transactions={} left={} read_errors={} status_faults={} temperature_c={}",
+        "sensor   transactions={} left={} read_errors={} status_faults={} beyond_full_scale={} temperature_c={}",
         sensor.transactions(),
         sensor.remaining(),
         read_errors,
         status_faults,
+        beyond_full_scale,
         temperature_c
     );
     let mut clean = read_errors == 0 && status_faults == 0 && sensor.remaining() == 0;

@@ -40,6 +40,11 @@ pub struct Args {
     /// Override the model's compensation.
     #[arg(long, value_enum)]
     compensation: Option<CompensationArg>,
+    /// The sensor's full-scale range (deg/s): a movement during which a reading reaches it
+    /// is flagged saturated. Default: the model's (`config.range_dps`, else
+    /// `sensor.range_dps`); without a model, unknown (only clip plateaus are flagged).
+    #[arg(long, value_name = "DPS")]
+    range_dps: Option<f32>,
     /// Output format on stdout (csv: the movements).
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -61,10 +66,17 @@ pub fn run(args: &Args) -> Result<()> {
     let (mut config, options) = match &args.model {
         Some(path) => {
             let model = model::load(path)?;
-            (model.config, replay::ReplayOptions::from_model(&model))
+            let config = Config {
+                range_dps: Some(model.range_dps()),
+                ..model.config
+            };
+            (config, replay::ReplayOptions::from_model(&model))
         }
         None => (Config::default(), replay::ReplayOptions::default()),
     };
+    if let Some(range_dps) = args.range_dps {
+        config.range_dps = Some(range_dps);
+    }
     if let Some(c) = args.compensation {
         config.compensation = match c {
             CompensationArg::None => Compensation::None,

@@ -1,0 +1,137 @@
+//! Simulated bench runs with a gyro that clips at 75 deg/s: every movement whose readings
+//! clipped is flagged saturated, and none is in the same runs without the clip.
+//!
+//! Two ways to clip: a sensor whose range is ±75 deg/s, with the range known to the
+//! pipeline (the model file's `sensor.range_dps`); and a ±300 deg/s sensor that clips at
+//! 75 deg/s (effect `saturation`), where only the clip plateau tells. `cargo test -p
+//! gyro-analysis --test saturation_sim -- --nocapture` prints the counts.
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+use gyro_analysis::replay::{replay, MovementResult};
+use gyro_core::Config;
+use gyro_log::GridOptions;
+use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+
+const CLIP_DPS: f64 = 75.0;
+const SEEDS: std::ops::RangeInclusive<u64> = 1..=16;
+
+/// Per rotation: its true peak |rate| (deg/s), the angle the clip takes off it (deg,
+/// from the true rate), and whether a logged reading sits at ±clip.
+struct Truth {
+    peak_dps: f64,
+    lost_deg: f64,
+    clipped: bool,
+}
+
+fn truths(motion: &Motion, log: &gyro_log::Log, clip_dps: f64) -> Vec<Truth> {
+    motion
+        .rotations()
+        .iter()
+        .map(|r| {
+            let (start, end) = (r.start_s, r.start_s + r.duration_s);
+            let n = (r.duration_s * 1000.0).ceil() as usize;
+            let rates = (0..=n).map(|k| motion.rate_dps(start + k as f64 * 1e-3).abs());
+            let (peak_dps, lost_deg) = rates.fold((0.0_f64, 0.0), |(p, l), v| {
+                (p.max(v), l + (v - clip_dps).max(0.0) * 1e-3)
+            });
+            let clipped = log.rows.iter().any(|row| {
+                row.time_s >= start
+                    && row.time_s <= end
+                    && row.rate_dps.is_some_and(|v| v.abs() >= clip_dps)
+            });
+            Truth {
+                peak_dps,
+                lost_deg,
+                clipped,
+            }
+        })
+        .collect()
+}
+
+fn movements(log: &gyro_log::Log, range_dps: Option<f32>) -> Vec<MovementResult> {
+    let regular = gyro_log::regularize(log, &GridOptions::default()).unwrap();
+    let config = Config {
+        range_dps,
+        ..Config::default()
+    };
+    replay(&regular, &config).unwrap().movements
+}
+
+#[test]
+fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
+    let options = |seed| SimOptions {
+        seed,
+        ..SimOptions::default()
+    };
+    let (mut movements_seen, mut clipped_seen) = (0, 0);
+    let (mut by_range, mut by_plateau, mut plateau_missed) = (0, 0, 0);
+    let mut missed_lost_deg = 0.0_f64;
+    for seed in SEEDS {
+        let motion = Motion::bench(&BenchProfile::default(), seed);
+        let clean = simulate(&SensorModel::default(), &[], &motion, &options(seed));
+        // No clip: nothing flagged, with the range known or not.
+        for range_dps in [None, Some(300.0)] {
+            let found = movements(&clean, range_dps);
+            assert_eq!(found.len(), motion.rotations().len(), "seed {seed}");
+            assert!(found.iter().all(|m| !m.saturated), "seed {seed}");
+        }
+
+        // A ±75 deg/s sensor, range known: every movement with a clipped reading.
+        let narrow = SensorModel {
+            range_dps: CLIP_DPS,
+            ..SensorModel::default()
+        };
+        let log = simulate(&narrow, &[], &motion, &options(seed));
+        let truth = truths(&motion, &log, CLIP_DPS);
+        let found = movements(&log, Some(CLIP_DPS as f32));
+        assert_eq!(found.len(), truth.len(), "seed {seed}");
+        for (t, m) in truth.iter().zip(&found) {
+            if t.clipped || t.peak_dps > CLIP_DPS {
+                assert!(m.saturated, "seed {seed}: peak {} {m:?}", t.peak_dps);
+            }
+            // Well below the range (bias 0.3, 5 sigma of noise): never.
+            if t.peak_dps < CLIP_DPS * 0.995 - 0.3 - 0.75 {
+                assert!(!m.saturated, "seed {seed}: peak {} {m:?}", t.peak_dps);
+            }
+            movements_seen += 1;
+            clipped_seen += usize::from(t.clipped);
+            by_range += usize::from(m.saturated);
+        }
+
+        // A ±300 deg/s sensor clipping at 75 deg/s, range 300 (the model's) or unknown:
+        // the plateau flags every movement whose true peak passes the clip by 1 deg/s;
+        // one that barely touches it may go unflagged, losing almost nothing.
+        let effect = [Effect::Saturation {
+            limit_dps: CLIP_DPS,
+        }];
+        let log = simulate(&SensorModel::default(), &effect, &motion, &options(seed));
+        let truth = truths(&motion, &log, CLIP_DPS);
+        for range_dps in [None, Some(300.0)] {
+            let found = movements(&log, range_dps);
+            assert_eq!(found.len(), truth.len(), "seed {seed}");
+            for (t, m) in truth.iter().zip(&found) {
+                if t.peak_dps > CLIP_DPS + 1.0 {
+                    assert!(m.saturated, "seed {seed}: peak {} {m:?}", t.peak_dps);
+                }
+                if !t.clipped {
+                    assert!(!m.saturated, "seed {seed}: not clipped {m:?}");
+                }
+                if range_dps.is_none() {
+                    by_plateau += usize::from(m.saturated);
+                    if t.clipped && !m.saturated {
+                        plateau_missed += 1;
+                        missed_lost_deg = missed_lost_deg.max(t.lost_deg);
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "{} runs, {movements_seen} movements, {clipped_seen} with a clipped reading; \
+         range known: {by_range} flagged; plateau only: {by_plateau} flagged, \
+         {plateau_missed} clipped but not flagged (at most {missed_lost_deg:.4} deg lost)",
+        SEEDS.count()
+    );
+    assert!(clipped_seen >= 40, "{clipped_seen}");
+    assert!(missed_lost_deg < 0.05, "{missed_lost_deg}");
+}

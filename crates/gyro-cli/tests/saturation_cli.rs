@@ -1,0 +1,162 @@
+//! `gyro-cli run` says which movements reached the sensor's range: `"saturated"` on every
+//! movement in JSON, a column in CSV, a mark and a warning in the table.
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+mod common;
+use common::{bench_log, gyro, json_of, ok, temp_dir, write};
+
+/// (time_s, rate_dps) of the bench fixture.
+fn fixture_rates() -> Vec<(f64, f64)> {
+    let text = std::fs::read_to_string(bench_log()).unwrap();
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("time_s"))
+        .map(|l| {
+            let mut fields = l.split(',');
+            let t = fields.next().unwrap().parse().unwrap();
+            let r = fields.next().unwrap().parse().unwrap();
+            (t, r)
+        })
+        .collect()
+}
+
+#[test]
+fn json_carries_saturated_on_every_movement() {
+    let log = bench_log();
+    let log = log.to_str().unwrap();
+    // The fixture never reaches ±300 deg/s: no movement is saturated, range known or not.
+    for extra in [&[][..], &["--range-dps", "300"][..]] {
+        let mut args = vec!["run", log, "--format", "json"];
+        args.extend_from_slice(extra);
+        let report = json_of(&gyro(&args));
+        let movements = report["movements"].as_array().unwrap();
+        assert_eq!(movements.len(), 6);
+        for m in movements {
+            assert_eq!(m["saturated"].as_bool(), Some(false), "{m}");
+        }
+    }
+
+    // Told the sensor's range is ±120 deg/s: exactly the movements with a reading within
+    // 0.5% of it are flagged (peaks 78 to 208 deg/s: three of six).
+    let report = json_of(&gyro(&[
+        "run",
+        log,
+        "--format",
+        "json",
+        "--range-dps",
+        "120",
+    ]));
+    assert_eq!(report["config"]["range_dps"].as_f64(), Some(120.0));
+    let rates = fixture_rates();
+    let mut flagged = 0;
+    for m in report["movements"].as_array().unwrap() {
+        let (start, end) = (
+            m["start_time_s"].as_f64().unwrap(),
+            m["end_time_s"].as_f64().unwrap(),
+        );
+        let peak = rates
+            .iter()
+            .filter(|(t, _)| *t >= start && *t <= end)
+            .fold(0.0_f64, |a, (_, r)| a.max(r.abs()));
+        let reached = peak >= 120.0 * (1.0 - 0.005);
+        assert_eq!(m["saturated"].as_bool(), Some(reached), "peak {peak}: {m}");
+        flagged += usize::from(reached);
+    }
+    assert_eq!(flagged, 3);
+}
+
+#[test]
+fn table_marks_and_warns_and_csv_has_a_column() {
+    let log = bench_log();
+    let log = log.to_str().unwrap();
+    let table = ok(&gyro(&["run", log, "--range-dps", "120"]));
+    assert!(table.contains("sensor range ±120 deg/s"), "{table}");
+    let marked = table.lines().filter(|l| l.ends_with("SATURATED")).count();
+    let warnings: Vec<&str> = table
+        .lines()
+        .filter(|l| l.starts_with("warning: movement "))
+        .collect();
+    assert!(marked == 3 && warnings.len() == marked, "{table}");
+    assert!(
+        warnings[0].ends_with(
+            "reached the sensor range (120 deg/s) or clipped below it: its angle is a lower bound"
+        ),
+        "{}",
+        warnings[0]
+    );
+    let plain = ok(&gyro(&["run", log]));
+    assert!(
+        !plain.contains("SATURATED") && !plain.contains("warning"),
+        "{plain}"
+    );
+
+    let csv = ok(&gyro(&[
+        "run",
+        log,
+        "--format",
+        "csv",
+        "--range-dps",
+        "120",
+    ]));
+    let mut lines = csv.lines();
+    assert!(lines.next().unwrap().ends_with(",saturated"));
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 6);
+    assert_eq!(rows.iter().filter(|r| r.ends_with(",true")).count(), marked);
+    assert_eq!(
+        rows.iter().filter(|r| r.ends_with(",false")).count(),
+        6 - marked
+    );
+}
+
+#[test]
+fn range_comes_from_the_model_unless_given() {
+    let dir = temp_dir("saturation-model");
+    let log = bench_log();
+    let log = log.to_str().unwrap();
+    let model = write(
+        &dir,
+        "m.json",
+        r#"{"format": "gyro-model", "version": 1, "sensor": {"range_dps": 120}}"#,
+    );
+    let flagged = |args: &[&str]| -> (Option<f64>, usize) {
+        let report = json_of(&gyro(args));
+        let n = report["movements"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|m| m["saturated"].as_bool().unwrap())
+            .count();
+        (report["config"]["range_dps"].as_f64(), n)
+    };
+    let from_model = flagged(&["run", log, "--format", "json", "--model", &model]);
+    let from_flag = flagged(&["run", log, "--format", "json", "--range-dps", "120"]);
+    assert_eq!(from_model, from_flag);
+    assert_eq!(from_model, (Some(120.0), 3));
+    // The flag wins over the model.
+    let overridden = flagged(&[
+        "run",
+        log,
+        "--format",
+        "json",
+        "--model",
+        &model,
+        "--range-dps",
+        "300",
+    ]);
+    assert_eq!(overridden, (Some(300.0), 0));
+    // A model without a sensor section: the section's default range, the CRM100's ±300.
+    let bare = write(
+        &dir,
+        "bare.json",
+        r#"{"format": "gyro-model", "version": 1}"#,
+    );
+    assert_eq!(
+        flagged(&["run", log, "--format", "json", "--model", &bare]),
+        (Some(300.0), 0)
+    );
+    // A range that is no range is an error naming the setting.
+    let out = gyro(&["run", log, "--range-dps", "0"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("range_dps"), "{stderr}");
+}
