@@ -15,7 +15,7 @@
 //! data's correlation estimate (or 0.01 1/s), b0 = the median rest bias, o0 = 0.
 
 use crate::replay::{replay, RunReport, Summary};
-use gyro_core::{Compensation, Config, GaussMarkov, MotionState};
+use gyro_core::{Compensation, Config, GaussMarkov, KalmanConfig, MotionConfig, MotionState};
 use gyro_log::RegularLog;
 use nelder_mead::{Bounds, InitialSteps, NelderMead, Termination};
 use serde::Serialize;
@@ -262,6 +262,8 @@ impl Trace {
 pub struct RunScore {
     /// The run.
     pub name: String,
+    /// Max abs error with the starting configuration, nothing fitted (deg).
+    pub default_max_abs_deg: f64,
     /// Max abs error without compensation (deg).
     pub none_max_abs_deg: f64,
     /// Max abs error with the paper error model (deg).
@@ -301,11 +303,140 @@ pub struct Spread {
     pub o0_deg: ParamSpread,
 }
 
+/// A configuration `calibrate` can write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Candidate {
+    /// The starting configuration as given (built-in, or `--model`'s): nothing fitted.
+    Default,
+    /// No compensation, with the fitted motion thresholds.
+    None,
+    /// The fitted paper error model.
+    Paper,
+    /// The Kalman form with settings from the rest statistics.
+    Kalman,
+}
+
+impl Candidate {
+    /// Every candidate, the default first.
+    pub const ALL: [Candidate; 4] = [
+        Candidate::Default,
+        Candidate::None,
+        Candidate::Paper,
+        Candidate::Kalman,
+    ];
+}
+
+/// What calibration fits on a set of runs, on top of the starting configuration.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Fitted {
+    /// Motion detector thresholds (the starting ones unless fitted).
+    pub motion: MotionConfig,
+    /// The paper error model.
+    pub paper: GaussMarkov,
+    /// The Kalman settings from the rest statistics.
+    pub kalman: KalmanConfig,
+}
+
+impl Fitted {
+    /// The configuration `candidate` stands for, on top of `base`.
+    pub fn config(&self, base: &Config, candidate: Candidate) -> Config {
+        let compensation = match candidate {
+            Candidate::Default => return *base,
+            Candidate::None => Compensation::None,
+            Candidate::Paper => Compensation::Paper,
+            Candidate::Kalman => Compensation::Kalman,
+        };
+        Config {
+            motion: self.motion,
+            paper: self.paper,
+            kalman: self.kalman,
+            compensation,
+            ..*base
+        }
+    }
+}
+
+/// One candidate's error under the objective (deg).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CandidateScore {
+    /// The candidate.
+    pub candidate: Candidate,
+    /// Leave-one-run-out: each training run scored with what was fitted on the others.
+    /// The choice is made on this; `None` without refits.
+    pub leave_one_out_deg: Option<f64>,
+    /// The same per left-out run, in training order: its max abs error (RMS error for
+    /// `mean_rms`, RMS movement error for `movement_rms`). Empty without refits.
+    pub leave_one_out_runs_deg: Vec<f64>,
+    /// On the training runs with what was fitted on all of them (not used for the choice).
+    pub training_deg: f64,
+}
+
+/// Why [`choose`] picked its candidate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ChoiceReason {
+    /// It beats the default held out, and has the lowest held-out error of those that do.
+    LowestHeldOut,
+    /// No candidate beats the default held out.
+    DefaultNotBeaten,
+    /// No leave-one-run-out refits (switched off, or one training run): default kept.
+    NoRefits,
+}
+
+/// The candidate written to the model file, and the figures it was chosen on.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Choice {
+    /// The candidate written.
+    pub written: Candidate,
+    /// Why.
+    pub reason: ChoiceReason,
+    /// Every candidate's error, the default first.
+    pub scores: Vec<CandidateScore>,
+}
+
+/// The candidate to write. A candidate beats the default when, held out (leave one run
+/// out), its objective is lower and it is better on most runs (so one run cannot decide);
+/// of those, the lowest objective is written, else the default. Training errors are not
+/// looked at.
+pub fn choose(scores: &[CandidateScore]) -> (Candidate, ChoiceReason) {
+    if scores.iter().all(|s| s.leave_one_out_deg.is_none()) {
+        return (Candidate::Default, ChoiceReason::NoRefits);
+    }
+    let Some(default) = scores.iter().find(|s| s.candidate == Candidate::Default) else {
+        return (Candidate::Default, ChoiceReason::DefaultNotBeaten);
+    };
+    let finite = |s: &CandidateScore| s.leave_one_out_deg.filter(|v| v.is_finite());
+    let beats_default = |s: &CandidateScore| {
+        let (Some(v), Some(d)) = (finite(s), finite(default)) else {
+            return false;
+        };
+        let runs = &default.leave_one_out_runs_deg;
+        let better = s
+            .leave_one_out_runs_deg
+            .iter()
+            .zip(runs)
+            .filter(|(c, d)| c < d)
+            .count();
+        s.leave_one_out_runs_deg.len() == runs.len() && v < d && 2 * better > runs.len()
+    };
+    scores
+        .iter()
+        .filter(|s| s.candidate != Candidate::Default && beats_default(s))
+        .filter_map(|s| Some((s.candidate, finite(s)?)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(
+            (Candidate::Default, ChoiceReason::DefaultNotBeaten),
+            |(candidate, _)| (candidate, ChoiceReason::LowestHeldOut),
+        )
+}
+
 /// The outcome of a calibration.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Calibration {
-    /// Fitted paper-mode parameters.
-    pub paper: GaussMarkov,
+    /// Fitted on all training runs: motion thresholds, paper model, Kalman settings.
+    #[serde(flatten)]
+    pub fitted: Fitted,
     /// Objective minimised.
     pub objective: Objective,
     /// Its value at the fit (deg).
@@ -317,6 +448,10 @@ pub struct Calibration {
     pub termination: String,
     /// Objective evaluations.
     pub evaluations: usize,
+    /// The starting configuration: the default candidate.
+    pub start: Config,
+    /// Which candidate is written, chosen on leave-one-run-out error.
+    pub choice: Choice,
     /// The configuration written to the model file.
     pub config: Config,
     /// Per training run.
@@ -325,6 +460,13 @@ pub struct Calibration {
     pub holdout: Vec<RunScore>,
     /// Leave-one-run-out spread (with 3 or more training runs).
     pub spread: Option<Spread>,
+}
+
+impl Calibration {
+    /// The configuration of `candidate` as fitted on all training runs.
+    pub fn candidate_config(&self, candidate: Candidate) -> Config {
+        self.fitted.config(&self.start, candidate)
+    }
 }
 
 /// Why calibration failed.
@@ -441,38 +583,96 @@ fn fit_paper(
     ))
 }
 
-fn score(run: &BenchRun, config: &Config) -> Result<RunScore, CalibrateError> {
-    let summary = |compensation| -> Result<Summary, CalibrateError> {
-        let config = Config {
-            compensation,
-            ..*config
+/// What every objective is computed from, for one run under one configuration.
+#[derive(Clone, Debug, PartialEq)]
+struct RunErrors {
+    max_abs_deg: f64,
+    rms_deg: f64,
+    /// Error of each completed movement.
+    movement_deg: Vec<f64>,
+}
+
+impl Objective {
+    /// The objective's measure of one run (deg).
+    fn per_run(self, run: &RunErrors) -> f64 {
+        match self {
+            Objective::MeanRms => run.rms_deg,
+            Objective::MovementRms => Objective::MovementRms.aggregate([run]),
+            Objective::MeanMaxAbs | Objective::WorstMaxAbs => run.max_abs_deg,
+        }
+    }
+
+    /// The objective over real replays, one per run (deg); as [`Objective::evaluate`].
+    fn aggregate<'a>(self, runs: impl IntoIterator<Item = &'a RunErrors>) -> f64 {
+        let runs: Vec<&RunErrors> = runs.into_iter().collect();
+        if self == Objective::MovementRms {
+            let errors: Vec<f64> = runs
+                .iter()
+                .flat_map(|r| r.movement_deg.iter().copied())
+                .collect();
+            return if errors.is_empty() {
+                f64::INFINITY
+            } else {
+                (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt()
+            };
+        }
+        let value = |r: &&RunErrors| {
+            if self == Objective::MeanRms {
+                r.rms_deg
+            } else {
+                r.max_abs_deg
+            }
         };
-        replay(&run.log, &config)
-            .map(|r| r.summary)
-            .map_err(|source| CalibrateError::Config {
-                name: run.name.clone(),
-                source,
-            })
-    };
-    let [none, paper, kalman] = [
-        Compensation::None,
-        Compensation::Paper,
-        Compensation::Kalman,
-    ]
-    .map(summary);
-    let (none, paper, kalman) = (none?, paper?, kalman?);
-    let nan = f64::NAN;
-    Ok(RunScore {
+        match self {
+            Objective::WorstMaxAbs => runs.iter().map(value).fold(0.0, f64::max),
+            _ if runs.is_empty() => f64::INFINITY,
+            _ => runs.iter().map(value).sum::<f64>() / runs.len() as f64,
+        }
+    }
+}
+
+fn replay_errors(run: &BenchRun, config: &Config) -> Result<RunErrors, CalibrateError> {
+    let report = replay(&run.log, config).map_err(|source| CalibrateError::Config {
         name: run.name.clone(),
-        none_max_abs_deg: none.max_abs_error_deg.unwrap_or(nan),
-        paper_max_abs_deg: paper.max_abs_error_deg.unwrap_or(nan),
-        kalman_max_abs_deg: kalman.max_abs_error_deg.unwrap_or(nan),
-        rms_deg: [
-            none.rms_error_deg.unwrap_or(nan),
-            paper.rms_error_deg.unwrap_or(nan),
-            kalman.rms_error_deg.unwrap_or(nan),
-        ],
+        source,
+    })?;
+    let Summary {
+        max_abs_error_deg,
+        rms_error_deg,
+        ..
+    } = report.summary;
+    Ok(RunErrors {
+        max_abs_deg: max_abs_error_deg.unwrap_or(f64::NAN),
+        rms_deg: rms_error_deg.unwrap_or(f64::NAN),
+        movement_deg: report
+            .movements
+            .iter()
+            .filter(|m| m.complete)
+            .filter_map(|m| m.error_deg)
+            .collect(),
     })
+}
+
+/// Errors of `run` under every candidate, in the order of [`Candidate::ALL`].
+fn candidate_errors(
+    run: &BenchRun,
+    base: &Config,
+    fitted: &Fitted,
+) -> Result<[RunErrors; 4], CalibrateError> {
+    let [a, b, c, d] = Candidate::ALL.map(|c| replay_errors(run, &fitted.config(base, c)));
+    Ok([a?, b?, c?, d?])
+}
+
+fn run_score(name: &str, errors: &[RunErrors; 4]) -> RunScore {
+    let [default, none, paper, kalman] = errors;
+    RunScore {
+        name: name.to_string(),
+        default_max_abs_deg: default.max_abs_deg,
+        none_max_abs_deg: none.max_abs_deg,
+        paper_max_abs_deg: paper.max_abs_deg,
+        kalman_max_abs_deg: kalman.max_abs_deg,
+        rms_deg: [none.rms_deg, paper.rms_deg, kalman.rms_deg],
+    }
 }
 
 /// Options of [`calibrate`].
@@ -480,7 +680,8 @@ fn score(run: &BenchRun, config: &Config) -> Result<RunScore, CalibrateError> {
 pub struct CalibrateOptions {
     /// What to minimise.
     pub objective: Objective,
-    /// Refit leaving each run out, for the parameters' spread.
+    /// Refit leaving each run out: the held-out errors the written candidate is chosen
+    /// on, and the parameters' spread. Without them the starting configuration is kept.
     pub leave_one_out: bool,
     /// Initial correlation time of the bias (s), e.g. from `noise`; default: the
     /// Gauss-Markov term fitted to the rest segments' Allan deviation, else 100 s.
@@ -492,7 +693,7 @@ pub struct CalibrateOptions {
 /// The correlation time of the bias from the rest segments of `runs` (Allan deviation
 /// with a significant Gauss-Markov term), if they show one. Runs at another sample rate
 /// than the first are left out.
-fn rest_correlation_time(runs: &[BenchRun], base: &Config) -> Option<f64> {
+fn rest_correlation_time(runs: &[&BenchRun], base: &Config) -> Option<f64> {
     let rate_hz = runs.first()?.log.sample_rate_hz;
     let mut segments: Vec<Vec<f64>> = Vec::new();
     for run in runs.iter().filter(|r| r.log.sample_rate_hz == rate_hz) {
@@ -512,7 +713,7 @@ fn rest_correlation_time(runs: &[BenchRun], base: &Config) -> Option<f64> {
     }
 }
 
-fn traces_for(runs: &[BenchRun], base: &Config) -> Result<Vec<Trace>, CalibrateError> {
+fn traces_for(runs: &[&BenchRun], base: &Config) -> Result<Vec<Trace>, CalibrateError> {
     runs.iter()
         .map(|run| {
             Trace::new(&run.log, base).map_err(|source| CalibrateError::Config {
@@ -527,7 +728,7 @@ fn traces_for(runs: &[BenchRun], base: &Config) -> Result<Vec<Trace>, CalibrateE
 /// (ln exit_dps, ln(enter_dps − exit_dps)), each point scored by the best paper fit on
 /// traces replayed with those thresholds.
 fn fit_motion(
-    train: &[BenchRun],
+    train: &[&BenchRun],
     base: &Config,
     objective: Objective,
     start: GaussMarkov,
@@ -572,94 +773,18 @@ fn fit_motion(
     Ok(with(&outcome.x))
 }
 
-/// Calibrate `base` on `train`; score on `train` and `holdout`.
-pub fn calibrate(
-    train: &[BenchRun],
-    holdout: &[BenchRun],
-    base: &Config,
-    options: &CalibrateOptions,
-    progress: &mut dyn FnMut(&str, usize, f64),
-) -> Result<Calibration, CalibrateError> {
-    if train.is_empty() {
-        return Err(CalibrateError::NoRuns);
-    }
-    for run in train.iter().chain(holdout) {
-        if !run.log.has_reference {
-            return Err(CalibrateError::NoReference(run.name.clone()));
-        }
-    }
-    let initial_tau = match options.initial_tau_s {
-        Some(tau_s) => (tau_s, "option"),
-        None => match rest_correlation_time(train, base) {
-            Some(tau_s) => (tau_s, "rest_allan"),
-            None => (100.0, "default"),
-        },
-    };
-    let mut base = *base;
-    let mut traces = traces_for(train, &base)?;
-    if traces.iter().all(|t| t.spans.is_empty()) {
-        return Err(CalibrateError::NoMovement);
-    }
-    let rest_means: Vec<f64> = traces
-        .iter()
-        .flat_map(|t| t.rest_means_dps.iter().copied())
-        .collect();
-    let start = GaussMarkov {
-        beta_per_s: (1.0 / initial_tau.0) as f32,
-        b0_dps: median(rest_means.clone()).unwrap_or(0.0) as f32,
-        o0_deg: 0.0,
-    };
-    if options.fit_motion {
-        base = fit_motion(train, &base, options.objective, start, progress)?;
-        traces = traces_for(train, &base)?;
-    }
-    let (paper, objective_deg, termination, evaluations) =
-        fit_paper(&traces, options.objective, start, &mut |n, best| {
-            progress("fit", n, best)
-        })?;
-
-    let spread = if options.leave_one_out && traces.len() >= 3 {
-        let mut fits = Vec::with_capacity(traces.len());
-        for i in 0..traces.len() {
-            let others: Vec<Trace> = traces
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != i)
-                .map(|(_, t)| t.clone())
-                .collect();
-            let (gm, ..) = fit_paper(&others, options.objective, paper, &mut |_, best| {
-                progress(
-                    &format!("leave-one-out {}/{}", i + 1, traces.len()),
-                    i,
-                    best,
-                )
-            })?;
-            fits.push(gm);
-        }
-        let pick = |f: fn(&GaussMarkov) -> f32| {
-            param_spread(&fits.iter().map(|g| f64::from(f(g))).collect::<Vec<_>>())
-        };
-        Some(Spread {
-            refits: fits.len(),
-            beta_per_s: pick(|g| g.beta_per_s),
-            b0_dps: pick(|g| g.b0_dps),
-            o0_deg: pick(|g| g.o0_deg),
-        })
-    } else {
-        None
-    };
-
-    // The Kalman form from the rest statistics. The bias wanders within a run (the spread
-    // of a run's rest means about their mean: the Gauss-Markov sigma) and differs between
-    // runs (turn-on: the initial uncertainty). Mixing the two would make the filter chase
-    // noise. White noise: of the filtered rate at rest.
-    let mut config = base;
-    config.paper = paper;
-    if let Some(mean) = median(rest_means.clone()) {
-        config.kalman.bias_mean_dps = mean as f32;
+/// The Kalman settings from the rest statistics, on top of `base`. The bias wanders within
+/// a run (the spread of a run's rest means about their mean: the Gauss-Markov sigma) and
+/// differs between runs (turn-on: the initial uncertainty). Mixing the two would make the
+/// filter chase noise. White noise: of the filtered rate at rest. `rest_means`: the bias
+/// mean's source (the rests under the starting motion thresholds).
+fn kalman_from_rests(base: KalmanConfig, rest_means: &[f64], traces: &[Trace]) -> KalmanConfig {
+    let mut kalman = base;
+    if let Some(mean) = median(rest_means.to_vec()) {
+        kalman.bias_mean_dps = mean as f32;
     }
     let (mut within_sq, mut within_n, mut run_means) = (0.0, 0_usize, Vec::new());
-    for t in &traces {
+    for t in traces {
         if let [first, ..] = t.rest_means_dps.as_slice() {
             let mean = t.rest_means_dps.iter().sum::<f64>() / t.rest_means_dps.len() as f64;
             within_sq += t
@@ -676,43 +801,285 @@ pub fn calibrate(
         }
     }
     if within_n > 0 {
-        config.kalman.bias_sigma_dps = (within_sq / within_n as f64).sqrt().max(0.005) as f32;
+        kalman.bias_sigma_dps = (within_sq / within_n as f64).sqrt().max(0.005) as f32;
     }
     if run_means.len() >= 2 {
-        config.kalman.initial_bias_sigma_dps =
-            (stats(&run_means)[1] as f32).max(config.kalman.bias_sigma_dps);
+        kalman.initial_bias_sigma_dps = (stats(&run_means)[1] as f32).max(kalman.bias_sigma_dps);
     }
     let noises: Vec<f64> = traces.iter().filter_map(|t| t.rest_noise_dps).collect();
     if let Some(noise) = median(noises) {
-        config.kalman.rate_noise_dps = noise.max(1e-4) as f32;
+        kalman.rate_noise_dps = noise.max(1e-4) as f32;
     }
-    let train_scores = train
+    kalman
+}
+
+/// A fit on a set of runs.
+struct Fit {
+    fitted: Fitted,
+    objective_deg: f64,
+    termination: Termination,
+    evaluations: usize,
+}
+
+/// Fit everything calibration fits on `runs`, whose traces under `base` are `traces`,
+/// starting from correlation time `tau_s`.
+fn fit(
+    runs: &[&BenchRun],
+    traces: Vec<Trace>,
+    base: &Config,
+    options: &CalibrateOptions,
+    tau_s: f64,
+    progress: &mut dyn FnMut(&str, usize, f64),
+) -> Result<(Fit, Vec<Trace>), CalibrateError> {
+    let rest_means: Vec<f64> = traces
         .iter()
-        .map(|run| score(run, &config))
+        .flat_map(|t| t.rest_means_dps.iter().copied())
+        .collect();
+    let start = GaussMarkov {
+        beta_per_s: (1.0 / tau_s) as f32,
+        b0_dps: median(rest_means.clone()).unwrap_or(0.0) as f32,
+        o0_deg: 0.0,
+    };
+    let (motion, traces) = if options.fit_motion {
+        let config = fit_motion(runs, base, options.objective, start, progress)?;
+        (config.motion, traces_for(runs, &config)?)
+    } else {
+        (base.motion, traces)
+    };
+    let (paper, objective_deg, termination, evaluations) =
+        fit_paper(&traces, options.objective, start, &mut |n, best| {
+            progress("fit", n, best)
+        })?;
+    let fitted = Fitted {
+        motion,
+        paper,
+        kalman: kalman_from_rests(base.kalman, &rest_means, &traces),
+    };
+    Ok((
+        Fit {
+            fitted,
+            objective_deg,
+            termination,
+            evaluations,
+        },
+        traces,
+    ))
+}
+
+/// Calibrate `base` on `train`; score on `train` and `holdout`. The configuration
+/// written is the candidate with the lowest leave-one-run-out error ([`choose`]), the
+/// starting configuration unless one beats it.
+pub fn calibrate(
+    train: &[BenchRun],
+    holdout: &[BenchRun],
+    base: &Config,
+    options: &CalibrateOptions,
+    progress: &mut dyn FnMut(&str, usize, f64),
+) -> Result<Calibration, CalibrateError> {
+    if train.is_empty() {
+        return Err(CalibrateError::NoRuns);
+    }
+    for run in train.iter().chain(holdout) {
+        if !run.log.has_reference {
+            return Err(CalibrateError::NoReference(run.name.clone()));
+        }
+    }
+    let runs: Vec<&BenchRun> = train.iter().collect();
+    let tau_for = |runs: &[&BenchRun]| match options.initial_tau_s {
+        Some(tau_s) => (tau_s, "option"),
+        None => match rest_correlation_time(runs, base) {
+            Some(tau_s) => (tau_s, "rest_allan"),
+            None => (100.0, "default"),
+        },
+    };
+    let initial_tau = tau_for(&runs);
+    let base_traces = traces_for(&runs, base)?;
+    if base_traces.iter().all(|t| t.spans.is_empty()) {
+        return Err(CalibrateError::NoMovement);
+    }
+    let (full, _) = fit(
+        &runs,
+        base_traces.clone(),
+        base,
+        options,
+        initial_tau.0,
+        progress,
+    )?;
+
+    // Leave-one-run-out: refit everything on the other runs, from their own start, and
+    // score the left-out run with each candidate.
+    let mut fold_fits = Vec::new();
+    let mut held_out: Vec<[RunErrors; 4]> = Vec::new();
+    if options.leave_one_out && train.len() >= 2 {
+        for (i, run) in train.iter().enumerate() {
+            let others: Vec<&BenchRun> = runs
+                .iter()
+                .enumerate()
+                .filter_map(|(j, r)| (j != i).then_some(*r))
+                .collect();
+            let traces: Vec<Trace> = base_traces
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, t)| t.clone())
+                .collect();
+            let stage = format!("leave-one-out {}/{}", i + 1, train.len());
+            let (fold, _) = fit(
+                &others,
+                traces,
+                base,
+                options,
+                tau_for(&others).0,
+                &mut |_, n, best| progress(&stage, n, best),
+            )?;
+            held_out.push(candidate_errors(run, base, &fold.fitted)?);
+            fold_fits.push(fold.fitted.paper);
+        }
+    }
+    let spread = (fold_fits.len() >= 3).then(|| {
+        let pick = |f: fn(&GaussMarkov) -> f32| {
+            param_spread(
+                &fold_fits
+                    .iter()
+                    .map(|g| f64::from(f(g)))
+                    .collect::<Vec<_>>(),
+            )
+        };
+        Spread {
+            refits: fold_fits.len(),
+            beta_per_s: pick(|g| g.beta_per_s),
+            b0_dps: pick(|g| g.b0_dps),
+            o0_deg: pick(|g| g.o0_deg),
+        }
+    });
+
+    let train_errors = train
+        .iter()
+        .map(|run| candidate_errors(run, base, &full.fitted))
         .collect::<Result<Vec<_>, _>>()?;
     let holdout_scores = holdout
         .iter()
-        .map(|run| score(run, &config))
-        .collect::<Result<Vec<_>, _>>()?;
-    // Use the compensation that did best on the training runs.
-    let mean = |f: fn(&RunScore) -> f64| {
-        train_scores.iter().map(f).sum::<f64>() / train_scores.len() as f64
-    };
-    config.compensation = if mean(|s| s.kalman_max_abs_deg) < mean(|s| s.paper_max_abs_deg) {
-        Compensation::Kalman
-    } else {
-        Compensation::Paper
-    };
+        .map(|run| {
+            Ok(run_score(
+                &run.name,
+                &candidate_errors(run, base, &full.fitted)?,
+            ))
+        })
+        .collect::<Result<Vec<_>, CalibrateError>>()?;
+    let scores: Vec<CandidateScore> = Candidate::ALL
+        .iter()
+        .enumerate()
+        .map(|(k, &candidate)| CandidateScore {
+            candidate,
+            leave_one_out_deg: (!held_out.is_empty())
+                .then(|| options.objective.aggregate(held_out.iter().map(|e| &e[k]))),
+            leave_one_out_runs_deg: held_out
+                .iter()
+                .map(|e| options.objective.per_run(&e[k]))
+                .collect(),
+            training_deg: options
+                .objective
+                .aggregate(train_errors.iter().map(|e| &e[k])),
+        })
+        .collect();
+    let (written, reason) = choose(&scores);
     Ok(Calibration {
-        paper,
+        fitted: full.fitted,
         objective: options.objective,
-        objective_deg,
+        objective_deg: full.objective_deg,
         initial_tau,
-        termination: format!("{termination:?}"),
-        evaluations,
-        config,
-        train: train_scores,
+        termination: format!("{:?}", full.termination),
+        evaluations: full.evaluations,
+        start: *base,
+        choice: Choice {
+            written,
+            reason,
+            scores,
+        },
+        config: full.fitted.config(base, written),
+        train: train
+            .iter()
+            .zip(&train_errors)
+            .map(|(run, e)| run_score(&run.name, e))
+            .collect(),
         holdout: holdout_scores,
         spread,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{choose, Candidate, CandidateScore, ChoiceReason};
+
+    fn score(candidate: Candidate, runs: &[f64], training_deg: f64) -> CandidateScore {
+        CandidateScore {
+            candidate,
+            leave_one_out_deg: (!runs.is_empty())
+                .then(|| runs.iter().sum::<f64>() / runs.len() as f64),
+            leave_one_out_runs_deg: runs.to_vec(),
+            training_deg,
+        }
+    }
+
+    #[test]
+    fn held_out_error_decides_not_training_error() {
+        // Paper is best on the training runs, Kalman held out.
+        let scores = [
+            score(Candidate::Default, &[1.0, 1.0, 1.0], 1.0),
+            score(Candidate::Paper, &[0.9, 1.2, 1.1], 0.1),
+            score(Candidate::Kalman, &[0.5, 0.6, 1.1], 0.9),
+        ];
+        assert_eq!(
+            choose(&scores),
+            (Candidate::Kalman, ChoiceReason::LowestHeldOut)
+        );
+    }
+
+    #[test]
+    fn the_default_is_kept_unless_beaten_held_out() {
+        let default = score(Candidate::Default, &[1.0, 1.0, 1.0], 1.0);
+        // Worse, and equal: the default stays.
+        for runs in [[1.1, 1.2, 1.3], [1.0, 1.0, 1.0]] {
+            let scores = [default.clone(), score(Candidate::Paper, &runs, 0.1)];
+            assert_eq!(
+                choose(&scores),
+                (Candidate::Default, ChoiceReason::DefaultNotBeaten)
+            );
+        }
+        // Lower mean from one run only, worse on most: one run does not decide.
+        let scores = [
+            default.clone(),
+            score(Candidate::Kalman, &[0.1, 1.1, 1.1], 0.1),
+        ];
+        assert_eq!(
+            choose(&scores),
+            (Candidate::Default, ChoiceReason::DefaultNotBeaten)
+        );
+        // Better on most runs but a higher mean: the default stays.
+        let scores = [default, score(Candidate::Kalman, &[0.9, 0.9, 3.0], 0.1)];
+        assert_eq!(
+            choose(&scores),
+            (Candidate::Default, ChoiceReason::DefaultNotBeaten)
+        );
+    }
+
+    #[test]
+    fn non_finite_or_missing_refits_keep_the_default() {
+        let scores = [
+            score(Candidate::Default, &[f64::NAN, 1.0], 1.0),
+            score(Candidate::Paper, &[0.1, 0.1], 0.1),
+        ];
+        assert_eq!(
+            choose(&scores),
+            (Candidate::Default, ChoiceReason::DefaultNotBeaten)
+        );
+        let scores = [
+            score(Candidate::Default, &[], 1.0),
+            score(Candidate::Paper, &[], 0.1),
+        ];
+        assert_eq!(
+            choose(&scores),
+            (Candidate::Default, ChoiceReason::NoRefits)
+        );
+    }
 }

@@ -2,7 +2,9 @@
 //! the paper's own error model recovers its parameters.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use gyro_analysis::calibrate::{calibrate, BenchRun, CalibrateOptions, Objective, Trace};
+use gyro_analysis::calibrate::{
+    calibrate, BenchRun, CalibrateOptions, Candidate, Objective, RunScore, Trace,
+};
 use gyro_analysis::replay::replay;
 use gyro_core::{Compensation, Config, GaussMarkov};
 use gyro_log::{regularize, GridOptions, Log, Row};
@@ -143,7 +145,7 @@ fn fit_recovers_the_paper_model_and_halves_holdout_error() {
         &mut |_, _, _| {},
     )
     .unwrap();
-    let fit = result.paper;
+    let fit = result.fitted.paper;
     println!("truth {truth:?}\nfit   {fit:?}\nspread {:?}", result.spread);
     // Each parameter within two jackknife standard errors of the truth. (β, b0, o0) trade
     // off against each other over movements of 0.8-4 s, so the curve o(t) is pinned much
@@ -213,7 +215,7 @@ fn paper_objective_also_halves_holdout_error() {
         &mut |_, _, _| {},
     )
     .unwrap();
-    println!("paper objective fit {:?}", result.paper);
+    println!("paper objective fit {:?}", result.fitted.paper);
     for s in &result.holdout {
         assert!(s.paper_max_abs_deg <= 0.5 * s.none_max_abs_deg, "{s:?}");
     }
@@ -277,4 +279,71 @@ fn motion_thresholds_fit_never_worsens_the_objective() {
         "{m:?}"
     );
     assert_eq!(fitted.initial_tau, (2.0, "option"));
+}
+
+/// A simulated bench run (nominal CRM100 model, 1 kHz) whose bias follows a random walk.
+fn random_walk_run(seed: u64) -> BenchRun {
+    let sensor = SensorModel::default();
+    let walk = sim::Effect::parse("rate_random_walk:k_dps_per_rt_s=0.02").unwrap();
+    let motion = Motion::bench(&BenchProfile::default(), seed);
+    let options = SimOptions {
+        seed,
+        ..SimOptions::default()
+    };
+    let log = sim::simulate(&sensor, &[walk], &motion, &options);
+    BenchRun {
+        name: format!("random-walk-{seed}"),
+        log: regularize(&log, &GridOptions::default()).unwrap(),
+    }
+}
+
+/// Median over `runs` of the max abs angle error with `config` (deg).
+fn median_max_abs(runs: &[BenchRun], config: &Config) -> f64 {
+    let mut errors: Vec<f64> = runs
+        .iter()
+        .map(|run| {
+            replay(&run.log, config)
+                .unwrap()
+                .summary
+                .max_abs_error_deg
+                .unwrap()
+        })
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    let n = errors.len();
+    (errors[(n - 1) / 2] + errors[n / 2]) / 2.0
+}
+
+#[test]
+fn written_model_is_not_worse_than_the_default_on_other_runs() {
+    let train: Vec<BenchRun> = (201..=210).map(random_walk_run).collect();
+    let other: Vec<BenchRun> = (211..=230).map(random_walk_run).collect();
+    let options = CalibrateOptions {
+        objective: Objective::MeanMaxAbs,
+        leave_one_out: true,
+        initial_tau_s: None,
+        fit_motion: false,
+    };
+    let base = Config::default();
+    let result = calibrate(&train, &[], &base, &options, &mut |_, _, _| {}).unwrap();
+    let written = median_max_abs(&other, &result.config);
+    let default = median_max_abs(&other, &base);
+    // The rule calibrate used to write by: the lower mean max abs error on the training runs
+    // of the paper model and the Kalman form.
+    let mean = |f: fn(&RunScore) -> f64| result.train.iter().map(f).sum::<f64>() / 10.0;
+    let by_training = if mean(|s| s.kalman_max_abs_deg) < mean(|s| s.paper_max_abs_deg) {
+        Candidate::Kalman
+    } else {
+        Candidate::Paper
+    };
+    let training_choice = median_max_abs(&other, &result.candidate_config(by_training));
+    println!(
+        "{:?}: {:?}\nmedian max abs error on 20 other runs: written {written:.3} deg, default {default:.3} deg, {by_training:?} (best on training) {training_choice:.3} deg",
+        result.choice.written, result.choice.scores
+    );
+    assert!(written <= default, "{written} vs default {default}");
+    assert!(
+        training_choice > default,
+        "the training-error choice {by_training:?} is not worse here: {training_choice} vs {default}"
+    );
 }

@@ -1,7 +1,7 @@
 //! The text of `calibrate`: fitted models and the per-run scores.
 
-use gyro_analysis::calibrate::{Calibration, RunScore};
-use gyro_core::Config;
+use gyro_analysis::calibrate::{Calibration, Candidate, ChoiceReason, RunScore};
+use gyro_core::{Compensation, Config};
 
 /// The last `n` characters of `s` (whole characters: names may be non-ASCII).
 fn last_chars(s: &str, n: usize) -> &str {
@@ -21,15 +21,19 @@ fn score_table(title: &str, scores: &[RunScore]) -> String {
     let _ = writeln!(s, "{title}: max abs angle error per run (deg)");
     let _ = writeln!(
         s,
-        "  {:<40} {:>9} {:>9} {:>9}",
-        "run", "none", "paper", "kalman"
+        "  {:<40} {:>9} {:>9} {:>9} {:>9}",
+        "run", "default", "none", "paper", "kalman"
     );
     for r in scores {
         let name = last_chars(&r.name, 40);
         let _ = writeln!(
             s,
-            "  {:<40} {:>9.4} {:>9.4} {:>9.4}",
-            name, r.none_max_abs_deg, r.paper_max_abs_deg, r.kalman_max_abs_deg
+            "  {:<40} {:>9.4} {:>9.4} {:>9.4} {:>9.4}",
+            name,
+            r.default_max_abs_deg,
+            r.none_max_abs_deg,
+            r.paper_max_abs_deg,
+            r.kalman_max_abs_deg
         );
     }
     let median = |f: fn(&RunScore) -> f64| {
@@ -39,8 +43,9 @@ fn score_table(title: &str, scores: &[RunScore]) -> String {
     };
     let _ = writeln!(
         s,
-        "  {:<40} {:>9.4} {:>9.4} {:>9.4}",
+        "  {:<40} {:>9.4} {:>9.4} {:>9.4} {:>9.4}",
         "median",
+        median(|r| r.default_max_abs_deg),
         median(|r| r.none_max_abs_deg),
         median(|r| r.paper_max_abs_deg),
         median(|r| r.kalman_max_abs_deg)
@@ -48,25 +53,48 @@ fn score_table(title: &str, scores: &[RunScore]) -> String {
     s
 }
 
+fn compensation_text(compensation: Compensation) -> &'static str {
+    match compensation {
+        Compensation::None => "no",
+        Compensation::Paper => "paper",
+        Compensation::Kalman => "Kalman",
+    }
+}
+
+/// What a candidate is, in words.
+pub fn candidate_text(c: &Calibration, candidate: Candidate) -> String {
+    match candidate {
+        Candidate::Default => format!(
+            "the starting configuration with {} compensation, nothing fitted",
+            compensation_text(c.start.compensation)
+        ),
+        Candidate::None => "no compensation".to_string(),
+        Candidate::Paper => "the fitted paper error model".to_string(),
+        Candidate::Kalman => "the Kalman form with the fitted settings".to_string(),
+    }
+}
+
 /// The calibration as text: the fitted paper model with its leave-one-run-out spread, the
-/// Kalman form, and the max abs angle error per run by compensation mode.
+/// Kalman form, the max abs angle error per run by candidate, and which candidate is
+/// written, chosen on the leave-one-run-out errors.
 pub fn table(c: &Calibration) -> String {
     let mut s = format!(
         "start: correlation time {:.1} s ({})\n",
         c.initial_tau.0, c.initial_tau.1
     );
-    if c.config.motion != Config::default().motion {
+    let f = &c.fitted;
+    if f.motion != Config::default().motion {
         s += &format!(
             "motion thresholds: enter {:.3} deg/s, exit {:.3} deg/s\n",
-            c.config.motion.enter_dps, c.config.motion.exit_dps
+            f.motion.enter_dps, f.motion.exit_dps
         );
     }
     s += &format!(
         "paper error model: beta {:.5} 1/s (T {:.1} s), b0 {:.5} deg/s, o0 {:.5} deg\n  objective {:?} = {:.4} deg after {} evaluations ({})\n",
-        c.paper.beta_per_s,
-        1.0 / c.paper.beta_per_s,
-        c.paper.b0_dps,
-        c.paper.o0_deg,
+        f.paper.beta_per_s,
+        1.0 / f.paper.beta_per_s,
+        f.paper.b0_dps,
+        f.paper.o0_deg,
         c.objective,
         c.objective_deg,
         c.evaluations,
@@ -88,18 +116,94 @@ pub fn table(c: &Calibration) -> String {
             );
         }
     }
-    let k = &c.config.kalman;
+    let k = &f.kalman;
     s += &format!(
         "kalman form: bias mean {:.4} deg/s, within-run sigma {:.4} deg/s, between-run sigma {:.4} deg/s, rate noise {:.4} deg/s\n",
         k.bias_mean_dps, k.bias_sigma_dps, k.initial_bias_sigma_dps, k.rate_noise_dps
     );
     s += &score_table("training runs", &c.train);
     s += &score_table("hold-out runs", &c.holdout);
-    s += &format!(
-        "model compensation: {:?} (best on the training runs)\n",
-        c.config.compensation
-    );
+    s += &choice_table(c);
     s
+}
+
+/// Each candidate's held-out (leave-one-run-out) and training error, and the one written.
+fn choice_table(c: &Calibration) -> String {
+    use std::fmt::Write as _;
+    let mut s = format!(
+        "choice of the model written, on leave-one-run-out error (each training run scored with what was fitted on the other runs; objective {:?}, deg; training error not used)\n",
+        c.objective
+    );
+    let _ = writeln!(
+        s,
+        "  {:<10} {:>11} {:>14} {:>11}",
+        "candidate", "held-out", "runs better", "training"
+    );
+    let default = c
+        .choice
+        .scores
+        .iter()
+        .find(|score| score.candidate == Candidate::Default);
+    for score in &c.choice.scores {
+        let held_out = score
+            .leave_one_out_deg
+            .map_or_else(|| "-".to_string(), |v| format!("{v:.4}"));
+        // Left-out runs on which the candidate beats the default.
+        let better = match default {
+            Some(d)
+                if score.candidate != Candidate::Default && score.leave_one_out_deg.is_some() =>
+            {
+                let wins = score
+                    .leave_one_out_runs_deg
+                    .iter()
+                    .zip(&d.leave_one_out_runs_deg)
+                    .filter(|(v, d)| v < d)
+                    .count();
+                format!("{wins}/{}", d.leave_one_out_runs_deg.len())
+            }
+            _ => "-".to_string(),
+        };
+        let _ = writeln!(
+            s,
+            "  {:<10} {:>11} {:>14} {:>11.4}",
+            candidate_name(score.candidate),
+            held_out,
+            better,
+            score.training_deg
+        );
+    }
+    let _ = writeln!(s, "model written: {}", choice_text(c));
+    s
+}
+
+fn candidate_name(candidate: Candidate) -> &'static str {
+    match candidate {
+        Candidate::Default => "default",
+        Candidate::None => "none",
+        Candidate::Paper => "paper",
+        Candidate::Kalman => "kalman",
+    }
+}
+
+/// The candidate written and why, in one line.
+pub fn choice_text(c: &Calibration) -> String {
+    let written = c.choice.written;
+    let why = match c.choice.reason {
+        ChoiceReason::LowestHeldOut => {
+            "held out it beats the default (lower objective, better on most runs), lowest of those that do"
+        }
+        ChoiceReason::DefaultNotBeaten => {
+            "no fitted candidate beats it held out (lower objective and better on most runs)"
+        }
+        ChoiceReason::NoRefits => {
+            "no leave-one-run-out refits (switched off, or one training run), so nothing fitted is written"
+        }
+    };
+    format!(
+        "{} ({}): {why}",
+        candidate_name(written),
+        candidate_text(c, written)
+    )
 }
 
 #[cfg(test)]

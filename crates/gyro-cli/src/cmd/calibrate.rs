@@ -1,7 +1,7 @@
 //! `gyro-cli calibrate`: fit the error model on bench runs and write a model file.
 
 use anyhow::{Context, Result};
-use gyro_analysis::calibrate::{calibrate, BenchRun, CalibrateOptions, Objective};
+use gyro_analysis::calibrate::{calibrate, BenchRun, CalibrateOptions, ChoiceReason, Objective};
 use gyro_analysis::model;
 use gyro_core::Config;
 use gyro_log as log;
@@ -33,7 +33,8 @@ pub struct Args {
     /// Also fit the motion detector's thresholds (slower: runs are replayed per trial).
     #[arg(long)]
     fit_motion: bool,
-    /// Skip the leave-one-run-out refits.
+    /// Skip the leave-one-run-out refits. The model written is chosen on their held-out
+    /// errors, so without them the starting configuration is written.
     #[arg(long)]
     no_leave_one_out: bool,
     #[command(flatten)]
@@ -103,7 +104,14 @@ pub fn run(args: &Args) -> Result<()> {
         super::run::Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
         _ => write!(stdout, "{}", gyro_report::calibrate::table(&result))?,
     }
-    eprintln!("wrote {}", args.out.display());
+    eprintln!(
+        "wrote {}: {}",
+        args.out.display(),
+        gyro_report::calibrate::choice_text(&result)
+    );
+    if result.choice.reason == ChoiceReason::NoRefits && args.no_leave_one_out {
+        eprintln!("drop --no-leave-one-out to let calibrate write a fitted model");
+    }
     if let Some(path) = &args.plot {
         gyro_report::plot::calibrate_plot(path, &result)?;
         eprintln!("wrote {}", path.display());

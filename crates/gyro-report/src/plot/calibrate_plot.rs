@@ -7,7 +7,6 @@ use super::{
     LABEL_PX, TICK_PX,
 };
 use gyro_analysis::calibrate::{Calibration, Objective, RunScore};
-use gyro_core::Compensation;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -137,20 +136,16 @@ impl Figure for CalibrationPlot<'_> {
         // Room on the right for the section labels.
         let hi = hi * (hi / lo).powf(0.3);
 
-        let p = &c.paper;
-        let chosen = match c.config.compensation {
-            Compensation::None => NONE_LABEL,
-            Compensation::Paper => PAPER_LABEL,
-            Compensation::Kalman => KALMAN_LABEL,
-        };
+        let p = &c.fitted.paper;
         let subtitle = format!(
-            "paper model β = {} 1/s (T = {} s), b0 = {} deg/s, o0 = {} deg; objective: {} = {} deg\nthe model file uses: {chosen} (best on the training runs)",
+            "paper model β = {} 1/s (T = {} s), b0 = {} deg/s, o0 = {} deg; objective: {} = {} deg\nthe model file uses: {}",
             sig(f64::from(p.beta_per_s), 3),
             sig(1.0 / f64::from(p.beta_per_s), 3),
             sig(f64::from(p.b0_dps), 3),
             sig(f64::from(p.o0_deg), 3),
             objective_text(c.objective),
             sig(c.objective_deg, 3),
+            crate::calibrate::choice_text(c),
         );
         let body = titled(root, "calibration: max abs angle error per run", &subtitle)?;
 
