@@ -44,6 +44,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "{:<30} {:>5} {:>10} {:>10} {:>6}   {:>10} {:>10} {:>6}",
         "scenario", "runs", "run max", "oracle", "ratio", "run/move", "oracle", "ratio"
     );
+    let mut all = Decisions::default();
     for (name, specs) in scenarios {
         let effects = specs
             .iter()
@@ -52,6 +53,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (mut max_run, mut max_oracle, mut move_run, mut move_oracle) =
             (vec![], vec![], vec![], vec![]);
         let mut events = vec![];
+        let mut covered = (0_usize, 0_usize);
+        let mut stds = vec![];
+        let mut decisions = Decisions::default();
         for seed in 1..=runs {
             let motion = Motion::bench(&BenchProfile::default(), seed);
             let rotations: Vec<(f64, f64)> = motion
@@ -73,6 +77,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .movements
                     .iter()
                     .find(|m| m.start_time_s <= mid && mid <= m.end_time_s);
+                if let Some(m) = found {
+                    if let Some(std) = m.angle_std_deg {
+                        let e = (f64::from(m.angle_deg) - r.angle_deg).abs();
+                        covered.0 += usize::from(e <= 1.96 * f64::from(std));
+                        covered.1 += 1;
+                        stds.push(f64::from(std));
+                        judge(&mut decisions, m, r.angle_deg);
+                    }
+                }
                 events.push(found.map_or(f64::INFINITY, |m| {
                     (f64::from(m.angle_deg) - r.angle_deg).abs()
                 }));
@@ -91,12 +104,98 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         events.sort_by(f64::total_cmp);
         println!(
             "{name:<30} {runs:>5} {a:>9.3}° {b:>9.3}° {:>6.2}   {c:>9.3}° {d:>9.3}° {:>6.2}   \
-             event {:>7.3}° p90 {:>7.3}° missed {missed}",
+             event {:>7.3}° p90 {:>7.3}° missed {missed}  σ {:>6.3}° cover95 {:>5.1}%",
             a / b,
             c / d,
             events[events.len() / 2],
             events[events.len() * 9 / 10],
+            median(stds),
+            100.0 * covered.0 as f64 / covered.1.max(1) as f64,
+        );
+        all.add(&decisions);
+        println!(
+            "    decisions: {} (ok {}, nok {}, recheck {} = {:.1}%); wrong ok {}, wrong nok {}",
+            decisions.total,
+            decisions.ok,
+            decisions.nok,
+            decisions.recheck,
+            100.0 * decisions.recheck as f64 / decisions.total.max(1) as f64,
+            decisions.wrong_ok,
+            decisions.wrong_nok
         );
     }
+    println!(
+        "all decisions: {} (recheck {:.1}%); wrong ok {}, wrong nok {}",
+        all.total,
+        100.0 * all.recheck as f64 / all.total.max(1) as f64,
+        all.wrong_ok,
+        all.wrong_nok
+    );
     Ok(())
+}
+
+/// Counts of tightening decisions against known truth.
+#[derive(Default)]
+struct Decisions {
+    total: usize,
+    ok: usize,
+    nok: usize,
+    recheck: usize,
+    wrong_ok: usize,
+    wrong_nok: usize,
+}
+
+impl Decisions {
+    fn add(&mut self, other: &Decisions) {
+        self.total += other.total;
+        self.ok += other.ok;
+        self.nok += other.nok;
+        self.recheck += other.recheck;
+        self.wrong_ok += other.wrong_ok;
+        self.wrong_nok += other.wrong_nok;
+    }
+}
+
+/// Judge movement `m` (true angle `truth_deg`) against windows near the spread of the
+/// angle errors: half-widths of 0.25, 0.5 and 1 deg, targets from 1.2 half-widths below
+/// the truth to 1.2 above in steps of 0.2 (the truth inside for offsets under one
+/// half-width), in the direction of the turn; k = 2.
+fn judge(decisions: &mut Decisions, m: &gyro_analysis::replay::MovementResult, truth_deg: f64) {
+    use gyro_core::{decide, Direction, Tightening, Verdict};
+    let direction = if truth_deg > 0.0 {
+        Direction::Positive
+    } else {
+        Direction::Negative
+    };
+    for tolerance_deg in [0.25_f64, 0.5, 1.0] {
+        for step in -6..=6 {
+            let offset_deg = f64::from(step) * 0.2 * tolerance_deg;
+            let window = Tightening {
+                target_deg: (truth_deg.abs() + offset_deg) as f32,
+                tolerance_deg: tolerance_deg as f32,
+                k_sigma: 2.0,
+                direction,
+            };
+            let inside = offset_deg.abs() < tolerance_deg;
+            let untrusted = m.saturated || !m.complete || m.filled_samples > 0;
+            let verdict = decide(
+                &window,
+                m.angle_deg,
+                m.angle_std_deg.unwrap_or(0.0),
+                untrusted,
+            );
+            decisions.total += 1;
+            match verdict {
+                Some(Verdict::Ok) => {
+                    decisions.ok += 1;
+                    decisions.wrong_ok += usize::from(!inside);
+                }
+                Some(Verdict::Nok) => {
+                    decisions.nok += 1;
+                    decisions.wrong_nok += usize::from(inside);
+                }
+                _ => decisions.recheck += 1,
+            }
+        }
+    }
 }

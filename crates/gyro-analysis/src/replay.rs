@@ -11,7 +11,10 @@
 //! is a matter of scoring only: the reference is shifted by it before the comparison.
 
 use crate::model::ModelFile;
-use gyro_core::{Compensation, Config, Decimator, Event, MotionState, Pipeline, Sos, SosState};
+use gyro_core::{
+    decide, Compensation, Config, Decimator, Event, MotionState, Pipeline, Sos, SosState,
+    Tightening, Verdict,
+};
 use gyro_log::{GridOptions, LogError, LogOptions, Quality, RegularLog, Slot, SlotSink};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -70,6 +73,17 @@ pub struct MovementResult {
     /// A reading reached the sensor's range or a clip plateau during the movement (the
     /// core's [`gyro_core::Movement::saturated`]): the angle is a lower bound.
     pub saturated: bool,
+    /// Input samples interpolated during the movement (a gap in the log, or missing
+    /// rates): the rotation across them is a guess.
+    pub filled_samples: u32,
+    /// Standard deviation of `angle_deg` (deg), in Kalman mode, for a complete movement
+    /// ([`gyro_core::Movement::angle_std_deg`]).
+    pub angle_std_deg: Option<f32>,
+    /// The tightening decision ([`gyro_core::decide`]) when the configuration has a window;
+    /// absent without one, or for a turn the other way (not a tightening). `invalid` when
+    /// the movement saturated, was cut off by the end of the log, or has filled samples.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<Verdict>,
     /// The output samples (indices into [`RunReport::series`]) that bound the movement, as
     /// the core published them: its last quiet sample before and first quiet sample after
     /// (the last sample if the log ends while moving). Not in the JSON.
@@ -318,6 +332,10 @@ pub struct Replayer {
     series: Vec<SeriesPoint>,
     movements: Vec<MovementResult>,
     open: Option<(f64, usize)>,
+    /// Filled input slots (gaps, missing rates) before each output sample, counted up to
+    /// the slot that completed it.
+    filled_before: Vec<u32>,
+    filled_total: u32,
 }
 
 impl Replayer {
@@ -356,6 +374,8 @@ impl Replayer {
             series: Vec::new(),
             movements: Vec::new(),
             open: None,
+            filled_before: Vec::new(),
+            filled_total: 0,
         })
     }
 
@@ -384,6 +404,7 @@ impl Replayer {
             }
         };
         let ref_mean = self.ref_decimator.push(reference.unwrap_or(self.ref_last));
+        self.filled_total = self.filled_total.saturating_add(u32::from(slot.filled));
         // A slot without temperature in a log that has them (a filled gap) keeps the last
         // valid temperature: NaN tells the pipeline so.
         let out = if self.has_temperature || slot.temperature_c.is_some() {
@@ -408,6 +429,7 @@ impl Replayer {
             }
             None => None,
         };
+        self.filled_before.push(self.filled_total);
         let series = &mut self.series;
         series.push(SeriesPoint {
             time_s: out.time_s,
@@ -433,14 +455,22 @@ impl Replayer {
                     index_at(series, m.start_time_s),
                     index_at(series, m.end_time_s),
                 );
+                let filled = &self.filled_before;
+                let filled_samples = filled.get(samples.1).copied().unwrap_or(0)
+                    - filled.get(samples.0).copied().unwrap_or(0);
                 self.movements.push(movement_result(
                     self.movements.len() + 1,
                     (m.start_time_s, m.end_time_s),
-                    true,
                     (m.angle_deg, m.raw_angle_deg),
-                    m.saturated,
+                    Flags {
+                        complete: true,
+                        saturated: m.saturated,
+                        filled_samples,
+                        angle_std_deg: m.angle_std_deg,
+                    },
                     samples,
                     reference_change(series, at_times),
+                    self.config.tightening.as_ref(),
                 ));
             }
             None => {}
@@ -459,23 +489,31 @@ impl Replayer {
             series,
             mut movements,
             open,
+            filled_before,
             ..
         } = self;
         if let (Some((start_time_s, start)), Some(last)) = (open, series.last()) {
             let first = &series[start];
             let samples = (start, series.len() - 1);
             let at_times = (index_at(&series, start_time_s), series.len() - 1);
+            let filled_samples = filled_before.last().copied().unwrap_or(0)
+                - filled_before.get(start).copied().unwrap_or(0);
             movements.push(movement_result(
                 movements.len() + 1,
                 (start_time_s, last.time_s),
-                false,
                 (
                     last.angle_deg - first.angle_deg,
                     last.raw_angle_deg - first.raw_angle_deg,
                 ),
-                pipeline.movement_saturated(),
+                Flags {
+                    complete: false,
+                    saturated: pipeline.movement_saturated(),
+                    filled_samples,
+                    angle_std_deg: None,
+                },
                 samples,
                 reference_change(&series, at_times),
+                config.tightening.as_ref(),
             ));
         }
 
@@ -564,27 +602,46 @@ fn reference_change(series: &[SeriesPoint], (start, end): (usize, usize)) -> Opt
     Some(series.get(end)?.reference_deg? - series.get(start)?.reference_deg?)
 }
 
+/// What the core and the replay know about a movement besides its times and angles.
+struct Flags {
+    complete: bool,
+    saturated: bool,
+    filled_samples: u32,
+    angle_std_deg: Option<f32>,
+}
+
 fn movement_result(
     index: usize,
     (start_time_s, end_time_s): (f64, f64),
-    complete: bool,
     (angle_deg, raw_angle_deg): (f32, f32),
-    saturated: bool,
+    flags: Flags,
     samples: (usize, usize),
     reference_deg: Option<f64>,
+    tightening: Option<&Tightening>,
 ) -> MovementResult {
+    let untrusted = flags.saturated || !flags.complete || flags.filled_samples > 0;
     MovementResult {
         index,
         start_time_s,
         end_time_s,
         duration_s: end_time_s - start_time_s,
-        complete,
+        complete: flags.complete,
         angle_deg,
         raw_angle_deg,
         reference_deg,
         error_deg: reference_deg.map(|r| f64::from(angle_deg) - r),
         raw_error_deg: reference_deg.map(|r| f64::from(raw_angle_deg) - r),
-        saturated,
+        saturated: flags.saturated,
+        filled_samples: flags.filled_samples,
+        angle_std_deg: flags.angle_std_deg,
+        verdict: tightening.and_then(|window| {
+            decide(
+                window,
+                angle_deg,
+                flags.angle_std_deg.unwrap_or(0.0),
+                untrusted,
+            )
+        }),
         samples,
     }
 }

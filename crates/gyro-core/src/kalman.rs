@@ -112,6 +112,20 @@ impl KalmanBias {
         libm::sqrtf(self.p[(0, 0)].max(0.0))
     }
 
+    /// Standard deviation (deg) of the angle gained over a movement of `samples` steps that
+    /// has just ended (before the rest after it updates the bias): the bias error times
+    /// the duration, the white rate noise integrated over it, and the bias's own wander
+    /// during it, `(n·dt)²·P_bb + n·q_θ + q_b·dt²·n³/3`. The bias variance is the one at
+    /// the end, a little above the one at the start (conservative by the wander it grew).
+    pub fn movement_std_deg(&self, samples: u32) -> f32 {
+        let n = samples as f32;
+        let duration_s = n * self.dt_s;
+        let variance = duration_s * duration_s * self.p[(1, 1)].max(0.0)
+            + n * self.q_angle
+            + self.q_bias * self.dt_s * self.dt_s * n * n * n / 3.0;
+        libm::sqrtf(variance)
+    }
+
     /// Standard deviation of the bias estimate (deg/s).
     pub fn bias_std_dps(&self) -> f32 {
         libm::sqrtf(self.p[(1, 1)].max(0.0))

@@ -3,6 +3,7 @@
 use crate::butterworth::{Butterworth, SosDesign};
 use crate::correction::{Correction, Corrector};
 use crate::decimator::Decimator;
+use crate::decision::Tightening;
 use crate::error::{check_range, Error};
 use crate::gauss_markov::GaussMarkov;
 use crate::integrator::Integrator;
@@ -62,6 +63,11 @@ pub struct Config {
     /// when serialized as unknown.
     #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
     pub range_dps: Option<f32>,
+    /// The tightening window movements are judged against ([`crate::decide`]), if any.
+    /// The pipeline only validates it (it keeps no state for it): whoever receives a
+    /// [`Movement`] decides. Left out when serialized as none.
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    pub tightening: Option<Tightening>,
 }
 
 /// A reading within this fraction of [`Config::range_dps`] counts as reaching the range
@@ -109,6 +115,7 @@ impl Default for Config {
             kalman: KalmanConfig::default(),
             correction: Correction::IDENTITY,
             range_dps: None,
+            tightening: None,
         }
     }
 }
@@ -172,6 +179,10 @@ pub struct Movement {
     /// ([`CLIP_PLATEAU_SAMPLES`] identical readings at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`]):
     /// the angle is then a lower bound of the turn.
     pub saturated: bool,
+    /// Standard deviation of `angle_deg` (deg), in Kalman mode: what the filter's bias
+    /// uncertainty and rate noise make of this movement's angle (the input to a
+    /// guard-banded decision, [`crate::decide`]).
+    pub angle_std_deg: Option<f32>,
 }
 
 /// One output sample, at the decimated rate.
@@ -352,6 +363,9 @@ impl Pipeline {
         config.paper.validate()?;
         let output_period_s = 1.0 / output_rate_hz;
         let detector = MotionDetector::try_new(&config.motion, output_rate_hz)?;
+        if let Some(tightening) = &config.tightening {
+            tightening.validate()?;
+        }
         let clip_level_dps = match config.range_dps {
             Some(range_dps) => {
                 check_range("range_dps", range_dps.into(), 1e-3, 1e30)?;
@@ -668,6 +682,8 @@ impl Pipeline {
             angle_deg: self.angle_deg() - track.angle_at_start_deg,
             raw_angle_deg,
             saturated: track.saturated,
+            angle_std_deg: (self.compensation == Compensation::Kalman)
+                .then(|| self.kalman.movement_std_deg(end_index - track.start_index)),
         })
     }
 

@@ -270,6 +270,7 @@ fn any_valid_config() -> impl Strategy<Value = Config> {
                     },
                     correction,
                     range_dps,
+                    tightening: None,
                 }
             },
         )

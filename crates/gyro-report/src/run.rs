@@ -1,6 +1,7 @@
 //! Rendering a [`RunReport`]: a human table, JSON, or CSV; and the 50 Hz series as CSV.
 
 use gyro_analysis::replay::{MovementResult, RunReport};
+use gyro_core::Verdict;
 use std::fmt::Write as _;
 use std::io::{self, Write};
 
@@ -109,7 +110,9 @@ pub fn table(file: &str, report: &RunReport) -> String {
     }
     let _ = writeln!(s, "movements: {}", report.movements.len());
     if !report.movements.is_empty() {
-        let _ = writeln!(
+        let with_std = report.movements.iter().any(|m| m.angle_std_deg.is_some());
+        let with_verdict = c.tightening.is_some();
+        let _ = write!(
             s,
             "  {:>4} {:>10} {:>10} {:>8} {:>11} {:>11} {:>11} {:>10} {:>10}",
             "#",
@@ -122,10 +125,17 @@ pub fn table(file: &str, report: &RunReport) -> String {
             "error_deg",
             "raw_err"
         );
+        if with_std {
+            let _ = write!(s, " {:>8}", "std_deg");
+        }
+        if with_verdict {
+            let _ = write!(s, " {:>8}", "verdict");
+        }
+        let _ = writeln!(s);
         for m in &report.movements {
-            let _ = writeln!(
+            let _ = write!(
                 s,
-                "  {:>4} {:>10.3} {:>10.3} {:>8.3} {:>11.3} {:>11.3} {:>11} {:>10} {:>10}{}",
+                "  {:>4} {:>10.3} {:>10.3} {:>8.3} {:>11.3} {:>11.3} {:>11} {:>10} {:>10}",
                 m.index,
                 m.start_time_s,
                 m.end_time_s,
@@ -135,16 +145,68 @@ pub fn table(file: &str, report: &RunReport) -> String {
                 opt(m.reference_deg, 3),
                 opt(m.error_deg, 3),
                 opt(m.raw_error_deg, 3),
-                match (m.saturated, m.complete) {
-                    (false, true) => "",
-                    (false, false) => "  (log ends while moving)",
-                    (true, true) => "  SATURATED",
-                    (true, false) => "  SATURATED (log ends while moving)",
-                }
             );
+            if with_std {
+                let _ = write!(s, " {:>8}", opt(m.angle_std_deg.map(f64::from), 3));
+            }
+            if with_verdict {
+                let _ = write!(s, " {:>8}", m.verdict.map_or("-", verdict_name));
+            }
+            let mut marks = Vec::new();
+            if m.saturated {
+                marks.push("SATURATED".to_string());
+            }
+            if m.filled_samples > 0 {
+                marks.push(format!("GAP ({} samples filled)", m.filled_samples));
+            }
+            if !m.complete {
+                marks.push("(log ends while moving)".to_string());
+            }
+            if marks.is_empty() {
+                let _ = writeln!(s);
+            } else {
+                let _ = writeln!(s, "  {}", marks.join(" "));
+            }
         }
         for m in report.movements.iter().filter(|m| m.saturated) {
             let _ = writeln!(s, "warning: {}", saturation_warning(m.index, c.range_dps));
+        }
+        for m in report.movements.iter().filter(|m| m.filled_samples > 0) {
+            let _ = writeln!(
+                s,
+                "warning: movement {} spans {} interpolated input samples (a gap or missing rates in the log): its angle across them is a guess",
+                m.index, m.filled_samples
+            );
+        }
+        if let Some(t) = &c.tightening {
+            let count = |v: Verdict| {
+                report
+                    .movements
+                    .iter()
+                    .filter(|m| m.verdict == Some(v))
+                    .count()
+            };
+            let other_way = report
+                .movements
+                .iter()
+                .filter(|m| m.verdict.is_none())
+                .count();
+            let _ = writeln!(
+                s,
+                "tightening {} ± {} deg ({} direction, guard band {} σ): ok {}, nok {}, recheck {}, invalid {}; {} turned the other way",
+                t.target_deg,
+                t.tolerance_deg,
+                match t.direction {
+                    gyro_core::Direction::Positive => "positive",
+                    gyro_core::Direction::Negative => "negative",
+                },
+                t.k_sigma,
+                count(Verdict::Ok),
+                count(Verdict::Nok),
+                count(Verdict::Recheck),
+                count(Verdict::Invalid),
+                other_way
+            );
         }
     }
     let sm = &report.summary;
@@ -172,6 +234,16 @@ pub fn table(file: &str, report: &RunReport) -> String {
         let _ = writeln!(s, "  no reference_deg column: no error figures");
     }
     s
+}
+
+/// The JSON name of a verdict.
+fn verdict_name(verdict: Verdict) -> &'static str {
+    match verdict {
+        Verdict::Ok => "ok",
+        Verdict::Nok => "nok",
+        Verdict::Recheck => "recheck",
+        Verdict::Invalid => "invalid",
+    }
 }
 
 /// Why movement `index` is flagged saturated, and what that means for its angle.
@@ -202,12 +274,12 @@ pub fn json(file: &str, report: &RunReport) -> serde_json::Result<String> {
 pub fn movements_csv(out: &mut impl Write, movements: &[MovementResult]) -> io::Result<()> {
     writeln!(
         out,
-        "index,start_time_s,end_time_s,duration_s,complete,angle_deg,raw_angle_deg,reference_deg,error_deg,raw_error_deg,saturated"
+        "index,start_time_s,end_time_s,duration_s,complete,angle_deg,raw_angle_deg,reference_deg,error_deg,raw_error_deg,saturated,filled_samples,angle_std_deg,verdict"
     )?;
     for m in movements {
         writeln!(
             out,
-            "{},{:.6},{:.6},{:.6},{},{:.6},{:.6},{},{},{},{}",
+            "{},{:.6},{:.6},{:.6},{},{:.6},{:.6},{},{},{},{},{},{},{}",
             m.index,
             m.start_time_s,
             m.end_time_s,
@@ -219,6 +291,9 @@ pub fn movements_csv(out: &mut impl Write, movements: &[MovementResult]) -> io::
             m.error_deg.map_or(String::new(), |v| format!("{v:.6}")),
             m.raw_error_deg.map_or(String::new(), |v| format!("{v:.6}")),
             m.saturated,
+            m.filled_samples,
+            m.angle_std_deg.map_or(String::new(), |v| format!("{v:.6}")),
+            m.verdict.map_or("", verdict_name),
         )?;
     }
     Ok(())

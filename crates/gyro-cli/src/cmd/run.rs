@@ -4,7 +4,7 @@ use anyhow::{Context, Result};
 use clap::ValueEnum;
 use gyro_analysis::model;
 use gyro_analysis::replay;
-use gyro_core::{Compensation, Config};
+use gyro_core::{Compensation, Config, Direction, Tightening};
 use gyro_log as log;
 use gyro_report::run as report;
 use std::io::Write;
@@ -27,6 +27,12 @@ pub enum CompensationArg {
     Kalman,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DirectionArg {
+    Positive,
+    Negative,
+}
+
 #[derive(clap::Args)]
 pub struct Args {
     /// The log: CSV (`time_s,rate_dps[,temperature_c][,reference_deg]`), MCAP (`/gyro`,
@@ -45,6 +51,21 @@ pub struct Args {
     /// `sensor.range_dps`); without a model, unknown (only clip plateaus are flagged).
     #[arg(long, value_name = "DPS")]
     range_dps: Option<f32>,
+    /// Judge each movement against a tightening window: its target angle (deg, in the
+    /// tightening direction). Default: the model's `config.tightening`, else no decision.
+    #[arg(long, value_name = "DEG", requires = "tolerance_deg")]
+    target_deg: Option<f32>,
+    /// Half-width of the tightening window (deg): accepted angles lie in target ± this.
+    #[arg(long, value_name = "DEG", requires = "target_deg")]
+    tolerance_deg: Option<f32>,
+    /// Guard band of the decision in standard deviations of the movement's angle: `ok`
+    /// needs the angle inside the window by more than k·σ, `nok` outside by more than k·σ,
+    /// else `recheck`.
+    #[arg(long, value_name = "K", default_value_t = 2.0)]
+    k_sigma: f32,
+    /// Which sign of the angle tightens; a turn the other way gets no verdict.
+    #[arg(long, value_enum, default_value_t = DirectionArg::Positive)]
+    tightening_direction: DirectionArg,
     /// Output format on stdout (csv: the movements).
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -76,6 +97,17 @@ pub fn run(args: &Args) -> Result<()> {
     };
     if let Some(range_dps) = args.range_dps {
         config.range_dps = Some(range_dps);
+    }
+    if let (Some(target_deg), Some(tolerance_deg)) = (args.target_deg, args.tolerance_deg) {
+        config.tightening = Some(Tightening {
+            target_deg,
+            tolerance_deg,
+            k_sigma: args.k_sigma,
+            direction: match args.tightening_direction {
+                DirectionArg::Positive => Direction::Positive,
+                DirectionArg::Negative => Direction::Negative,
+            },
+        });
     }
     if let Some(c) = args.compensation {
         config.compensation = match c {
