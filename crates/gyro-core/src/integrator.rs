@@ -6,29 +6,34 @@
 
 use crate::kahan::KahanSum;
 
-/// Angle accumulator (degrees) for samples `dt_s` apart.
+/// Angle accumulator (degrees). The sample period is the caller's (the pipeline keeps one
+/// for both of its integrators: 4 bytes of state each).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Integrator {
-    half_dt_s: f32,
     committed: KahanSum,
     pending: KahanSum,
 }
 
+impl Default for Integrator {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl Integrator {
-    /// Integrator for a fixed sample period `dt_s` (seconds).
-    pub const fn new(dt_s: f32) -> Self {
+    /// An empty integrator.
+    pub const fn new() -> Self {
         Self {
-            half_dt_s: 0.5 * dt_s,
             committed: KahanSum::ZERO,
             pending: KahanSum::ZERO,
         }
     }
 
-    /// Add the trapezoid between consecutive rates `previous_dps` and `rate_dps` to the
-    /// pending part.
+    /// Add the trapezoid between consecutive rates `previous_dps` and `rate_dps`, samples
+    /// `2 × half_dt_s` apart, to the pending part.
     #[inline]
-    pub fn step(&mut self, previous_dps: f32, rate_dps: f32) {
-        self.pending.add(self.half_dt_s * (previous_dps + rate_dps));
+    pub fn step(&mut self, half_dt_s: f32, previous_dps: f32, rate_dps: f32) {
+        self.pending.add(half_dt_s * (previous_dps + rate_dps));
     }
 
     /// Keep the pending part.
@@ -64,11 +69,11 @@ mod tests {
 
     #[test]
     fn trapezoid_of_a_ramp_is_exact() {
-        let mut i = Integrator::new(0.1);
+        let mut i = Integrator::new();
         let mut prev = 0.0;
         for k in 1..=10 {
             let rate = k as f32; // rate = 10 t
-            i.step(prev, rate);
+            i.step(0.05, prev, rate);
             prev = rate;
         }
         i.commit();
@@ -78,13 +83,13 @@ mod tests {
 
     #[test]
     fn pending_is_kept_or_dropped() {
-        let mut i = Integrator::new(1.0);
-        i.step(1.0, 1.0);
+        let mut i = Integrator::new();
+        i.step(0.5, 1.0, 1.0);
         assert_eq!(i.angle_deg(), 1.0);
         assert_eq!(i.committed_deg(), 0.0);
         i.discard();
         assert_eq!(i.angle_deg(), 0.0);
-        i.step(2.0, 2.0);
+        i.step(0.5, 2.0, 2.0);
         i.commit();
         assert_eq!(i.committed_deg(), 2.0);
     }

@@ -66,39 +66,66 @@ impl KalmanConfig {
     }
 }
 
+/// Weight of a new pair of rest-block means in the block-mean variance estimate.
+const BLOCK_VARIANCE_WEIGHT: f32 = 1.0 / 16.0;
+/// Share of the movement bias-error variance kept at each movement (the largest one seen
+/// fades over some tens of movements).
+const MOVEMENT_VARIANCE_RETAIN: f32 = 0.95;
+/// Step γ of the bias-wander scale per rest update: α ← α·exp(γ·(NIS − 1)).
+const WANDER_SCALE_STEP: f32 = 0.05;
+/// A normalised innovation above this counts as this (one disturbed block moves α little).
+const NIS_CAP: f32 = 10.0;
+/// The bias-wander scale stays within these bounds.
+const WANDER_SCALE_RANGE: (f32, f32) = (1e-4, 1e2);
+
 /// The filter's state for a fixed step `dt_s`.
+///
+/// The configured noise levels are a prior; the rests correct them. The variance of a rest
+/// block's mean is measured from consecutive block means (half the mean square of their
+/// difference, which holds for correlated, low-passed noise too) and replaces `R/n` once
+/// known; the bias wander `q` is scaled by α, which follows the normalised innovations of
+/// the rest updates (α grows when the rests disagree with the prediction more than its
+/// variance says, shrinks when they agree better), so that `angle_std_deg` is calibrated
+/// by the log's own rests.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct KalmanBias {
     dt_s: f32,
-    phi: f32,
+    /// β·dt: the bias's mean reversion per step (before the wander scale).
+    beta_dt: f32,
     bias_mean_dps: f32,
-    q_bias: f32,
-    q_angle: f32,
+    /// Stationary variance of the bias about its mean (deg/s)².
+    sigma_b2: f32,
     r_rate: f32,
     bias_dps: f32,
     p: Matrix2<f32>,
+    /// Variance of a rest block's mean (deg/s)², NaN until a pair of blocks was seen.
+    block_variance: f32,
+    /// Variance of the bias error a movement leaves (deg/s)², from the first rest block
+    /// after each movement; NaN until one was seen.
+    movement_bias_variance: f32,
+    /// α: the scale of the bias's wander rate (β·α, so `q` scales by about α while the
+    /// bias keeps its stationary spread).
+    wander_scale: f32,
 }
 
 impl KalmanBias {
     /// Filter for samples `dt_s` apart.
     pub fn try_new(config: &KalmanConfig, dt_s: f32) -> Result<Self, Error> {
         config.validate()?;
-        let phi = libm::expf(-config.beta_per_s * dt_s);
         let sigma_b2 = config.bias_sigma_dps * config.bias_sigma_dps;
-        // Discrete GM: var(b) stays sigma_b² when q = sigma_b² (1 − φ²). At β = 0 the bias
-        // is a constant and only its initial uncertainty remains.
-        let q_bias = sigma_b2 * (1.0 - phi * phi);
         let noise2 = config.rate_noise_dps * config.rate_noise_dps;
         let p0 = config.initial_bias_sigma_dps * config.initial_bias_sigma_dps;
         Ok(Self {
             dt_s,
-            phi,
+            beta_dt: config.beta_per_s * dt_s,
             bias_mean_dps: config.bias_mean_dps,
-            q_bias,
-            q_angle: noise2 * dt_s * dt_s,
+            sigma_b2,
             r_rate: noise2,
             bias_dps: config.bias_mean_dps,
             p: Matrix2::new(0.0, 0.0, 0.0, p0),
+            block_variance: f32::NAN,
+            movement_bias_variance: f32::NAN,
+            wander_scale: 1.0,
         })
     }
 
@@ -120,9 +147,14 @@ impl KalmanBias {
     pub fn movement_std_deg(&self, samples: u32) -> f32 {
         let n = samples as f32;
         let duration_s = n * self.dt_s;
-        let variance = duration_s * duration_s * self.p[(1, 1)].max(0.0)
-            + n * self.q_angle
-            + self.q_bias * self.dt_s * self.dt_s * n * n * n / 3.0;
+        let bias_variance = if self.movement_bias_variance > self.p[(1, 1)] {
+            self.movement_bias_variance
+        } else {
+            self.p[(1, 1)].max(0.0)
+        };
+        let variance = duration_s * duration_s * bias_variance
+            + n * self.q_angle()
+            + self.transition().1 * self.dt_s * self.dt_s * n * n * n / 3.0;
         libm::sqrtf(variance)
     }
 
@@ -131,13 +163,27 @@ impl KalmanBias {
         libm::sqrtf(self.p[(1, 1)].max(0.0))
     }
 
+    /// Process noise of the angle per moving step: the rate noise integrated over `dt`.
+    fn q_angle(&self) -> f32 {
+        self.r_rate * self.dt_s * self.dt_s
+    }
+
+    /// The bias's transition φ = e^(−β·α·dt) and its process noise σ_b²·(1 − φ²) per step.
+    /// Discrete GM: var(b) stays σ_b² with that q. At β = 0 the bias is a constant and
+    /// only its initial uncertainty remains.
+    fn transition(&self) -> (f32, f32) {
+        let phi = libm::expf(-self.beta_dt * self.wander_scale);
+        (phi, self.sigma_b2 * (1.0 - phi * phi))
+    }
+
     /// Propagate one step; `moving` if the angle integrates this step.
     pub fn predict(&mut self, moving: bool) {
         let coupling = if moving { -self.dt_s } else { 0.0 };
-        let f = Matrix2::new(1.0, coupling, 0.0, self.phi);
-        let q_angle = if moving { self.q_angle } else { 0.0 };
-        self.p = f * self.p * f.transpose() + Matrix2::new(q_angle, 0.0, 0.0, self.q_bias);
-        self.bias_dps = self.bias_mean_dps + self.phi * (self.bias_dps - self.bias_mean_dps);
+        let (phi, q_bias) = self.transition();
+        let f = Matrix2::new(1.0, coupling, 0.0, phi);
+        let q_angle = if moving { self.q_angle() } else { 0.0 };
+        self.p = f * self.p * f.transpose() + Matrix2::new(q_angle, 0.0, 0.0, q_bias);
+        self.bias_dps = self.bias_mean_dps + phi * (self.bias_dps - self.bias_mean_dps);
     }
 
     /// Add the angle uncertainty of `samples` steps that were integrated while the motion
@@ -149,14 +195,59 @@ impl KalmanBias {
         }
         let n = samples as f32;
         let g = Matrix2::new(1.0, -self.dt_s * n, 0.0, 1.0);
-        self.p = g * self.p * g.transpose() + Matrix2::new(self.q_angle * n, 0.0, 0.0, 0.0);
+        self.p = g * self.p * g.transpose() + Matrix2::new(self.q_angle() * n, 0.0, 0.0, 0.0);
+    }
+
+    /// The first rest block after a movement (before its update): how far the bias the
+    /// movement was integrated with is from the one the rest shows. The mean square of
+    /// that innovation, less the block noise, is the bias error movements actually leave,
+    /// which a model fitted within rests can miss (a bias that shifts with motion); the
+    /// movement's standard deviation uses it when it exceeds the filter's own.
+    pub fn observe_after_movement(&mut self, mean_rate_dps: f32) {
+        let innovation = mean_rate_dps - self.bias_dps;
+        let noise = if self.block_variance > 0.0 {
+            self.block_variance
+        } else {
+            0.0
+        };
+        let variance = (innovation * innovation - noise).max(0.0);
+        if !variance.is_finite() {
+            return;
+        }
+        // The largest seen, forgetting slowly: a guard band must hold for the movements
+        // the rests explain worst, not for the average one.
+        self.movement_bias_variance = if self.movement_bias_variance.is_nan() {
+            variance
+        } else {
+            variance.max(self.movement_bias_variance * MOVEMENT_VARIANCE_RETAIN)
+        };
+    }
+
+    /// Two consecutive rest blocks' means: their difference measures the variance of a
+    /// block mean (the rest noise as the updates see it).
+    pub fn observe_block_pair(&mut self, first_mean_dps: f32, second_mean_dps: f32) {
+        let difference = second_mean_dps - first_mean_dps;
+        let variance = 0.5 * difference * difference;
+        if !variance.is_finite() {
+            return;
+        }
+        self.block_variance = if self.block_variance.is_nan() {
+            variance
+        } else {
+            self.block_variance + BLOCK_VARIANCE_WEIGHT * (variance - self.block_variance)
+        };
     }
 
     /// Zero-rate update with the mean of `samples` rates measured at rest (its noise
-    /// variance is R/samples). Returns the angle correction (deg).
+    /// variance is the measured block variance, else R/samples). Returns the angle
+    /// correction (deg).
     pub fn update_at_rest(&mut self, mean_rate_dps: f32, samples: u32) -> f32 {
         let rate_dps = mean_rate_dps;
-        let r = self.r_rate / samples.max(1) as f32;
+        let r = if self.block_variance > 0.0 {
+            self.block_variance
+        } else {
+            self.r_rate / samples.max(1) as f32
+        };
         let h = RowVector2::new(0.0, 1.0);
         let s = self.p[(1, 1)] + r;
         if s.is_nan() || s <= 0.0 {
@@ -164,6 +255,12 @@ impl KalmanBias {
         }
         let gain: Vector2<f32> = self.p * h.transpose() / s;
         let innovation = rate_dps - self.bias_dps;
+        let nis = innovation * innovation / s;
+        if nis.is_finite() {
+            let scaled =
+                self.wander_scale * libm::expf(WANDER_SCALE_STEP * (nis.min(NIS_CAP) - 1.0));
+            self.wander_scale = scaled.clamp(WANDER_SCALE_RANGE.0, WANDER_SCALE_RANGE.1);
+        }
         self.bias_dps += gain[1] * innovation;
         // Joseph form keeps P symmetric and positive in f32.
         let i_kh = Matrix2::identity() - gain * h;
@@ -173,7 +270,14 @@ impl KalmanBias {
 
     /// True if the state is finite.
     pub fn is_finite(&self) -> bool {
-        self.bias_dps.is_finite() && self.p.iter().all(|v| v.is_finite())
+        self.bias_dps.is_finite()
+            && self.p.iter().all(|v| v.is_finite())
+            && self.wander_scale.is_finite()
+    }
+
+    /// α: the scale the rests have set on the configured bias wander.
+    pub const fn wander_scale(&self) -> f32 {
+        self.wander_scale
     }
 }
 
@@ -181,22 +285,52 @@ impl KalmanBias {
 mod tests {
     use super::*;
 
+    /// Deterministic noise of standard deviation about `sigma` (uniform, a fixed sequence).
+    fn noise(k: u32, sigma: f32) -> f32 {
+        let x = k.wrapping_mul(2_654_435_761) >> 8;
+        sigma * 1.732 * ((x % 2001) as f32 / 1000.0 - 1.0)
+    }
+
     #[test]
     fn rest_updates_converge_to_the_bias() {
         let mut kf = KalmanBias::try_new(&KalmanConfig::default(), 0.02).unwrap();
-        for _ in 0..500 {
+        for k in 0..500 {
             kf.predict(false);
-            kf.update_at_rest(0.7, 1);
+            kf.update_at_rest(0.7 + noise(k, 0.05), 1);
         }
-        assert!((kf.bias_dps() - 0.7).abs() < 1e-3);
-        // Steady state of a random walk observed directly: P ≈ √(q R), so the standard
-        // deviation is (q R)^¼ = (0.25·(1 − φ²) · 0.05²)^¼ ≈ 0.017 deg/s.
-        let phi = (-0.02_f32 / 300.0).exp();
-        let expected = (0.25 * (1.0 - phi * phi) * 0.0025_f32).powf(0.25);
+        // Updated sample by sample (gain about 0.1), the estimate follows the noise by
+        // about 0.011 deg/s.
+        assert!((kf.bias_dps() - 0.7).abs() < 0.04, "{}", kf.bias_dps());
+        // A constant bias wanders less than the prior says: the wander scale shrinks.
+        assert!(kf.wander_scale() < 0.9, "{}", kf.wander_scale());
+    }
+
+    /// The rests set the noise the filter assumes: a bias wandering much faster than the
+    /// prior (σ 0.5 deg/s, β 1/300 s: about 0.04 deg/s/√s per step of `dt`; here 0.2 deg/s
+    /// per √(10 dt) per update) raises the wander scale, and a
+    /// block variance measured from consecutive blocks replaces R/n.
+    #[test]
+    fn the_rests_calibrate_the_noise_model() {
+        let dt = 0.02;
+        let mut kf = KalmanBias::try_new(&KalmanConfig::default(), dt).unwrap();
+        let mut bias = 0.0_f32;
+        let (mut previous, block) = (f32::NAN, 10);
+        for k in 0..2000_u32 {
+            // A random walk of 0.2 deg/s/√s, seen through blocks of 10 samples.
+            bias += noise(k + 7, 0.2 * (block as f32 * dt).sqrt());
+            let mean = bias + noise(k, 0.02);
+            kf.predict(false);
+            if previous.is_finite() {
+                kf.observe_block_pair(previous, mean);
+            }
+            kf.update_at_rest(mean, block);
+            previous = mean;
+        }
+        assert!(kf.wander_scale() > 4.0, "{}", kf.wander_scale());
         assert!(
-            (kf.bias_std_dps() - expected).abs() < 0.2 * expected,
-            "{}",
-            kf.bias_std_dps()
+            (kf.bias_dps() - bias).abs() < 0.15,
+            "{} vs {bias}",
+            kf.bias_dps()
         );
     }
 

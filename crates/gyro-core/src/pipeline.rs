@@ -255,6 +255,8 @@ struct RestBlocks {
     fresh_count: u16,
     aged_count: u16,
     block: u16,
+    /// No block released since the last movement (in the struct's padding).
+    after_movement: bool,
 }
 
 impl RestBlocks {
@@ -265,26 +267,36 @@ impl RestBlocks {
             fresh_count: 0,
             aged_count: 0,
             block,
+            after_movement: false,
         }
     }
 
-    /// Add a rest sample; returns a released block's (mean, count).
-    fn push(&mut self, rate_dps: f32) -> Option<(f32, u16)> {
+    /// Add a rest sample; returns a released block's (mean, count), the mean of the block
+    /// completed after it, and whether it is the first since a movement.
+    fn push(&mut self, rate_dps: f32) -> Option<(f32, u16, f32, bool)> {
         self.fresh_sum.add(rate_dps);
         self.fresh_count += 1;
         if self.fresh_count < self.block.max(1) {
             return None;
         }
+        let next_mean = self.fresh_sum.value() / f32::from(self.fresh_count);
         let sum = core::mem::replace(&mut self.aged_sum, self.fresh_sum);
         let count = core::mem::replace(&mut self.aged_count, self.fresh_count);
         self.fresh_sum = KahanSum::ZERO;
         self.fresh_count = 0;
-        (count > 0).then(|| (sum.value() / f32::from(count), count))
+        if count == 0 {
+            return None;
+        }
+        let first = core::mem::replace(&mut self.after_movement, false);
+        Some((sum.value() / f32::from(count), count, next_mean, first))
     }
 
     /// Drop the pending blocks (a movement starts).
     fn clear(&mut self) {
-        *self = Self::new(self.block);
+        *self = Self {
+            after_movement: true,
+            ..Self::new(self.block)
+        };
     }
 
     fn is_finite(&self) -> bool {
@@ -388,8 +400,8 @@ impl Pipeline {
             sos,
             sos_state: SosState::new(),
             detector,
-            raw: Integrator::new(output_period_s),
-            corrected: Integrator::new(output_period_s),
+            raw: Integrator::new(),
+            corrected: Integrator::new(),
             kalman: KalmanBias::try_new(&config.kalman, output_period_s)?,
             rest_blocks: RestBlocks::new(detector.min_rest_samples()),
             kalman_correction: KahanSum::ZERO,
@@ -560,8 +572,10 @@ impl Pipeline {
         // in motion would otherwise gain a whole step of T × rate).
         if integrates && self.index > 0 {
             let (previous_rate, previous_corrected) = self.previous;
-            self.raw.step(previous_rate, rate_dps);
-            self.corrected.step(previous_corrected, corrected_dps);
+            let half_dt_s = 0.5 * self.output_period_s;
+            self.raw.step(half_dt_s, previous_rate, rate_dps);
+            self.corrected
+                .step(half_dt_s, previous_corrected, corrected_dps);
         }
         self.previous = (rate_dps, corrected_dps);
 
@@ -576,7 +590,13 @@ impl Pipeline {
 
         let event = match phase {
             Phase::Rest => {
-                if let Some((mean_dps, samples)) = self.rest_blocks.push(rate_dps) {
+                if let Some((mean_dps, samples, next_mean_dps, first)) =
+                    self.rest_blocks.push(rate_dps)
+                {
+                    if first {
+                        self.kalman.observe_after_movement(mean_dps);
+                    }
+                    self.kalman.observe_block_pair(mean_dps, next_mean_dps);
                     let correction = self.kalman.update_at_rest(mean_dps, u32::from(samples));
                     self.kalman_correction.add(correction);
                 }
