@@ -171,7 +171,7 @@ fn chunks_out_of_time_order_are_read_in_time_order() {
     let dir = temp_dir("stream-order");
     let times: Vec<u64> = (0..3000).collect();
     let in_order = dir.join("in_order.mcap");
-    write_groups(&in_order, &[times.clone()], true);
+    write_groups(&in_order, std::slice::from_ref(&times), true);
     let expected = gyro_log::read_mcap(&in_order, &McapOptions::default()).unwrap();
     assert_eq!(expected.log.rows.len(), 3000);
     // The last second first, then the first, then the middle.
@@ -184,7 +184,7 @@ fn chunks_out_of_time_order_are_read_in_time_order() {
     write_groups(&shuffled, &groups, true);
     let got = gyro_log::read_mcap(&shuffled, &McapOptions::default()).unwrap();
     assert!(got.warnings.is_empty());
-    let strip = |rows: &[Row]| -> Vec<_> { rows.iter().map(|r| values(r)).collect() };
+    let strip = |rows: &[Row]| -> Vec<_> { rows.iter().map(values).collect() };
     assert_eq!(strip(&got.log.rows), strip(&expected.log.rows));
     // Every row has its reference (exact times), whatever chunk it was in.
     assert!(got.log.rows.iter().all(|r| r.reference_deg.is_some()));
@@ -200,7 +200,7 @@ fn rows_held_stay_within_a_chunk_whatever_the_length() {
     log.rows = (0..120_000)
         .map(|i| {
             let mut row = rows[i % rows.len()];
-            row.time_s = (i / rows.len()) as f64 * period + row.time_s;
+            row.time_s += (i / rows.len()) as f64 * period;
             row.time_s = (row.time_s * 1000.0).round() / 1000.0;
             row.line = i as u64 + 1;
             row
