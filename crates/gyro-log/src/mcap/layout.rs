@@ -109,7 +109,11 @@ pub(super) fn scan(file: &mut File) -> io::Result<Layout> {
         let body_len = u64::from_le_bytes(le8(&head[1..9]));
         if body_len > RECORD_LENGTH_LIMIT {
             layout.damage = Some(fail(
-                format!("a record (opcode {opcode:#04x}) claims {body_len} bytes: corrupt"),
+                if body_len == u64::MAX {
+                    format!("a record (opcode {opcode:#04x}) whose length was never written: an unfinished chunk")
+                } else {
+                    format!("a record (opcode {opcode:#04x}) claims {body_len} bytes: corrupt")
+                },
                 false,
             ));
             break;
