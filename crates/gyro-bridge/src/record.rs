@@ -7,7 +7,7 @@
 //! | `/gyro` (`gyro.Sample`) | `rate_dps`, `temperature_c`, `status` of each frame | bridge timestamp |
 //! | `/crm100/raw` (`crm100.BridgeFrame`) | every good bridge frame: `sequence`, `timestamp_us`, `command`, `hex` (the 6 response bytes), `checksum_ok` | bridge timestamp |
 //! | `/crm100/events` (`crm100.Event`) | one message per loss or fault: `gap` (`from`, `to`, `lost`), `crc_error`, `skipped_bytes`, `checksum_error`, `status_fault`, `saturated`, `duplicate`, `backwards`, `command_mismatch` | bridge time of the last good frame |
-//! | `/crm100/stats` (`crm100.Stats`) | the cumulative counters ([`RecordStats`]), every flush (0.5 s) and at the end | bridge time of the last good frame |
+//! | `/crm100/stats` (`crm100.Stats`) | the cumulative counters ([`RecordStats`]), every flush (0.25 s) and at the end | bridge time of the last good frame |
 //!
 //! plus a `gyro` metadata record: `sensor`, `sample_rate_hz`, `range_dps`, `lsb_per_dps`,
 //! `bridge_format`, `time_base`, `source`, `checks`. Every channel is a JSON channel with a
@@ -28,9 +28,11 @@
 //! `/crm100/raw` but not written to `/gyro` a second time.
 //!
 //! # Durability
-//! The MCAP writer closes a chunk every 0.5 s of bridge time, and [`record`] also flushes
-//! every [`RecordOptions::flush_interval`] of wall time, so a killed recorder loses at most
-//! about that much; Ctrl-C (the `stop` flag) finishes the file with its summary.
+//! The MCAP writer closes a chunk every 0.5 s of bridge time, and [`record`] also closes
+//! it and flushes every [`RecordOptions::flush_interval`] (0.25 s) of wall time, so a
+//! killed recorder loses at most about that much (under 0.5 s); Ctrl-C (the `stop` flag)
+//! finishes the file with its summary. A killed file has no summary: every reader in
+//! `gyro_log` reads it up to its unfinished last chunk, with a warning.
 
 use crm100_driver::{
     BridgeFrame, BridgeReader, Checks, Range, ReadEvent, ReaderStats, Received, Response, SeqEvent,
@@ -66,7 +68,7 @@ pub struct RecordOptions {
     /// Stop when no byte arrived for this long.
     pub idle_stop: Option<Duration>,
     /// Flush the output (close the MCAP chunk) at least this often (wall time), and write
-    /// a `/crm100/stats` message each time. Default 0.5 s.
+    /// a `/crm100/stats` message each time. Default 0.25 s (a killed recorder loses less than 0.5 s).
     pub flush_interval: Duration,
     /// Call the status callback this often. Default 0.25 s.
     pub status_interval: Duration,
@@ -82,7 +84,7 @@ impl Default for RecordOptions {
             sample_rate_hz: 1000.0,
             duration: None,
             idle_stop: None,
-            flush_interval: Duration::from_millis(500),
+            flush_interval: Duration::from_millis(250),
             status_interval: Duration::from_millis(250),
             source: String::new(),
         }

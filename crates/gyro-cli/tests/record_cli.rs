@@ -102,7 +102,7 @@ fn assert_prefix(rows: &[log::Row]) {
 }
 
 #[test]
-fn sigkill_leaves_all_but_the_last_second_readable() {
+fn sigkill_loses_under_half_a_second() {
     let dir = temp_dir("kill");
     let out = dir.join("killed.mcap");
     let bridge = start_bridge(60);
@@ -125,12 +125,35 @@ fn sigkill_leaves_all_but_the_last_second_readable() {
     assert!(!read.warnings.is_empty(), "an unfinished file is reported");
     assert!(rows <= sent_at_kill);
     assert!(
-        rows + 1000 >= sent_at_kill,
+        rows + 500 >= sent_at_kill,
         "only {rows} of {sent_at_kill} frames survived the kill"
     );
     assert!(rows >= 2000, "{rows}");
     assert_prefix(&read.log.rows);
     assert_eq!(read.log.metadata_rate_hz(), Some(1000.0));
+    assert!(
+        read.warnings[0].contains("read up to byte"),
+        "{:?}",
+        read.warnings
+    );
+
+    // Recovery (README): `convert` writes a finished copy of everything before the damage.
+    let recovered = dir.join("recovered.mcap");
+    let status = Command::new(BIN)
+        .arg("convert")
+        .args([&out, &recovered])
+        .stderr(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let bytes = std::fs::read(&recovered).unwrap();
+    assert!(
+        mcap::Summary::read(&bytes).unwrap().is_some(),
+        "indexed readers open it"
+    );
+    let again = log::read_mcap(&recovered, &McapOptions::default()).unwrap();
+    assert!(again.warnings.is_empty());
+    assert_eq!(again.log.rows.len(), read.log.rows.len());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -100,7 +100,7 @@ fn parse_field(field: &[u8]) -> Result<Option<f64>, ()> {
 /// decimal correctly rounded: what `str::parse` returns (its own fast path, Clinger's).
 /// `None` for anything else (a `+`, an exponent, spaces, `nan`, more digits…), which the
 /// general path decides.
-fn parse_plain_decimal(field: &[u8]) -> Option<f64> {
+pub(crate) fn parse_plain_decimal(field: &[u8]) -> Option<f64> {
     const POW10: [f64; 23] = [
         1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
         1e17, 1e18, 1e19, 1e20, 1e21, 1e22,

@@ -31,7 +31,7 @@ pub(crate) use csv_log::CsvRows;
 pub use csv_log::{read_csv, write_csv, ColumnOptions, RateUnit, TimeUnit};
 pub use load::{load, stream};
 pub use mcap::{
-    read_mcap, write_mcap, Axis, JsonChannel, McapLogWriter, McapOptions, McapRead,
+    read_mcap, write_mcap, Axis, JsonChannel, McapLogWriter, McapOptions, McapRead, McapRows,
     McapWriteOptions, TimeSource,
 };
 pub use regular::{

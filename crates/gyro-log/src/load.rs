@@ -2,13 +2,14 @@
 //! caller, and put it on the regular grid ([`load`] whole, [`stream`] slot by slot).
 
 use crate::{
-    metadata_rate_hz, place, read_ahead, read_log_with_warnings, read_mcap, regularize, CsvRows,
-    GridOptions, LogError, LogFormat, LogInfo, LogOptions, Quality, RegularLog, SlotSink,
+    metadata_rate_hz, place, read_ahead, read_csv, regularize, CsvRows, GridOptions, LogError,
+    LogFormat, LogInfo, LogOptions, McapRows, Quality, RegularLog, Slot, SlotSink,
 };
 use std::path::Path;
 
-/// Read the log at `path` and place it on the grid. Warnings (MCAP damage that did not stop
-/// reading) go to `warn`, one line each, before anything else is reported.
+/// Read the log at `path` and place it on the grid (an MCAP log through [`stream`], so its
+/// rows are never all held). Warnings (MCAP damage read around) go to `warn`, one line
+/// each, before the log is returned.
 ///
 /// ```no_run
 /// let regular = gyro_log::load(
@@ -26,16 +27,45 @@ pub fn load(
     grid: &GridOptions,
     warn: &mut dyn FnMut(&str),
 ) -> Result<RegularLog, LogError> {
-    let (raw, warnings) = read_log_with_warnings(path, options)?;
-    for warning in &warnings {
-        warn(warning);
+    match LogFormat::detect(path) {
+        LogFormat::Csv => regularize(&read_csv(path, &options.columns)?, grid),
+        LogFormat::Mcap => {
+            let mut collect = Collect::default();
+            let quality = stream(path, options, grid, &mut collect, warn)?;
+            Ok(RegularLog {
+                slots: collect.slots,
+                sample_rate_hz: quality.sample_rate_hz,
+                has_reference: collect.has_reference,
+                has_temperature: collect.has_temperature,
+                quality,
+            })
+        }
     }
-    regularize(&raw, grid)
+}
+
+/// The slots of a log, kept.
+#[derive(Default)]
+struct Collect {
+    slots: Vec<Slot>,
+    has_reference: bool,
+    has_temperature: bool,
+}
+
+impl SlotSink for Collect {
+    fn columns(&mut self, has_reference: bool, has_temperature: bool) {
+        self.has_reference = has_reference;
+        self.has_temperature = has_temperature;
+    }
+    fn start(&mut self, _sample_rate_hz: f64) {}
+    fn slot(&mut self, slot: &Slot) {
+        self.slots.push(*slot);
+    }
 }
 
 /// What [`load`] does, without holding the log: each slot goes to `sink` as soon as it is
-/// final. A CSV log is parsed on a second thread and streamed row by row; an MCAP log is
-/// read whole, then streamed from its rows. Returns what was irregular.
+/// final. Either format is read on a second thread (CSV row by row, MCAP chunk by chunk)
+/// while this one places the rows. Warnings (MCAP damage read around) go to `warn` once
+/// the rows are read. Returns what was irregular.
 pub fn stream<S: SlotSink + ?Sized>(
     path: &Path,
     options: &LogOptions,
@@ -56,16 +86,20 @@ pub fn stream<S: SlotSink + ?Sized>(
             read_ahead(rows, |rows| place(&info, rows, grid, sink))
         }
         LogFormat::Mcap => {
-            let read = read_mcap(path, &options.mcap)?;
-            for warning in &read.warnings {
-                warn(warning);
+            let mut rows = McapRows::open(path, &options.mcap)?;
+            // The columns are decided by the rows placing holds back anyway.
+            rows.prime();
+            let info = LogInfo {
+                path,
+                metadata_rate_hz: rows.metadata_rate_hz(),
+                has_reference: rows.has_reference(),
+                has_temperature: rows.has_temperature(),
+            };
+            let placed = read_ahead(&mut rows, |rows| place(&info, rows, grid, sink));
+            for warning in rows.warnings() {
+                warn(&warning);
             }
-            place(
-                &LogInfo::of(&read.log),
-                read.log.rows.iter().copied().map(Ok),
-                grid,
-                sink,
-            )
+            placed
         }
     }
 }

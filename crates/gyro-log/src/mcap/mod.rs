@@ -1,5 +1,5 @@
 //! MCAP logs (docs/log-formats.md, "MCAP"): JSON channels Foxglove plots directly, written
-//! incrementally in small zstd chunks, read as a stream; ROS 2 bags (`sensor_msgs/msg/Imu`
+//! incrementally in small zstd chunks, read chunk by chunk in constant memory; ROS 2 bags (`sensor_msgs/msg/Imu`
 //! in CDR) are read too.
 //!
 //! # Layout written
@@ -23,11 +23,15 @@
 //! exactly, values are JSON numbers in their shortest round-trip form and come back
 //! bit for bit.
 
+mod attach;
+mod json;
+mod layout;
 mod read;
 mod ros2;
+mod unit;
 mod write;
 
-pub use read::{read_mcap, McapOptions, McapRead, REFERENCE_MAX_SPAN_S, TIME_ORIGIN_KEY};
+pub use read::{read_mcap, McapOptions, McapRead, McapRows, REFERENCE_MAX_SPAN_S, TIME_ORIGIN_KEY};
 pub use ros2::{Axis, TimeSource, IMU_SCHEMA_NAME};
 pub use write::{write_mcap, JsonChannel, McapLogWriter, McapWriteOptions};
 

@@ -14,12 +14,22 @@
 //! for an Imu channel `time_s` counts from the whole second at or before the earliest
 //! sample, and the metadata key [`TIME_ORIGIN_KEY`] holds that second.
 //!
+//! # Order and memory
+//! The file is read chunk by chunk ([`McapRows`]): one walk over the top-level record
+//! headers finds the chunks (with or without a summary section), then the chunks are read
+//! in order of their first log time (`message_start_time`; equal ones in file order), so
+//! chunks written out of time order are read in time order; the messages of a chunk in
+//! their order in the file. Memory holds a chunk and the rows waiting for their reference
+//! (in a file whose channels share chunks in time order, at most a chunk's worth), never
+//! the log.
+//!
 //! # Reference attachment
 //! Reference samples (`/reference`, `{"angle_deg": f64|null}`) are attached to rate rows by
-//! log time, after the whole file is read (so neither channel needs to be sorted):
+//! log time (neither channel needs to be sorted; a row waits until no unread chunk can
+//! hold a reference that decides it):
 //! - a reference message at exactly a row's time gives that row its value (`null`: the row
 //!   has no reference); the k-th of several rows with one time stamp takes the k-th
-//!   reference message with that time, in file order;
+//!   reference message with that time, in the order read;
 //! - otherwise the value is interpolated linearly between the latest earlier and the
 //!   earliest later reference message, if both are non-null and at most
 //!   [`REFERENCE_MAX_SPAN_S`] apart;
@@ -29,22 +39,22 @@
 //! # Damaged files
 //! A file that ends with the MCAP magic was finished by its writer: any unreadable record
 //! in it is an error. A file without it is an interrupted recording or a cut copy: every
-//! record up to the first incomplete or unreadable one is used (chunks are CRC-checked
-//! before any of their messages is), and a warning says what was lost. Bad magic, an empty
-//! file, a wrong schema on a known channel or an undecodable message are one-line errors
-//! naming the file (and the channel and 1-based message index on that channel).
+//! chunk up to the first incomplete or unreadable record is used (chunks are CRC-checked
+//! before any of their messages is), and a warning names the byte offset where reading
+//! stopped and how many rate samples were kept. Bad magic, an empty file, a wrong schema on
+//! a known channel or an undecodable message are one-line errors naming the file (and the
+//! channel and 1-based message index on that channel).
 
+use super::attach::Attacher;
+use super::layout::{self, Layout};
 use super::ros2::{decode_imu, Axis, TimeSource, IMU_SCHEMA_NAME};
-use super::{ns_to_seconds, GYRO_TOPIC, MAGIC, METADATA_NAME, REFERENCE_TOPIC};
-use crate::{Log, LogError, Row};
+use super::unit::{Event, UnitError, Units};
+use super::{json, ns_to_seconds, GYRO_TOPIC, METADATA_NAME, REFERENCE_TOPIC};
+use crate::{metadata_rate_hz, Log, LogError, Row, RATE_WINDOW_STEPS};
 use mcap::records::{op, Record};
-use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
-use mcap::McapError;
-use serde::{Deserialize, Deserializer};
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap, VecDeque};
 use std::fs::File;
-use std::io::{BufReader, ErrorKind, Read, Seek, SeekFrom};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Longest time (s) between two reference samples across which a rate row's reference is
 /// interpolated.
@@ -53,9 +63,6 @@ pub const REFERENCE_MAX_SPAN_S: f64 = 0.5;
 /// Metadata key set for ROS 2 logs: the source-clock time (whole seconds; ROS time counts
 /// from the Unix epoch) at which the log's `time_s` is 0.
 pub const TIME_ORIGIN_KEY: &str = "time_origin_s";
-
-/// Records (and chunks) larger than this are treated as corrupt rather than allocated.
-const RECORD_LENGTH_LIMIT: usize = 1 << 30;
 
 /// How to read an MCAP log (ignored for CSV).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -135,157 +142,397 @@ struct SchemaInfo {
     data: Vec<u8>,
 }
 
-/// Deserialize a field whose presence matters: absent → `None`, `null` → `Some(None)`.
-fn present<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Option<f64>>, D::Error> {
-    Option::<f64>::deserialize(d).map(Some)
-}
-
-#[derive(Deserialize)]
-struct GyroIn {
-    #[serde(default, deserialize_with = "present")]
-    rate_dps: Option<Option<f64>>,
-    #[serde(default, deserialize_with = "present")]
-    temperature_c: Option<Option<f64>>,
-    #[serde(default)]
-    #[allow(dead_code)] // checked for type; `Row` has no status yet
-    status: Option<u32>,
-}
-
-#[derive(Deserialize)]
-struct ReferenceIn {
-    #[serde(default, deserialize_with = "present")]
-    angle_deg: Option<Option<f64>>,
-}
-
-/// Everything gathered while streaming.
-struct State<'a> {
-    path: &'a Path,
-    options: &'a McapOptions,
+/// Everything gathered while streaming, besides the rows.
+struct State {
+    path: PathBuf,
+    options: McapOptions,
     saw_header: bool,
     schemas: HashMap<u16, SchemaInfo>,
-    channels: HashMap<u16, ChannelInfo>,
+    /// By id (a B-tree: a lookup per message, among a few channels, costs less than a hash).
+    channels: BTreeMap<u16, ChannelInfo>,
     metadata: BTreeMap<String, String>,
-    rate_topic: Option<(String, Kind)>,
-    rows: Vec<Row>,
-    row_ns: Vec<u64>,
-    reference: Vec<(u64, Option<f64>)>,
+    /// The rate channel: its id, topic and kind.
+    rate_channel: Option<(u16, String, Kind)>,
+    attacher: Attacher,
     has_reference: bool,
     has_temperature: bool,
     messages: u64,
 }
 
-/// Read an MCAP log (or a ROS 2 bag in MCAP) as a stream; see the module docs for which
-/// channel gives the rate, how the reference is attached and how damage is handled.
-pub fn read_mcap(path: &Path, options: &McapOptions) -> Result<McapRead, LogError> {
-    let io_err = |cause| LogError::Io {
-        path: path.to_path_buf(),
-        cause,
-    };
-    let mcap_err = |message: String| LogError::Mcap {
-        path: path.to_path_buf(),
-        message,
-    };
-    let mut file = File::open(path).map_err(io_err)?;
-    let len = file.metadata().map_err(io_err)?.len();
-    if len == 0 {
-        return Err(mcap_err("empty file (0 bytes), not an MCAP log".into()));
-    }
-    let finished = ends_with_magic(&mut file, len).map_err(io_err)?;
-    let mut source = BufReader::with_capacity(1 << 20, file);
+/// Where reading stopped early in a file without footer.
+struct Stop {
+    offset: u64,
+    what: String,
+}
 
-    let mut reader = LinearReader::new_with_options(
-        LinearReaderOptions::default()
-            .with_prevalidate_chunk_crcs(true)
-            .with_validate_data_section_crc(true)
-            .with_record_length_limit(RECORD_LENGTH_LIMIT),
-    );
-    let mut state = State {
-        path,
-        options,
-        saw_header: false,
-        schemas: HashMap::new(),
-        channels: HashMap::new(),
-        metadata: BTreeMap::new(),
-        rate_topic: None,
-        rows: Vec::new(),
-        row_ns: Vec::new(),
-        reference: Vec::new(),
-        has_reference: false,
-        has_temperature: false,
-        messages: 0,
-    };
-    // What stopped the reading early, and whether it was the end of the file.
-    let mut damage: Option<(String, bool)> = None;
-    while let Some(event) = reader.next_event() {
-        match event {
-            Ok(LinearReadEvent::ReadRequest(need)) => {
-                let read = loop {
-                    match source.read(reader.insert(need)) {
-                        Ok(n) => break n,
-                        Err(e) if e.kind() == ErrorKind::Interrupted => continue,
-                        Err(e) => return Err(io_err(e)),
-                    }
-                };
-                reader.notify_read(read);
+/// The rate rows of an MCAP log (or a ROS 2 bag in MCAP), read chunk by chunk, with their
+/// reference attached; see the module docs for which channel gives the rate, the order,
+/// how the reference is attached and how damage is handled.
+///
+/// An iterator of rows; an error ends it. [`McapRows::warnings`] then says what damage was
+/// read around.
+pub struct McapRows {
+    state: State,
+    units: Units,
+    finished: bool,
+    /// Damage the walk over the file met (reading stops there).
+    scan_damage: Option<layout::Damage>,
+    /// Where reading stopped.
+    stop: Option<Stop>,
+    /// All units read (or reading stopped).
+    ended: bool,
+    /// An error was given: nothing more.
+    failed: bool,
+    /// Rows read ahead by [`McapRows::prime`].
+    primed: VecDeque<Result<Row, LogError>>,
+    /// For ROS 2 Imu rows: the whole second (ns) their times count from.
+    origin_ns: Option<u64>,
+    /// Rows given.
+    rows: u64,
+}
+
+impl McapRows {
+    /// Open the file and read what precedes the first message: the layout, the schemas,
+    /// channels and metadata outside chunks.
+    pub fn open(path: &Path, options: &McapOptions) -> Result<Self, LogError> {
+        let io_err = |cause| LogError::Io {
+            path: path.to_path_buf(),
+            cause,
+        };
+        let mcap_err = |message: String| LogError::Mcap {
+            path: path.to_path_buf(),
+            message,
+        };
+        let mut file = File::open(path).map_err(io_err)?;
+        let Layout {
+            len,
+            finished,
+            saw_header,
+            units,
+            definitions,
+            damage,
+        } = layout::scan(&mut file).map_err(io_err)?;
+        if len == 0 {
+            return Err(mcap_err("empty file (0 bytes), not an MCAP log".into()));
+        }
+        if let Some(damage) = &damage {
+            if !saw_header {
+                return Err(mcap_err(if damage.cut {
+                    format!("cut short ({len} bytes) before the end of the MCAP header")
+                } else {
+                    format!("not an MCAP file ({})", damage.what)
+                }));
             }
-            Ok(LinearReadEvent::Record { opcode, data }) => {
-                if let Err(e) = state.record(opcode, data)? {
-                    damage = Some((e, false));
-                    break;
+            if finished {
+                return Err(mcap_err(format!(
+                    "corrupt MCAP file: {} (byte {})",
+                    damage.what, damage.offset
+                )));
+            }
+        }
+        let mut state = State {
+            path: path.to_path_buf(),
+            options: options.clone(),
+            saw_header,
+            schemas: HashMap::new(),
+            channels: BTreeMap::new(),
+            metadata: BTreeMap::new(),
+            rate_channel: None,
+            attacher: Attacher::new(REFERENCE_MAX_SPAN_S),
+            has_reference: false,
+            has_temperature: false,
+            messages: 0,
+        };
+        for definition in &definitions {
+            if let Err(what) = state.record(definition.opcode, &definition.body)? {
+                return Err(mcap_err(format!("corrupt MCAP file: {what}")));
+            }
+        }
+        Ok(Self {
+            state,
+            units: Units::new(file, units),
+            finished,
+            scan_damage: damage,
+            stop: None,
+            ended: false,
+            failed: false,
+            primed: VecDeque::new(),
+            origin_ns: None,
+            rows: 0,
+        })
+    }
+
+    /// Read ahead until [`RATE_WINDOW_STEPS`] + 1 rows are held (the rows placing holds
+    /// back anyway) or the file ends, so that whether the log has a temperature and a
+    /// reference is decided by them before the first row is placed. An error met is given
+    /// by the iterator, after the rows before it.
+    pub fn prime(&mut self) {
+        while self.primed.len() <= RATE_WINDOW_STEPS {
+            match self.next_row() {
+                Some(row) => self.primed.push_back(row),
+                None => break,
+            }
+        }
+    }
+
+    /// True if the log has a reference channel (so far).
+    pub fn has_reference(&self) -> bool {
+        self.state.has_reference
+    }
+
+    /// True if a rate message had a `temperature_c` field (so far).
+    pub fn has_temperature(&self) -> bool {
+        self.state.has_temperature
+    }
+
+    /// The `gyro` metadata (records outside chunks, all known from the start).
+    pub fn metadata(&self) -> &BTreeMap<String, String> {
+        &self.state.metadata
+    }
+
+    /// The `sample_rate_hz` metadata value, if valid.
+    pub fn metadata_rate_hz(&self) -> Option<f64> {
+        metadata_rate_hz(&self.state.metadata)
+    }
+
+    /// Rows held waiting for their reference now, and at most so far (read-ahead by
+    /// [`McapRows::prime`] not counted).
+    pub fn rows_held(&self) -> (usize, usize) {
+        self.state.attacher.held()
+    }
+
+    /// Damage read around (a file without footer), one line each; final once the rows are
+    /// all read.
+    pub fn warnings(&self) -> Vec<String> {
+        let stop = self
+            .stop
+            .as_ref()
+            .map(|s| (s.offset, s.what.as_str()))
+            .or(self
+                .scan_damage
+                .as_ref()
+                .map(|d| (d.offset, d.what.as_str())));
+        stop.map(|(offset, what)| {
+            format!(
+                "{}: the file has no MCAP footer (an interrupted recording or a cut copy); read up to byte {offset} of {} ({what}): {} rate samples kept",
+                self.state.path.display(),
+                self.units.file_len(),
+                self.rows
+            )
+        })
+        .into_iter()
+        .collect()
+    }
+
+    /// The next row, with its reference; `None` at the end or after an error.
+    fn next_row(&mut self) -> Option<Result<Row, LogError>> {
+        if self.failed {
+            return None;
+        }
+        let row = self.read_row();
+        if let Some(Err(_)) = row {
+            self.failed = true;
+        }
+        row
+    }
+
+    fn read_row(&mut self) -> Option<Result<Row, LogError>> {
+        loop {
+            if let Some((time_ns, mut row)) = self.state.attacher.pop() {
+                let origin_ns = match self.origin() {
+                    Ok(origin_ns) => origin_ns,
+                    Err(e) => return Some(Err(e)),
+                };
+                row.time_s = ns_to_seconds(time_ns - origin_ns);
+                self.rows += 1;
+                return Some(Ok(row));
+            }
+            if self.ended {
+                if self.state.rate_channel.is_none() {
+                    let damaged = self.stop.is_some() || self.scan_damage.is_some();
+                    return Some(Err(self.state.no_rate_channel(damaged)));
+                }
+                return None;
+            }
+            match self.units.next_event() {
+                None => self.end(),
+                Some(Ok(Event::UnitDone { next_start_ns })) => {
+                    self.state.attacher.advance(next_start_ns);
+                }
+                Some(Ok(Event::Record { opcode, data })) => match self.state.record(opcode, data) {
+                    Ok(Ok(())) => {}
+                    Ok(Err(what)) => {
+                        let offset = self.units.current_offset();
+                        if let Err(e) = self.damaged(offset, what) {
+                            return Some(Err(e));
+                        }
+                    }
+                    Err(e) => return Some(Err(e)),
+                },
+                Some(Err(UnitError::Io(cause))) => {
+                    return Some(Err(LogError::Io {
+                        path: self.state.path.clone(),
+                        cause,
+                    }))
+                }
+                Some(Err(UnitError::Damaged { offset, what })) => {
+                    if let Err(e) = self.damaged(offset, what) {
+                        return Some(Err(e));
+                    }
                 }
             }
-            Err(e) => {
-                damage = Some((describe(&e), matches!(e, McapError::UnexpectedEof)));
+        }
+    }
+
+    /// Every unit read: every row is decided.
+    fn end(&mut self) {
+        self.ended = true;
+        self.state.attacher.advance(u64::MAX);
+    }
+
+    /// Reading stops at damage: an error in a finished file, else the end.
+    fn damaged(&mut self, offset: u64, what: String) -> Result<(), LogError> {
+        if self.finished {
+            return Err(LogError::Mcap {
+                path: self.state.path.clone(),
+                message: format!("corrupt MCAP file: {what} (byte {offset})"),
+            });
+        }
+        self.stop = Some(Stop { offset, what });
+        self.end();
+        Ok(())
+    }
+
+    /// What row times count from: 0, or for ROS 2 Imu rows the whole second at or before
+    /// the earliest (found by a pass over the rate channel's messages up to where reading
+    /// stops).
+    fn origin(&mut self) -> Result<u64, LogError> {
+        if let Some(origin_ns) = self.origin_ns {
+            return Ok(origin_ns);
+        }
+        let origin_ns = match &self.state.rate_channel {
+            Some((id, _, Kind::Imu)) => {
+                let earliest = self.earliest_imu_time(*id)?;
+                earliest / 1_000_000_000 * 1_000_000_000
+            }
+            _ => 0,
+        };
+        self.origin_ns = Some(origin_ns);
+        Ok(origin_ns)
+    }
+
+    /// The earliest time of the Imu channel `id`'s messages, read in a separate pass.
+    fn earliest_imu_time(&self, id: u16) -> Result<u64, LogError> {
+        let path = &self.state.path;
+        let file = File::open(path).map_err(|cause| LogError::Io {
+            path: path.clone(),
+            cause,
+        })?;
+        let options = &self.state.options;
+        let mut units = Units::new(file, self.units.units().to_vec());
+        let mut earliest = u64::MAX;
+        while let Some(event) = units.next_event() {
+            let Ok(Event::Record { opcode, data }) = event else {
+                if let Err(UnitError::Io(cause)) = event {
+                    return Err(LogError::Io {
+                        path: path.clone(),
+                        cause,
+                    });
+                }
+                if event.is_err() {
+                    break; // damage: reading stops there too
+                }
+                continue;
+            };
+            if opcode != op::MESSAGE {
+                continue;
+            }
+            let Ok(Record::Message { header, data }) = mcap::parse_record(opcode, data) else {
                 break;
+            };
+            if header.channel_id != id {
+                continue;
+            }
+            // Undecodable messages are reported by the main pass.
+            if let Ok(sample) = decode_imu(&data, options.axis, options.flip) {
+                let time_ns = match options.time_source {
+                    TimeSource::LogTime => Some(header.log_time),
+                    TimeSource::Header => sample.stamp_ns,
+                };
+                earliest = earliest.min(time_ns.unwrap_or(u64::MAX));
             }
         }
+        Ok(if earliest == u64::MAX { 0 } else { earliest })
     }
 
-    let mut warnings = Vec::new();
-    if let Some((what, eof)) = damage {
-        if !state.saw_header {
-            return Err(mcap_err(if eof {
-                format!("cut short ({len} bytes) before the end of the MCAP header")
-            } else {
-                format!("not an MCAP file ({what})")
-            }));
+    /// Read every row into memory.
+    fn read_all(mut self) -> Result<McapRead, LogError> {
+        let mut rows = Vec::new();
+        for row in self.by_ref() {
+            rows.push(row?);
         }
-        if finished {
-            return Err(mcap_err(format!("corrupt MCAP file: {what}")));
+        let warnings = self.warnings();
+        let Some((_, rate_topic, kind)) = self.state.rate_channel.take() else {
+            return Err(self.state.no_rate_channel(!warnings.is_empty()));
+        };
+        if kind == Kind::Imu {
+            let origin_s = self.origin_ns.unwrap_or(0) / 1_000_000_000;
+            self.state
+                .metadata
+                .insert(TIME_ORIGIN_KEY.to_string(), origin_s.to_string());
         }
-        warnings.push(format!(
-            "{}: the file has no MCAP footer (an interrupted recording or a cut copy); read up to the first unreadable record ({what}): {} rate samples kept",
-            path.display(),
-            state.rows.len()
-        ));
-    }
-    state.finish(warnings)
-}
-
-/// True if the file ends with the MCAP magic (its writer finished it).
-fn ends_with_magic(file: &mut File, len: u64) -> std::io::Result<bool> {
-    if len < 2 * MAGIC.len() as u64 {
-        return Ok(false);
-    }
-    let mut tail = [0_u8; 8];
-    file.seek(SeekFrom::End(-(MAGIC.len() as i64)))?;
-    file.read_exact(&mut tail)?;
-    file.seek(SeekFrom::Start(0))?;
-    Ok(&tail == MAGIC)
-}
-
-fn describe(e: &McapError) -> String {
-    match e {
-        McapError::BadMagic => "bad magic".into(),
-        McapError::UnexpectedEof => "the file ends inside a record".into(),
-        McapError::RecordTooLarge { .. } | McapError::ChunkTooLarge(_) => {
-            format!("{e} (an unfinished chunk or a corrupt length)")
-        }
-        e => e.to_string(),
+        Ok(McapRead {
+            log: Log {
+                path: self.state.path,
+                metadata: self.state.metadata,
+                has_reference: self.state.has_reference,
+                has_temperature: self.state.has_temperature,
+                rows,
+            },
+            rate_topic,
+            ros2: kind == Kind::Imu,
+            messages: self.state.messages,
+            warnings,
+        })
     }
 }
 
-impl State<'_> {
+impl Iterator for McapRows {
+    type Item = Result<Row, LogError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        match self.primed.pop_front() {
+            Some(row) => Some(row),
+            None => self.next_row(),
+        }
+    }
+}
+
+/// Read an MCAP log (or a ROS 2 bag in MCAP) into memory ([`McapRows`], collected).
+pub fn read_mcap(path: &Path, options: &McapOptions) -> Result<McapRead, LogError> {
+    McapRows::open(path, options)?.read_all()
+}
+
+/// Bytes of a message record's header: channel id, sequence, log time, publish time.
+const MESSAGE_HEADER_LEN: usize = 2 + 4 + 8 + 8;
+
+/// The header of a message record's body, if it is long enough.
+fn message_header(data: &[u8]) -> Option<mcap::records::MessageHeader> {
+    let header = data.get(..MESSAGE_HEADER_LEN)?;
+    let u64_at = |i: usize| {
+        let mut bytes = [0_u8; 8];
+        bytes.copy_from_slice(&header[i..i + 8]);
+        u64::from_le_bytes(bytes)
+    };
+    Some(mcap::records::MessageHeader {
+        channel_id: u16::from_le_bytes([header[0], header[1]]),
+        sequence: u32::from_le_bytes([header[2], header[3], header[4], header[5]]),
+        log_time: u64_at(6),
+        publish_time: u64_at(14),
+    })
+}
+
+impl State {
     /// Handle one record. Outer error: the file is bad in a way that is never tolerated
     /// (wrong schema, undecodable message); inner error: the record does not parse
     /// (damage, handled like a read error).
@@ -295,6 +542,13 @@ impl State<'_> {
             op::HEADER | op::SCHEMA | op::CHANNEL | op::MESSAGE | op::METADATA
         ) {
             return Ok(Ok(()));
+        }
+        if opcode == op::MESSAGE {
+            // Parsed here: the most frequent record, by far.
+            let Some(header) = message_header(data) else {
+                return Ok(Err("unreadable record (opcode 0x05): too short".into()));
+            };
+            return self.message(&header, &data[MESSAGE_HEADER_LEN..]).map(Ok);
         }
         let record = match mcap::parse_record(opcode, data) {
             Ok(record) => record,
@@ -419,19 +673,28 @@ impl State<'_> {
         match channel.kind {
             Kind::Ignored => {}
             Kind::Reference => {
-                let message: ReferenceIn = serde_json::from_slice(data)
-                    .map_err(|e| fail(format!("not a reference JSON message: {e}")))?;
-                let angle = message
-                    .angle_deg
+                let angle = json::reference(data)
+                    .map_err(|e| fail(format!("not a reference JSON message: {e}")))?
                     .ok_or_else(|| fail("no `angle_deg` field".into()))?;
-                self.reference
-                    .push((header.log_time, angle.filter(|a| a.is_finite())));
+                self.attacher
+                    .reference(header.log_time, angle.filter(|a| a.is_finite()));
             }
             Kind::GyroJson | Kind::Imu => {
-                match &self.rate_topic {
-                    None => self.rate_topic = Some((channel.topic.clone(), channel.kind.clone())),
-                    Some((topic, _)) if *topic == channel.topic => {}
-                    Some((topic, _)) => {
+                match &self.rate_channel {
+                    None => {
+                        self.rate_channel = Some((
+                            header.channel_id,
+                            channel.topic.clone(),
+                            channel.kind.clone(),
+                        ));
+                        if channel.kind == Kind::Imu
+                            && self.options.time_source == TimeSource::Header
+                        {
+                            self.attacher.rows_not_at_log_time();
+                        }
+                    }
+                    Some((_, topic, _)) if *topic == channel.topic => {}
+                    Some((_, topic, _)) => {
                         return Err(LogError::McapSecondRate {
                             path: self.path.to_path_buf(),
                             channel: channel.topic.clone(),
@@ -454,7 +717,7 @@ impl State<'_> {
                     };
                     (time_ns, sample.rate_dps, None)
                 } else {
-                    let message: GyroIn = serde_json::from_slice(data)
+                    let message = json::gyro(data)
                         .map_err(|e| fail(format!("not a gyro JSON message: {e}")))?;
                     let rate = message
                         .rate_dps
@@ -464,52 +727,20 @@ impl State<'_> {
                     }
                     (header.log_time, rate, message.temperature_c.flatten())
                 };
-                self.rows.push(Row {
+                let row = Row {
                     line: index,
-                    time_s: ns_to_seconds(time_ns),
+                    time_s: 0.0, // from `time_ns` when the row is given
                     rate_dps: rate_dps.filter(|r| r.is_finite()),
                     reference_deg: None,
                     temperature_c: temperature_c.filter(|t| t.is_finite()),
-                });
-                self.row_ns.push(time_ns);
+                };
+                self.attacher.row(time_ns, row);
             }
         }
         Ok(())
     }
 
-    /// Attach the reference and build the log.
-    fn finish(mut self, warnings: Vec<String>) -> Result<McapRead, LogError> {
-        let Some((rate_topic, kind)) = self.rate_topic.take() else {
-            return Err(self.no_rate_channel(&warnings));
-        };
-        attach_reference(&mut self.rows, &self.row_ns, &mut self.reference);
-        if kind == Kind::Imu {
-            // ROS time is epoch-scale, where an f64 resolves only ~0.24 us: count from the
-            // whole second before the first sample instead, and say so in the metadata.
-            let origin_s = self.row_ns.iter().min().map_or(0, |t| t / 1_000_000_000);
-            let origin_ns = origin_s * 1_000_000_000;
-            for (row, &t) in self.rows.iter_mut().zip(&self.row_ns) {
-                row.time_s = ns_to_seconds(t - origin_ns);
-            }
-            self.metadata
-                .insert(TIME_ORIGIN_KEY.to_string(), origin_s.to_string());
-        }
-        Ok(McapRead {
-            log: Log {
-                path: self.path.to_path_buf(),
-                metadata: self.metadata,
-                has_reference: self.has_reference,
-                has_temperature: self.has_temperature,
-                rows: self.rows,
-            },
-            rate_topic,
-            ros2: kind == Kind::Imu,
-            messages: self.messages,
-            warnings,
-        })
-    }
-
-    fn no_rate_channel(&self, warnings: &[String]) -> LogError {
+    fn no_rate_channel(&self, damaged: bool) -> LogError {
         let channels: BTreeSet<String> = self
             .channels
             .values()
@@ -536,7 +767,7 @@ impl State<'_> {
                 format!("no `{GYRO_TOPIC}` JSON channel and no {IMU_SCHEMA_NAME} channel in CDR")
             }
         };
-        let damage = if warnings.is_empty() {
+        let damage = if !damaged {
             String::new()
         } else {
             " (the file is cut short)".to_string()
@@ -590,104 +821,9 @@ fn check_json(
     Ok(())
 }
 
-/// Attach reference samples to rows by time (rule in the module docs).
-fn attach_reference(rows: &mut [Row], row_ns: &[u64], reference: &mut [(u64, Option<f64>)]) {
-    if reference.is_empty() {
-        return;
-    }
-    reference.sort_by_key(|&(t, _)| t); // stable: equal times keep file order
-    let max_span_ns = (REFERENCE_MAX_SPAN_S * 1e9) as u64;
-    let mut previous: Option<u64> = None;
-    let mut same_time = 0_usize;
-    let mut lo = 0_usize;
-    for (row, &t) in rows.iter_mut().zip(row_ns) {
-        same_time = if previous == Some(t) {
-            same_time + 1
-        } else {
-            0
-        };
-        previous = Some(t);
-        // First reference at or after t: walk forward from the last row's (rows are
-        // usually in time order), search again when time goes back.
-        lo = if lo > 0 && reference[lo - 1].0 >= t {
-            reference.partition_point(|&(r, _)| r < t)
-        } else {
-            lo + reference[lo..].iter().take_while(|&&(r, _)| r < t).count()
-        };
-        let hi = lo + reference[lo..].iter().take_while(|&&(r, _)| r == t).count();
-        row.reference_deg = if hi > lo {
-            reference[lo + same_time.min(hi - lo - 1)].1
-        } else if lo > 0 && lo < reference.len() {
-            let (t0, v0) = reference[lo - 1];
-            let (t1, v1) = reference[lo];
-            match (v0, v1) {
-                (Some(v0), Some(v1)) if t1 - t0 <= max_span_ns => {
-                    let w = (t - t0) as f64 / (t1 - t0) as f64;
-                    Some(v0 + w * (v1 - v0))
-                }
-                _ => None,
-            }
-        } else {
-            None
-        };
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn row(t: u64) -> Row {
-        Row {
-            line: 0,
-            time_s: ns_to_seconds(t),
-            rate_dps: Some(0.0),
-            reference_deg: Some(-99.0),
-            temperature_c: None,
-        }
-    }
-
-    #[test]
-    fn reference_exact_interpolated_or_none() {
-        let ms = 1_000_000;
-        let times = [
-            0,
-            5 * ms,
-            10 * ms,
-            10 * ms,
-            15 * ms,
-            20 * ms,
-            900 * ms,
-            2000 * ms,
-            3000 * ms,
-        ];
-        let mut rows: Vec<Row> = times.iter().map(|&t| row(t)).collect();
-        let mut reference = vec![
-            (20 * ms, None),
-            (10 * ms, Some(1.0)),
-            (10 * ms, Some(2.0)),
-            (0, Some(0.0)),
-            (1000 * ms, Some(10.0)),
-            (1400 * ms, Some(14.0)),
-            (2100 * ms, Some(21.0)),
-        ];
-        attach_reference(&mut rows, &times, &mut reference);
-        let got: Vec<Option<f64>> = rows.iter().map(|r| r.reference_deg).collect();
-        assert_eq!(
-            got,
-            [
-                Some(0.0), // exact
-                Some(0.5), // halfway between 0 and 1.0 (the first at 10 ms)
-                Some(1.0), // first row at 10 ms takes the first reference at 10 ms
-                Some(2.0), // second row, second reference
-                None,      // between 2.0 and null
-                None,      // exact null
-                None,      // between null (20 ms) and 10.0 (1 s)
-                None,      // 1.4 s .. 2.1 s is longer than 0.5 s
-                None,      // after the last reference: no extrapolation
-            ]
-        );
-    }
 
     #[test]
     fn check_json_messages() {

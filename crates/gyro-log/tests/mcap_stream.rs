@@ -1,0 +1,222 @@
+//! MCAP read chunk by chunk: the same rows and slots as reading whole, truncated files read
+//! up to the damage with its byte offset, chunks out of time order, and a bound on the rows
+//! held.
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+mod common;
+use common::{temp_dir, workspace_root};
+
+use gyro_log::{
+    self, GridOptions, Log, LogOptions, McapOptions, McapRows, RegularLog, Row, Slot, SlotSink,
+};
+use std::collections::BTreeMap;
+use std::io::BufWriter;
+use std::path::Path;
+
+fn bench() -> Log {
+    gyro_log::read_csv(
+        &workspace_root().join("fixtures/logs/bench_run.csv"),
+        &gyro_log::ColumnOptions::default(),
+    )
+    .unwrap()
+}
+
+fn values(row: &Row) -> (u64, u64, Option<f64>, Option<f64>, Option<f64>) {
+    (
+        row.line,
+        row.time_s.to_bits(),
+        row.rate_dps,
+        row.reference_deg,
+        row.temperature_c,
+    )
+}
+
+struct Slots(Vec<Slot>);
+impl SlotSink for Slots {
+    fn start(&mut self, _: f64) {}
+    fn slot(&mut self, slot: &Slot) {
+        self.0.push(*slot);
+    }
+}
+
+/// `stream` and `load` of an MCAP file give the slots and quality of placing the log
+/// read whole.
+fn assert_stream_equals_whole(path: &Path, whole: &Log, options: &LogOptions) {
+    let grid = GridOptions::default();
+    let expected: RegularLog = gyro_log::regularize(whole, &grid).unwrap();
+    let mut slots = Slots(Vec::new());
+    let mut warnings = Vec::new();
+    let quality = gyro_log::stream(path, options, &grid, &mut slots, &mut |w| {
+        warnings.push(w.to_string())
+    })
+    .unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(quality, expected.quality);
+    assert_eq!(slots.0.len(), expected.slots.len());
+    assert!(slots.0 == expected.slots, "slots differ");
+    let loaded = gyro_log::load(path, options, &grid, &mut |_| {}).unwrap();
+    assert!(loaded == expected, "loaded log differs");
+}
+
+#[test]
+fn streaming_equals_whole_file_reading_on_the_fixtures() {
+    let dir = temp_dir("stream-fixtures");
+    let path = dir.join("bench.mcap");
+    let csv = bench();
+    gyro_log::write_mcap(&path, &csv).unwrap();
+    let read = gyro_log::read_mcap(&path, &McapOptions::default()).unwrap();
+    assert_eq!(read.log.rows.len(), csv.rows.len());
+    for (a, b) in read.log.rows.iter().zip(&csv.rows) {
+        assert_eq!(values(a).1, values(b).1);
+        assert_eq!(values(a).2..=values(a).4, values(b).2..=values(b).4);
+    }
+    assert_stream_equals_whole(&path, &read.log, &LogOptions::default());
+    let ros = workspace_root().join("fixtures/mcap/ros2_imu.mcap");
+    let whole = gyro_log::read_mcap(&ros, &McapOptions::default())
+        .unwrap()
+        .log;
+    assert_stream_equals_whole(&ros, &whole, &LogOptions::default());
+}
+
+#[test]
+fn a_truncated_file_warns_with_the_byte_offset_and_keeps_the_rows_before() {
+    let dir = temp_dir("stream-cut");
+    let full = dir.join("full.mcap");
+    gyro_log::write_mcap(&full, &bench()).unwrap();
+    let bytes = std::fs::read(&full).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let all = gyro_log::read_mcap(&full, &McapOptions::default())
+        .unwrap()
+        .log;
+    let chunk = &summary.chunk_indexes[30];
+    let cut = (chunk.chunk_start_offset + chunk.chunk_length / 2) as usize;
+    let path = dir.join("cut.mcap");
+    std::fs::write(&path, &bytes[..cut]).unwrap();
+
+    let mut rows = McapRows::open(&path, &McapOptions::default()).unwrap();
+    let got: Vec<Row> = rows.by_ref().map(Result::unwrap).collect();
+    let before = chunk.message_start_time as f64 / 1e9;
+    let kept = all.rows.iter().filter(|r| r.time_s < before).count();
+    assert_eq!(got.len(), kept);
+    for (a, b) in got.iter().zip(&all.rows) {
+        assert_eq!(values(a), values(b));
+    }
+    let warnings = rows.warnings();
+    assert_eq!(warnings.len(), 1);
+    let offset = format!("read up to byte {} of {cut}", chunk.chunk_start_offset);
+    assert!(warnings[0].contains(&offset), "{}", warnings[0]);
+    assert!(warnings[0].contains(&format!("{kept} rate samples kept")));
+
+    // `stream` passes the warning on and places the rows kept.
+    let mut slots = Slots(Vec::new());
+    let mut warned = Vec::new();
+    let grid = GridOptions::default();
+    let quality = gyro_log::stream(&path, &LogOptions::default(), &grid, &mut slots, &mut |w| {
+        warned.push(w.to_string())
+    })
+    .unwrap();
+    assert_eq!(warned, warnings);
+    assert_eq!(quality.rows, kept as u64);
+}
+
+/// Messages of one channel pair (`/gyro`, `/reference`) at the given times, written in the
+/// given groups, each group closed as a chunk of its own.
+fn write_groups(path: &Path, groups: &[Vec<u64>], finish: bool) {
+    let file = std::fs::File::create(path).unwrap();
+    let mut w = mcap::WriteOptions::new()
+        .compression(Some(mcap::Compression::Zstd))
+        .create(BufWriter::new(file))
+        .unwrap();
+    let gyro_schema = r#"{"type":"object","properties":{"rate_dps":{}}}"#;
+    let ref_schema = r#"{"type":"object","properties":{"angle_deg":{}}}"#;
+    let g = w
+        .add_schema("gyro.Sample", "jsonschema", gyro_schema.as_bytes())
+        .unwrap();
+    let r = w
+        .add_schema("gyro.Reference", "jsonschema", ref_schema.as_bytes())
+        .unwrap();
+    let gyro = w.add_channel(g, "/gyro", "json", &BTreeMap::new()).unwrap();
+    let reference = w
+        .add_channel(r, "/reference", "json", &BTreeMap::new())
+        .unwrap();
+    let mut sequence = 0;
+    for group in groups {
+        for &ms in group {
+            for (channel, text) in [
+                (gyro, format!(r#"{{"rate_dps":{}}}"#, ms % 7)),
+                (
+                    reference,
+                    format!(r#"{{"angle_deg":{}}}"#, ms as f64 / 10.0),
+                ),
+            ] {
+                sequence += 1;
+                let header = mcap::records::MessageHeader {
+                    channel_id: channel,
+                    sequence,
+                    log_time: ms * 1_000_000,
+                    publish_time: ms * 1_000_000,
+                };
+                w.write_to_known_channel(&header, text.as_bytes()).unwrap();
+            }
+        }
+        w.flush().unwrap(); // close the chunk
+    }
+    if finish {
+        w.finish().unwrap();
+    }
+}
+
+#[test]
+fn chunks_out_of_time_order_are_read_in_time_order() {
+    let dir = temp_dir("stream-order");
+    let times: Vec<u64> = (0..3000).collect();
+    let in_order = dir.join("in_order.mcap");
+    write_groups(&in_order, std::slice::from_ref(&times), true);
+    let expected = gyro_log::read_mcap(&in_order, &McapOptions::default()).unwrap();
+    assert_eq!(expected.log.rows.len(), 3000);
+    // The last second first, then the first, then the middle.
+    let shuffled = dir.join("shuffled.mcap");
+    let groups = vec![
+        times[2000..].to_vec(),
+        times[..1000].to_vec(),
+        times[1000..2000].to_vec(),
+    ];
+    write_groups(&shuffled, &groups, true);
+    let got = gyro_log::read_mcap(&shuffled, &McapOptions::default()).unwrap();
+    assert!(got.warnings.is_empty());
+    let strip = |rows: &[Row]| -> Vec<_> { rows.iter().map(values).collect() };
+    assert_eq!(strip(&got.log.rows), strip(&expected.log.rows));
+    // Every row has its reference (exact times), whatever chunk it was in.
+    assert!(got.log.rows.iter().all(|r| r.reference_deg.is_some()));
+}
+
+#[test]
+fn rows_held_stay_within_a_chunk_whatever_the_length() {
+    let dir = temp_dir("stream-memory");
+    let mut log = bench();
+    // 120 s at 1 kHz with a reference: 240 chunks of 0.5 s.
+    let rows = log.rows.clone();
+    let period = rows.len() as f64 / 1000.0;
+    log.rows = (0..120_000)
+        .map(|i| {
+            let mut row = rows[i % rows.len()];
+            row.time_s += (i / rows.len()) as f64 * period;
+            row.time_s = (row.time_s * 1000.0).round() / 1000.0;
+            row.line = i as u64 + 1;
+            row
+        })
+        .collect();
+    let path = dir.join("long.mcap");
+    gyro_log::write_mcap(&path, &log).unwrap();
+    let mut reader = McapRows::open(&path, &McapOptions::default()).unwrap();
+    let mut count = 0;
+    for row in reader.by_ref() {
+        row.unwrap();
+        count += 1;
+    }
+    assert_eq!(count, 120_000);
+    let (now, most) = reader.rows_held();
+    assert_eq!(now, 0);
+    // A chunk holds at most 0.5 s (500 rows); nothing else is held.
+    assert!(most <= 500, "{most} rows held");
+}
