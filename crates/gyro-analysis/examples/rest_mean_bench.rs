@@ -175,6 +175,7 @@ fn judge(decisions: &mut Decisions, m: &gyro_analysis::replay::MovementResult, t
                 tolerance_deg: tolerance_deg as f32,
                 k_sigma: 2.0,
                 direction,
+                scale_sigma: 0.0,
             };
             let inside = offset_deg.abs() < tolerance_deg;
             let untrusted = m.saturated || !m.complete || m.filled_samples > 0;

@@ -13,7 +13,7 @@
 //!
 //! ```
 //! use gyro_core::{decide, Direction, Tightening, Verdict};
-//! let window = Tightening { target_deg: 90.0, tolerance_deg: 5.0, k_sigma: 2.0, direction: Direction::Positive };
+//! let window = Tightening { target_deg: 90.0, tolerance_deg: 5.0, ..Tightening::default() };
 //! assert_eq!(decide(&window, 91.0, 0.5, false), Some(Verdict::Ok));
 //! assert_eq!(decide(&window, 94.5, 0.5, false), Some(Verdict::Recheck));
 //! assert_eq!(decide(&window, 97.0, 0.5, false), Some(Verdict::Nok));
@@ -48,6 +48,12 @@ pub struct Tightening {
     pub k_sigma: f32,
     /// Which sign of the angle tightens.
     pub direction: Direction,
+    /// Relative standard uncertainty of the gyro's scale factor (e.g. 0.01 for 1%), added to
+    /// the movement's σ in quadrature as `scale_sigma · |angle|`. The filter's σ knows the
+    /// bias and the noise, not the scale: an uncalibrated MEMS gyro is off by 1–3% of the
+    /// angle (the rasteiro recordings: 0–1.5%), more than the rest of the error. 0 by
+    /// default (a calibrated scale, `config.correction`).
+    pub scale_sigma: f32,
 }
 
 impl Default for Tightening {
@@ -57,6 +63,7 @@ impl Default for Tightening {
             tolerance_deg: 5.0,
             k_sigma: 2.0,
             direction: Direction::Positive,
+            scale_sigma: 0.0,
         }
     }
 }
@@ -72,6 +79,7 @@ impl Tightening {
             f64::from(self.target_deg),
         )?;
         check_range("tightening.k_sigma", self.k_sigma.into(), 0.0, 100.0)?;
+        check_range("tightening.scale_sigma", self.scale_sigma.into(), 0.0, 1.0)?;
         Ok(())
     }
 }
@@ -92,8 +100,9 @@ pub enum Verdict {
 }
 
 /// The verdict on a movement of `angle_deg` with standard deviation `angle_std_deg` (0 if
-/// the compensation gives none: then there is no guard band), `None` if it turned the
-/// other way (not a tightening). `untrusted` makes it [`Verdict::Invalid`].
+/// the compensation gives none: then only the scale term guards), `None` if it turned the
+/// other way (not a tightening). `untrusted` makes it [`Verdict::Invalid`]. The guard band
+/// is `k · sqrt(σ² + (scale_sigma · angle)²)`.
 ///
 /// A σ that is not finite (or negative) cannot be guarded against: such a movement is
 /// `Recheck` at best.
@@ -118,7 +127,13 @@ pub fn decide(
     }
     let low = window.target_deg - window.tolerance_deg;
     let high = window.target_deg + window.tolerance_deg;
-    let guard = window.k_sigma * angle_std_deg;
+    let scale_deg = window.scale_sigma * turned;
+    let sigma_deg = libm::sqrtf(angle_std_deg * angle_std_deg + scale_deg * scale_deg);
+    let guard = if angle_std_deg >= 0.0 {
+        window.k_sigma * sigma_deg
+    } else {
+        f32::NAN
+    };
     if guard.is_nan() || guard < 0.0 || guard.is_infinite() {
         return Some(Verdict::Recheck);
     }
@@ -141,7 +156,27 @@ mod tests {
             tolerance_deg: 5.0,
             k_sigma: 2.0,
             direction: Direction::Positive,
+            scale_sigma: 0.0,
         }
+    }
+
+    /// A scale uncertainty widens the guard band with the angle: 1% of 90° is 0.9°.
+    #[test]
+    fn the_scale_uncertainty_adds_in_quadrature() {
+        let w = Tightening {
+            scale_sigma: 0.01,
+            ..window()
+        };
+        // Guard 2·sqrt(0.1² + 0.935²) ≈ 1.88: 93.5 is within it of the upper limit 95.
+        assert_eq!(decide(&w, 93.5, 0.1, false), Some(Verdict::Recheck));
+        assert_eq!(decide(&window(), 93.5, 0.1, false), Some(Verdict::Ok));
+        assert_eq!(decide(&w, 92.0, 0.1, false), Some(Verdict::Ok));
+        assert!(Tightening {
+            scale_sigma: -0.1,
+            ..window()
+        }
+        .validate()
+        .is_err());
     }
 
     #[test]

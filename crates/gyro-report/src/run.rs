@@ -193,7 +193,7 @@ pub fn table(file: &str, report: &RunReport) -> String {
                 .count();
             let _ = writeln!(
                 s,
-                "tightening {} ± {} deg ({} direction, guard band {} σ): ok {}, nok {}, recheck {}, invalid {}; {} turned the other way",
+                "tightening {} ± {} deg ({} direction, guard band {} σ{}): ok {}, nok {}, recheck {}, invalid {}; {} turned the other way",
                 t.target_deg,
                 t.tolerance_deg,
                 match t.direction {
@@ -201,6 +201,11 @@ pub fn table(file: &str, report: &RunReport) -> String {
                     gyro_core::Direction::Negative => "negative",
                 },
                 t.k_sigma,
+                if t.scale_sigma > 0.0 {
+                    format!(", scale uncertainty {}%", 100.0 * t.scale_sigma)
+                } else {
+                    String::new()
+                },
                 count(Verdict::Ok),
                 count(Verdict::Nok),
                 count(Verdict::Recheck),

@@ -66,6 +66,11 @@ pub struct Args {
     /// Which sign of the angle tightens; a turn the other way gets no verdict.
     #[arg(long, value_enum, default_value_t = DirectionArg::Positive)]
     tightening_direction: DirectionArg,
+    /// Relative uncertainty of the gyro's scale factor (0.01 = 1%), added to each
+    /// movement's σ as a share of its angle: the filter's σ does not know the scale. Use it
+    /// for a gyro whose scale is not calibrated.
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.0)]
+    scale_sigma: f32,
     /// Output format on stdout (csv: the movements).
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -107,6 +112,7 @@ pub fn run(args: &Args) -> Result<()> {
                 DirectionArg::Positive => Direction::Positive,
                 DirectionArg::Negative => Direction::Negative,
             },
+            scale_sigma: args.scale_sigma,
         });
     }
     if let Some(c) = args.compensation {
