@@ -148,7 +148,9 @@ pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
         path: path.to_path_buf(),
         cause,
     })?;
-    let model: ModelFile = serde_json::from_str(&text).map_err(|e| ModelError::Json {
+    // A byte-order mark (as some Windows editors write) is not part of the JSON.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let model: ModelFile = serde_json::from_str(text).map_err(|e| ModelError::Json {
         path: path.to_path_buf(),
         line: e.line(),
         column: e.column(),

@@ -87,7 +87,7 @@ fn flag_hint(error: &anyhow::Error) -> Option<&'static str> {
             LogError::SampleRateDisagrees { .. } => {
                 Some(" (fix --sample-rate-hz or the metadata, or leave it out)")
             }
-            LogError::Gap { .. } => Some(" (--max-gap-s)"),
+            LogError::Gap { .. } | LogError::MaxGapInvalid { .. } => Some(" (--max-gap-s)"),
             LogError::McapSecondRate { .. } => Some(" with --topic"),
             LogError::McapZeroStamp { .. } => Some(": --time-source log-time"),
             _ => None,

@@ -296,3 +296,58 @@ fn a_declared_rate_the_stamps_contradict_is_refused() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// Input that is valid but unusual is read: a Latin-1 byte in a comment line, a UTF-8
+/// byte-order mark before the header or the model file; an invalid `--max-gap-s` is refused.
+#[test]
+fn unusual_encodings_are_read_and_bad_gap_limits_refused() {
+    let dir = temp_dir("encodings");
+    let latin = dir.join("latin.csv");
+    std::fs::write(
+        &latin,
+        b"# sample_rate_hz: 100\n# note: caf\xe9\ntime_s,rate_dps\n0.00,1\n0.01,1\n0.02,1\n",
+    )
+    .unwrap();
+    let out = gyro(&["run", latin.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bom = dir.join("bom.csv");
+    std::fs::write(
+        &bom,
+        b"\xef\xbb\xbftime_s,rate_dps\n0.00,1\n0.01,1\n0.02,1\n",
+    )
+    .unwrap();
+    let out = gyro(&["run", bom.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let model = dir.join("model.json");
+    std::fs::write(
+        &model,
+        b"\xef\xbb\xbf{\"format\":\"gyro-model\",\"version\":1}",
+    )
+    .unwrap();
+    let log = bench_log();
+    let out = gyro(&[
+        "run",
+        log.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for bad in ["nan", "inf", "-1"] {
+        let out = gyro(&["run", log.to_str().unwrap(), &format!("--max-gap-s={bad}")]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{bad}: {stderr}");
+        assert!(stderr.contains("--max-gap-s"), "{bad}: {stderr}");
+    }
+}

@@ -216,14 +216,25 @@ impl CsvRows {
         let mut metadata = BTreeMap::new();
         let mut prelude_lines = 0_u64;
         let mut prelude_bytes = 0_u64;
+        // A UTF-8 byte-order mark (as some Windows tools write) is not part of the header.
+        if reader
+            .fill_buf()
+            .map_err(io_err)?
+            .starts_with(&[0xEF, 0xBB, 0xBF])
+        {
+            reader.consume(3);
+            prelude_bytes += 3;
+        }
         loop {
             let buf = reader.fill_buf().map_err(io_err)?;
             if buf.first() != Some(&b'#') {
                 break;
             }
-            let mut line = String::new();
-            prelude_bytes += reader.read_line(&mut line).map_err(io_err)? as u64;
+            // Comments may be in any encoding (a Latin-1 "é" in a note): read as bytes.
+            let mut bytes = Vec::new();
+            prelude_bytes += reader.read_until(b'\n', &mut bytes).map_err(io_err)? as u64;
             prelude_lines += 1;
+            let line = String::from_utf8_lossy(&bytes);
             if let Some((key, value)) = line.trim_start_matches('#').split_once(':') {
                 metadata.insert(key.trim().to_string(), value.trim().to_string());
             }

@@ -260,6 +260,16 @@ pub enum LogError {
         /// The rate given (Hz).
         rate_hz: f64,
     },
+    /// The longest gap to bridge ([`GridOptions::max_gap_s`]) is not a finite number ≥ 0.
+    #[error(
+        "{path}: the longest gap to bridge, {max_gap_s} s, is not a finite number of seconds >= 0"
+    )]
+    MaxGapInvalid {
+        /// File.
+        path: PathBuf,
+        /// The value given (s).
+        max_gap_s: f64,
+    },
     /// The sample rate given (option or metadata) disagrees with the time stamps.
     #[error(
         "{path}: the {source_name} gives {rate_hz} Hz but the time stamps say {measured_hz:.6} Hz ({ratio:.4} times that); on the given rate every angle would be off by that factor"

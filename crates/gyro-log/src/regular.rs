@@ -192,6 +192,19 @@ fn given_rate(
     info.metadata_rate_hz.map(|rate| Ok((rate, "metadata")))
 }
 
+/// `max_gap_s` must be a finite number of seconds ≥ 0 (NaN would disable the gap check,
+/// infinity would let a gap fill memory).
+pub(crate) fn check_max_gap(path: &Path, options: &GridOptions) -> Result<(), LogError> {
+    if options.max_gap_s.is_finite() && options.max_gap_s >= 0.0 {
+        Ok(())
+    } else {
+        Err(LogError::MaxGapInvalid {
+            path: path.to_path_buf(),
+            max_gap_s: options.max_gap_s,
+        })
+    }
+}
+
 /// A given rate further than this factor from the rate the stamps measure is refused.
 pub const RATE_DISAGREEMENT: f64 = 1.2;
 
@@ -330,6 +343,7 @@ pub fn place<S: SlotSink + ?Sized>(
         (None, Some(b)) => Ok((1.0 / b.mean_step_s, "mean_step")),
         (None, None) => median_step_rate(info.path, &ahead),
     };
+    let rate = check_max_gap(info.path, options).and(rate);
     let rate = rate.and_then(|(rate_hz, source)| {
         check_given_rate(info.path, &ahead, arrival, rate_hz, source).map(|()| (rate_hz, source))
     });
@@ -835,6 +849,7 @@ mod tests {
                 });
             }
             let arrival = crate::bursts::classify(&log.rows, 100_000);
+            super::super::check_max_gap(&log.path, options)?;
             let (rate_hz, source) = sample_rate(log, options, arrival)?;
             super::super::check_given_rate(&log.path, &log.rows, arrival, rate_hz, source)?;
             if let Some(b) = arrival {
