@@ -65,6 +65,8 @@ fn load_runs(paths: &[PathBuf], args: &Args) -> Result<Vec<BenchRun>> {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
+    let inputs = args.logs.iter().chain(&args.holdout).map(PathBuf::as_path);
+    super::refuse_to_overwrite(&args.out, inputs.chain(args.model.as_deref()))?;
     let base = match &args.model {
         Some(path) => model::load(path)?,
         None => model::ModelFile::new(Config::default()),

@@ -1,6 +1,6 @@
 //! `gyro-cli convert`: a log from one format to another (CSV, MCAP, ROS 2 bag in MCAP).
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use gyro_log as log;
 use std::path::PathBuf;
 
@@ -19,12 +19,7 @@ pub struct Args {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    if args.input == args.output {
-        bail!(
-            "{}: input and output are the same file",
-            args.input.display()
-        );
-    }
+    super::refuse_to_overwrite(&args.output, [args.input.as_path()])?;
     let log = super::read(&args.input, &args.input_options)?;
     log::write_log(&args.output, &log, args.to)?;
     let yes_no = |b: bool| if b { "yes" } else { "no" };

@@ -136,6 +136,10 @@ fn load(paths: &[PathBuf], args: &Args, role: &str) -> Result<Vec<RealRun>> {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
+    if let Some(out) = &args.out {
+        let inputs = args.train.iter().chain(&args.holdout).map(PathBuf::as_path);
+        super::refuse_to_overwrite(out, inputs.chain(args.model.as_deref()))?;
+    }
     if args.self_test {
         return self_test(args);
     }

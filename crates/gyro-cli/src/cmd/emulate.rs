@@ -87,6 +87,9 @@ fn samples(args: &Args) -> Result<(Vec<Sample>, String)> {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
+    if let Some(fault_log) = &args.fault_log {
+        super::refuse_to_overwrite(fault_log, args.log.as_deref())?;
+    }
     if let Some(rate) = args.rate_hz {
         if !(rate > 0.0 && rate <= 1e6) {
             bail!("--rate-hz must be in (0, 1e6]");

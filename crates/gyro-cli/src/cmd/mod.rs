@@ -15,6 +15,42 @@ use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
+/// Refuse to write `output` if it is one of `inputs` (the same file by device and inode
+/// on Unix, whatever the spelling: `./in.csv`, an absolute path, a symlink, a hard link),
+/// so that nothing already recorded is lost. An output that does not exist yet is fine.
+pub fn refuse_to_overwrite<'a>(
+    output: &Path,
+    inputs: impl IntoIterator<Item = &'a Path>,
+) -> Result<()> {
+    let Ok(written) = std::fs::metadata(output) else {
+        return Ok(());
+    };
+    for input in inputs {
+        let Ok(read) = std::fs::metadata(input) else {
+            continue;
+        };
+        if same_file(&written, &read, output, input) {
+            anyhow::bail!(
+                "{}: is also an input ({}); refusing to overwrite it",
+                output.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+#[cfg(unix)]
+fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata, _: &Path, _: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    a.dev() == b.dev() && a.ino() == b.ino()
+}
+
+#[cfg(not(unix))]
+fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata, a: &Path, b: &Path) -> bool {
+    matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+}
+
 /// Print a warning about the input on stderr.
 pub fn warn(warning: &str) {
     eprintln!("warning: {warning}");

@@ -112,6 +112,10 @@ fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<NoiseLog
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
+    for out in [&args.model_out, &args.psd_out].into_iter().flatten() {
+        let inputs = args.logs.iter().map(PathBuf::as_path);
+        super::refuse_to_overwrite(out, inputs.chain(args.model.as_deref()))?;
+    }
     if !(args.confidence > 0.0 && args.confidence < 1.0) {
         bail!("--confidence must be in (0, 1)");
     }

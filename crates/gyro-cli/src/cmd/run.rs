@@ -89,6 +89,14 @@ pub struct Args {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
+    if let Some(out) = &args.out {
+        super::refuse_to_overwrite(
+            out,
+            [args.log.as_path()]
+                .into_iter()
+                .chain(args.model.as_deref()),
+        )?;
+    }
     let (mut config, options) = match &args.model {
         Some(path) => {
             let model = model::load(path)?;

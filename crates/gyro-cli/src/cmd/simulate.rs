@@ -65,6 +65,15 @@ fn list_effects(out: &mut impl Write) -> std::io::Result<()> {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
+    if let Some(out) = &args.out {
+        super::refuse_to_overwrite(
+            out,
+            args.motion_from
+                .as_deref()
+                .into_iter()
+                .chain(args.model.as_deref()),
+        )?;
+    }
     if args.list_effects {
         list_effects(&mut std::io::stdout().lock())?;
         return Ok(());
