@@ -133,12 +133,13 @@ pub enum ModelError {
         value: f64,
     },
     /// A setting is invalid.
-    #[error("{path}: {source}")]
+    #[error("{path}: {setting}")]
     Invalid {
         /// File.
         path: PathBuf,
-        /// Which setting.
-        source: gyro_core::Error,
+        /// Which setting (part of this message, not a separate cause: it would print
+        /// twice).
+        setting: gyro_core::Error,
     },
 }
 
@@ -163,9 +164,9 @@ pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
             version: model.version,
         });
     }
-    Pipeline::try_new(&model.config).map_err(|source| ModelError::Invalid {
+    Pipeline::try_new(&model.config).map_err(|setting| ModelError::Invalid {
         path: path.to_path_buf(),
-        source,
+        setting,
     })?;
     model
         .sensor

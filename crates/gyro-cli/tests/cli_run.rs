@@ -344,6 +344,46 @@ fn unusual_encodings_are_read_and_bad_gap_limits_refused() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // UTF-16 is refused plainly; a huge bad field is not echoed whole.
+    let utf16 = dir.join("utf16.csv");
+    let mut bytes = vec![0xFF, 0xFE];
+    for unit in "time_s,rate_dps\n0.0,1\n".encode_utf16() {
+        bytes.extend_from_slice(&unit.to_le_bytes());
+    }
+    std::fs::write(&utf16, bytes).unwrap();
+    let out = gyro(&["run", utf16.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("this file is UTF-16"), "{stderr}");
+    let long = dir.join("long.csv");
+    std::fs::write(
+        &long,
+        format!("time_s,rate_dps\n0.0,1\n0.01,{}\n", "x".repeat(100_000)),
+    )
+    .unwrap();
+    let out = gyro(&["run", long.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.len() < 300, "{}", stderr.len());
+    assert!(stderr.contains("(100000 characters)"), "{stderr}");
+    // A bad setting in a model file is said once.
+    let bad_model = dir.join("bad-model.json");
+    std::fs::write(
+        &bad_model,
+        r#"{"format":"gyro-model","version":1,"config":{"output_rate_hz":-5}}"#,
+    )
+    .unwrap();
+    let out = gyro(&[
+        "run",
+        log.to_str().unwrap(),
+        "--model",
+        bad_model.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        stderr.matches("out of its valid range").count(),
+        1,
+        "{stderr}"
+    );
     for bad in ["nan", "inf", "-1"] {
         let out = gyro(&["run", log.to_str().unwrap(), &format!("--max-gap-s={bad}")]);
         let stderr = String::from_utf8_lossy(&out.stderr);

@@ -31,12 +31,23 @@ fn outputs_never_overwrite_inputs() {
         let out = gyro(&args);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
-        assert!(stderr.contains("refusing to overwrite"), "{args:?}: {stderr}");
-        assert_eq!(std::fs::read(&log).unwrap(), original, "{args:?} changed the input");
+        assert!(
+            stderr.contains("refusing to overwrite"),
+            "{args:?}: {stderr}"
+        );
+        assert_eq!(
+            std::fs::read(&log).unwrap(),
+            original,
+            "{args:?} changed the input"
+        );
     }
     // A new output is written as before.
     let series = dir.join("series.csv");
     let out = gyro(&["run", l, "--out", series.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(series.exists());
 }

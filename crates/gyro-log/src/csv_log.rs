@@ -216,6 +216,20 @@ impl CsvRows {
         let mut metadata = BTreeMap::new();
         let mut prelude_lines = 0_u64;
         let mut prelude_bytes = 0_u64;
+        // UTF-16 (a byte-order mark, or NUL bytes between ASCII characters) is refused
+        // plainly rather than read as a garbled header.
+        {
+            let start = reader.fill_buf().map_err(io_err)?;
+            let utf16 = start.starts_with(&[0xFF, 0xFE])
+                || start.starts_with(&[0xFE, 0xFF])
+                || start.iter().take(64).filter(|b| **b == 0).count() >= 8;
+            if utf16 {
+                return Err(LogError::NotUtf8 {
+                    path: path.to_path_buf(),
+                    what: "this file is UTF-16 (or binary); save it as UTF-8 CSV".into(),
+                });
+            }
+        }
         // A UTF-8 byte-order mark (as some Windows tools write) is not part of the header.
         if reader
             .fill_buf()
@@ -372,6 +386,29 @@ impl CsvRows {
     }
 }
 
+/// A field as an error shows it: at most 40 characters (a longer one cut, with its length),
+/// control characters escaped, so that a corrupt line cannot flood the terminal.
+pub(crate) fn excerpt(raw: &[u8]) -> String {
+    const SHOWN: usize = 40;
+    let text = String::from_utf8_lossy(raw);
+    let chars = text.chars().count();
+    let mut shown: String = text
+        .chars()
+        .take(SHOWN)
+        .flat_map(|c| {
+            if c.is_control() {
+                c.escape_default().collect::<Vec<_>>()
+            } else {
+                vec![c]
+            }
+        })
+        .collect();
+    if chars > SHOWN {
+        shown.push_str(&format!("… ({chars} characters)"));
+    }
+    shown
+}
+
 impl Columns {
     /// The row of the fields `field(i)` (as many as the header has), at `line`.
     fn row<'a>(&self, line: u64, field: impl Fn(usize) -> &'a [u8]) -> Result<Row, LogError> {
@@ -381,7 +418,7 @@ impl Columns {
                 path: self.path.clone(),
                 line,
                 column: column.to_string(),
-                value: String::from_utf8_lossy(raw).into_owned(),
+                value: excerpt(raw),
             })
         };
         let names = &self.names;

@@ -260,6 +260,14 @@ pub enum LogError {
         /// The rate given (Hz).
         rate_hz: f64,
     },
+    /// The file is not text in UTF-8 (UTF-16, binary).
+    #[error("{path}: {what}")]
+    NotUtf8 {
+        /// File.
+        path: PathBuf,
+        /// What it looks like.
+        what: String,
+    },
     /// The longest gap to bridge ([`GridOptions::max_gap_s`]) is not a finite number ≥ 0.
     #[error(
         "{path}: the longest gap to bridge, {max_gap_s} s, is not a finite number of seconds >= 0"
