@@ -51,3 +51,47 @@ fn outputs_never_overwrite_inputs() {
     );
     assert!(series.exists());
 }
+
+/// `record` keeps an earlier recording unless told `--force`; a failed `convert` leaves
+/// the file that was there and no partial one; `simulate -o x.mcap` writes MCAP.
+#[test]
+fn recordings_and_outputs_are_kept_or_written_whole() {
+    let dir = temp_dir("kept");
+    let earlier = dir.join("earlier.mcap");
+    std::fs::write(&earlier, b"an earlier recording").unwrap();
+    let out = gyro(&[
+        "record",
+        "--port",
+        "/nonexistent/port",
+        "-o",
+        earlier.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("--force"), "{stderr}");
+    assert_eq!(std::fs::read(&earlier).unwrap(), b"an earlier recording");
+
+    let bad = dir.join("bad.csv");
+    std::fs::write(&bad, "time_s,rate_dps\n0.0,x\n").unwrap();
+    let out = gyro(&["convert", bad.to_str().unwrap(), earlier.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(std::fs::read(&earlier).unwrap(), b"an earlier recording");
+    assert!(!dir.join("earlier.mcap.partial").exists());
+
+    let simulated = dir.join("sim.mcap");
+    let out = gyro(&[
+        "simulate",
+        "-o",
+        simulated.to_str().unwrap(),
+        "--duration-s",
+        "2",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(std::fs::read(&simulated)
+        .unwrap()
+        .starts_with(b"\x89MCAP0\r\n"));
+}

@@ -16,9 +16,13 @@ pub struct Args {
     /// Baud rate (24-byte frames at 1 kHz need at least 460800).
     #[arg(long, default_value_t = serial::DEFAULT_BAUD)]
     baud: u32,
-    /// Output log: MCAP (default) or, with --csv, CSV.
+    /// Output log: MCAP (default) or, with --csv, CSV. An existing file is kept unless
+    /// --force: a recording is not replaced by accident.
     #[arg(short, long)]
     out: PathBuf,
+    /// Replace OUT if it exists.
+    #[arg(long)]
+    force: bool,
     /// Stop after this many seconds (default: until Ctrl-C or the port closes).
     #[arg(long)]
     duration: Option<f64>,
@@ -79,6 +83,12 @@ fn status_line(s: &LiveStatus) -> String {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
+    if !args.force && args.out.exists() {
+        anyhow::bail!(
+            "{}: exists (an earlier recording?); choose another name, or --force to replace it",
+            args.out.display()
+        );
+    }
     let stop = super::stop_flag()?;
     let options = RecordOptions {
         range: args.range,

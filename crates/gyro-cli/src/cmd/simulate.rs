@@ -143,12 +143,9 @@ pub fn run(args: &Args) -> Result<()> {
         anyhow::bail!("--out is required");
     };
     let log = sim::simulate(&sensor, &effects, &motion, &options);
-    let write = || -> std::io::Result<()> {
-        let mut w = std::io::BufWriter::new(std::fs::File::create(out)?);
-        log::write_csv(&mut w, &log)?;
-        w.flush()
-    };
-    write().with_context(|| format!("cannot write {}", out.display()))?;
+    // MCAP for a `.mcap` name, else CSV (the format the command always wrote).
+    let format = log::LogFormat::from_extension(out).unwrap_or(log::LogFormat::Csv);
+    log::write_log(out, &log, Some(format))?;
     eprintln!(
         "wrote {} samples ({:.1} s at {} Hz, {} rotations, effects: {}) to {}",
         log.rows.len(),
