@@ -4,10 +4,9 @@
 //!
 //! `cargo run --release -p gyro-analysis --example rest_mean_bench [RUNS]` (default 20 runs
 //! of 90 s at 1 kHz per scenario, seeds 1..=RUNS).
-use gyro_analysis::rest_mean::score;
+use gyro_analysis::rest_mean::{score_report, simulate_bench_run};
 use gyro_core::Config;
-use gyro_log::{regularize, GridOptions};
-use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+use gyro_sim::{Effect, SensorModel};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -57,21 +56,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut stds = vec![];
         let mut decisions = Decisions::default();
         for seed in 1..=runs {
-            let motion = Motion::bench(&BenchProfile::default(), seed);
-            let rotations: Vec<(f64, f64)> = motion
-                .rotations()
-                .iter()
-                .map(|r| (r.start_s, r.start_s + r.duration_s))
-                .collect();
-            let options = SimOptions {
-                seed,
-                ..SimOptions::default()
-            };
-            let log = simulate(&SensorModel::default(), &effects, &motion, &options);
-            let regular = regularize(&log, &GridOptions::default())?;
-            let errors = score(&regular, &rotations, &Config::default())?;
-            let report = gyro_analysis::replay::replay(&regular, &Config::default())?;
-            for r in motion.rotations() {
+            let run = simulate_bench_run(&SensorModel::default(), &effects, seed)?;
+            // One replay, scored both ways.
+            let report = gyro_analysis::replay::replay(&run.log, &Config::default())?;
+            let errors = score_report(&run.log, &run.rotations, &report);
+            for r in run.motion.rotations() {
                 let mid = r.start_s + 0.5 * r.duration_s;
                 let found = report
                     .movements

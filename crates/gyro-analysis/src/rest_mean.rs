@@ -130,11 +130,23 @@ pub fn score(
     rotations: &[(f64, f64)],
     config: &gyro_core::Config,
 ) -> Result<RestErrors, gyro_core::Error> {
+    Ok(score_report(
+        log,
+        rotations,
+        &crate::replay::replay(log, config)?,
+    ))
+}
+
+/// [`score`] with the pipeline's run already replayed (`report`, from `log`).
+pub fn score_report(
+    log: &gyro_log::RegularLog,
+    rotations: &[(f64, f64)],
+    report: &crate::replay::RunReport,
+) -> RestErrors {
     let times_s: Vec<f64> = log.slots.iter().map(|s| s.time_s).collect();
     let rates_dps: Vec<f64> = log.slots.iter().map(|s| s.rate_dps).collect();
     let rests = rests_between(rotations, &times_s);
     let oracle = per_rest_angles(&rates_dps, 1.0 / log.sample_rate_hz, &rests);
-    let report = crate::replay::replay(log, config)?;
     let series_times: Vec<f64> = report.series.iter().map(|p| p.time_s).collect();
     let angle_at = |time_s: f64| -> f64 {
         let k = series_times.partition_point(|t| *t < time_s);
@@ -162,5 +174,41 @@ pub fn score(
             .push(pipeline_deg - p0 - (reference_deg - r0));
         errors.oracle_deg.push(oracle_deg - (reference_deg - r0));
     }
-    Ok(errors)
+    errors
+}
+
+/// A simulated bench run: the true motion, its rotations as (start, end) in s, and the
+/// log on the grid.
+pub struct SimulatedRun {
+    /// The true motion.
+    pub motion: gyro_sim::Motion,
+    /// Its rotations, (start, end) in s.
+    pub rotations: Vec<(f64, f64)>,
+    /// The simulated log on the grid.
+    pub log: gyro_log::RegularLog,
+}
+
+/// Simulate `sensor` with `effects` on the default bench motion of `seed`.
+pub fn simulate_bench_run(
+    sensor: &gyro_sim::SensorModel,
+    effects: &[gyro_sim::Effect],
+    seed: u64,
+) -> Result<SimulatedRun, gyro_log::LogError> {
+    let motion = gyro_sim::Motion::bench(&gyro_sim::BenchProfile::default(), seed);
+    let rotations = motion
+        .rotations()
+        .iter()
+        .map(|r| (r.start_s, r.start_s + r.duration_s))
+        .collect();
+    let options = gyro_sim::SimOptions {
+        seed,
+        ..gyro_sim::SimOptions::default()
+    };
+    let raw = gyro_sim::simulate(sensor, effects, &motion, &options);
+    let log = gyro_log::regularize(&raw, &gyro_log::GridOptions::default())?;
+    Ok(SimulatedRun {
+        motion,
+        rotations,
+        log,
+    })
 }

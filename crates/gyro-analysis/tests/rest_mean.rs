@@ -3,10 +3,9 @@
 //! rest_mean_bench` prints the full table).
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use gyro_analysis::rest_mean::score;
+use gyro_analysis::rest_mean::{score, simulate_bench_run};
 use gyro_core::Config;
-use gyro_log::{regularize, GridOptions};
-use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+use gyro_sim::{Effect, SensorModel};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -19,20 +18,9 @@ fn per_movement(effects: &[&str], runs: u64) -> (f64, f64) {
     let sensor = SensorModel::default();
     let (mut pipeline, mut oracle) = (vec![], vec![]);
     for seed in 1..=runs {
-        let motion = Motion::bench(&BenchProfile::default(), seed);
-        let rotations: Vec<(f64, f64)> = motion
-            .rotations()
-            .iter()
-            .map(|r| (r.start_s, r.start_s + r.duration_s))
-            .collect();
-        let options = SimOptions {
-            seed,
-            ..SimOptions::default()
-        };
-        let log = simulate(&sensor, &effects, &motion, &options);
-        let regular = regularize(&log, &GridOptions::default()).unwrap();
-        let errors = score(&regular, &rotations, &Config::default()).unwrap();
-        assert_eq!(errors.pipeline_deg.len(), rotations.len() + 1);
+        let run = simulate_bench_run(&sensor, &effects, seed).unwrap();
+        let errors = score(&run.log, &run.rotations, &Config::default()).unwrap();
+        assert_eq!(errors.pipeline_deg.len(), run.rotations.len() + 1);
         for (p, o) in errors.per_movement() {
             pipeline.push(p.abs());
             oracle.push(o.abs());
