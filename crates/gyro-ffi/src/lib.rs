@@ -103,6 +103,11 @@
 //! assert_eq!((status, field), (GyroStatus::ConfigOutOfRange, GyroField::MotionExitDps));
 //! ```
 //!
+//! On a bare-metal target the staticlib carries a `#[panic_handler]` (feature
+//! `panic-handler`, on by default), because a staticlib must name one; it raises a HardFault.
+//! Nothing in this crate can panic, and the checks of gyro-core it links (slices bounded by
+//! the filter's section count) guard the pipeline's own invariants, not its input.
+//!
 //! The header is committed and checked: `cargo test -p gyro-ffi --test header` fails when
 //! `include/gyro.h` differs from what cbindgen makes of this crate, and
 //! `GYRO_FFI_BLESS=1 cargo test -p gyro-ffi --test header` rewrites it.
