@@ -24,7 +24,8 @@
 
 // What a function did. Every function of this API returns one; none aborts or panics.
 //
-// Negative values are errors: nothing was changed (a push that fails takes no sample).
+// Negative values are errors: nothing was changed (a push that fails takes no sample; a
+// refused configuration is named in `*field`).
 enum GyroStatus
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
   : int32_t

@@ -4,7 +4,8 @@ use core::ffi::{c_char, CStr};
 
 /// What a function did. Every function of this API returns one; none aborts or panics.
 ///
-/// Negative values are errors: nothing was changed (a push that fails takes no sample).
+/// Negative values are errors: nothing was changed (a push that fails takes no sample; a
+/// refused configuration is named in `*field`).
 #[repr(i32)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GyroStatus {
