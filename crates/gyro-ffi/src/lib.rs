@@ -1,9 +1,9 @@
 //! # gyro-ffi
 //!
 //! The C API of [`gyro_core`]: the pipeline a C firmware links from `libgyro_ffi.a`, with
-//! the header `crates/gyro-ffi/include/gyro.h` generated from this crate by cbindgen. `no_std`, no allocation, no global state: the
-//! pipeline lives in storage the caller owns, `GYRO_PIPELINE_SIZE` bytes aligned to
-//! `GYRO_PIPELINE_ALIGN`. Every function returns a [`GyroStatus`]; none aborts or panics on
+//! the header `crates/gyro-ffi/include/gyro.h` generated from this crate by cbindgen.
+//! `no_std`, no allocation, no global state: the pipeline lives in storage the caller owns,
+//! `GYRO_PIPELINE_SIZE` bytes aligned to `GYRO_PIPELINE_ALIGN`. Every function returns a [`GyroStatus`]; none aborts or panics on
 //! any input: every pointer is checked for NULL and alignment, every flag and code of the
 //! configuration for its values, and gyro-core validates the numbers. The API only
 //! translates: the pipeline and the tightening decision are gyro-core's own
