@@ -9,7 +9,7 @@
 //! 2 / (2π · 1.554 f_c)), or Kalman compensation of the bias at every rest.
 
 use super::ensemble::RealRun;
-use super::{CompensationRun, CompensationSummary};
+use super::{CompensationRun, CompensationSummary, NotCorrected};
 use crate::model::ModelFile;
 use crate::replay::{replay_with, ReplayOptions};
 use gyro_core::Compensation;
@@ -64,48 +64,104 @@ pub fn corrected_model(base: &ModelFile, effects: &[Effect]) -> (ModelFile, Vec<
     (model, ids)
 }
 
-/// Stage 5: the base model with the corrections of the selected effects and its
-/// held-out angle errors, when any selected effect is correctable.
+/// Significance of a correction's held-out improvement (bootstrap over runs).
+pub const CORRECTION_P: f64 = 0.05;
+
+/// Stage 5: the corrections of the selected effects that lower the held-out angle
+/// error, each on top of those accepted before it (in selection order): paired over the
+/// held-out runs, the total max abs error must fall with bootstrap P <
+/// [`CORRECTION_P`]. The others are named, not corrected. Returns the summary (when any
+/// selected effect is correctable) and the model to write (when a correction is kept).
 pub(crate) fn compensate(
     holdout: &[RealRun],
-    base: &ModelFile,
+    options: &super::Options,
     selected: &[Effect],
     progress: &dyn super::Progress,
 ) -> (Option<CompensationSummary>, Option<ModelFile>) {
-    let (corrected, ids) = corrected_model(base, selected);
-    if ids.is_empty() {
+    let base = &options.base_model;
+    let correctable: Vec<Effect> = selected
+        .iter()
+        .filter(|e| !matches!(e.info().correction, CoreCorrection::None))
+        .copied()
+        .collect();
+    if correctable.is_empty() {
         return (None, None);
     }
     progress.stage("compensated replays of held-out runs", 0);
-    let summary = score(holdout, base, &corrected, ids);
-    (Some(summary), Some(corrected))
-}
-
-/// Max abs angle error of every held-out run with `base` and with `corrected`.
-pub fn score(
-    holdout: &[RealRun],
-    base: &ModelFile,
-    corrected: &ModelFile,
-    ids: Vec<&'static str>,
-) -> CompensationSummary {
+    let before = max_abs_errors(holdout, base);
+    let mut kept: Vec<Effect> = Vec::new();
+    let mut current = before.clone();
+    let mut not_corrected = Vec::new();
+    for (k, effect) in correctable.iter().enumerate() {
+        let mut trial = kept.clone();
+        trial.push(*effect);
+        let (model, _) = corrected_model(base, &trial);
+        let after = max_abs_errors(holdout, &model);
+        let paired: Vec<f64> = current
+            .iter()
+            .zip(&after)
+            .filter(|(a, b)| a.is_finite() && b.is_finite())
+            .map(|(a, b)| a - b)
+            .collect();
+        let seed = crate::seed::derive_seed(options.seed, "correction", k as u64);
+        let p = super::score::bootstrap_p(&paired, options.bootstrap.max(1), seed);
+        if !paired.is_empty() && p < CORRECTION_P {
+            kept = trial;
+            current = after;
+        } else {
+            not_corrected.push(NotCorrected {
+                id: effect.id(),
+                median_max_abs_error_without_deg: median(&current),
+                median_max_abs_error_with_deg: median(&after),
+                runs_better: paired.iter().filter(|d| **d > 0.0).count(),
+                runs: paired.len(),
+                bootstrap_p: p,
+            });
+        }
+    }
+    let (corrected, ids) = corrected_model(base, &kept);
     let runs = holdout
-        .par_iter()
-        .map(|run| {
-            let max_abs = |m: &ModelFile| -> f64 {
-                replay_with(&run.log, &m.config, &ReplayOptions::from_model(m))
-                    .ok()
-                    .and_then(|r| r.summary.max_abs_error_deg)
-                    .unwrap_or(f64::NAN)
-            };
-            CompensationRun {
-                name: run.name.clone(),
-                max_abs_error_before_deg: max_abs(base),
-                max_abs_error_after_deg: max_abs(corrected),
-            }
+        .iter()
+        .zip(before.iter().zip(&current))
+        .map(|(run, (b, a))| CompensationRun {
+            name: run.name.clone(),
+            max_abs_error_before_deg: *b,
+            max_abs_error_after_deg: *a,
         })
         .collect();
-    CompensationSummary {
-        corrected: ids,
+    let summary = CompensationSummary {
+        corrected: ids.clone(),
+        not_corrected,
         runs,
+    };
+    (Some(summary), (!ids.is_empty()).then_some(corrected))
+}
+
+/// Median of the finite values (NaN when none).
+fn median(values: &[f64]) -> f64 {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return f64::NAN;
     }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Max abs angle error of every held-out run replayed with `model` (NaN when a run
+/// cannot be replayed or has no reference).
+fn max_abs_errors(holdout: &[RealRun], model: &ModelFile) -> Vec<f64> {
+    holdout
+        .par_iter()
+        .map(|run| {
+            replay_with(&run.log, &model.config, &ReplayOptions::from_model(model))
+                .ok()
+                .and_then(|r| r.summary.max_abs_error_deg)
+                .unwrap_or(f64::NAN)
+        })
+        .collect()
 }

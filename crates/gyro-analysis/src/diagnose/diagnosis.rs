@@ -60,6 +60,10 @@ pub struct EffectResult {
     pub bootstrap_p: f64,
     /// Effects it is confounded with (indistinguishable on these runs).
     pub confounded_with: Vec<&'static str>,
+    /// The posterior check on its signature statistics (see
+    /// [`super::posterior`]): with the named set for a named effect, alone otherwise.
+    /// An effect that fails it is not named.
+    pub posterior_check: Option<super::posterior::PosteriorCheck>,
 }
 
 /// The verdict.
@@ -142,10 +146,32 @@ pub struct RunSummary {
 /// effects compensated (`run --model`).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CompensationSummary {
-    /// The model file's corrections, as written.
+    /// The model file's corrections, as written: each lowered the held-out angle error
+    /// on top of those before it (paired over the held-out runs, bootstrap P < 5%).
     pub corrected: Vec<&'static str>,
-    /// Per held-out run.
+    /// Named correctable effects whose correction did not lower the held-out angle
+    /// error: named, not corrected, with what the correction did.
+    pub not_corrected: Vec<NotCorrected>,
+    /// Per held-out run, without and with the written corrections.
     pub runs: Vec<CompensationRun>,
+}
+
+/// A named effect whose correction is not written.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NotCorrected {
+    /// Effect id.
+    pub id: &'static str,
+    /// Median over held-out runs of the max abs angle error without this correction
+    /// (with those written before it) (deg).
+    pub median_max_abs_error_without_deg: f64,
+    /// The same with it (deg).
+    pub median_max_abs_error_with_deg: f64,
+    /// Held-out runs it made better.
+    pub runs_better: usize,
+    /// Held-out runs scored.
+    pub runs: usize,
+    /// Bootstrap over held-out runs: P(no lower total max abs error).
+    pub bootstrap_p: f64,
 }
 
 /// One run's angle error without and with compensation.

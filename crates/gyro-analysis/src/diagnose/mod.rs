@@ -36,6 +36,7 @@ pub mod envelopes;
 pub(crate) mod features;
 pub(crate) mod fit;
 mod locate;
+pub mod posterior;
 pub(crate) mod score;
 mod select;
 pub mod selftest;
@@ -44,7 +45,7 @@ mod summarise;
 
 pub use diagnosis::{
     CompensationRun, CompensationSummary, Diagnosis, EffectResult, GapSummary, ModelSummary,
-    RunSummary, UntestableEntry, Verdict, Where,
+    NotCorrected, RunSummary, UntestableEntry, Verdict, Where,
 };
 pub use ensemble::{split, RealRun};
 pub use features::MIN_TEMPERATURE_RANGE_C;
@@ -62,10 +63,6 @@ pub const MAX_EFFECTS: usize = 6;
 /// Cosine similarity of two effects' shifts of the held-out z-scores above which one
 /// that is not selected is reported as confounded with the selected one.
 pub const CONFOUND_COSINE: f64 = 0.8;
-
-/// ΔBIC difference below which two effects count as tied (Kass & Raftery: "not worth
-/// more than a bare mention").
-pub const TIE_BIC: f64 = 2.0;
 
 /// Settings of a diagnosis.
 #[derive(Clone, Debug, PartialEq)]
@@ -213,14 +210,14 @@ pub fn diagnose(
     // 4. Select on the held-out runs.
     let scorer = Scorer::new(&runs, &base, options, progress, &joint);
     let mut candidates = select::score_alone(&scorer, fits);
-    let selection = select::select(&scorer, &mut candidates);
+    let selection = select::select_checked(&scorer, &mut candidates);
     let holdout_before = scorer.before;
     let selected_effects = select::joint_refit(&joint, &mut candidates, &selection.selected);
     let selected_sensor = fit::model_with(&base.nominal, &selected_effects, base.white_target);
 
     // 5. Compensate the correctable effects.
     let (compensation, corrected_model) =
-        compensate::compensate(holdout, &options.base_model, &selected_effects, progress);
+        compensate::compensate(holdout, options, &selected_effects, progress);
 
     // 6. Summarise.
     let train_after = summarise::train_after(

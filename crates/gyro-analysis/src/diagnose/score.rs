@@ -10,10 +10,16 @@
 //! [`FLOOR_MEMBERS`] members are taken out in turn and scored against the others. This is
 //! the gap between two independent simulated ensembles, the least any model can reach.
 //!
-//! **Likelihood**: each statistic of a run is taken as Gaussian with the ensemble's mean
-//! and standard deviation, `ℓ = −½ Σ (z² + ln 2πσ²)`, statistics treated as independent
-//! (they are not; the bootstrap over runs is what guards the decision). The ln σ² term
-//! keeps an effect that only widens the ensemble from looking like an improvement.
+//! **Likelihood**: each statistic of a run is taken as Student-t with
+//! [`LIKELIHOOD_DOF`] degrees of freedom, located at the ensemble's mean and scaled by its
+//! standard deviation, `ℓ = Σ [−(ν+1)/2 · ln(1 + z²/ν) − ln σ]` ([`loglik`]), statistics
+//! treated as independent (they are not; the bootstrap over runs is what guards the
+//! decision). On a real sensor some statistics sit thousands of σ from any candidate's
+//! ensemble; under a Gaussian their z² would decide every comparison (an effect that
+//! merely widens those ensembles would win), while the t's heavy tails let a statistic an
+//! effect brings to its ensemble count for more than large misfits shifted a little. The
+//! ln σ term keeps an effect that only widens the ensemble from looking like an
+//! improvement.
 
 use super::ensemble::Member;
 use super::stats::{z_scores, Stat, STD_FLOOR_ABS, STD_FLOOR_REL};
@@ -33,6 +39,9 @@ pub struct RunScore {
     pub loglik: f64,
     /// The z-scores, by (segment, statistic).
     pub z: Vec<(Stat, f64)>,
+    /// The ensemble's mean and standard deviation (floored as for the z-score) of each
+    /// statistic of `z`, in the same order (NaN where the ensemble has no value).
+    pub moments: Vec<(f64, f64)>,
 }
 
 /// Score `real` statistics against `members`.
@@ -58,11 +67,9 @@ fn score_stats(real: &[Stat], ensemble: &[Vec<Stat>]) -> RunScore {
     }
     let mut out = RunScore::default();
     for (stat, zv) in &z {
-        if !zv.is_finite() {
-            continue;
-        }
         let Some(&(sum, sum2, n)) = values.get(&(stat.segment.as_str(), stat.statistic.as_str()))
         else {
+            out.moments.push((f64::NAN, f64::NAN));
             continue;
         };
         let nf = n as f64;
@@ -70,12 +77,29 @@ fn score_stats(real: &[Stat], ensemble: &[Vec<Stat>]) -> RunScore {
         let var = ((sum2 - sum * mean) / (nf - 1.0)).max(0.0);
         let floor = STD_FLOOR_ABS.max(STD_FLOOR_REL * mean.abs().max(stat.value.abs()));
         let sd = var.sqrt().max(floor);
+        out.moments.push((mean, sd));
+        if !zv.is_finite() {
+            continue;
+        }
         out.sum_z2 += zv * zv;
         out.count += 1;
-        out.loglik -= 0.5 * (zv * zv + (2.0 * std::f64::consts::PI * sd * sd).ln());
+        out.loglik += loglik(*zv, sd);
     }
     out.z = z;
     out
+}
+
+/// Degrees of freedom of the Student-t likelihood of one statistic.
+pub const LIKELIHOOD_DOF: f64 = 4.0;
+
+/// Log-likelihood of a statistic at `z` standard deviations `sd` from its ensemble's
+/// mean: Student-t with [`LIKELIHOOD_DOF`] degrees of freedom, up to a constant. Close to
+/// Gaussian within a few σ; its heavy tails keep statistics that no candidate model
+/// reproduces (z in the thousands on a real sensor) from outweighing the statistics an
+/// effect does explain.
+pub fn loglik(z: f64, sd: f64) -> f64 {
+    let nu = LIKELIHOOD_DOF;
+    -0.5 * (nu + 1.0) * (z * z / nu).ln_1p() - sd.ln()
 }
 
 /// G of a set of run scores.
@@ -145,6 +169,21 @@ mod tests {
         assert_eq!(bootstrap_p(&[-1.0, -2.0], 1000, 1), 1.0);
         let p = bootstrap_p(&[1.0, -1.0, 1.0, -1.0, 0.5, -0.5], 4000, 2);
         assert!(p > 0.3 && p < 0.8, "{p}");
+    }
+
+    #[test]
+    fn likelihood_is_near_gaussian_close_in_and_heavy_tailed_far_out() {
+        let gauss = |z: f64| -0.5 * z * z;
+        // Close in: the t's shape differs from a Gaussian's by a factor of (ν+1)/ν.
+        let r = (loglik(0.5, 1.0) - loglik(0.0, 1.0)) / gauss(0.5);
+        assert!((r - 1.25).abs() < 0.1, "{r}");
+        // Far out: bringing one statistic from 5000σ to 1σ outweighs moving ten others
+        // from 3000σ to 3500σ.
+        let fixed = loglik(1.0, 1.0) - loglik(5000.0, 1.0);
+        let moved = 10.0 * (loglik(3500.0, 1.0) - loglik(3000.0, 1.0));
+        assert!(fixed + moved > 0.0, "{fixed} {moved}");
+        // Widening an ensemble tenfold costs ln 10.
+        assert!((loglik(0.0, 10.0) - loglik(0.0, 1.0) + 10f64.ln()).abs() < 1e-12);
     }
 
     #[test]

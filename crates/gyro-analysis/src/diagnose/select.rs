@@ -3,8 +3,9 @@
 
 use super::baseline::{evaluate, Baseline, Runs};
 use super::fit::{self, Fit, Joint};
+use super::posterior::{self, PosteriorCheck};
 use super::score::{bootstrap_p, gap, RunScore};
-use super::{Options, Progress, CONFOUND_COSINE, MAX_EFFECTS, TIE_BIC};
+use super::{Options, Progress, CONFOUND_COSINE, MAX_EFFECTS};
 use crate::seed::derive_seed;
 use gyro_sim::{Effect, SensorModel};
 use std::collections::BTreeMap;
@@ -33,6 +34,11 @@ pub(crate) struct Candidate {
     pub(crate) alone_ok: bool,
     /// Added on top of the effects selected before it (selected effects only).
     pub(crate) added: Option<Step>,
+    /// Failed its posterior check when selected: left out of the selection.
+    pub(crate) excluded: bool,
+    /// Its posterior check: with the named set for a named effect, with the set it
+    /// failed in for an excluded one, alone otherwise.
+    pub(crate) posterior: Option<PosteriorCheck>,
 }
 
 /// Scores sets of effects on the held-out runs against the nominal model, with the
@@ -47,6 +53,14 @@ pub(crate) struct Scorer<'a> {
     pub(crate) before: Vec<RunScore>,
     /// Statistics scored over the held-out runs (the BIC's observation count).
     observations: usize,
+}
+
+impl Candidate {
+    /// May be selected: its parameter test passes and it has not failed its posterior
+    /// check.
+    fn eligible(&self) -> bool {
+        self.fit.passes && !self.excluded
+    }
 }
 
 impl<'a> Scorer<'a> {
@@ -172,6 +186,8 @@ pub(crate) fn score_alone(scorer: &Scorer, fits: Vec<Fit>) -> Vec<Candidate> {
             alone_scores: scores,
             alone_ok,
             added: None,
+            excluded: false,
+            posterior: None,
         });
     }
     candidates
@@ -190,6 +206,9 @@ pub(crate) struct Selection {
 /// Stage 4: forward selection, swaps and leave-one-out over `candidates` (whose `added`
 /// steps it sets), and the confounds.
 pub(crate) fn select(scorer: &Scorer, candidates: &mut [Candidate]) -> Selection {
+    for c in candidates.iter_mut() {
+        c.added = None;
+    }
     let (mut selected, current) = forward(scorer, candidates);
     let current = swaps(scorer, candidates, &mut selected, current);
     let (dropped, current) = leave_one_out(scorer, candidates, &mut selected, current);
@@ -208,7 +227,7 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
     let mut current = scorer.before.clone();
     for step in 0..MAX_EFFECTS {
         let pool: Vec<usize> = (0..candidates.len())
-            .filter(|i| !selected.contains(i) && candidates[*i].fit.passes)
+            .filter(|i| !selected.contains(i) && candidates[*i].eligible())
             .collect();
         if pool.is_empty() {
             break;
@@ -248,30 +267,13 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
             .into_iter()
             .filter(|(i, st, _)| scorer.qualifies(&candidates[*i].fit, st))
             .collect();
-        // Best ΔBIC; an earlier effect of the vocabulary (the simpler, more common
-        // explanation of a shared signature) is preferred unless the best one is
-        // significantly better on the held-out runs (bootstrap of the per-run difference).
+        // Best held-out ΔBIC: look-alikes are told apart by the evidence (and by the
+        // posterior check on their signature statistics), never by vocabulary order.
         ok.sort_by(|a, b| b.1.delta_bic.total_cmp(&a.1.delta_bic));
         if ok.is_empty() {
             break;
         }
-        let lead = ok[0].0;
-        let lead_ll = loglik_diffs(&ok[0].2, &current);
-        let best = ok
-            .iter()
-            .filter(|t| {
-                let ll = loglik_diffs(&t.2, &current);
-                let d: Vec<f64> = lead_ll.iter().zip(&ll).map(|(a, b)| a - b).collect();
-                t.0 == lead
-                    || ok[0].1.delta_bic - t.1.delta_bic < TIE_BIC
-                    || bootstrap_p(&d, scorer.options.bootstrap, scorer.seed("tie", step)) > 0.05
-            })
-            .map(|t| t.0)
-            .min()
-            .unwrap_or(lead);
-        let Some(pos) = ok.iter().position(|t| t.0 == best) else {
-            break;
-        };
+        let pos = 0;
         let (i, st, scores) = ok.swap_remove(pos);
         candidates[i].added = Some(st);
         selected.push(i);
@@ -294,7 +296,7 @@ fn swaps(
     }
     let alternatives: Vec<usize> = (0..candidates.len())
         .filter(|i| {
-            !selected.contains(i) && candidates[*i].fit.passes && !candidates[*i].fit.direct
+            !selected.contains(i) && candidates[*i].eligible() && !candidates[*i].fit.direct
         })
         .collect();
     scorer.progress.stage(
@@ -464,5 +466,45 @@ fn cosine(a: &[f64], b: &[f64]) -> f64 {
         ab / (aa * bb).sqrt()
     } else {
         0.0
+    }
+}
+
+/// Select, then check every named effect against its signature statistics with the
+/// named set ([`posterior`]). When some fail, the first of them in the order added is
+/// left out (an effect named early for the wrong reason drags the fits of those added
+/// on top of it) and the selection is made again, until every named effect passes
+/// (each round leaves one out). Every candidate gets its posterior check.
+pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> Selection {
+    loop {
+        let selection = select(scorer, candidates);
+        for c in candidates.iter_mut().filter(|c| !c.excluded) {
+            c.posterior = None;
+        }
+        let mut first_failed = None;
+        for &i in &selection.selected {
+            let check = posterior::check(
+                candidates[i].fit.effect.id(),
+                &scorer.before,
+                &selection.holdout_scores,
+            );
+            if !check.passes && first_failed.is_none() {
+                first_failed = Some(i);
+            }
+            candidates[i].posterior = Some(check);
+        }
+        if let Some(i) = first_failed {
+            candidates[i].excluded = true;
+            continue;
+        }
+        for c in candidates.iter_mut() {
+            if c.posterior.is_none() {
+                c.posterior = Some(posterior::check(
+                    c.fit.effect.id(),
+                    &scorer.before,
+                    &c.alone_scores,
+                ));
+            }
+        }
+        return selection;
     }
 }

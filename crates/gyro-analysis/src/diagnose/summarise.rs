@@ -101,6 +101,7 @@ fn effect_results(
                     ),
                     bootstrap_p: st.p,
                     confounded_with: with,
+                    posterior_check: c.posterior.clone(),
                 },
             )
         })

@@ -183,7 +183,11 @@ pub fn run(args: &Args) -> Result<()> {
             "wrote {} ({})",
             out.display(),
             match &result.compensation {
-                Some(c) => format!("corrections for {}", c.corrected.join(", ")),
+                Some(c) if !c.corrected.is_empty() =>
+                    format!("corrections for {}", c.corrected.join(", ")),
+                Some(_) =>
+                    "no correction lowered the held-out angle error: the base model unchanged"
+                        .into(),
                 None => "no correctable effect selected: the base model unchanged".into(),
             }
         );

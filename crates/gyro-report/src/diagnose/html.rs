@@ -537,11 +537,25 @@ fn gap_map(d: &Diagnosis) -> GapMapPlot {
     }
 }
 
+/// What is corrected, and what is named but not corrected.
+fn subtitle(c: &gyro_analysis::diagnose::CompensationSummary) -> String {
+    let mut s = if c.corrected.is_empty() {
+        "corrected: none (no correction lowered the held-out error)".to_string()
+    } else {
+        format!("corrected: {}", c.corrected.join(", "))
+    };
+    if !c.not_corrected.is_empty() {
+        let ids: Vec<&str> = c.not_corrected.iter().map(|n| n.id).collect();
+        s.push_str(&format!("; named, not corrected: {}", ids.join(", ")));
+    }
+    s
+}
+
 fn angle_error_plot(d: &Diagnosis) -> Option<AngleErrorPlot> {
     let c = d.compensation.as_ref()?;
     Some(AngleErrorPlot {
         title: "Angle error of the held-out runs, without and with compensation".into(),
-        subtitle: format!("corrected: {}", c.corrected.join(", ")),
+        subtitle: subtitle(c),
         rows: c
             .runs
             .iter()
@@ -658,7 +672,11 @@ fn effect_row(s: &mut String, e: &EffectResult) {
         if e.significant { "yes" } else { "no" },
         params.join("<br>"),
         e.z.map_or("exact".to_string(), |z| format!("{z:.2}")),
-        format_args!("{:.1}", e.delta_bic),
+        format_args!(
+            "{} ({})",
+            super::evidence(e.delta_bic),
+            sig(e.delta_bic, 3)
+        ),
         num(e.holdout_gap_before),
         num(e.holdout_gap_after),
         num(e.fraction_closed),
@@ -693,7 +711,11 @@ fn header(s: &mut String, d: &Diagnosis, options: &Options) {
             percent(d.verdict.fraction_closed_holdout)
         )
     };
-    let _ = writeln!(s, "<p class=\"verdict\"><b>Verdict:</b> {verdict}</p>");
+    let _ = writeln!(s, "<div class=\"verdict\"><b>Diagnosis:</b><ul>");
+    for line in super::headline(d) {
+        let _ = writeln!(s, "<li>{}</li>", esc(&line));
+    }
+    let _ = writeln!(s, "</ul><b>Verdict:</b> {verdict}</div>");
     let _ = writeln!(
         s,
         "<table class=\"gap\"><tr><th>gap G</th><th>nominal model</th><th>with the selected effects</th></tr>\
@@ -777,6 +799,48 @@ Effects are fitted on the training runs only and scored on the held-out runs.</p
     }
 }
 
+/// The posterior checks of the named effects and of those left out for failing theirs.
+fn posterior_table(s: &mut String, d: &Diagnosis) {
+    let rows: Vec<_> = d
+        .effects
+        .iter()
+        .filter_map(|e| e.posterior_check.as_ref().map(|c| (e, c)))
+        .filter(|(e, c)| !c.statistics.is_empty() && (e.significant || !c.passes))
+        .collect();
+    if rows.is_empty() {
+        return;
+    }
+    let _ = writeln!(s, "<h2>Posterior checks</h2>");
+    let _ = writeln!(
+        s,
+        "<p>Before an effect is named, the held-out runs simulated with it (and the other named \
+effects) must reproduce the statistics that identify it: their ensembles cover the real value \
+(95% band of the pooled mean), or leave at most half of the nominal model's discrepancy. An \
+effect that fails is not named and the selection is made again without it.</p>"
+    );
+    let _ = writeln!(
+        s,
+        "<table><tr><th>effect</th><th>statistic</th><th>real</th><th>nominal</th><th>with the effect</th><th>±95%</th><th>check</th></tr>"
+    );
+    for (e, c) in rows {
+        for st in &c.statistics {
+            let _ = writeln!(
+                s,
+                "<tr><td><code>{}</code></td><td>{} {}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td></tr>",
+                esc(e.id),
+                esc(st.segment),
+                esc(st.statistic),
+                short(st.real, 4),
+                short(st.nominal, 4),
+                short(st.with_effect, 4),
+                short(st.band, 2),
+                if st.passes { "passes" } else { "<span class=\"warn\">fails</span>" }
+            );
+        }
+    }
+    let _ = writeln!(s, "</table>");
+}
+
 fn tables(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(s, "<h2>Candidate effects, ranked</h2>");
     let _ = writeln!(
@@ -792,7 +856,7 @@ z is the parameter test on the training runs (“exact” where the test is not 
     );
     let _ = writeln!(
         s,
-        "<table><tr><th>effect</th><th>significant</th><th>parameters [95% interval]</th><th>z</th><th>ΔBIC</th><th>held-out G before</th><th>after</th><th>closed</th><th>bootstrap p</th><th>confounded with</th><th>test</th></tr>"
+        "<table><tr><th>effect</th><th>significant</th><th>parameters [95% interval]</th><th>z</th><th>held-out evidence (ΔBIC)</th><th>held-out G before</th><th>after</th><th>closed</th><th>bootstrap p</th><th>confounded with</th><th>test</th></tr>"
     );
     for e in &d.effects {
         effect_row(s, e);
@@ -808,6 +872,8 @@ z is the parameter test on the training runs (“exact” where the test is not 
         }
         let _ = writeln!(s, "</ul>");
     }
+
+    posterior_table(s, d);
 
     let _ = writeln!(s, "<h2>Where the gap lies</h2>");
     let _ = writeln!(
@@ -1089,6 +1155,7 @@ mod tests {
             runs: vec![run("a.csv", "train", 3.0), run("b.csv", "holdout", -12.0)],
             compensation: Some(CompensationSummary {
                 corrected: vec!["clock_error"],
+                not_corrected: Vec::new(),
                 runs: vec![CompensationRun {
                     name: "b.csv".into(),
                     max_abs_error_before_deg: 1.5,

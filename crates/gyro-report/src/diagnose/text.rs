@@ -110,13 +110,33 @@ fn num(x: f64) -> String {
     }
 }
 
+/// The held-out runs' files, each once, by name.
+fn holdout_names(d: &Diagnosis) -> String {
+    let mut files: Vec<&str> = d
+        .runs
+        .iter()
+        .filter(|r| r.role == "holdout")
+        .map(|r| r.name.split('#').next().unwrap_or(&r.name))
+        .collect();
+    files.dedup();
+    let names: Vec<&str> = files
+        .iter()
+        .map(|f| f.rsplit(['/', '\\']).next().unwrap_or(f))
+        .collect();
+    names.join(", ")
+}
+
 /// The human-readable summary.
 pub fn table(d: &Diagnosis) -> String {
     let mut s = String::new();
     let g = &d.gap;
+    let _ = writeln!(s, "diagnosis (held out: {}):", holdout_names(d));
+    for line in super::headline(d) {
+        let _ = writeln!(s, "  {line}");
+    }
     let _ = writeln!(
         s,
-        "gap G (RMS z of the where-statistics; floor = two simulated ensembles)"
+        "\ngap G (RMS z of the where-statistics; floor = two simulated ensembles)"
     );
     let _ = writeln!(
         s,
@@ -147,8 +167,8 @@ pub fn table(d: &Diagnosis) -> String {
     );
     let _ = writeln!(
         s,
-        "  {:<18} {:>4} {:>9} {:>9} {:>9} {:>9}  parameters [95% interval]",
-        "effect", "sig", "z", "dBIC", "gap", "closed"
+        "  {:<18} {:>4} {:>9} {:>24} {:>9} {:>9}  parameters [95% interval]",
+        "effect", "sig", "z", "held-out evidence", "gap", "closed"
     );
     for e in &d.effects {
         let params: Vec<String> = e
@@ -164,11 +184,11 @@ pub fn table(d: &Diagnosis) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "  {:<18} {:>4} {:>9} {:>9.1} {:>9} {:>9}  {}{}",
+            "  {:<18} {:>4} {:>9} {:>24} {:>9} {:>9}  {}{}",
             e.id,
             if e.significant { "yes" } else { "" },
             e.z.map_or("exact".to_string(), |z| format!("{z:.1}")),
-            e.delta_bic,
+            super::evidence(e.delta_bic),
             num(e.holdout_gap_after),
             num(e.fraction_closed),
             params.join(", "),
@@ -182,11 +202,48 @@ pub fn table(d: &Diagnosis) -> String {
     for u in &d.untestable {
         let _ = writeln!(s, "  {:<18} untestable: {}", u.id, u.reason);
     }
+    let checks: Vec<_> = d
+        .effects
+        .iter()
+        .filter_map(|e| e.posterior_check.as_ref().map(|c| (e, c)))
+        .filter(|(e, c)| !c.statistics.is_empty() && (e.significant || !c.passes))
+        .collect();
+    if !checks.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nposterior checks (held-out runs; an effect is named only if the simulation with it covers its signature statistics or leaves at most half of the nominal discrepancy)"
+        );
+        for (e, c) in checks {
+            let _ = writeln!(
+                s,
+                "  {:<18} {:<6} {}",
+                e.id,
+                if c.passes { "passes" } else { "fails" },
+                c.describe()
+            );
+        }
+    }
     if let Some(c) = &d.compensation {
+        for n in &c.not_corrected {
+            let _ = writeln!(
+                s,
+                "\n{}: named, not corrected: its correction gives a median held-out max abs angle error of {:.2} deg against {:.2} without, better on {} of {} runs (bootstrap P {:.2})",
+                n.id,
+                n.median_max_abs_error_with_deg,
+                n.median_max_abs_error_without_deg,
+                n.runs_better,
+                n.runs,
+                n.bootstrap_p
+            );
+        }
         let _ = writeln!(
             s,
             "\nrun --model with corrections for {}: max abs angle error per held-out run (deg)",
-            c.corrected.join(", ")
+            if c.corrected.is_empty() {
+                "nothing (no correction lowered the held-out error)".to_string()
+            } else {
+                c.corrected.join(", ")
+            }
         );
         for r in &c.runs {
             let _ = writeln!(

@@ -1,0 +1,217 @@
+//! The diagnosis in a bench engineer's words: one sentence per named effect in the units
+//! of the trade, rounded to what the interval supports, then what the written model
+//! corrects; and the words for a ΔBIC (Kass & Raftery's scale).
+
+use gyro_analysis::diagnose::{Diagnosis, EffectResult};
+
+/// Kass & Raftery's words for a BIC difference in favour of a model.
+pub fn evidence(delta_bic: f64) -> &'static str {
+    if !delta_bic.is_finite() || delta_bic <= 0.0 {
+        "none"
+    } else if delta_bic < 2.0 {
+        "barely worth mentioning"
+    } else if delta_bic < 6.0 {
+        "positive"
+    } else if delta_bic < 10.0 {
+        "strong"
+    } else {
+        "decisive"
+    }
+}
+
+/// `x` with as many significant digits as a value of spread `half` supports (at least 2).
+pub fn rounded(x: f64, half: f64) -> String {
+    if !x.is_finite() {
+        return "-".into();
+    }
+    let scale = if half.is_finite() && half > 0.0 {
+        half
+    } else {
+        x.abs() * 1e-3
+    };
+    if scale == 0.0 {
+        return format!("{x}");
+    }
+    // One significant digit of the half-width, at least two of the value.
+    let digits_half = -(scale.log10().floor() as i32);
+    let digits_value = 1 - (x.abs().max(f64::MIN_POSITIVE).log10().floor() as i32);
+    let decimals = digits_half.max(digits_value).clamp(0, 9) as usize;
+    format!("{x:.decimals$}")
+}
+
+/// Parameter `name` of `e` times `unit`, with its 95% interval, as "v [lo, hi]".
+fn value(e: &EffectResult, name: &str, unit: f64) -> Option<String> {
+    let v = *e.params.get(name)? * unit;
+    let ci = e.ci95.get(name).copied().unwrap_or([None, None]);
+    Some(match ci {
+        [Some(lo), Some(hi)] => {
+            let (lo, hi) = (lo * unit, hi * unit);
+            let half = 0.5 * (hi - lo).abs();
+            format!(
+                "{} [{}, {}]",
+                rounded(v, half),
+                rounded(lo, half),
+                rounded(hi, half)
+            )
+        }
+        _ => rounded(v, f64::NAN),
+    })
+}
+
+/// The sentence for a named effect.
+pub fn sentence(e: &EffectResult) -> String {
+    let v = |name: &str, unit: f64| value(e, name, unit).unwrap_or_else(|| "-".into());
+    match e.id {
+        "latency" => format!("the gyro lags the reference by {} ms", v("delay_s", 1e3)),
+        "bandwidth" => format!(
+            "the gyro's response is low-passed (two poles) at {} Hz",
+            v("cutoff_hz", 1.0)
+        ),
+        "scale_factor" => format!(
+            "scale {} % (the gyro reads that much more than the reference)",
+            v("k", 100.0)
+        ),
+        "scale_asymmetry" => format!(
+            "the scale differs by the sign of the rate: {} % (positive minus negative turns)",
+            v("k", 100.0)
+        ),
+        "nonlinearity" => format!(
+            "odd (cubic) nonlinearity {} per (deg/s)², i.e. {} % of the rate at 100 deg/s",
+            v("k3_per_dps2", 1.0),
+            v("k3_per_dps2", 1e6)
+        ),
+        "saturation" => format!("the output clips at ±{} deg/s", v("limit_dps", 1.0)),
+        "quantization" => format!("the output moves in steps of {} deg/s", v("lsb_dps", 1.0)),
+        "clock_error" => format!(
+            "the time stamps' clock is off by {} ppm against the declared sample rate",
+            v("ppm", 1.0)
+        ),
+        "dropouts" => format!(
+            "{} dropouts per s of {} samples each",
+            v("rate_per_s", 1.0),
+            v("mean_samples", 1.0)
+        ),
+        "temperature_bias" => format!("the bias moves by {} deg/s per degC", v("dps_per_c", 1.0)),
+        "temperature_scale" => format!("the scale moves by {} % per degC", v("per_c", 100.0)),
+        "bias_instability" => format!(
+            "the bias wanders by σ {} deg/s within a run",
+            v("sigma_dps", 1.0)
+        ),
+        "rate_random_walk" => format!(
+            "the bias random-walks by {} deg/s/√s",
+            v("k_dps_per_rt_s", 1.0)
+        ),
+        "turn_on_bias" => format!(
+            "the bias differs from run to run by σ {} deg/s",
+            v("sigma_dps", 1.0)
+        ),
+        other => {
+            let params: Vec<String> = e
+                .params
+                .keys()
+                .map(|k| format!("{k} = {}", v(k, 1.0)))
+                .collect();
+            format!("{other}: {}", params.join(", "))
+        }
+    }
+}
+
+/// The headline: one line per named effect (in the order named), then what the written
+/// model corrects and what it does to the held-out angle error; or that nothing is named.
+pub fn headline(d: &Diagnosis) -> Vec<String> {
+    let mut lines: Vec<String> = d
+        .effects
+        .iter()
+        .filter(|e| e.significant)
+        .map(|e| {
+            format!(
+                "{}: {} (evidence on the held-out runs {})",
+                e.id,
+                sentence(e),
+                evidence(e.delta_bic)
+            )
+        })
+        .collect();
+    if lines.is_empty() {
+        lines.push("no effect of the vocabulary is named: the nominal model holds on these runs, or what differs is not in the vocabulary (see the where-statistics)".into());
+    }
+    if let Some(c) = &d.compensation {
+        let median = |f: &dyn Fn(&gyro_analysis::diagnose::CompensationRun) -> f64| {
+            let mut v: Vec<f64> = c.runs.iter().map(f).filter(|x| x.is_finite()).collect();
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+        };
+        let before = median(&|r| r.max_abs_error_before_deg);
+        let after = median(&|r| r.max_abs_error_after_deg);
+        if c.corrected.is_empty() {
+            lines.push(format!(
+                "no correction is written: none lowered the held-out angle error (median max |error| {before:.2} deg)"
+            ));
+        } else {
+            let better = c
+                .runs
+                .iter()
+                .filter(|r| r.max_abs_error_after_deg < r.max_abs_error_before_deg)
+                .count();
+            lines.push(format!(
+                "the written model corrects {}: held-out median max |angle error| {before:.2} -> {after:.2} deg, better on {better} of {} runs",
+                c.corrected.join(", "),
+                c.runs.len()
+            ));
+        }
+        for n in &c.not_corrected {
+            lines.push(format!(
+                "{}: named, not corrected (its correction did not lower the held-out error)",
+                n.id
+            ));
+        }
+    }
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeMap;
+
+    fn latency(v: f64, lo: f64, hi: f64) -> EffectResult {
+        EffectResult {
+            id: "latency",
+            params: BTreeMap::from([("delay_s", v)]),
+            delta_bic: 34_905_881.7,
+            holdout_gap_before: 1.0,
+            holdout_gap_after: 1.0,
+            fraction_closed: 0.0,
+            significant: true,
+            ci95: BTreeMap::from([("delay_s", [Some(lo), Some(hi)])]),
+            z: Some(10.0),
+            test: String::new(),
+            bootstrap_p: 0.0,
+            confounded_with: Vec::new(),
+            posterior_check: None,
+        }
+    }
+
+    #[test]
+    fn a_latency_reads_in_milliseconds_rounded_to_its_interval() {
+        let s = sentence(&latency(0.012_618, 0.012_31, 0.012_93));
+        assert_eq!(s, "the gyro lags the reference by 12.6 [12.3, 12.9] ms");
+    }
+
+    #[test]
+    fn evidence_words_follow_kass_and_raftery() {
+        assert_eq!(evidence(34_905_881.7), "decisive");
+        assert_eq!(evidence(7.0), "strong");
+        assert_eq!(evidence(3.0), "positive");
+        assert_eq!(evidence(1.0), "barely worth mentioning");
+        assert_eq!(evidence(-4.0), "none");
+    }
+
+    #[test]
+    fn rounding_keeps_one_digit_of_the_interval() {
+        assert_eq!(rounded(0.6123, 0.05), "0.61");
+        assert_eq!(rounded(4.5681, 0.09), "4.57");
+        assert_eq!(rounded(626.72, 171.0), "627");
+        assert_eq!(rounded(f64::NAN, 1.0), "-");
+    }
+}
