@@ -51,12 +51,13 @@ pub struct Sample {
 }
 
 /// Samples of a simulated bench run: bench-like rotations (seeded) seen by `sensor`, with
-/// no extra effects — what `emulate` plays when it is given no log.
+/// no extra effects — what `emulate` plays when it is given no log. A run of more than
+/// [`gyro_sim::MAX_SAMPLES`] samples is refused before it is made.
 pub fn simulated_samples(
     sensor: &gyro_sim::SensorModel,
     duration_s: f64,
     seed: u64,
-) -> Vec<Sample> {
+) -> Result<Vec<Sample>, gyro_sim::TooManySamples> {
     use gyro_sim::{simulate, BenchProfile, Motion, SimOptions};
     let motion = Motion::bench(
         &BenchProfile {
@@ -69,11 +70,12 @@ pub fn simulated_samples(
         seed,
         ..SimOptions::default()
     };
-    simulate(sensor, &[], &motion, &options)
+    gyro_sim::check_size(sensor, &motion)?;
+    Ok(simulate(sensor, &[], &motion, &options)
         .rows
         .iter()
         .map(Sample::from)
-        .collect()
+        .collect())
 }
 
 impl From<&gyro_log::Row> for Sample {

@@ -8,7 +8,7 @@
 //! use gyro_sim::SensorModel;
 //! // Ten seconds of a simulated run as bridge frames with the typical faults, into a buffer
 //! // (a serial port or a pseudo-terminal in `gyro-cli emulate`).
-//! let samples = simulated_samples(&SensorModel::default(), 10.0, 3);
+//! let samples = simulated_samples(&SensorModel::default(), 10.0, 3)?;
 //! let config = EmulatorConfig {
 //!     rate_hz: Some(1000.0),
 //!     faults: FaultSpec::parse("typical,seed=7")?,

@@ -31,7 +31,7 @@ fn temp_dir(name: &str) -> PathBuf {
 
 /// A simulated bench run at 1 kHz in the ±300 °/s range.
 fn simulated(duration_s: f64, seed: u64) -> Vec<Sample> {
-    gyro_bridge::simulated_samples(&SensorModel::default(), duration_s, seed)
+    gyro_bridge::simulated_samples(&SensorModel::default(), duration_s, seed).unwrap()
 }
 
 /// Streams `planned` as fast as possible into a pty pair while `record` reads it into the

@@ -24,6 +24,7 @@ mod csv_log;
 mod load;
 pub mod mcap;
 mod regular;
+pub mod value;
 
 pub(crate) use ahead::read_ahead;
 pub use bursts::Bursts;

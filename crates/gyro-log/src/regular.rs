@@ -28,10 +28,13 @@ use std::path::Path;
 pub struct GridOptions {
     /// Sample rate of the log (Hz); default: its `sample_rate_hz` metadata, else the median
     /// time step.
-    #[cfg_attr(feature = "clap", arg(long))]
+    #[cfg_attr(feature = "clap", arg(long, value_parser = crate::value::positive::<f64>))]
     pub sample_rate_hz: Option<f64>,
     /// Longest stretch of missing data (s) bridged by interpolation; longer is an error.
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = 0.5))]
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, default_value_t = 0.5, value_parser = crate::value::non_negative::<f64>)
+    )]
     pub max_gap_s: f64,
 }
 

@@ -43,8 +43,8 @@ pub(crate) mod stats;
 mod summarise;
 
 pub use diagnosis::{
-    CompensationRun, CompensationSummary, Diagnosis, EffectResult, GapSummary, ModelSummary,
-    RunSummary, UntestableEntry, Verdict, Where,
+    CompensationRun, CompensationSummary, Diagnosis, EffectResult, GapSummary, InputEntry,
+    ModelSummary, RunSummary, UntestableEntry, Verdict, Where,
 };
 pub use ensemble::{split, RealRun};
 pub use features::MIN_TEMPERATURE_RANGE_C;

@@ -28,7 +28,7 @@ pub struct Args {
     #[arg(long)]
     model: Option<PathBuf>,
     /// Initial bias correlation time (s), e.g. from `gyro-cli noise`.
-    #[arg(long)]
+    #[arg(long, value_parser = gyro_log::value::positive::<f64>)]
     tau_s: Option<f64>,
     /// Also fit the motion detector's thresholds (slower: runs are replayed per trial).
     #[arg(long)]
@@ -67,6 +67,7 @@ fn load_runs(paths: &[PathBuf], args: &Args) -> Result<Vec<BenchRun>> {
 pub fn run(args: &Args) -> Result<()> {
     let inputs = args.logs.iter().chain(&args.holdout).map(PathBuf::as_path);
     super::refuse_to_overwrite(&args.out, inputs.chain(args.model.as_deref()))?;
+    super::refuse_repeated_runs(&[("training", &args.logs), ("hold-out", &args.holdout)])?;
     let base = match &args.model {
         Some(path) => model::load(path)?,
         None => model::ModelFile::new(Config::default()),
@@ -101,10 +102,27 @@ pub fn run(args: &Args) -> Result<()> {
     let mut out = base.clone();
     out.config = result.config;
     model::save(&args.out, &out).with_context(|| "writing the model file".to_string())?;
+    let inputs: Vec<_> = train
+        .iter()
+        .chain(&holdout)
+        .map(|run| gyro_report::input::InputJson {
+            file: &run.name,
+            input: &run.log.quality,
+        })
+        .collect();
     let mut stdout = std::io::stdout().lock();
     match args.format {
-        super::run::Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
-        _ => write!(stdout, "{}", gyro_report::calibrate::table(&result))?,
+        super::run::Format::Json => writeln!(
+            stdout,
+            "{}",
+            gyro_report::calibrate::json(&inputs, &result)?
+        )?,
+        _ => write!(
+            stdout,
+            "{}{}",
+            gyro_report::input::tables(inputs.iter().map(|i| (i.file, i.input))),
+            gyro_report::calibrate::table(&result)
+        )?,
     }
     eprintln!(
         "wrote {}: {}",

@@ -26,7 +26,7 @@ pub struct Args {
     #[arg(long)]
     create_pty: bool,
     /// Baud rate when --port is a real serial port.
-    #[arg(long, default_value_t = serial::DEFAULT_BAUD)]
+    #[arg(long, default_value_t = serial::DEFAULT_BAUD, value_parser = clap::value_parser!(u32).range(1..))]
     baud: u32,
     /// Log (CSV or MCAP) whose rate and temperature are played.
     #[arg(long, conflicts_with_all = ["seed", "duration_s"])]
@@ -35,13 +35,13 @@ pub struct Args {
     #[arg(long)]
     seed: Option<u64>,
     /// Duration of the simulated run (s).
-    #[arg(long)]
+    #[arg(long, value_parser = gyro_log::value::positive::<f64>)]
     duration_s: Option<f64>,
     /// Range (°/s) whose LSB scales the rate word: 75, 150, 300 or 900.
     #[arg(long, default_value = "300", value_parser = bridge::parse_range)]
     range: Range,
     /// Frame rate (Hz). Simulated runs: default 1000. Logs: default the log's own times.
-    #[arg(long)]
+    #[arg(long, value_parser = gyro_log::value::positive::<f64>)]
     rate_hz: Option<f64>,
     /// Send each frame at its time (default).
     #[arg(long, conflicts_with = "as_fast_as_possible")]
@@ -78,7 +78,8 @@ fn samples(args: &Args) -> Result<(Vec<Sample>, String)> {
         ..SensorModel::default()
     };
     sensor.validate()?;
-    let samples = bridge::simulated_samples(&sensor, duration_s, seed);
+    let samples = bridge::simulated_samples(&sensor, duration_s, seed)
+        .context("the simulated run (--duration-s, --rate-hz)")?;
     Ok((
         samples,
         format!("simulated run, seed {seed}, {duration_s} s"),

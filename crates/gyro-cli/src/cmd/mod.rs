@@ -11,7 +11,7 @@ pub mod simulate;
 
 use anyhow::{Context, Result};
 use gyro_log::{GridOptions, Log, LogOptions, RegularLog};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
@@ -35,6 +35,36 @@ pub fn refuse_to_overwrite<'a>(
                 output.display(),
                 input.display()
             );
+        }
+    }
+    Ok(())
+}
+
+/// Refuse a run given twice: the same file (by device and inode, whatever the spelling)
+/// twice in one list, or in two lists (`names` say which: "training", "hold-out"), would
+/// count as independent evidence twice, or score a fit on the runs it was fitted to.
+pub fn refuse_repeated_runs(lists: &[(&str, &[PathBuf])]) -> Result<()> {
+    let mut seen: Vec<(std::fs::Metadata, &Path, &str)> = Vec::new();
+    for (name, paths) in lists {
+        for path in paths.iter() {
+            let Ok(meta) = std::fs::metadata(path) else {
+                continue; // reading it reports the error
+            };
+            if let Some((_, first, first_list)) =
+                seen.iter().find(|(m, p, _)| same_file(m, &meta, p, path))
+            {
+                let where_ = if first_list == name {
+                    format!("twice among the {name} runs")
+                } else {
+                    format!("among the {first_list} runs and again among the {name} runs")
+                };
+                anyhow::bail!(
+                    "{}: the same run as {} is given {where_}; give each run once",
+                    path.display(),
+                    first.display()
+                );
+            }
+            seen.push((meta, path, name));
         }
     }
     Ok(())

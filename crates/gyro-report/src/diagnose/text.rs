@@ -112,7 +112,7 @@ fn num(x: f64) -> String {
 
 /// The human-readable summary.
 pub fn table(d: &Diagnosis) -> String {
-    let mut s = String::new();
+    let mut s = crate::input::tables(d.inputs.iter().map(|i| (i.file.as_str(), &i.input)));
     let g = &d.gap;
     let _ = writeln!(
         s,
