@@ -6,7 +6,6 @@ use gyro_analysis::model;
 use gyro_core::Config;
 use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};
-use std::io::Write as _;
 use std::path::PathBuf;
 
 /// Arguments of `calibrate`.
@@ -110,20 +109,15 @@ pub fn run(args: &Args) -> Result<()> {
             input: &run.log.quality,
         })
         .collect();
-    let mut stdout = std::io::stdout().lock();
-    match args.format {
-        super::run::Format::Json => writeln!(
-            stdout,
-            "{}",
-            gyro_report::calibrate::json(&inputs, &result)?
-        )?,
-        _ => write!(
-            stdout,
+    let text = match args.format {
+        super::run::Format::Json => gyro_report::calibrate::json(&inputs, &result)? + "\n",
+        _ => format!(
             "{}{}",
             gyro_report::input::tables(inputs.iter().map(|i| (i.file, i.input))),
             gyro_report::calibrate::table(&result)
-        )?,
-    }
+        ),
+    };
+    super::to_stdout(|out| out.write_all(text.as_bytes()))?;
     eprintln!(
         "wrote {}: {}",
         args.out.display(),

@@ -8,7 +8,6 @@ use gyro_analysis::diagnose::{split, InputEntry, RealRun};
 use gyro_analysis::model;
 use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Output format.
@@ -189,11 +188,11 @@ pub fn run(args: &Args) -> Result<()> {
     bar.0.finish_and_clear();
     let mut result = result.map_err(with_advice)?;
     result.inputs = inputs;
-    let mut stdout = std::io::stdout().lock();
-    match args.format {
-        Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
-        Format::Table => write!(stdout, "{}", gyro_report::diagnose::table(&result))?,
-    }
+    let text = match args.format {
+        Format::Json => serde_json::to_string_pretty(&result)? + "\n",
+        Format::Table => gyro_report::diagnose::table(&result),
+    };
+    super::to_stdout(|out| out.write_all(text.as_bytes()))?;
     if let Some(dir) = &args.report {
         write_report(dir, &result, &train, &holdout, &options)?;
     }
@@ -245,15 +244,11 @@ fn self_test(args: &Args) -> Result<()> {
     );
     bar.finish_and_clear();
     let result = result.map_err(with_advice)?;
-    let mut stdout = std::io::stdout().lock();
-    match args.format {
-        Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
-        Format::Table => write!(
-            stdout,
-            "{}",
-            gyro_report::diagnose::self_test_table(&result)
-        )?,
-    }
+    let text = match args.format {
+        Format::Json => serde_json::to_string_pretty(&result)? + "\n",
+        Format::Table => gyro_report::diagnose::self_test_table(&result),
+    };
+    super::to_stdout(|out| out.write_all(text.as_bytes()))?;
     Ok(())
 }
 

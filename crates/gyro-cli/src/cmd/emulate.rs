@@ -223,7 +223,7 @@ fn open_pty(keep: &mut Option<PtySlave>) -> Result<Box<dyn serialport::SerialPor
     let (master, slave) =
         serialport::TTYPort::pair().context("cannot create a pseudo-terminal pair")?;
     let name = slave.name().context("the pseudo-terminal has no name")?;
-    writeln!(std::io::stdout().lock(), "{name}")?;
+    super::to_stdout(|out| writeln!(out, "{name}"))?;
     eprintln!("record from {name}, e.g.: gyro-cli record --port {name} -o run.mcap");
     *keep = Some(slave);
     Ok(Box::new(master))

@@ -11,6 +11,7 @@ pub mod simulate;
 
 use anyhow::{Context, Result};
 use gyro_log::{GridOptions, Log, LogOptions, RegularLog};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -79,6 +80,16 @@ fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata, _: &Path, _: &Path) -
 #[cfg(not(unix))]
 fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata, a: &Path, b: &Path) -> bool {
     matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+}
+
+/// Write a command's output to stdout with `write`, then flush: any failure is one error
+/// naming stdout (a full disk: "No space left on device"). A reader that has gone (`| head`)
+/// stays a broken pipe underneath, which `main` ends quietly.
+pub fn to_stdout(write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    write(&mut out)
+        .and_then(|()| out.flush())
+        .context("cannot write to stdout")
 }
 
 /// Print a warning about the input on stderr.

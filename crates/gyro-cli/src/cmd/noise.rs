@@ -212,15 +212,13 @@ pub fn run(args: &Args) -> Result<()> {
         gyro_report::plot::noise_plot(path, &title, result)?;
     }
 
-    let mut stdout = std::io::stdout().lock();
-    match args.format {
-        Format::Table => write!(stdout, "{}", gyro_report::noise::tables(&loaded, &run))?,
+    let text = match args.format {
+        Format::Table => gyro_report::noise::tables(&loaded, &run),
         Format::Json => {
             let model_out = args.model_out.as_ref().map(|p| p.display().to_string());
-            let json =
-                gyro_report::noise::json(&loaded, &run, args.static_only, model_out.as_deref())?;
-            writeln!(stdout, "{json}")?;
+            gyro_report::noise::json(&loaded, &run, args.static_only, model_out.as_deref())? + "\n"
         }
-    }
+    };
+    super::to_stdout(|out| out.write_all(text.as_bytes()))?;
     Ok(())
 }

@@ -151,12 +151,15 @@ pub fn run(args: &Args) -> Result<()> {
         }
     })?;
     let file = args.log.display().to_string();
-    let mut stdout = std::io::stdout().lock();
-    match args.format {
-        Format::Table => write!(stdout, "{}", report::table(&file, &result))?,
-        Format::Json => writeln!(stdout, "{}", report::json(&file, &result)?)?,
-        Format::Csv => report::movements_csv(&mut stdout, &result.movements)?,
-    }
+    let json = match args.format {
+        Format::Json => Some(report::json(&file, &result)?),
+        _ => None,
+    };
+    super::to_stdout(|out| match args.format {
+        Format::Table => write!(out, "{}", report::table(&file, &result)),
+        Format::Json => writeln!(out, "{}", json.unwrap_or_default()),
+        Format::Csv => report::movements_csv(&mut &mut *out, &result.movements),
+    })?;
     if let Some(out) = &args.out {
         let write = || -> std::io::Result<()> {
             let mut w = std::io::BufWriter::new(std::fs::File::create(out)?);

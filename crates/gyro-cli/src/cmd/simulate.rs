@@ -44,7 +44,7 @@ pub struct Args {
     encoder_counts: Option<u32>,
 }
 
-fn list_effects(out: &mut impl Write) -> std::io::Result<()> {
+fn list_effects(out: &mut dyn Write) -> std::io::Result<()> {
     writeln!(out, "{:<18} {:<36} signature", "id", "parameters (typical)")?;
     for info in sim::EFFECTS {
         let params: Vec<String> = info
@@ -76,7 +76,7 @@ pub fn run(args: &Args) -> Result<()> {
         )?;
     }
     if args.list_effects {
-        list_effects(&mut std::io::stdout().lock())?;
+        super::to_stdout(|out| list_effects(out))?;
         return Ok(());
     }
     let mut sensor = match &args.model {
