@@ -15,7 +15,7 @@
 //!     ..EmulatorConfig::default()
 //! };
 //! let mut wire = Vec::new();
-//! let report = stream(Emulator::new(samples.into_iter(), config), &mut wire, Pacing::AsFastAsPossible, None, None)?;
+//! let report = stream(Emulator::new(samples.into_iter(), config), &mut wire, Pacing::AsFastAsPossible, None, None, None)?;
 //! assert!(report.intact > 9_000 && !wire.is_empty());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```

@@ -54,6 +54,9 @@ pub struct Args {
     /// `typical,seed=7` or `drop=1e-3,bit_flip=5e-4`.
     #[arg(long, default_value = "none", value_parser = FaultSpec::parse)]
     faults: FaultSpec,
+    /// Give up when the port takes no byte for this many seconds (nobody reading it).
+    #[arg(long, default_value_t = 30.0, value_parser = gyro_log::value::positive::<f64>)]
+    write_timeout_s: f64,
     /// Write the fault log (the report, with every lost sequence number) as JSON here.
     #[arg(long)]
     fault_log: Option<PathBuf>,
@@ -123,8 +126,17 @@ pub fn run(args: &Args) -> Result<()> {
         pacing
     );
     let mut emulator = Emulator::new(samples.into_iter(), config);
-    let report = bridge::stream(&mut emulator, &mut *port, pacing, Some(&stop), None)
-        .context("writing to the port failed")?;
+    let write_timeout = Duration::try_from_secs_f64(args.write_timeout_s).ok();
+    let port_name = args.port.as_deref().unwrap_or("the pseudo-terminal");
+    let report = bridge::stream(
+        &mut emulator,
+        &mut *port,
+        pacing,
+        Some(&stop),
+        None,
+        write_timeout,
+    )
+    .with_context(|| format!("writing to {port_name} failed (--write-timeout-s)"))?;
     // Closing the port hangs the line up, and a pseudo-terminal then discards what the
     // reader has not read yet: wait until it has.
     let unread = drain(&mut *port, _pty_slave.as_ref(), &stop);
