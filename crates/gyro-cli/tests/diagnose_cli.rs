@@ -296,7 +296,10 @@ fn bad_input_is_refused_with_a_clear_message() {
     ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("invalid value '0' for '--split-s"), "{stderr}");
+    assert!(
+        stderr.contains("invalid value '0' for '--split-s"),
+        "{stderr}"
+    );
     fails_with(
         &["diagnose", "--train", &a, &b, "--holdout", &c, &c],
         "the same run as",
