@@ -322,7 +322,7 @@ fn a_bridge_clock_stepping_back_is_counted_not_wrapped() {
         Emulator::new(simulated(2.0, 3).into_iter(), EmulatorConfig::default()).collect();
     // From frame 1000 on, the clock reads 0.5 s earlier.
     for p in planned.iter_mut().skip(1000) {
-        p.frame.timestamp_us = p.frame.timestamp_us - 500_000;
+        p.frame.timestamp_us -= 500_000;
     }
     let mut wire = Vec::new();
     planned.iter().for_each(|p| p.extend_wire(&mut wire));
