@@ -51,12 +51,13 @@ pub struct Sample {
 }
 
 /// Samples of a simulated bench run: bench-like rotations (seeded) seen by `sensor`, with
-/// no extra effects — what `emulate` plays when it is given no log.
+/// no extra effects — what `emulate` plays when it is given no log. A run of more than
+/// [`gyro_sim::MAX_SAMPLES`] samples is refused before it is made.
 pub fn simulated_samples(
     sensor: &gyro_sim::SensorModel,
     duration_s: f64,
     seed: u64,
-) -> Vec<Sample> {
+) -> Result<Vec<Sample>, gyro_sim::TooManySamples> {
     use gyro_sim::{simulate, BenchProfile, Motion, SimOptions};
     let motion = Motion::bench(
         &BenchProfile {
@@ -69,11 +70,12 @@ pub fn simulated_samples(
         seed,
         ..SimOptions::default()
     };
-    simulate(sensor, &[], &motion, &options)
+    gyro_sim::check_size(sensor, &motion)?;
+    Ok(simulate(sensor, &[], &motion, &options)
         .rows
         .iter()
         .map(Sample::from)
-        .collect()
+        .collect())
 }
 
 impl From<&gyro_log::Row> for Sample {
@@ -531,7 +533,9 @@ const BATCH_FRAMES: usize = 512;
 /// Writes the frames to `out` at `pacing`, and returns the fault log.
 ///
 /// Writes that time out or are interrupted (a serial port or pseudo-terminal whose reader
-/// is slow) are retried; `stop` (e.g. set by a signal handler) ends streaming early, and
+/// is slow) are retried until `write_timeout` passes without a byte taken (`None`: for
+/// ever), then it is an error of kind `TimedOut`; `stop` (e.g. set by a signal handler)
+/// ends streaming early, and
 /// `sent` (if given) is updated with the number of frames handed to `out` so far, for a
 /// test or a progress display. When `stop` ends a blocked write, the frames of that last
 /// batch are counted in the report but may be partly unsent.
@@ -541,6 +545,7 @@ pub fn stream<W: Write + ?Sized>(
     pacing: Pacing,
     stop: Option<&AtomicBool>,
     sent: Option<&AtomicU64>,
+    write_timeout: Option<Duration>,
 ) -> io::Result<EmulatorReport> {
     let start = Instant::now();
     let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
@@ -566,7 +571,7 @@ pub fn stream<W: Write + ?Sized>(
         let early = offset.is_some_and(|offset| clock + offset > Instant::now());
         // Send what is batched before waiting (a stall, or the next frame's time).
         if planned.stall_ms > 0 || early {
-            write_batch(out, &mut batch, stop)?;
+            write_batch(out, &mut batch, stop, write_timeout)?;
             publish(sent, &mut batch_frames);
         }
         if planned.stall_ms > 0 {
@@ -586,13 +591,13 @@ pub fn stream<W: Write + ?Sized>(
         planned.extend_wire(&mut batch);
         batch_frames += 1;
         if batch.len() >= BATCH_FRAMES * BRIDGE_FRAME_LEN || pacing == Pacing::RealTime {
-            write_batch(out, &mut batch, stop)?;
+            write_batch(out, &mut batch, stop, write_timeout)?;
             publish(sent, &mut batch_frames);
         }
     }
-    write_batch(out, &mut batch, stop)?;
+    write_batch(out, &mut batch, stop, write_timeout)?;
     publish(sent, &mut batch_frames);
-    flush_retrying(out, stop)?;
+    flush_retrying(out, stop, write_timeout)?;
     report.bytes = report_bytes(&report);
     report.elapsed_s = start.elapsed().as_secs_f64();
     Ok(report)
@@ -617,8 +622,10 @@ fn write_batch<W: Write + ?Sized>(
     out: &mut W,
     batch: &mut Vec<u8>,
     stop: Option<&AtomicBool>,
+    write_timeout: Option<Duration>,
 ) -> io::Result<()> {
     let mut rest = batch.as_slice();
+    let mut progress = Instant::now();
     while !rest.is_empty() {
         match out.write(rest) {
             Ok(0) => {
@@ -627,10 +634,22 @@ fn write_batch<W: Write + ?Sized>(
                     "the port took no bytes",
                 ))
             }
-            Ok(n) => rest = &rest[n..],
+            Ok(n) => {
+                rest = &rest[n..];
+                progress = Instant::now();
+            }
             Err(e) if retryable(&e) => {
                 if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
                     break;
+                }
+                if let Some(limit) = write_timeout.filter(|l| progress.elapsed() >= *l) {
+                    return Err(io::Error::new(
+                        ErrorKind::TimedOut,
+                        format!(
+                            "the port took no byte for {} s: is anything reading it?",
+                            limit.as_secs_f64()
+                        ),
+                    ));
                 }
             }
             Err(e) => return Err(e),
@@ -640,10 +659,21 @@ fn write_batch<W: Write + ?Sized>(
     Ok(())
 }
 
-fn flush_retrying<W: Write + ?Sized>(out: &mut W, stop: Option<&AtomicBool>) -> io::Result<()> {
+fn flush_retrying<W: Write + ?Sized>(
+    out: &mut W,
+    stop: Option<&AtomicBool>,
+    write_timeout: Option<Duration>,
+) -> io::Result<()> {
+    let start = Instant::now();
     loop {
         match out.flush() {
             Ok(()) => return Ok(()),
+            Err(e) if retryable(&e) && write_timeout.is_some_and(|l| start.elapsed() >= l) => {
+                return Err(io::Error::new(
+                    ErrorKind::TimedOut,
+                    "the port took no byte in time: is anything reading it?",
+                ))
+            }
             Err(e) if retryable(&e) && !stop.is_some_and(|s| s.load(Ordering::Relaxed)) => {}
             Err(e) if retryable(&e) => return Ok(()),
             Err(e) => return Err(e),
@@ -735,6 +765,7 @@ mod tests {
             Pacing::AsFastAsPossible,
             None,
             None,
+            None,
         )
         .unwrap();
         assert_eq!(out, wire);
@@ -790,7 +821,7 @@ mod tests {
         };
         let planned = Emulator::new(samples(150).into_iter(), config);
         let mut out = Vec::new();
-        let report = stream(planned, &mut out, Pacing::RealTime, None, None).unwrap();
+        let report = stream(planned, &mut out, Pacing::RealTime, None, None, None).unwrap();
         assert!(report.elapsed_s >= 0.149, "{}", report.elapsed_s);
         assert_eq!(out.len(), 150 * BRIDGE_FRAME_LEN);
     }

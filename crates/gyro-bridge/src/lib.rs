@@ -8,14 +8,14 @@
 //! use gyro_sim::SensorModel;
 //! // Ten seconds of a simulated run as bridge frames with the typical faults, into a buffer
 //! // (a serial port or a pseudo-terminal in `gyro-cli emulate`).
-//! let samples = simulated_samples(&SensorModel::default(), 10.0, 3);
+//! let samples = simulated_samples(&SensorModel::default(), 10.0, 3)?;
 //! let config = EmulatorConfig {
 //!     rate_hz: Some(1000.0),
 //!     faults: FaultSpec::parse("typical,seed=7")?,
 //!     ..EmulatorConfig::default()
 //! };
 //! let mut wire = Vec::new();
-//! let report = stream(Emulator::new(samples.into_iter(), config), &mut wire, Pacing::AsFastAsPossible, None, None)?;
+//! let report = stream(Emulator::new(samples.into_iter(), config), &mut wire, Pacing::AsFastAsPossible, None, None, None)?;
 //! assert!(report.intact > 9_000 && !wire.is_empty());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```

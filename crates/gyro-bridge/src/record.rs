@@ -175,6 +175,12 @@ pub struct RecordStats {
     pub command_mismatches: u64,
     /// Read timeouts (quiet line).
     pub timeouts: u64,
+    /// Good frames stamped earlier than the good frame before them (the bridge clock
+    /// stepped back: a restart, a wrap).
+    pub clock_steps_back: u64,
+    /// Bridge time covered (µs): the sum of the forward steps between consecutive good
+    /// frames' timestamps (a step back adds nothing).
+    pub bridge_time_us: u64,
     /// Bridge timestamp of the first good frame (µs).
     pub first_timestamp_us: Option<u64>,
     /// Bridge timestamp of the last good frame (µs).
@@ -194,12 +200,10 @@ impl RecordStats {
         self.timeouts = reader.timeouts;
     }
 
-    /// Bridge time covered (s), first to last good frame.
+    /// Bridge time covered (s): the forward steps of the bridge clock from the first to
+    /// the last good frame (steps back, counted in `clock_steps_back`, add nothing).
     pub fn bridge_span_s(&self) -> f64 {
-        match (self.first_timestamp_us, self.last_timestamp_us) {
-            (Some(a), Some(b)) => b.saturating_sub(a) as f64 * 1e-6,
-            _ => 0.0,
-        }
+        self.bridge_time_us as f64 * 1e-6
     }
 }
 
@@ -395,6 +399,8 @@ fn stats_schema() -> serde_json::Value {
             "backwards": counter("sequence steps back"),
             "command_mismatches": counter("command byte of another range"),
             "timeouts": counter("read timeouts"),
+            "clock_steps_back": counter("good frames stamped before the previous good frame"),
+            "bridge_time_us": counter("forward steps of the bridge clock, summed (us)"),
             "first_timestamp_us": {"type": ["integer", "null"]},
             "last_timestamp_us": {"type": ["integer", "null"]}
         },
@@ -628,7 +634,15 @@ impl std::fmt::Display for RecordSummary {
             f,
             "checksum errors {}  status faults {}  saturated {}  duplicates {}  backwards {}  command mismatches {}  timeouts {}",
             s.checksum_errors, s.status_faults, s.saturated, s.duplicates, s.backwards, s.command_mismatches, s.timeouts
-        )
+        )?;
+        if s.clock_steps_back > 0 {
+            write!(
+                f,
+                "\nwarning: the bridge clock stepped back {} times (a restart?): bridge time counts its forward steps only, and the log's times go back there",
+                s.clock_steps_back
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -764,6 +778,12 @@ fn handle_frame(
     let time_ns = timestamp_ns(frame.timestamp_us);
     stats.frames += 1;
     stats.first_timestamp_us.get_or_insert(frame.timestamp_us);
+    if let Some(last) = stats.last_timestamp_us {
+        match frame.timestamp_us.checked_sub(last) {
+            Some(step) => stats.bridge_time_us = stats.bridge_time_us.saturating_add(step),
+            None => stats.clock_steps_back += 1,
+        }
+    }
     stats.last_timestamp_us = Some(frame.timestamp_us);
     match received.sequence {
         SeqEvent::Gap(gap) => sink.event(

@@ -31,7 +31,7 @@ fn temp_dir(name: &str) -> PathBuf {
 
 /// A simulated bench run at 1 kHz in the ±300 °/s range.
 fn simulated(duration_s: f64, seed: u64) -> Vec<Sample> {
-    gyro_bridge::simulated_samples(&SensorModel::default(), duration_s, seed)
+    gyro_bridge::simulated_samples(&SensorModel::default(), duration_s, seed).unwrap()
 }
 
 /// Streams `planned` as fast as possible into a pty pair while `record` reads it into the
@@ -54,8 +54,15 @@ fn run_through_pty(
     // The emulator hands the master back: it stays open until `record` has read
     // everything (closing it would hang up the line and discard unread bytes).
     let emulator = std::thread::spawn(move || {
-        let report =
-            bridge::stream(frames, &mut master, Pacing::AsFastAsPossible, None, None).unwrap();
+        let report = bridge::stream(
+            frames,
+            &mut master,
+            Pacing::AsFastAsPossible,
+            None,
+            None,
+            None,
+        )
+        .unwrap();
         (report, master)
     });
     let stop = AtomicBool::new(false);
@@ -303,4 +310,44 @@ fn csv_output_has_a_row_per_intact_frame() {
         .collect();
     assert_eq!(header["range_dps"], "300");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A bridge clock that steps back (a restart) is counted and warned about, and the bridge
+/// time of the summary sums the clock's forward steps instead of wrapping to 2^64 µs.
+#[test]
+fn a_bridge_clock_stepping_back_is_counted_not_wrapped() {
+    let dir = temp_dir("clock-back");
+    let path = dir.join("run.csv");
+    let mut planned: Vec<PlannedFrame> =
+        Emulator::new(simulated(2.0, 3).into_iter(), EmulatorConfig::default()).collect();
+    // From frame 1000 on, the clock reads 0.5 s earlier.
+    for p in planned.iter_mut().skip(1000) {
+        p.frame.timestamp_us -= 500_000;
+    }
+    let mut wire = Vec::new();
+    planned.iter().for_each(|p| p.extend_wire(&mut wire));
+    let options = RecordOptions::default();
+    let sink = Box::new(CsvSink::create(&path, &options).unwrap());
+    let mut reader = crm100_driver::BridgeReader::new(std::io::Cursor::new(wire));
+    let summary = bridge::record(
+        &mut reader,
+        sink,
+        &options,
+        &AtomicBool::new(false),
+        &mut |_| {},
+    )
+    .unwrap();
+    assert_eq!(summary.stats.clock_steps_back, 1);
+    // 999 ms before the step, 1000 ms after it.
+    assert!(
+        (summary.stats.bridge_span_s() - 1.999).abs() < 1e-9,
+        "{}",
+        summary.stats.bridge_span_s()
+    );
+    let text = summary.to_string();
+    assert!(
+        text.contains("(1.999 s of bridge time)")
+            && text.contains("warning: the bridge clock stepped back 1 times"),
+        "{text}"
+    );
 }

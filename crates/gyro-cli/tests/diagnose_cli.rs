@@ -282,19 +282,27 @@ fn bad_input_is_refused_with_a_clear_message() {
         &["diagnose", "--train", &a, &b, "--holdout", &c, &fast],
         "sample rates differ",
     );
-    fails_with(
-        &[
-            "diagnose",
-            "--train",
-            &a,
-            &b,
-            "--holdout",
-            &c,
-            &c,
-            "--split-s",
-            "0",
-        ],
+    // Refused as the command line is parsed (status 2), the option named.
+    let out = gyro(&[
+        "diagnose",
+        "--train",
+        &a,
+        &b,
+        "--holdout",
+        &c,
+        &fast,
         "--split-s",
+        "0",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("invalid value '0' for '--split-s"),
+        "{stderr}"
+    );
+    fails_with(
+        &["diagnose", "--train", &a, &b, "--holdout", &c, &c],
+        "the same run as",
     );
     fails_with(
         &[

@@ -55,6 +55,7 @@ fn start_bridge(seconds: usize) -> Bridge {
             Pacing::RealTime,
             Some(&stop2),
             Some(&sent2),
+            None,
         )
         .unwrap();
         (master, slave)

@@ -152,9 +152,9 @@ fn range_comes_from_the_model_unless_given() {
         flagged(&["run", log, "--format", "json", "--model", &bare]),
         (Some(300.0), 0)
     );
-    // A range that is no range is an error naming the setting.
+    // A range that is no range is refused as the command line is parsed, naming it.
     let out = gyro(&["run", log, "--range-dps", "0"]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("range_dps"), "{stderr}");
+    assert!(stderr.contains("--range-dps"), "{stderr}");
 }

@@ -59,12 +59,35 @@ pub struct ColumnOptions {
     /// Unit of the rate column.
     #[cfg_attr(feature = "clap", arg(long, value_enum, default_value_t = RateUnit::Dps))]
     pub rate_unit: RateUnit,
-    /// Name of the reference (encoder) angle column, in degrees; optional in the log.
-    #[cfg_attr(feature = "clap", arg(long, default_value = "reference_deg"))]
-    pub reference_column: String,
-    /// Name of the temperature column, in °C; optional in the log.
-    #[cfg_attr(feature = "clap", arg(long, default_value = "temperature_c"))]
-    pub temperature_column: String,
+    /// Name of the reference (encoder) angle column, in degrees [default: reference_deg,
+    /// used if the log has it]. A name given must be in the header.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "NAME"))]
+    pub reference_column: Option<String>,
+    /// Name of the temperature column, in °C [default: temperature_c, used if the log has
+    /// it]. A name given must be in the header.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "NAME"))]
+    pub temperature_column: Option<String>,
+}
+
+/// The reference column looked for when none is named.
+pub const DEFAULT_REFERENCE_COLUMN: &str = "reference_deg";
+/// The temperature column looked for when none is named.
+pub const DEFAULT_TEMPERATURE_COLUMN: &str = "temperature_c";
+
+impl ColumnOptions {
+    /// The reference column's name (the one given, else the default).
+    pub fn reference_name(&self) -> &str {
+        self.reference_column
+            .as_deref()
+            .unwrap_or(DEFAULT_REFERENCE_COLUMN)
+    }
+
+    /// The temperature column's name (the one given, else the default).
+    pub fn temperature_name(&self) -> &str {
+        self.temperature_column
+            .as_deref()
+            .unwrap_or(DEFAULT_TEMPERATURE_COLUMN)
+    }
 }
 
 impl Default for ColumnOptions {
@@ -74,8 +97,8 @@ impl Default for ColumnOptions {
             time_unit: TimeUnit::S,
             rate_column: "rate_dps".into(),
             rate_unit: RateUnit::Dps,
-            reference_column: "reference_deg".into(),
-            temperature_column: "temperature_c".into(),
+            reference_column: None,
+            temperature_column: None,
         }
     }
 }
@@ -250,7 +273,16 @@ impl CsvRows {
             prelude_lines += 1;
             let line = String::from_utf8_lossy(&bytes);
             if let Some((key, value)) = line.trim_start_matches('#').split_once(':') {
-                metadata.insert(key.trim().to_string(), value.trim().to_string());
+                let (key, value) = (key.trim(), value.trim());
+                if key == crate::SAMPLE_RATE_KEY {
+                    crate::check_rate_metadata(value, metadata.get(key).map(String::as_str))
+                        .map_err(|message| LogError::Metadata {
+                            path: path.to_path_buf(),
+                            line: Some(prelude_lines),
+                            message,
+                        })?;
+                }
+                metadata.insert(key.to_string(), value.to_string());
             }
         }
 
@@ -272,6 +304,21 @@ impl CsvRows {
             .iter()
             .map(|h| String::from_utf8_lossy(h).trim().to_string())
             .collect();
+        // Two columns of one name: which one is meant cannot be known.
+        for (i, name) in names.iter().enumerate() {
+            if let Some(j) = names[..i].iter().position(|n| !n.is_empty() && n == name) {
+                return Err(LogError::Csv {
+                    path: path.to_path_buf(),
+                    line: header_line,
+                    message: format!(
+                        "column `{}` appears twice in the header (fields {} and {}); rename one",
+                        excerpt(name.as_bytes()),
+                        j + 1,
+                        i + 1
+                    ),
+                });
+            }
+        }
         let find = |name: &str| names.iter().position(|n| n == name);
         let required = |name: &str| {
             find(name).ok_or_else(|| LogError::MissingColumn {
@@ -289,8 +336,14 @@ impl CsvRows {
             len: headers.len(),
             time,
             rate,
-            reference: find(&columns.reference_column),
-            temperature: find(&columns.temperature_column),
+            reference: match &columns.reference_column {
+                Some(name) => Some(required(name)?),
+                None => find(DEFAULT_REFERENCE_COLUMN),
+            },
+            temperature: match &columns.temperature_column {
+                Some(name) => Some(required(name)?),
+                None => find(DEFAULT_TEMPERATURE_COLUMN),
+            },
             time_scale: columns.time_unit.to_seconds(),
             rate_scale: match columns.rate_unit {
                 RateUnit::Dps => 1.0,
@@ -431,11 +484,11 @@ impl Columns {
             })?;
         let rate_dps = value(self.rate, &names.rate_column)?.map(|r| r * self.rate_scale);
         let reference_deg = match self.reference {
-            Some(idx) => value(idx, &names.reference_column)?,
+            Some(idx) => value(idx, names.reference_name())?,
             None => None,
         };
         let temperature_c = match self.temperature {
-            Some(idx) => value(idx, &names.temperature_column)?,
+            Some(idx) => value(idx, names.temperature_name())?,
             None => None,
         };
         Ok(Row {
@@ -1043,5 +1096,66 @@ mod tests {
             );
         }
         assert_eq!(back.metadata, log.metadata);
+    }
+
+    /// The `sample_rate_hz` metadata is a positive number of Hz, given once: anything else
+    /// is an error naming the file and the line.
+    #[test]
+    fn invalid_rate_metadata_is_an_error_naming_its_line() {
+        for (name, lines) in [
+            ("negative", "# sample_rate_hz: -1000\n"),
+            ("zero", "# sample_rate_hz: 0\n"),
+            ("nan", "# sample_rate_hz: NaN\n"),
+            ("word", "# sample_rate_hz: fast\n"),
+            ("unit", "# sample_rate_hz: 1000 Hz\n"),
+            ("twice", "# sample_rate_hz: 1000\n# sample_rate_hz: 500\n"),
+        ] {
+            let text = format!("# sensor: x\n{lines}time_s,rate_dps\n0,1\n0.001,1\n");
+            let path = write_temp(&format!("meta-{name}.csv"), &text);
+            let err = read_csv(&path, &ColumnOptions::default())
+                .unwrap_err()
+                .to_string();
+            let line = 1 + lines.lines().count();
+            assert!(
+                err.contains(&format!("meta-{name}.csv:{line}: `sample_rate_hz")),
+                "{name}: {err}"
+            );
+        }
+        // The same value twice, and a valid one, are read.
+        let path = write_temp(
+            "meta-same.csv",
+            "# sample_rate_hz: 1000\n# sample_rate_hz: 1e3\ntime_s,rate_dps\n0,1\n",
+        );
+        let log = read_csv(&path, &ColumnOptions::default()).unwrap();
+        assert_eq!(log.metadata_rate_hz(), Some(1000.0));
+    }
+
+    /// Two columns of one name, and a named column the header lacks, are errors naming the
+    /// header line.
+    #[test]
+    fn duplicate_and_missing_named_columns_are_errors() {
+        let path = write_temp("dup.csv", "time_s,rate_dps,rate_dps\n0,1,2\n");
+        let err = read_csv(&path, &ColumnOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(
+                "dup.csv:1: column `rate_dps` appears twice in the header (fields 2 and 3)"
+            ),
+            "{err}"
+        );
+        let path = write_temp("named.csv", "time_s,rate_dps,reference_deg\n0,1,2\n");
+        let columns = ColumnOptions {
+            reference_column: Some("ref_deg".into()),
+            ..ColumnOptions::default()
+        };
+        let err = read_csv(&path, &columns).unwrap_err().to_string();
+        assert!(
+            err.contains("named.csv:1: no column `ref_deg` in the header"),
+            "{err}"
+        );
+        // Not named: used if present, else none.
+        let log = read_csv(&path, &ColumnOptions::default()).unwrap();
+        assert!(log.has_reference && !log.has_temperature);
     }
 }

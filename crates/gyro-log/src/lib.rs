@@ -24,18 +24,23 @@ mod csv_log;
 mod load;
 pub mod mcap;
 mod regular;
+pub mod value;
 
 pub(crate) use ahead::read_ahead;
 pub use bursts::Bursts;
 pub(crate) use csv_log::CsvRows;
-pub use csv_log::{read_csv, write_csv, ColumnOptions, RateUnit, TimeUnit};
+pub use csv_log::{
+    read_csv, write_csv, ColumnOptions, RateUnit, TimeUnit, DEFAULT_REFERENCE_COLUMN,
+    DEFAULT_TEMPERATURE_COLUMN,
+};
 pub use load::{load, stream};
 pub use mcap::{
     read_mcap, write_mcap, Axis, JsonChannel, McapLogWriter, McapOptions, McapRead, McapRows,
     McapWriteOptions, TimeSource,
 };
 pub use regular::{
-    place, regularize, GridOptions, LogInfo, Quality, RegularLog, Slot, SlotSink, RATE_WINDOW_STEPS,
+    place, regularize, GridOptions, LogInfo, Quality, RegularLog, Slot, SlotSink,
+    MAX_BRIDGED_SLOTS, MAX_HELD_SLOTS, RATE_DISAGREEMENT, RATE_WARNING_SHARE, RATE_WINDOW_STEPS,
 };
 
 use std::collections::BTreeMap;
@@ -197,9 +202,51 @@ impl Log {
 /// The `sample_rate_hz` value of a log's metadata, if present and a positive number.
 pub fn metadata_rate_hz(metadata: &BTreeMap<String, String>) -> Option<f64> {
     metadata
-        .get("sample_rate_hz")
+        .get(SAMPLE_RATE_KEY)
         .and_then(|v| v.trim().parse::<f64>().ok())
         .filter(|v| v.is_finite() && *v > 0.0)
+}
+
+/// The metadata key of the nominal sample rate (Hz), the one key the code acts on.
+pub const SAMPLE_RATE_KEY: &str = "sample_rate_hz";
+
+/// Check a `sample_rate_hz` metadata value as it is read: a positive, finite number of Hz,
+/// the same as any value given before it (`previous`). The error says what is wrong.
+pub(crate) fn check_rate_metadata(value: &str, previous: Option<&str>) -> Result<f64, String> {
+    let shown = csv_log::excerpt(value.as_bytes());
+    let rate = value
+        .trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| {
+            format!(
+                "`{SAMPLE_RATE_KEY}: {shown}`: expected a positive number of Hz (e.g. `{SAMPLE_RATE_KEY}: 1000`)"
+            )
+        })?;
+    match previous {
+        Some(before) if before.trim().parse::<f64>().ok() != Some(rate) => Err(format!(
+            "`{SAMPLE_RATE_KEY}` given twice with different values ({} and {shown}); keep one",
+            csv_log::excerpt(before.as_bytes())
+        )),
+        _ => Ok(rate),
+    }
+}
+
+/// A rate as errors show it: at most three decimals, no trailing zeros (`1000`, `108.509`).
+pub(crate) fn hz(rate_hz: f64) -> String {
+    let text = format!("{rate_hz:.3}");
+    text.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// The memory `slots` grid slots take (GiB).
+fn gib(slots: f64) -> f64 {
+    slots * std::mem::size_of::<Slot>() as f64 / f64::from(1_u32 << 30)
+}
+
+/// `": {line}"` for an error naming a line, else nothing.
+fn at_line(line: &Option<u64>) -> String {
+    line.map_or_else(String::new, |l| format!(":{l}"))
 }
 
 /// Why a log could not be read. Every variant names the file; row-level ones the line.
@@ -271,6 +318,17 @@ pub enum LogError {
         /// What is missing.
         what: String,
     },
+    /// A metadata value the code acts on is invalid (`sample_rate_hz` not a positive
+    /// number, or given twice with different values).
+    #[error("{path}{}: {message}", at_line(line))]
+    Metadata {
+        /// File.
+        path: PathBuf,
+        /// The metadata line (CSV); `None` for MCAP's metadata record.
+        line: Option<u64>,
+        /// What is wrong.
+        message: String,
+    },
     /// The sample rate given ([`GridOptions::sample_rate_hz`]) is not a positive number.
     #[error("{path}: the sample rate {rate_hz} Hz is not a positive number")]
     SampleRateInvalid {
@@ -313,6 +371,23 @@ pub enum LogError {
         measured_hz: f64,
         /// `measured_hz / rate_hz`.
         ratio: f64,
+    },
+    /// The grid would need more memory than allowed ([`MAX_BRIDGED_SLOTS`],
+    /// [`MAX_HELD_SLOTS`]); refused before it is made.
+    #[error(
+        "{path}: {what} {samples} samples ({:.1} GiB), more than the limit of {limit} ({:.1} GiB)",
+        gib(*samples),
+        gib(*limit as f64)
+    )]
+    TooLarge {
+        /// File.
+        path: PathBuf,
+        /// What would need them ("the grid at 1000 Hz holds").
+        what: String,
+        /// The samples it would need.
+        samples: f64,
+        /// The limit (samples).
+        limit: u64,
     },
     /// No sample rate given, none in the metadata, and the stamps cannot give one.
     #[error(

@@ -28,10 +28,13 @@ use std::path::Path;
 pub struct GridOptions {
     /// Sample rate of the log (Hz); default: its `sample_rate_hz` metadata, else the median
     /// time step.
-    #[cfg_attr(feature = "clap", arg(long))]
+    #[cfg_attr(feature = "clap", arg(long, value_parser = crate::value::positive::<f64>))]
     pub sample_rate_hz: Option<f64>,
     /// Longest stretch of missing data (s) bridged by interpolation; longer is an error.
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = 0.5))]
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, default_value_t = 0.5, value_parser = crate::value::non_negative::<f64>)
+    )]
     pub max_gap_s: f64,
 }
 
@@ -102,6 +105,10 @@ pub struct Quality {
     /// gaps are steps over `gap_step_s`, and slot times are grid times, not stamps.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bursts: Option<Bursts>,
+    /// What did not stop the log but may make its results wrong (a given rate more than
+    /// [`RATE_WARNING_SHARE`] off the stamps'), one line each; left out when empty.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 const MAX_EXAMPLES: usize = 12;
@@ -206,52 +213,104 @@ pub(crate) fn check_max_gap(path: &Path, options: &GridOptions) -> Result<(), Lo
 }
 
 /// A given rate further than this factor from the rate the stamps measure is refused.
-pub const RATE_DISAGREEMENT: f64 = 1.2;
+pub const RATE_DISAGREEMENT: f64 = 2.0;
 
-/// Positive steps needed before a given rate is checked against the stamps.
+/// A given rate further than this share from the rate the stamps measure (but within
+/// [`RATE_DISAGREEMENT`]) is accepted with a warning.
+pub const RATE_WARNING_SHARE: f64 = 0.01;
+
+/// Positive steps needed before a given rate is checked against the stamps' median step.
 pub const RATE_CHECK_MIN_STEPS: usize = 20;
 
-/// Refuse a given rate (option or metadata) that the first rows' stamps contradict by more
-/// than [`RATE_DISAGREEMENT`]: the stamps' rate is the mean row rate for rows arriving in
-/// bursts, else the median step's. (Nothing to check with fewer than
-/// [`RATE_CHECK_MIN_STEPS`] positive steps: a median of a few steps says little.)
+/// Check a given rate (option or metadata) against the first rows' stamps: the stamps'
+/// rate is the mean row rate for rows arriving in bursts, else the median step's. More
+/// than [`RATE_DISAGREEMENT`] off either way is an error; more than [`RATE_WARNING_SHARE`]
+/// off, a warning (returned). With fewer than [`RATE_CHECK_MIN_STEPS`] positive steps (a
+/// median of a few steps says little) only a rate more than [`RATE_DISAGREEMENT`] above the
+/// fastest step's is refused: every step would be a gap.
 pub(crate) fn check_given_rate(
     path: &Path,
     rows: &[Row],
     arrival: Option<Bursts>,
     rate_hz: f64,
     source: &'static str,
-) -> Result<(), LogError> {
+) -> Result<Option<String>, LogError> {
     if source != "option" && source != "metadata" {
-        return Ok(());
+        return Ok(None);
     }
-    let positive = rows
-        .windows(2)
-        .take(RATE_WINDOW_STEPS)
-        .filter(|w| w[1].time_s > w[0].time_s)
-        .count();
+    let source_name = if source == "option" {
+        "--sample-rate-hz option"
+    } else {
+        "sample_rate_hz metadata"
+    };
+    let disagrees = |measured_hz: f64| LogError::SampleRateDisagrees {
+        path: path.to_path_buf(),
+        rate_hz,
+        source_name,
+        measured_hz,
+        ratio: measured_hz / rate_hz,
+    };
+    let steps = || {
+        rows.windows(2)
+            .take(RATE_WINDOW_STEPS)
+            .map(|w| w[1].time_s - w[0].time_s)
+            .filter(|dt| *dt > 0.0)
+    };
+    let positive = steps().count();
     if positive < RATE_CHECK_MIN_STEPS {
-        return Ok(());
+        let shortest = steps().fold(f64::INFINITY, f64::min);
+        if positive > 0 && rate_hz * shortest > RATE_DISAGREEMENT {
+            return Err(disagrees(1.0 / shortest));
+        }
+        return Ok(None);
     }
     let measured_hz = match arrival {
         Some(b) => 1.0 / b.mean_step_s,
         None => match median_step_rate(path, rows) {
             Ok((hz, _)) => hz,
-            Err(_) => return Ok(()),
+            Err(_) => return Ok(None),
         },
     };
     let ratio = measured_hz / rate_hz;
     if !(1.0 / RATE_DISAGREEMENT..=RATE_DISAGREEMENT).contains(&ratio) {
-        return Err(LogError::SampleRateDisagrees {
+        return Err(disagrees(measured_hz));
+    }
+    Ok(((ratio - 1.0).abs() > RATE_WARNING_SHARE).then(|| {
+        format!(
+            "{}: the {source_name} gives {rate_hz} Hz but the time stamps say {measured_hz:.3} Hz \
+             ({ratio:.4} times that); the grid follows the given rate, so angles are off by up \
+             to that factor if the stamps are right",
+            path.display()
+        )
+    }))
+}
+
+/// Most slots a run bridged by interpolation may need (`max_gap_s` × the grid rate): the
+/// placer holds such a run in memory. 2^24 slots, 1 GiB; at 1 kHz, gaps of 4.6 hours.
+pub const MAX_BRIDGED_SLOTS: u64 = 1 << 24;
+
+/// Most slots of a log held whole in memory ([`crate::load`]): 2^26 slots, 4 GiB; at
+/// 1 kHz, 18.6 hours.
+pub const MAX_HELD_SLOTS: u64 = 1 << 26;
+
+/// Refuse a grid on which bridging a gap of `max_gap_s` would hold more than
+/// [`MAX_BRIDGED_SLOTS`] slots, before any is made.
+pub(crate) fn check_bridged_slots(
+    path: &Path,
+    options: &GridOptions,
+    rate_hz: f64,
+) -> Result<(), LogError> {
+    let slots = (options.max_gap_s * rate_hz).floor();
+    if slots > MAX_BRIDGED_SLOTS as f64 {
+        return Err(LogError::TooLarge {
             path: path.to_path_buf(),
-            rate_hz,
-            source_name: if source == "option" {
-                "--sample-rate-hz option"
-            } else {
-                "sample_rate_hz metadata"
-            },
-            measured_hz,
-            ratio,
+            what: format!(
+                "bridging gaps of up to {} s at {} Hz would hold",
+                options.max_gap_s,
+                crate::hz(rate_hz)
+            ),
+            samples: slots,
+            limit: MAX_BRIDGED_SLOTS,
         });
     }
     Ok(())
@@ -345,9 +404,11 @@ pub fn place<S: SlotSink + ?Sized>(
     };
     let rate = check_max_gap(info.path, options).and(rate);
     let rate = rate.and_then(|(rate_hz, source)| {
-        check_given_rate(info.path, &ahead, arrival, rate_hz, source).map(|()| (rate_hz, source))
+        let warning = check_given_rate(info.path, &ahead, arrival, rate_hz, source)?;
+        check_bridged_slots(info.path, options, rate_hz)?;
+        Ok((rate_hz, source, warning))
     });
-    let (rate_hz, source) = match rate {
+    let (rate_hz, source, warning) = match rate {
         Ok(rate) => rate,
         Err(e) => {
             // A read error further on comes first.
@@ -359,6 +420,7 @@ pub fn place<S: SlotSink + ?Sized>(
     };
     sink.start(rate_hz);
     let mut placer = Placer::new(info, options, rate_hz, source, arrival, sink);
+    placer.quality.warnings.extend(warning);
     for row in std::mem::take(&mut ahead) {
         placer.row(&row);
     }
@@ -851,15 +913,20 @@ mod tests {
             let arrival = crate::bursts::classify(&log.rows, 100_000);
             super::super::check_max_gap(&log.path, options)?;
             let (rate_hz, source) = sample_rate(log, options, arrival)?;
-            super::super::check_given_rate(&log.path, &log.rows, arrival, rate_hz, source)?;
+            let warning =
+                super::super::check_given_rate(&log.path, &log.rows, arrival, rate_hz, source)?;
+            super::super::check_bridged_slots(&log.path, options, rate_hz)?;
             if let Some(b) = arrival {
-                return resample_whole(log, options, rate_hz, source, b);
+                let mut whole = resample_whole(log, options, rate_hz, source, b)?;
+                whole.quality.warnings.extend(warning);
+                return Ok(whole);
             }
             let period_s = 1.0 / rate_hz;
             let mut quality = Quality {
                 rows: log.rows.len() as u64,
                 sample_rate_hz: rate_hz,
                 sample_rate_source: source,
+                warnings: warning.into_iter().collect(),
                 ..Quality::default()
             };
 
@@ -1470,5 +1537,102 @@ mod tests {
             outcome(Ok(streamed)),
             outcome(whole::regularize_whole(&log, &options))
         );
+    }
+
+    /// A log of `n` rows `step_s` apart, with the rate in the metadata if given.
+    fn steady_log(n: usize, step_s: f64, metadata_rate: Option<&str>) -> Log {
+        let mut metadata = BTreeMap::new();
+        if let Some(rate) = metadata_rate {
+            metadata.insert("sample_rate_hz".to_string(), rate.to_string());
+        }
+        Log {
+            path: "steady.csv".into(),
+            metadata,
+            rows: (0..n)
+                .map(|i| Row {
+                    line: i as u64 + 2,
+                    time_s: i as f64 * step_s,
+                    rate_dps: Some(0.5),
+                    reference_deg: None,
+                    temperature_c: None,
+                })
+                .collect(),
+            ..Log::default()
+        }
+    }
+
+    /// A given rate more than twice or under half the stamps' is refused; more than 1% off,
+    /// accepted with a warning; within 1%, silently.
+    #[test]
+    fn given_rates_are_refused_beyond_a_factor_two_and_warned_beyond_one_percent() {
+        let log = steady_log(100, 0.001, None);
+        let at = |rate: f64| {
+            let options = GridOptions {
+                sample_rate_hz: Some(rate),
+                ..GridOptions::default()
+            };
+            regularize(&log, &options)
+        };
+        for rate in [100.0, 499.0, 2001.0, 1e9] {
+            let err = at(rate).unwrap_err().to_string();
+            assert!(err.contains("time stamps say 1000"), "{rate}: {err}");
+        }
+        for rate in [600.0, 980.0, 1900.0] {
+            let warnings = at(rate).unwrap().quality.warnings;
+            assert_eq!(warnings.len(), 1, "{rate}");
+            assert!(
+                warnings[0].contains("time stamps say 1000.000 Hz"),
+                "{warnings:?}"
+            );
+        }
+        assert!(at(1005.0).unwrap().quality.warnings.is_empty());
+        // From the metadata, the same rule.
+        let err = regularize(
+            &steady_log(100, 0.001, Some("1e9")),
+            &GridOptions::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("sample_rate_hz metadata gives 1000000000 Hz"),
+            "{err}"
+        );
+    }
+
+    /// With fewer steps than the median needs, a rate more than twice the fastest step's is
+    /// still refused (every step would be a gap of up to a million slots).
+    #[test]
+    fn a_rate_far_above_a_few_steps_is_refused() {
+        let log = steady_log(10, 0.001, Some("1e9"));
+        let err = regularize(&log, &GridOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("time stamps say 1000"), "{err}");
+        assert!(regularize(
+            &steady_log(10, 0.001, Some("1500")),
+            &GridOptions::default()
+        )
+        .is_ok());
+    }
+
+    /// A grid on which bridging one gap would hold more than MAX_BRIDGED_SLOTS slots is
+    /// refused before any slot is made, with the number and the memory.
+    #[test]
+    fn a_grid_bridging_too_many_slots_is_refused_up_front() {
+        let log = steady_log(100, 0.001, Some("1000"));
+        let options = GridOptions {
+            max_gap_s: 1e6,
+            ..GridOptions::default()
+        };
+        let err = regularize(&log, &options).unwrap_err().to_string();
+        assert!(
+            err.contains("bridging gaps of up to 1000000 s at 1000 Hz would hold 1000000000 samples (59.6 GiB), more than the limit of 16777216 (1.0 GiB)"),
+            "{err}"
+        );
+        let options = GridOptions {
+            max_gap_s: 3600.0,
+            ..GridOptions::default()
+        };
+        assert!(regularize(&log, &options).is_ok());
     }
 }

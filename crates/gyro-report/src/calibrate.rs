@@ -2,6 +2,24 @@
 
 use gyro_analysis::calibrate::{Calibration, Candidate, ChoiceReason, RunScore};
 use gyro_core::{Compensation, Config};
+use serde::Serialize;
+
+/// The JSON of `calibrate`: the calibration, then each run's input-quality report.
+pub fn json(
+    inputs: &[crate::input::InputJson<'_>],
+    calibration: &Calibration,
+) -> serde_json::Result<String> {
+    #[derive(Serialize)]
+    struct Json<'a> {
+        #[serde(flatten)]
+        calibration: &'a Calibration,
+        inputs: &'a [crate::input::InputJson<'a>],
+    }
+    serde_json::to_string_pretty(&Json {
+        calibration,
+        inputs,
+    })
+}
 
 /// The last `n` characters of `s` (whole characters: names may be non-ASCII).
 fn last_chars(s: &str, n: usize) -> &str {

@@ -1,5 +1,5 @@
-//! Renderers of gyro's results: the text, JSON and CSV of `run` ([`run`]), the noise table
-//! ([`noise`]), the calibration table ([`calibrate`]), the diagnosis report in HTML ([`diagnose`]) and every plot ([`plot`]).
+//! Renderers of gyro's results: the text, JSON and CSV of `run` ([`run`]), the input-quality
+//! report every command shows ([`input`]), the noise table ([`noise`]), the calibration table ([`calibrate`]), the diagnosis report in HTML ([`diagnose`]) and every plot ([`plot`]).
 //! Renderers take what the analysis computed and lay it out.
 //!
 //! ```
@@ -19,6 +19,7 @@
 
 pub mod calibrate;
 pub mod diagnose;
+pub mod input;
 pub mod noise;
 pub mod plot;
 pub mod run;

@@ -9,64 +9,13 @@ fn opt(value: Option<f64>, decimals: usize) -> String {
     value.map_or_else(|| "-".to_string(), |v| format!("{v:.decimals$}"))
 }
 
-/// A rate in Hz to at most three decimals, without trailing zeros (`1000`, `108.509`).
-fn hz(rate_hz: f64) -> String {
-    let text = format!("{rate_hz:.3}");
-    text.trim_end_matches('0').trim_end_matches('.').to_string()
-}
-
 /// A human-readable report.
 pub fn table(file: &str, report: &RunReport) -> String {
     let mut s = String::new();
     let q = &report.input;
     let c = &report.config;
     let _ = writeln!(s, "file: {file}");
-    let _ = writeln!(
-        s,
-        "input: {} rows -> {} samples at {} Hz ({}), effective {:.3} Hz",
-        q.rows,
-        q.slots,
-        hz(q.sample_rate_hz),
-        q.sample_rate_source,
-        q.effective_rate_hz
-    );
-    if let Some(b) = &q.bursts {
-        let _ = writeln!(
-            s,
-            "  rows arrive in bursts: {:.0}% of steps off the grid of the median step {:.1} ms \
-             (mean {:.2} ms); the integral of the rate was resampled onto the grid, not placed \
-             row by row",
-            100.0 * b.off_grid_share,
-            1e3 * b.median_step_s,
-            1e3 * b.mean_step_s
-        );
-    }
-    let issues: Vec<String> = [
-        (q.duplicate_rows, "duplicate rows dropped"),
-        (q.same_time_rows, "rows with a repeated time stamp"),
-        (q.backward_steps, "steps back in time"),
-        (q.jittered_steps, "jittered steps"),
-        (q.gaps, "gaps"),
-        (q.missing_rate_rows, "missing rates"),
-        (q.filled_slots, "samples interpolated"),
-        (q.trimmed_slots, "samples trimmed at the ends"),
-        (q.missing_reference_slots, "samples without reference"),
-    ]
-    .iter()
-    .filter(|(n, _)| *n > 0)
-    .map(|(n, what)| format!("{n} {what}"))
-    .collect();
-    if !issues.is_empty() {
-        let _ = writeln!(
-            s,
-            "  irregular: {} (longest step {:.3} s)",
-            issues.join(", "),
-            q.longest_step_s
-        );
-        for (what, line) in q.examples.iter().take(5) {
-            let _ = writeln!(s, "    line {line}: {what}");
-        }
-    }
+    s.push_str(&crate::input::table(q));
     let _ = writeln!(
         s,
         "pipeline: decimate x{} -> {} Hz, Butterworth order {} at {} Hz, compensation {}{}",

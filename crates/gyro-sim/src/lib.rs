@@ -23,5 +23,6 @@ pub use effects::{
 };
 pub use motion::{BenchProfile, Motion, Rotation};
 pub use sensor::{
-    simulate, simulate_series, InvalidSensorModel, SensorModel, SimOptions, SimSeries,
+    check_size, sample_count, simulate, simulate_series, InvalidSensorModel, SensorModel,
+    SimOptions, SimSeries, TooManySamples, BYTES_PER_SAMPLE, MAX_SAMPLES,
 };

@@ -87,6 +87,56 @@ pub struct InvalidSensorModel {
     pub reason: &'static str,
 }
 
+/// Most samples one simulated run may have: 2^26 (67 million; 18.6 h at 1 kHz), the most
+/// a command holds of a log it reads (`gyro_log::MAX_HELD_SLOTS`), so that what is
+/// simulated can be read back.
+pub const MAX_SAMPLES: u64 = 1 << 26;
+
+/// Memory a simulated sample takes while the run is made: its row of the log and its
+/// three columns (rate, reference, temperature).
+pub const BYTES_PER_SAMPLE: usize = std::mem::size_of::<Row>() + 3 * std::mem::size_of::<f64>();
+
+/// A run too long to simulate (more than [`MAX_SAMPLES`]), refused before anything is
+/// allocated.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "{duration_s} s at {sample_rate_hz} Hz would be {samples} samples ({:.1} GiB), more than the limit of {MAX_SAMPLES} samples ({:.1} GiB)",
+    gib(*samples),
+    gib(MAX_SAMPLES as f64)
+)]
+pub struct TooManySamples {
+    /// Duration of the motion (s).
+    pub duration_s: f64,
+    /// Sample rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Samples the run would have.
+    pub samples: f64,
+}
+
+fn gib(samples: f64) -> f64 {
+    samples * BYTES_PER_SAMPLE as f64 / f64::from(1_u32 << 30)
+}
+
+/// The samples [`simulate`] makes of `motion` at `model`'s rate.
+pub fn sample_count(model: &SensorModel, motion: &Motion) -> f64 {
+    (motion.duration_s() * model.sample_rate_hz).floor() + 1.0
+}
+
+/// Refuse a run of more than [`MAX_SAMPLES`] samples (or of a duration that is not a
+/// finite number), before [`simulate`] allocates them.
+pub fn check_size(model: &SensorModel, motion: &Motion) -> Result<(), TooManySamples> {
+    let samples = sample_count(model, motion);
+    if samples.is_finite() && samples <= MAX_SAMPLES as f64 {
+        Ok(())
+    } else {
+        Err(TooManySamples {
+            duration_s: motion.duration_s(),
+            sample_rate_hz: model.sample_rate_hz,
+            samples,
+        })
+    }
+}
+
 /// Conditions of a simulated run.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SimOptions {

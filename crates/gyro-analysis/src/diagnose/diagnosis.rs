@@ -103,6 +103,10 @@ pub struct Diagnosis {
     pub runs: Vec<RunSummary>,
     /// Angle error with the correctable effects compensated, if any were selected.
     pub compensation: Option<CompensationSummary>,
+    /// What was read of each log and what was irregular in it (filled in by the caller,
+    /// which read the logs; empty for the self-check's simulated runs).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub inputs: Vec<InputEntry>,
     /// The model file with those corrections (`--out`).
     #[serde(skip)]
     pub corrected_model: Option<ModelFile>,
@@ -110,6 +114,15 @@ pub struct Diagnosis {
     /// white noise matched again under an extra output rounding); for the report.
     #[serde(skip)]
     pub selected_sensor: SensorModel,
+}
+
+/// One log's input-quality report.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct InputEntry {
+    /// The log as named on the command line.
+    pub file: String,
+    /// What was read and what was irregular ([`gyro_log::Quality`]).
+    pub input: gyro_log::Quality,
 }
 
 /// The nominal model.

@@ -466,7 +466,18 @@ pub fn fit_all<'a>(input: &'a FitInput<'a>) -> (Vec<Fit>, Vec<Untestable>, Joint
         .collect();
     let known = Known::new(input, quiet, clock.clone());
     for info in EFFECTS {
-        match fit_one(input, &known, info) {
+        let fitted = fit_one(input, &known, info).and_then(|f| {
+            let finite = f.effect.params().iter().all(|v| v.is_finite())
+                && f.ci95
+                    .iter()
+                    .all(|(lo, hi)| !lo.is_some_and(f64::is_nan) && !hi.is_some_and(f64::is_nan));
+            if finite {
+                Ok(f)
+            } else {
+                Err(FitError::NotFinite)
+            }
+        });
+        match fitted {
             Ok(f) => fits.push(f),
             Err(reason) => untestable.push(Untestable {
                 id: info.id,
@@ -592,6 +603,18 @@ pub(crate) enum FitError {
         /// Shortest usable run (s).
         min_s: f64,
     },
+    /// The residual regression has no estimate for the effect's regressor.
+    #[error(
+        "needs training runs whose motion determines it: the residual regression on {regressor} \
+         has no estimate (runs too short, or without rotations)"
+    )]
+    NoRegression {
+        /// What the regressor is.
+        regressor: &'static str,
+    },
+    /// The fit gave a parameter or a bound that is not a number.
+    #[error("the fit gives no finite estimate on these runs (too short, or too little motion)")]
+    NotFinite,
     /// The table pairs the effect with a procedure for another number of parameters.
     #[error("effect `{id}`: its fitting procedure fits {expected} parameter(s)")]
     ParamCount {
@@ -645,6 +668,19 @@ fn single_param(info: &'static EffectInfo) -> Result<impl Fn(f64) -> Effect, Fit
     Ok(move |v: f64| info.typical.with_params(&[v]).unwrap_or(info.typical))
 }
 
+/// What the regression column `index` is, for a reason given to the user.
+fn regressor_name(index: usize) -> &'static str {
+    match index {
+        reg::RATE => "the reference rate",
+        reg::ABS_RATE => "the absolute reference rate",
+        reg::RATE_CUBED => "the cubed reference rate",
+        reg::ACCELERATION => "the angular acceleration",
+        reg::DELTA_T => "the temperature change",
+        reg::RATE_DELTA_T => "the rate times the temperature change",
+        _ => "its regressor",
+    }
+}
+
 /// The column of the residual regression for `regressor`.
 fn regressor_index(regressor: Regressor) -> usize {
     match regressor {
@@ -692,6 +728,15 @@ fn regression_procedure(
     test: &str,
 ) -> Result<Fit, FitError> {
     let make = single_param(info)?;
+    // Runs too short, or without the motion the regressor needs, leave the regression
+    // without an estimate: untestable, never a NaN fit.
+    let (real, replicas) = input.pooled(&|f| f.coef[index]);
+    let finite_replicas = replicas.iter().filter(|c| c.is_finite()).count();
+    if !real.is_finite() || finite_replicas < 2 {
+        return Err(FitError::NoRegression {
+            regressor: regressor_name(index),
+        });
+    }
     Ok(match reading {
         Reading::Coefficient => {
             let (e, z, ci) = regression_fit(input, known, index, &make, &|x| x);

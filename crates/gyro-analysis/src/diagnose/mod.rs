@@ -44,8 +44,8 @@ pub(crate) mod stats;
 mod summarise;
 
 pub use diagnosis::{
-    CompensationRun, CompensationSummary, Diagnosis, EffectResult, GapSummary, ModelSummary,
-    NotCorrected, RunSummary, UntestableEntry, Verdict, Where,
+    CompensationRun, CompensationSummary, Diagnosis, EffectResult, GapSummary, InputEntry,
+    ModelSummary, NotCorrected, RunSummary, UntestableEntry, Verdict, Where,
 };
 pub use ensemble::{split, RealRun};
 pub use features::MIN_TEMPERATURE_RANGE_C;

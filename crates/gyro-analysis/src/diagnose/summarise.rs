@@ -204,6 +204,7 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         },
         runs,
         compensation: f.compensation,
+        inputs: Vec::new(),
         corrected_model: f.corrected_model,
         selected_sensor: f.selected_sensor,
     }

@@ -73,6 +73,14 @@ pub enum NoiseError {
     /// The sample rate is not a positive number.
     #[error("sample rate {0} Hz is not a positive number")]
     SampleRate(f64),
+    /// The rates are so large that their variance overflows.
+    #[error(
+        "rates up to {largest_dps:e} deg/s: too large to characterise (their variance overflows); is the rate column in deg/s?"
+    )]
+    Overflow {
+        /// The largest |rate| (deg/s).
+        largest_dps: f64,
+    },
     /// The confidence level is not in (0, 1).
     #[error("confidence {0} is not in (0, 1)")]
     Confidence(f64),
@@ -214,6 +222,11 @@ pub fn characterize(
     let all = || segments.iter().flat_map(|s| s.iter().copied());
     let mean = all().sum::<f64>() / samples as f64;
     let var = all().map(|v| (v - mean) * (v - mean)).sum::<f64>() / samples as f64;
+    if !(mean.is_finite() && var.is_finite()) {
+        // Rates near f64's limit (1e300 deg/s): every square overflows.
+        let largest_dps = all().map(f64::abs).fold(0.0, f64::max);
+        return Err(NoiseError::Overflow { largest_dps });
+    }
     let values: Vec<f64> = all().collect();
 
     let factors = options.taus.factors(longest);

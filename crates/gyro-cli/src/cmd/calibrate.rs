@@ -6,7 +6,6 @@ use gyro_analysis::model;
 use gyro_core::Config;
 use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};
-use std::io::Write as _;
 use std::path::PathBuf;
 
 /// Arguments of `calibrate`.
@@ -28,7 +27,7 @@ pub struct Args {
     #[arg(long)]
     model: Option<PathBuf>,
     /// Initial bias correlation time (s), e.g. from `gyro-cli noise`.
-    #[arg(long)]
+    #[arg(long, value_parser = gyro_log::value::positive::<f64>)]
     tau_s: Option<f64>,
     /// Also fit the motion detector's thresholds (slower: runs are replayed per trial).
     #[arg(long)]
@@ -67,6 +66,7 @@ fn load_runs(paths: &[PathBuf], args: &Args) -> Result<Vec<BenchRun>> {
 pub fn run(args: &Args) -> Result<()> {
     let inputs = args.logs.iter().chain(&args.holdout).map(PathBuf::as_path);
     super::refuse_to_overwrite(&args.out, inputs.chain(args.model.as_deref()))?;
+    super::refuse_repeated_runs(&[("training", &args.logs), ("hold-out", &args.holdout)])?;
     let base = match &args.model {
         Some(path) => model::load(path)?,
         None => model::ModelFile::new(Config::default()),
@@ -101,11 +101,23 @@ pub fn run(args: &Args) -> Result<()> {
     let mut out = base.clone();
     out.config = result.config;
     model::save(&args.out, &out).with_context(|| "writing the model file".to_string())?;
-    let mut stdout = std::io::stdout().lock();
-    match args.format {
-        super::run::Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
-        _ => write!(stdout, "{}", gyro_report::calibrate::table(&result))?,
-    }
+    let inputs: Vec<_> = train
+        .iter()
+        .chain(&holdout)
+        .map(|run| gyro_report::input::InputJson {
+            file: &run.name,
+            input: &run.log.quality,
+        })
+        .collect();
+    let text = match args.format {
+        super::run::Format::Json => gyro_report::calibrate::json(&inputs, &result)? + "\n",
+        _ => format!(
+            "{}{}",
+            gyro_report::input::tables(inputs.iter().map(|i| (i.file, i.input))),
+            gyro_report::calibrate::table(&result)
+        ),
+    };
+    super::to_stdout(|out| out.write_all(text.as_bytes()))?;
     eprintln!(
         "wrote {}: {}",
         args.out.display(),

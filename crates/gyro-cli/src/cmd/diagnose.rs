@@ -4,11 +4,10 @@
 use anyhow::{bail, Result};
 use clap::ValueEnum;
 use gyro_analysis::diagnose::{self, selftest, DiagnoseError, Diagnosis, Options, Progress};
-use gyro_analysis::diagnose::{split, RealRun};
+use gyro_analysis::diagnose::{split, InputEntry, RealRun};
 use gyro_analysis::model;
 use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Output format.
@@ -31,7 +30,7 @@ pub struct Args {
     #[arg(long, num_args = 1.., required_unless_present = "self_test")]
     holdout: Vec<PathBuf>,
     /// Cut every log into windows of this many seconds, each a run (for long recordings).
-    #[arg(long)]
+    #[arg(long, value_parser = gyro_log::value::positive::<f64>)]
     split_s: Option<f64>,
     /// Use this model file's sensor model as the nominal model, as it is (and its
     /// pipeline configuration for the compensated replays).
@@ -52,10 +51,10 @@ pub struct Args {
     seed: u64,
     /// Members of the baseline ensemble per run (at least 50 for the figures to mean
     /// what the report says).
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = 50, value_parser = at_least_two)]
     members: usize,
     /// Members per held-out run for each candidate effect.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = 20, value_parser = at_least_two)]
     candidate_members: usize,
     /// Run the injection–recovery self-check instead of diagnosing logs.
     #[arg(long)]
@@ -68,6 +67,17 @@ pub struct Args {
     grid: log::GridOptions,
     #[command(flatten)]
     input: log::LogOptions,
+}
+
+/// A count of ensemble members: at least 2 (a spread needs two).
+fn at_least_two(text: &str) -> Result<usize, String> {
+    match text.trim().parse::<usize>() {
+        Ok(n) if n >= 2 => Ok(n),
+        _ => Err(format!(
+            "expected a whole number >= 2, got `{}`",
+            text.chars().take(40).collect::<String>()
+        )),
+    }
 }
 
 struct Bar(ProgressBar);
@@ -93,10 +103,20 @@ fn progress_bar() -> Bar {
     Bar(bar)
 }
 
-fn load(paths: &[PathBuf], args: &Args, role: &str) -> Result<Vec<RealRun>> {
+/// The runs of `paths` (cut by --split-s), each log's input report added to `inputs`.
+fn load(
+    paths: &[PathBuf],
+    args: &Args,
+    role: &str,
+    inputs: &mut Vec<InputEntry>,
+) -> Result<Vec<RealRun>> {
     let mut runs = Vec::new();
     for path in paths {
         let regular = super::load(path, &args.input, &args.grid)?;
+        inputs.push(InputEntry {
+            file: path.display().to_string(),
+            input: regular.quality.clone(),
+        });
         if !regular.has_reference {
             bail!(
                 "{}: no reference_deg column; diagnose compares the gyro with an encoder reference, so every {role} run needs one",
@@ -158,18 +178,21 @@ pub fn run(args: &Args) -> Result<()> {
         options.base_model = file;
         options.fixed_model = true;
     }
-    let train = load(&args.train, args, "training")?;
-    let holdout = load(&args.holdout, args, "held-out")?;
+    super::refuse_repeated_runs(&[("training", &args.train), ("hold-out", &args.holdout)])?;
+    let mut inputs = Vec::new();
+    let train = load(&args.train, args, "training", &mut inputs)?;
+    let holdout = load(&args.holdout, args, "held-out", &mut inputs)?;
     diagnose::check_runs(&train, &holdout).map_err(with_advice)?;
     let bar = progress_bar();
     let result = diagnose::diagnose(&train, &holdout, &options, &bar);
     bar.0.finish_and_clear();
-    let result = result.map_err(with_advice)?;
-    let mut stdout = std::io::stdout().lock();
-    match args.format {
-        Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
-        Format::Table => write!(stdout, "{}", gyro_report::diagnose::table(&result))?,
-    }
+    let mut result = result.map_err(with_advice)?;
+    result.inputs = inputs;
+    let text = match args.format {
+        Format::Json => serde_json::to_string_pretty(&result)? + "\n",
+        Format::Table => gyro_report::diagnose::table(&result),
+    };
+    super::to_stdout(|out| out.write_all(text.as_bytes()))?;
     if let Some(dir) = &args.report {
         write_report(dir, &result, &train, &holdout, &options)?;
     }
@@ -225,15 +248,11 @@ fn self_test(args: &Args) -> Result<()> {
     );
     bar.finish_and_clear();
     let result = result.map_err(with_advice)?;
-    let mut stdout = std::io::stdout().lock();
-    match args.format {
-        Format::Json => writeln!(stdout, "{}", serde_json::to_string_pretty(&result)?)?,
-        Format::Table => write!(
-            stdout,
-            "{}",
-            gyro_report::diagnose::self_test_table(&result)
-        )?,
-    }
+    let text = match args.format {
+        Format::Json => serde_json::to_string_pretty(&result)? + "\n",
+        Format::Table => gyro_report::diagnose::self_test_table(&result),
+    };
+    super::to_stdout(|out| out.write_all(text.as_bytes()))?;
     Ok(())
 }
 

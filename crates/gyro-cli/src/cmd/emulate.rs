@@ -26,7 +26,7 @@ pub struct Args {
     #[arg(long)]
     create_pty: bool,
     /// Baud rate when --port is a real serial port.
-    #[arg(long, default_value_t = serial::DEFAULT_BAUD)]
+    #[arg(long, default_value_t = serial::DEFAULT_BAUD, value_parser = clap::value_parser!(u32).range(1..))]
     baud: u32,
     /// Log (CSV or MCAP) whose rate and temperature are played.
     #[arg(long, conflicts_with_all = ["seed", "duration_s"])]
@@ -35,13 +35,13 @@ pub struct Args {
     #[arg(long)]
     seed: Option<u64>,
     /// Duration of the simulated run (s).
-    #[arg(long)]
+    #[arg(long, value_parser = gyro_log::value::positive::<f64>)]
     duration_s: Option<f64>,
     /// Range (°/s) whose LSB scales the rate word: 75, 150, 300 or 900.
     #[arg(long, default_value = "300", value_parser = bridge::parse_range)]
     range: Range,
     /// Frame rate (Hz). Simulated runs: default 1000. Logs: default the log's own times.
-    #[arg(long)]
+    #[arg(long, value_parser = gyro_log::value::positive::<f64>)]
     rate_hz: Option<f64>,
     /// Send each frame at its time (default).
     #[arg(long, conflicts_with = "as_fast_as_possible")]
@@ -54,6 +54,9 @@ pub struct Args {
     /// `typical,seed=7` or `drop=1e-3,bit_flip=5e-4`.
     #[arg(long, default_value = "none", value_parser = FaultSpec::parse)]
     faults: FaultSpec,
+    /// Give up when the port takes no byte for this many seconds (nobody reading it).
+    #[arg(long, default_value_t = 30.0, value_parser = gyro_log::value::positive::<f64>)]
+    write_timeout_s: f64,
     /// Write the fault log (the report, with every lost sequence number) as JSON here.
     #[arg(long)]
     fault_log: Option<PathBuf>,
@@ -78,7 +81,8 @@ fn samples(args: &Args) -> Result<(Vec<Sample>, String)> {
         ..SensorModel::default()
     };
     sensor.validate()?;
-    let samples = bridge::simulated_samples(&sensor, duration_s, seed);
+    let samples = bridge::simulated_samples(&sensor, duration_s, seed)
+        .context("the simulated run (--duration-s, --rate-hz)")?;
     Ok((
         samples,
         format!("simulated run, seed {seed}, {duration_s} s"),
@@ -122,8 +126,17 @@ pub fn run(args: &Args) -> Result<()> {
         pacing
     );
     let mut emulator = Emulator::new(samples.into_iter(), config);
-    let report = bridge::stream(&mut emulator, &mut *port, pacing, Some(&stop), None)
-        .context("writing to the port failed")?;
+    let write_timeout = Duration::try_from_secs_f64(args.write_timeout_s).ok();
+    let port_name = args.port.as_deref().unwrap_or("the pseudo-terminal");
+    let report = bridge::stream(
+        &mut emulator,
+        &mut *port,
+        pacing,
+        Some(&stop),
+        None,
+        write_timeout,
+    )
+    .with_context(|| format!("writing to {port_name} failed (--write-timeout-s)"))?;
     // Closing the port hangs the line up, and a pseudo-terminal then discards what the
     // reader has not read yet: wait until it has.
     let unread = drain(&mut *port, _pty_slave.as_ref(), &stop);
@@ -222,7 +235,7 @@ fn open_pty(keep: &mut Option<PtySlave>) -> Result<Box<dyn serialport::SerialPor
     let (master, slave) =
         serialport::TTYPort::pair().context("cannot create a pseudo-terminal pair")?;
     let name = slave.name().context("the pseudo-terminal has no name")?;
-    writeln!(std::io::stdout().lock(), "{name}")?;
+    super::to_stdout(|out| writeln!(out, "{name}"))?;
     eprintln!("record from {name}, e.g.: gyro-cli record --port {name} -o run.mcap");
     *keep = Some(slave);
     Ok(Box::new(master))

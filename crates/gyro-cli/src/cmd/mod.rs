@@ -11,7 +11,8 @@ pub mod simulate;
 
 use anyhow::{Context, Result};
 use gyro_log::{GridOptions, Log, LogOptions, RegularLog};
-use std::path::Path;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
@@ -40,6 +41,36 @@ pub fn refuse_to_overwrite<'a>(
     Ok(())
 }
 
+/// Refuse a run given twice: the same file (by device and inode, whatever the spelling)
+/// twice in one list, or in two lists (`names` say which: "training", "hold-out"), would
+/// count as independent evidence twice, or score a fit on the runs it was fitted to.
+pub fn refuse_repeated_runs(lists: &[(&str, &[PathBuf])]) -> Result<()> {
+    let mut seen: Vec<(std::fs::Metadata, &Path, &str)> = Vec::new();
+    for (name, paths) in lists {
+        for path in paths.iter() {
+            let Ok(meta) = std::fs::metadata(path) else {
+                continue; // reading it reports the error
+            };
+            if let Some((_, first, first_list)) =
+                seen.iter().find(|(m, p, _)| same_file(m, &meta, p, path))
+            {
+                let where_ = if first_list == name {
+                    format!("twice among the {name} runs")
+                } else {
+                    format!("among the {first_list} runs and again among the {name} runs")
+                };
+                anyhow::bail!(
+                    "{}: the same run as {} is given {where_}; give each run once",
+                    path.display(),
+                    first.display()
+                );
+            }
+            seen.push((meta, path, name));
+        }
+    }
+    Ok(())
+}
+
 #[cfg(unix)]
 fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata, _: &Path, _: &Path) -> bool {
     use std::os::unix::fs::MetadataExt;
@@ -49,6 +80,16 @@ fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata, _: &Path, _: &Path) -
 #[cfg(not(unix))]
 fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata, a: &Path, b: &Path) -> bool {
     matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+}
+
+/// Write a command's output to stdout with `write`, then flush: any failure is one error
+/// naming stdout (a full disk: "No space left on device"). A reader that has gone (`| head`)
+/// stays a broken pipe underneath, which `main` ends quietly.
+pub fn to_stdout(write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    write(&mut out)
+        .and_then(|()| out.flush())
+        .context("cannot write to stdout")
 }
 
 /// Print a warning about the input on stderr.

@@ -5,6 +5,7 @@ use clap::ValueEnum;
 use gyro_analysis::model;
 use gyro_analysis::noise::{self, NoiseLog, NoiseOptions, PsdOptions, TauGrid};
 use gyro_log as log;
+use gyro_log::value;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -43,10 +44,10 @@ pub struct Args {
     #[arg(long)]
     static_only: bool,
     /// With --static-only: margin cut on both sides of each movement (s).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, value_parser = value::non_negative::<f64>)]
     margin_s: f64,
     /// With --static-only: shortest rest stretch kept (s).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = value::non_negative::<f64>)]
     min_rest_s: f64,
     /// Model file: its pipeline configuration drives --static-only's motion detector, and
     /// --model-out starts from it (its sensor section replaced, its range kept).
@@ -57,10 +58,10 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Grid::Log)]
     tau_grid: Grid,
     /// Averaging times per decade with `--tau-grid log`.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
     per_decade: u32,
     /// Confidence of the Allan bounds (default 1σ).
-    #[arg(long, default_value_t = noise::ONE_SIGMA)]
+    #[arg(long, default_value_t = noise::ONE_SIGMA, value_parser = value::positive::<f64>)]
     confidence: f64,
     /// Welch segment length (a power of two); default: a quarter of the longest stretch,
     /// 16 to 16384.
@@ -116,6 +117,7 @@ pub fn run(args: &Args) -> Result<()> {
         let inputs = args.logs.iter().map(PathBuf::as_path);
         super::refuse_to_overwrite(out, inputs.chain(args.model.as_deref()))?;
     }
+    super::refuse_repeated_runs(&[("static", &args.logs)])?;
     if !(args.confidence > 0.0 && args.confidence < 1.0) {
         bail!("--confidence must be in (0, 1)");
     }
@@ -210,15 +212,13 @@ pub fn run(args: &Args) -> Result<()> {
         gyro_report::plot::noise_plot(path, &title, result)?;
     }
 
-    let mut stdout = std::io::stdout().lock();
-    match args.format {
-        Format::Table => write!(stdout, "{}", gyro_report::noise::tables(&loaded, &run))?,
+    let text = match args.format {
+        Format::Table => gyro_report::noise::tables(&loaded, &run),
         Format::Json => {
             let model_out = args.model_out.as_ref().map(|p| p.display().to_string());
-            let json =
-                gyro_report::noise::json(&loaded, &run, args.static_only, model_out.as_deref())?;
-            writeln!(stdout, "{json}")?;
+            gyro_report::noise::json(&loaded, &run, args.static_only, model_out.as_deref())? + "\n"
         }
-    }
+    };
+    super::to_stdout(|out| out.write_all(text.as_bytes()))?;
     Ok(())
 }

@@ -14,7 +14,7 @@ pub struct Args {
     #[arg(long)]
     port: String,
     /// Baud rate (24-byte frames at 1 kHz need at least 460800).
-    #[arg(long, default_value_t = serial::DEFAULT_BAUD)]
+    #[arg(long, default_value_t = serial::DEFAULT_BAUD, value_parser = clap::value_parser!(u32).range(1..))]
     baud: u32,
     /// Output log: MCAP (default) or, with --csv, CSV. An existing file is kept unless
     /// --force: a recording is not replaced by accident.
@@ -24,16 +24,16 @@ pub struct Args {
     #[arg(long)]
     force: bool,
     /// Stop after this many seconds (default: until Ctrl-C or the port closes).
-    #[arg(long)]
+    #[arg(long, value_parser = gyro_log::value::positive::<f64>)]
     duration: Option<f64>,
     /// Stop when no byte arrived for this many seconds.
-    #[arg(long)]
+    #[arg(long, value_parser = gyro_log::value::positive::<f64>)]
     idle_stop: Option<f64>,
     /// Range the sensor runs in (°/s): 75, 150, 300 or 900; scales the rate word.
     #[arg(long, default_value = "300", value_parser = bridge::parse_range)]
     range: Range,
     /// Nominal frame rate of the bridge (Hz), for the metadata.
-    #[arg(long, default_value_t = 1000.0)]
+    #[arg(long, default_value_t = 1000.0, value_parser = gyro_log::value::positive::<f64>)]
     sample_rate_hz: f64,
     /// Write CSV (time_s, rate_dps, temperature_c, status, sequence, raw) instead of MCAP.
     #[arg(long)]
@@ -43,7 +43,7 @@ pub struct Args {
     no_checksum: bool,
     /// Read timeout of the port (ms): how often the status line, flushes and Ctrl-C are
     /// looked at when the line is quiet.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..))]
     timeout_ms: u64,
 }
 

@@ -6,6 +6,7 @@ use gyro_analysis::model;
 use gyro_analysis::replay;
 use gyro_core::{Compensation, Config, Direction, Tightening};
 use gyro_log as log;
+use gyro_log::value;
 use gyro_report::run as report;
 use std::io::Write;
 use std::path::PathBuf;
@@ -49,19 +50,19 @@ pub struct Args {
     /// The sensor's full-scale range (deg/s): a movement during which a reading reaches it
     /// is flagged saturated. Default: the model's (`config.range_dps`, else
     /// `sensor.range_dps`); without a model, unknown (only clip plateaus are flagged).
-    #[arg(long, value_name = "DPS")]
+    #[arg(long, value_name = "DPS", value_parser = value::positive::<f32>)]
     range_dps: Option<f32>,
     /// Judge each movement against a tightening window: its target angle (deg, in the
     /// tightening direction). Default: the model's `config.tightening`, else no decision.
-    #[arg(long, value_name = "DEG", requires = "tolerance_deg")]
+    #[arg(long, value_name = "DEG", requires = "tolerance_deg", value_parser = value::finite::<f32>)]
     target_deg: Option<f32>,
     /// Half-width of the tightening window (deg): accepted angles lie in target ± this.
-    #[arg(long, value_name = "DEG", requires = "target_deg")]
+    #[arg(long, value_name = "DEG", requires = "target_deg", value_parser = value::positive::<f32>)]
     tolerance_deg: Option<f32>,
     /// Guard band of the decision in standard deviations of the movement's angle: `ok`
     /// needs the angle inside the window by more than k·σ, `nok` outside by more than k·σ,
     /// else `recheck`.
-    #[arg(long, value_name = "K", default_value_t = 2.0)]
+    #[arg(long, value_name = "K", default_value_t = 2.0, value_parser = value::non_negative::<f32>)]
     k_sigma: f32,
     /// Which sign of the angle tightens; a turn the other way gets no verdict.
     #[arg(long, value_enum, default_value_t = DirectionArg::Positive)]
@@ -69,7 +70,7 @@ pub struct Args {
     /// Relative uncertainty of the gyro's scale factor (0.01 = 1%), added to each
     /// movement's σ as a share of its angle: the filter's σ does not know the scale. Use it
     /// for a gyro whose scale is not calibrated.
-    #[arg(long, value_name = "FRACTION", default_value_t = 0.0)]
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.0, value_parser = value::non_negative::<f32>)]
     scale_sigma: f32,
     /// Output format on stdout (csv: the movements).
     #[arg(long, value_enum, default_value_t = Format::Table)]
@@ -150,12 +151,15 @@ pub fn run(args: &Args) -> Result<()> {
         }
     })?;
     let file = args.log.display().to_string();
-    let mut stdout = std::io::stdout().lock();
-    match args.format {
-        Format::Table => write!(stdout, "{}", report::table(&file, &result))?,
-        Format::Json => writeln!(stdout, "{}", report::json(&file, &result)?)?,
-        Format::Csv => report::movements_csv(&mut stdout, &result.movements)?,
-    }
+    let json = match args.format {
+        Format::Json => Some(report::json(&file, &result)?),
+        _ => None,
+    };
+    super::to_stdout(|out| match args.format {
+        Format::Table => write!(out, "{}", report::table(&file, &result)),
+        Format::Json => writeln!(out, "{}", json.unwrap_or_default()),
+        Format::Csv => report::movements_csv(&mut &mut *out, &result.movements),
+    })?;
     if let Some(out) = &args.out {
         let write = || -> std::io::Result<()> {
             let mut w = std::io::BufWriter::new(std::fs::File::create(out)?);

@@ -3,6 +3,7 @@
 use anyhow::{Context, Result};
 use gyro_analysis::model;
 use gyro_log as log;
+use gyro_log::value;
 use gyro_sim::{self as sim, BenchProfile, Effect, Motion, SensorModel, SimOptions};
 use std::io::Write;
 use std::path::PathBuf;
@@ -20,7 +21,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Duration of the generated bench-like motion (s).
-    #[arg(long, default_value_t = 90.0)]
+    #[arg(long, default_value_t = 90.0, value_parser = value::positive::<f64>)]
     duration_s: f64,
     /// Re-simulate the motion of this log's `reference_deg` instead of generating motion.
     #[arg(long)]
@@ -33,17 +34,17 @@ pub struct Args {
     #[arg(long)]
     list_effects: bool,
     /// Sample rate (Hz), overriding the model's.
-    #[arg(long)]
+    #[arg(long, value_parser = value::positive::<f64>)]
     sample_rate_hz: Option<f64>,
     /// Temperature rise during the run (°C, warm-up with a 120 s time constant).
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, value_parser = value::finite::<f64>)]
     temperature_rise_c: f64,
     /// Quantise the reference like an encoder with this many counts per revolution.
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     encoder_counts: Option<u32>,
 }
 
-fn list_effects(out: &mut impl Write) -> std::io::Result<()> {
+fn list_effects(out: &mut dyn Write) -> std::io::Result<()> {
     writeln!(out, "{:<18} {:<36} signature", "id", "parameters (typical)")?;
     for info in sim::EFFECTS {
         let params: Vec<String> = info
@@ -75,7 +76,7 @@ pub fn run(args: &Args) -> Result<()> {
         )?;
     }
     if args.list_effects {
-        list_effects(&mut std::io::stdout().lock())?;
+        super::to_stdout(|out| list_effects(out))?;
         return Ok(());
     }
     let mut sensor = match &args.model {
@@ -98,6 +99,14 @@ pub fn run(args: &Args) -> Result<()> {
                 &log::LogOptions::default(),
                 &log::GridOptions::default(),
             )?;
+            // What was read of it, as every command that reads a log shows it.
+            eprint!(
+                "{}",
+                gyro_report::input::tables([(
+                    path.display().to_string().as_str(),
+                    &regular.quality
+                )])
+            );
             if !regular.has_reference {
                 anyhow::bail!(
                     "{}: no reference_deg column to take the motion from",
@@ -142,6 +151,13 @@ pub fn run(args: &Args) -> Result<()> {
     let Some(out) = &args.out else {
         anyhow::bail!("--out is required");
     };
+    sim::check_size(&sensor, &motion).with_context(|| match &args.motion_from {
+        Some(path) => format!(
+            "{}: cannot simulate its motion at the sensor's rate (--sample-rate-hz)",
+            path.display()
+        ),
+        None => "cannot simulate the run (--duration-s, --sample-rate-hz)".into(),
+    })?;
     let log = sim::simulate(&sensor, &effects, &motion, &options);
     // MCAP for a `.mcap` name, else CSV (the format the command always wrote).
     let format = log::LogFormat::from_extension(out).unwrap_or(log::LogFormat::Csv);

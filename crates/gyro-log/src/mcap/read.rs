@@ -592,6 +592,16 @@ impl State {
             }
             Record::Message { header, data } => self.message(&header, &data)?,
             Record::Metadata(metadata) if metadata.name == METADATA_NAME => {
+                if let Some(value) = metadata.metadata.get(crate::SAMPLE_RATE_KEY) {
+                    let before = self.metadata.get(crate::SAMPLE_RATE_KEY);
+                    crate::check_rate_metadata(value, before.map(String::as_str)).map_err(
+                        |message| LogError::Metadata {
+                            path: self.path.to_path_buf(),
+                            line: None,
+                            message: format!("metadata record `{METADATA_NAME}`: {message}"),
+                        },
+                    )?;
+                }
                 self.metadata.extend(metadata.metadata);
             }
             _ => {}

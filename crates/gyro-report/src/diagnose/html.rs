@@ -1162,6 +1162,7 @@ mod tests {
                     max_abs_error_after_deg: 0.2,
                 }],
             }),
+            inputs: Vec::new(),
             corrected_model: None,
             selected_sensor: SensorModel::default(),
         }

@@ -128,7 +128,7 @@ fn holdout_names(d: &Diagnosis) -> String {
 
 /// The human-readable summary.
 pub fn table(d: &Diagnosis) -> String {
-    let mut s = String::new();
+    let mut s = crate::input::tables(d.inputs.iter().map(|i| (i.file.as_str(), &i.input)));
     let g = &d.gap;
     let _ = writeln!(s, "diagnosis (held out: {}):", holdout_names(d));
     for line in super::headline(d) {

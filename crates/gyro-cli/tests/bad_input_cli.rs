@@ -1,0 +1,449 @@
+//! Bad input, class by class (crash, hang, wrong output, silent accept): every command
+//! refuses it with one line naming the file or the option and the right exit code, never
+//! a panic, never a hang, never a silent wrong answer. Every file is made here.
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+mod common;
+
+use common::{bench_log, gyro, ok, temp_dir, write};
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// A CSV log: `rows` rows `step_s` apart (a slow sine rate, reference 0), after `metadata`.
+fn log_text(metadata: &str, rows: usize, step_s: f64) -> String {
+    let mut text = String::from(metadata);
+    text.push_str("time_s,rate_dps,reference_deg\n");
+    for i in 0..rows {
+        let rate = 0.01 * (i as f64 * 0.1).sin();
+        text.push_str(&format!("{:.6},{rate:.5},0.0\n", i as f64 * step_s));
+    }
+    text
+}
+
+/// Assert a clean refusal: exit `code` (1: the input; 2: the command line), no panic, the
+/// first stderr line an `error:` containing `needle`; for code 1, nothing but that line.
+fn refused(out: &Output, code: i32, needle: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_ne!(out.status.code(), Some(101), "panicked: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.code(), Some(code), "{stderr}");
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(errors.len(), 1, "{stderr}");
+    assert!(
+        errors[0].contains(needle),
+        "expected `{needle}` in: {stderr}"
+    );
+    if code == 1 {
+        let last = stderr.lines().last().unwrap_or_default();
+        assert!(
+            last.starts_with("error: "),
+            "the error is the last line: {stderr}"
+        );
+    }
+}
+
+/// Run `gyro-cli args` in a child process, killed after `limit`: `None` if it had to be.
+fn within(args: &[&str], limit: Duration) -> Option<Output> {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while start.elapsed() < limit {
+        if child.try_wait().unwrap().is_some() {
+            return Some(child.wait_with_output().unwrap());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    None
+}
+
+fn s(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+/// Crashes: an absurd declared rate, a run too long to simulate, a full stdout.
+#[test]
+fn absurd_sizes_and_a_full_stdout_are_one_line_errors() {
+    let dir = temp_dir("crash");
+    // 1e9 Hz declared on rows 1 ms apart: many rows (the median says 1000 Hz) and a few.
+    let many = write(
+        &dir,
+        "many.csv",
+        &log_text("# sample_rate_hz: 1e9\n", 3000, 0.001),
+    );
+    let few = write(
+        &dir,
+        "few.csv",
+        &log_text("# sample_rate_hz: 1e9\n", 10, 0.001),
+    );
+    let good = write(&dir, "good.csv", &log_text("", 3000, 0.001));
+    let model = dir.join("m.json");
+    let sim = dir.join("sim.csv");
+    for log in [&many, &few] {
+        let name = Path::new(log).file_name().unwrap().to_str().unwrap();
+        let needle = format!("{name}: the sample_rate_hz metadata gives 1000000000 Hz");
+        refused(&gyro(&["noise", log]), 1, &needle);
+        refused(&gyro(&["calibrate", log, "-o", s(&model)]), 1, &needle);
+        refused(
+            &gyro(&["diagnose", "--train", log, "--holdout", &good]),
+            1,
+            &needle,
+        );
+        refused(
+            &gyro(&["simulate", "--motion-from", log, "-o", s(&sim)]),
+            1,
+            &needle,
+        );
+    }
+    refused(
+        &gyro(&["noise", &good, "--sample-rate-hz", "1e9"]),
+        1,
+        "the --sample-rate-hz option gives 1000000000 Hz but the time stamps say 1000",
+    );
+    // Bridging gaps of 1e7 s at 1 kHz: refused before a slot is made.
+    refused(
+        &gyro(&["noise", &good, "--max-gap-s", "1e7"]),
+        1,
+        "good.csv: bridging gaps of up to 10000000 s at 1000 Hz would hold 99999999",
+    );
+    // Epoch-microsecond stamps read as seconds: 2 000 000 s of motion at 1 kHz.
+    let mut epoch = String::from("time_s,rate_dps,reference_deg\n");
+    for i in 0..2000_u64 {
+        epoch.push_str(&format!("{},0.0,0.0\n", 1_700_000_000_000_000 + i * 1000));
+    }
+    let epoch = write(&dir, "epoch_us.csv", &epoch);
+    let out = gyro(&["simulate", "--motion-from", &epoch, "-o", s(&sim)]);
+    refused(&out, 1, "epoch_us.csv: cannot simulate its motion");
+    refused(
+        &out,
+        1,
+        "1999000 s at 1000 Hz would be 1999000001 samples (163.8 GiB)",
+    );
+    let out = gyro(&[
+        "simulate",
+        "--sample-rate-hz",
+        "1e6",
+        "--duration-s",
+        "86400",
+        "-o",
+        s(&sim),
+    ]);
+    refused(
+        &out,
+        1,
+        "86400 s at 1000000 Hz would be 86400000001 samples",
+    );
+    assert!(!sim.exists());
+    // A full disk on stdout: one line, status 1.
+    #[cfg(unix)]
+    if Path::new("/dev/full").exists() {
+        let full = || {
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open("/dev/full")
+                .unwrap()
+        };
+        for args in [
+            vec![
+                "calibrate",
+                s(&bench_log()),
+                "-o",
+                s(&model),
+                "--no-leave-one-out",
+            ],
+            vec!["simulate", "--list-effects"],
+            vec!["run", s(&bench_log()), "--format", "csv"],
+        ] {
+            let out = Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
+                .args(&args)
+                .stdout(full())
+                .output()
+                .unwrap();
+            refused(&out, 1, "cannot write to stdout: No space left on device");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Hangs: a 1e9 Hz grid under `run`, an emulator whose port nobody reads; each must end
+/// on its own well within the limit.
+#[test]
+fn nothing_waits_forever() {
+    let dir = temp_dir("hang");
+    let limit = Duration::from_secs(60);
+    for (name, rows) in [("few.csv", 10), ("many.csv", 3000)] {
+        let log = write(&dir, name, &log_text("", rows, 0.001));
+        let out = within(&["run", &log, "--sample-rate-hz", "1e9"], limit)
+            .unwrap_or_else(|| panic!("run on a 1e9 Hz grid ({name}) did not end"));
+        refused(&out, 1, "--sample-rate-hz option gives 1000000000 Hz");
+    }
+    #[cfg(unix)]
+    {
+        let started = Instant::now();
+        let out = within(
+            &[
+                "emulate",
+                "--create-pty",
+                "--duration-s",
+                "30",
+                "--write-timeout-s",
+                "1",
+            ],
+            limit,
+        )
+        .expect("emulate to a port nobody reads did not end");
+        refused(
+            &out,
+            1,
+            "the port took no byte for 1 s: is anything reading it?",
+        );
+        assert!(started.elapsed() < Duration::from_secs(20));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Wrong output: fits that cannot be made are untestable (not NaN), rates that overflow
+/// are refused, and numbers that make no sense are refused at parse time.
+#[test]
+fn no_nan_fits_no_inf_tables_no_empty_simulations() {
+    let dir = temp_dir("wrong");
+    let runs: Vec<String> = (1..=4)
+        .map(|seed| {
+            let path = dir.join(format!("short{seed}.csv"));
+            let seed = seed.to_string();
+            ok(&gyro(&[
+                "simulate",
+                "-o",
+                s(&path),
+                "--seed",
+                &seed,
+                "--duration-s",
+                "15",
+            ]));
+            s(&path).to_string()
+        })
+        .collect();
+    let diagnose = |format: &str| {
+        gyro(&[
+            "diagnose",
+            "--train",
+            &runs[0],
+            &runs[1],
+            "--holdout",
+            &runs[2],
+            &runs[3],
+            "--members",
+            "6",
+            "--candidate-members",
+            "3",
+            "--format",
+            format,
+        ])
+    };
+    let table = ok(&diagnose("table"));
+    assert!(!table.contains("NaN"), "{table}");
+    assert!(
+        table.contains(
+            "scale_factor       untestable: needs training runs whose motion determines it"
+        ),
+        "{table}"
+    );
+    let json: serde_json::Value = serde_json::from_str(&ok(&diagnose("json"))).unwrap();
+    for effect in json["effects"].as_array().unwrap() {
+        for (name, value) in effect["params"].as_object().unwrap() {
+            assert!(value.is_number(), "{}: {name} = {value}", effect["id"]);
+        }
+        for (name, bounds) in effect["ci95"].as_object().unwrap() {
+            let finite = bounds.as_array().unwrap().iter().all(|b| !b.is_null());
+            assert!(
+                finite || effect["id"] == "bandwidth",
+                "{}: {name}",
+                effect["id"]
+            );
+        }
+    }
+    let untestable: Vec<&str> = json["untestable"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|u| u["id"].as_str().unwrap())
+        .collect();
+    assert!(untestable.contains(&"scale_factor"), "{untestable:?}");
+
+    let mut huge = String::from("# sample_rate_hz: 1000\ntime_s,rate_dps\n");
+    for i in 0..3000 {
+        let sign = if i % 2 == 0 { "-" } else { "" };
+        huge.push_str(&format!("{:.3},{sign}1e300\n", i as f64 * 0.001));
+    }
+    let huge = write(&dir, "huge.csv", &huge);
+    refused(
+        &gyro(&["noise", &huge]),
+        1,
+        "huge.csv: rates up to 1e300 deg/s: too large",
+    );
+
+    let out_csv = dir.join("out.csv");
+    for (option, value) in [
+        ("--temperature-rise-c", "nan"),
+        ("--temperature-rise-c", "inf"),
+        ("--encoder-counts", "0"),
+        ("--duration-s", "-5"),
+        ("--sample-rate-hz", "0"),
+    ] {
+        let arg = format!("{option}={value}");
+        let out = gyro(&["simulate", "-o", s(&out_csv), &arg]);
+        refused(&out, 2, &format!("invalid value '{value}' for '{option}"));
+        assert!(!out_csv.exists(), "{arg}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Silent accepts: bad metadata, duplicate or missing named columns, a run given twice,
+/// numeric options out of range are errors; calibrate, diagnose and simulate --motion-from
+/// show the input report.
+#[test]
+fn nothing_bad_is_accepted_silently() {
+    let dir = temp_dir("silent");
+    for (name, metadata, line) in [
+        ("negative.csv", "# sample_rate_hz: -1000\n", 1),
+        ("zero.csv", "# sample_rate_hz: 0\n", 1),
+        ("nan.csv", "# sample_rate_hz: NaN\n", 1),
+        ("word.csv", "# sample_rate_hz: fast\n", 1),
+        ("unit.csv", "# sample_rate_hz: 1000 Hz\n", 1),
+        (
+            "twice.csv",
+            "# sample_rate_hz: 1000\n# sample_rate_hz: 500\n",
+            2,
+        ),
+    ] {
+        let log = write(&dir, name, &log_text(metadata, 100, 0.001));
+        for command in ["run", "noise"] {
+            refused(
+                &gyro(&[command, &log]),
+                1,
+                &format!("{name}:{line}: `sample_rate_hz"),
+            );
+        }
+    }
+    let dup = write(
+        &dir,
+        "dup.csv",
+        "time_s,rate_dps,rate_dps\n0.000,1,2\n0.001,1,2\n0.002,1,2\n",
+    );
+    refused(
+        &gyro(&["run", &dup]),
+        1,
+        "dup.csv:1: column `rate_dps` appears twice",
+    );
+    let good = write(&dir, "good.csv", &log_text("", 3000, 0.001));
+    refused(
+        &gyro(&["run", &good, "--reference-column", "ref_deg"]),
+        1,
+        "good.csv:1: no column `ref_deg` in the header",
+    );
+
+    // The same run twice, or in training and hold-out (also through a hard link).
+    let model = dir.join("m.json");
+    let bench = bench_log();
+    let bench = s(&bench);
+    let link = dir.join("link.csv");
+    std::fs::hard_link(bench, &link).unwrap();
+    refused(
+        &gyro(&["calibrate", bench, bench, "-o", s(&model)]),
+        1,
+        "is given twice among the training runs",
+    );
+    refused(
+        &gyro(&["calibrate", bench, "--holdout", s(&link), "-o", s(&model)]),
+        1,
+        "is given among the training runs and again among the hold-out runs",
+    );
+    refused(
+        &gyro(&["diagnose", "--train", bench, &good, "--holdout", s(&link)]),
+        1,
+        "is given among the training runs and again among the hold-out runs",
+    );
+    refused(&gyro(&["noise", &good, &good]), 1, "given twice");
+    assert!(!model.exists());
+
+    // Numbers out of range, refused at parse time with the option named.
+    for args in [
+        vec!["run", bench, "--max-gap-s=nan"],
+        vec!["run", bench, "--sample-rate-hz=-1000"],
+        vec!["run", bench, "--range-dps=inf"],
+        vec!["run", bench, "--target-deg=90", "--tolerance-deg=-1"],
+        vec!["run", bench, "--k-sigma=nan"],
+        vec!["noise", bench, "--margin-s=-1"],
+        vec!["noise", bench, "--per-decade=0"],
+        vec!["calibrate", bench, "-o", s(&model), "--tau-s=0"],
+        vec![
+            "diagnose",
+            "--train",
+            bench,
+            "--holdout",
+            bench,
+            "--split-s=inf",
+        ],
+        vec![
+            "diagnose",
+            "--train",
+            bench,
+            "--holdout",
+            bench,
+            "--members=1",
+        ],
+        vec!["record", "--port", "x", "-o", s(&model), "--duration=-1"],
+        vec!["emulate", "--create-pty", "--rate-hz=nan"],
+    ] {
+        let option = args.last().unwrap().split('=').next().unwrap();
+        refused(&gyro(&args), 2, &format!("for '{option}"));
+    }
+
+    // The input report of run, in calibrate (table and JSON), diagnose and simulate.
+    let table = ok(&gyro(&[
+        "calibrate",
+        bench,
+        "-o",
+        s(&model),
+        "--no-leave-one-out",
+    ]));
+    assert!(
+        table.contains(&format!(
+            "file: {bench}\ninput: 40000 rows -> 40000 samples at 1000 Hz (metadata)"
+        )),
+        "{table}"
+    );
+    let json: serde_json::Value = serde_json::from_str(&ok(&gyro(&[
+        "calibrate",
+        bench,
+        "-o",
+        s(&model),
+        "--no-leave-one-out",
+        "--format",
+        "json",
+    ])))
+    .unwrap();
+    assert_eq!(json["inputs"][0]["file"], bench);
+    assert_eq!(json["inputs"][0]["input"]["slots"], 40000);
+    let out = gyro(&[
+        "simulate",
+        "--motion-from",
+        bench,
+        "-o",
+        s(&dir.join("again.csv")),
+    ]);
+    ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("input: 40000 rows -> 40000 samples"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
