@@ -10,8 +10,9 @@ pub mod run;
 pub mod simulate;
 
 use anyhow::{Context, Result};
+use gyro_analysis::noise::{NoiseParams, YamlFormat};
 use gyro_log::{GridOptions, Log, LogOptions, RegularLog};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
@@ -49,6 +50,42 @@ fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata, _: &Path, _: &Path) -
 #[cfg(not(unix))]
 fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata, a: &Path, b: &Path) -> bool {
     matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+}
+
+/// `--noise-yaml FILE [--noise-yaml-format F]` of `noise` and `diagnose`: the gyro noise
+/// as the YAML a visual-inertial filter takes.
+#[derive(clap::Args)]
+pub struct NoiseYamlArgs {
+    /// Write the gyro noise as filter YAML to this file: continuous-time
+    /// gyroscope_noise_density (rad/s/√Hz), gyroscope_random_walk (rad/s²/√Hz) and
+    /// update_rate (Hz), with units and provenance in comments; gyroscope keys only.
+    #[arg(long, value_name = "FILE")]
+    pub noise_yaml: Option<PathBuf>,
+    /// Whose YAML --noise-yaml writes.
+    #[arg(long, value_enum, value_name = "FORMAT", default_value_t = YamlFormat::Kalibr)]
+    pub noise_yaml_format: YamlFormat,
+}
+
+impl NoiseYamlArgs {
+    /// Write `params` to `--noise-yaml` in the chosen format, saying so on stderr.
+    pub fn write(&self, out: &Path, params: &NoiseParams) -> Result<()> {
+        std::fs::write(out, params.to_yaml(self.noise_yaml_format))
+            .with_context(|| format!("cannot write {}", out.display()))?;
+        eprintln!(
+            "wrote {} ({}): gyroscope_noise_density {} rad/s/√Hz ({:.4} deg/√h), gyroscope_random_walk {} rad/s²/√Hz, update_rate {} Hz",
+            out.display(),
+            match self.noise_yaml_format {
+                YamlFormat::Kalibr => "Kalibr imu.yaml",
+                YamlFormat::OpenVins => "OpenVINS kalibr_imu_chain.yaml",
+                YamlFormat::Vins => "VINS-Fusion gyr_n, gyr_w",
+            },
+            gyro_analysis::noise::export::sci(params.noise_density_rad_s_rt_hz),
+            params.noise_density_rad_s_rt_hz.to_degrees() * 60.0,
+            gyro_analysis::noise::export::sci(params.random_walk_rad_s2_rt_hz),
+            params.update_rate_hz
+        );
+        Ok(())
+    }
 }
 
 /// Print a warning about the input on stderr.
