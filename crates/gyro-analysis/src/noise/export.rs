@@ -694,9 +694,7 @@ mod tests {
         assert!((p.noise_density_rad_s_rt_hz / noise_density_from_arw(0.3) - 1.0).abs() < 1e-12);
         // K² = (0.1398436 · 0.05)² + 0.01².
         let k = (0.139_843_6f64 * 0.05).hypot(0.01);
-        assert!(
-            (p.random_walk_rad_s2_rt_hz / random_walk_from_dps_per_rt_s(k) - 1.0).abs() < 1e-6
-        );
+        assert!((p.random_walk_rad_s2_rt_hz / random_walk_from_dps_per_rt_s(k) - 1.0).abs() < 1e-6);
         assert_eq!(p.update_rate_hz, 100.0);
         assert!(p.notes.iter().any(|n| n.contains("turn_on_bias")));
         assert!(p.notes.iter().any(|n| n == "model: prior"));
