@@ -62,7 +62,7 @@ pub struct NoiseYamlArgs {
     #[arg(long, value_name = "FILE")]
     pub noise_yaml: Option<PathBuf>,
     /// Whose YAML --noise-yaml writes.
-    #[arg(long, value_enum, value_name = "FORMAT", default_value_t = YamlFormat::Kalibr)]
+    #[arg(long, value_enum, value_name = "FORMAT", default_value_t = YamlFormat::Kalibr, requires = "noise_yaml")]
     pub noise_yaml_format: YamlFormat,
 }
 
