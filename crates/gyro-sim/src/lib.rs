@@ -18,8 +18,9 @@ mod motion;
 mod sensor;
 
 pub use effects::{
-    effect_info, Bound, CoreCorrection, Effect, EffectError, EffectInfo, FitProcedure, ParamRange,
-    ParamSpec, Reading, Regressor, WanderShape, EFFECTS, LOW_PASS_POLE_RATIO,
+    bias_instability_components, effect_info, Bound, CoreCorrection, Effect, EffectError,
+    EffectInfo, FitProcedure, ParamRange, ParamSpec, Reading, Regressor, WanderShape, EFFECTS,
+    LOW_PASS_POLE_RATIO,
 };
 pub use motion::{BenchProfile, Motion, Rotation};
 pub use sensor::{

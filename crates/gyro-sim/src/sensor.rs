@@ -308,19 +308,13 @@ pub fn simulate_series(
         .dropouts
         .map(|(rate_per_s, mean_samples)| (rate_per_s / fs, 1.0 - 1.0 / mean_samples));
     // Six processes, τ from 1 s to 1000 s (half-decade steps): a flat floor.
-    let flicker_count = 6;
     let mut flicker: Vec<GaussMarkovProcess> = terms
         .flicker_sigma_dps
         .map(|sigma_dps| {
-            (0..flicker_count)
-                .map(|i| {
-                    let tau_s = 10f64.powf(i as f64 * 0.6);
-                    GaussMarkovProcess::new(
-                        sigma_dps / (flicker_count as f64).sqrt(),
-                        tau_s,
-                        dt,
-                        &mut flicker_rng,
-                    )
+            crate::bias_instability_components(sigma_dps)
+                .iter()
+                .map(|&(sigma_i, tau_s)| {
+                    GaussMarkovProcess::new(sigma_i, tau_s, dt, &mut flicker_rng)
                 })
                 .collect()
         })

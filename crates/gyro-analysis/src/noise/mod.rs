@@ -21,6 +21,8 @@
 //! - [`psd`]: Welch PSD (Hann, 50% overlap, one-sided) and the white density.
 //! - [`rest`]: rest stretches found by the gyro-core motion detector (`--static-only`).
 //! - [`characterize_logs`]: several logs, each and pooled.
+//! - [`export`]: the fitted noise as the YAML of Kalibr, OpenVINS and VINS-Fusion
+//!   ([`NoiseParams`]; also the effective values of a diagnosis's model).
 //!
 //! The table, the JSON and the PSD CSV are rendered by `gyro_report::noise`.
 //!
@@ -30,6 +32,7 @@
 
 pub mod allan;
 mod chi2;
+pub mod export;
 mod fft;
 pub mod fit;
 mod logs;
@@ -38,6 +41,7 @@ pub mod rest;
 
 pub use allan::{AllanDeviation, AllanPoint, NoiseType, TauGrid, ONE_SIGMA};
 pub use chi2::chi2_quantile;
+pub use export::{ExportError, NoiseParams, YamlFormat};
 pub use fit::{fit, AllanFloor, FitOptions, FitTerm, GaussMarkovFit, NoiseFit};
 pub use logs::{characterize_logs, NoiseLog, NoiseLogsError, NoiseRun};
 pub use psd::{welch, Psd, PsdBand, PsdOptions};
@@ -173,18 +177,16 @@ pub fn rate_step(values: &[f64]) -> Option<f64> {
 }
 
 /// The simulator's `bias_instability` σ (deg/s) whose Allan floor matches a bias
-/// instability `b_dps`: that effect is six Gauss-Markov processes of equal variance with
-/// T = 10^{0.6 i} s, i = 0..5; its Allan deviation's minimum over 1–1000 s, per unit σ,
-/// is computed from the Gauss-Markov formula.
+/// instability `b_dps`: that effect is six Gauss-Markov processes of equal variance
+/// ([`gyro_sim::bias_instability_components`]); its Allan deviation's minimum over
+/// 1–1000 s, per unit σ, is computed from the Gauss-Markov formula.
 pub fn bias_instability_effect_sigma(b_dps: f64) -> f64 {
     let per_unit = (0..=60)
         .map(|k| 10f64.powf(f64::from(k) / 20.0))
         .map(|tau| {
-            (0..6)
-                .map(|i| {
-                    let t = 10f64.powf(f64::from(i) * 0.6);
-                    fit::gauss_markov_avar_continuous(tau, (1.0 / 6.0f64).sqrt(), t)
-                })
+            gyro_sim::bias_instability_components(1.0)
+                .iter()
+                .map(|&(sigma, t)| fit::gauss_markov_avar_continuous(tau, sigma, t))
                 .sum::<f64>()
                 .sqrt()
         })

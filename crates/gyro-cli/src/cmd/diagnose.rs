@@ -64,6 +64,8 @@ pub struct Args {
     #[arg(long, requires = "self_test")]
     only: Option<String>,
     #[command(flatten)]
+    noise_yaml: super::NoiseYamlArgs,
+    #[command(flatten)]
     grid: log::GridOptions,
     #[command(flatten)]
     input: log::LogOptions,
@@ -160,6 +162,13 @@ pub fn run(args: &Args) -> Result<()> {
         let inputs = args.train.iter().chain(&args.holdout).map(PathBuf::as_path);
         super::refuse_to_overwrite(out, inputs.chain(args.model.as_deref()))?;
     }
+    if let Some(out) = &args.noise_yaml.noise_yaml {
+        if args.self_test {
+            bail!("--noise-yaml writes the noise of diagnosed logs, not of --self-test");
+        }
+        let inputs = args.train.iter().chain(&args.holdout).map(PathBuf::as_path);
+        super::refuse_to_overwrite(out, inputs.chain(args.model.as_deref()))?;
+    }
     if args.self_test {
         return self_test(args);
     }
@@ -195,6 +204,9 @@ pub fn run(args: &Args) -> Result<()> {
     super::to_stdout(|out| out.write_all(text.as_bytes()))?;
     if let Some(dir) = &args.report {
         write_report(dir, &result, &train, &holdout, &options)?;
+    }
+    if let Some(out) = &args.noise_yaml.noise_yaml {
+        write_noise_yaml(out, args, &result)?;
     }
     if let Some(out) = &args.out {
         let file = result
@@ -254,6 +266,31 @@ fn self_test(args: &Args) -> Result<()> {
     };
     super::to_stdout(|out| out.write_all(text.as_bytes()))?;
     Ok(())
+}
+
+/// `--noise-yaml`: the effective noise of the selected sensor model on these runs.
+fn write_noise_yaml(out: &Path, args: &Args, result: &Diagnosis) -> Result<()> {
+    let names = |paths: &[PathBuf]| {
+        paths
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let source = format!(
+        "effective values on moving data: the sensor model gyro-cli diagnose selected (training: {}; held out: {}{})",
+        names(&args.train),
+        names(&args.holdout),
+        args.split_s
+            .map_or(String::new(), |s| format!("; in windows of {s} s"))
+    );
+    let params = gyro_analysis::noise::NoiseParams::effective(
+        &result.selected_sensor,
+        &result.model.effects,
+        &result.model.notes,
+        source,
+    )?;
+    args.noise_yaml.write(out, &params)
 }
 
 /// `e` with what to pass on the command line to get past it, where there is advice.

@@ -10,6 +10,7 @@ pub mod run;
 pub mod simulate;
 
 use anyhow::{Context, Result};
+use gyro_analysis::noise::{NoiseParams, YamlFormat};
 use gyro_log::{GridOptions, Log, LogOptions, RegularLog};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -90,6 +91,42 @@ pub fn to_stdout(write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> R
     write(&mut out)
         .and_then(|()| out.flush())
         .context("cannot write to stdout")
+}
+
+/// `--noise-yaml FILE [--noise-yaml-format F]` of `noise` and `diagnose`: the gyro noise
+/// as the YAML a visual-inertial filter takes.
+#[derive(clap::Args)]
+pub struct NoiseYamlArgs {
+    /// Write the gyro noise as filter YAML to this file: continuous-time
+    /// gyroscope_noise_density (rad/s/√Hz), gyroscope_random_walk (rad/s²/√Hz) and
+    /// update_rate (Hz), with units and provenance in comments; gyroscope keys only.
+    #[arg(long, value_name = "FILE")]
+    pub noise_yaml: Option<PathBuf>,
+    /// Whose YAML --noise-yaml writes.
+    #[arg(long, value_enum, value_name = "FORMAT", default_value_t = YamlFormat::Kalibr, requires = "noise_yaml")]
+    pub noise_yaml_format: YamlFormat,
+}
+
+impl NoiseYamlArgs {
+    /// Write `params` to `--noise-yaml` in the chosen format, saying so on stderr.
+    pub fn write(&self, out: &Path, params: &NoiseParams) -> Result<()> {
+        std::fs::write(out, params.to_yaml(self.noise_yaml_format))
+            .with_context(|| format!("cannot write {}", out.display()))?;
+        eprintln!(
+            "wrote {} ({}): gyroscope_noise_density {} rad/s/√Hz ({:.4} deg/√h), gyroscope_random_walk {} rad/s²/√Hz, update_rate {} Hz",
+            out.display(),
+            match self.noise_yaml_format {
+                YamlFormat::Kalibr => "Kalibr imu.yaml",
+                YamlFormat::OpenVins => "OpenVINS kalibr_imu_chain.yaml",
+                YamlFormat::Vins => "VINS-Fusion gyr_n, gyr_w",
+            },
+            gyro_analysis::noise::export::sci(params.noise_density_rad_s_rt_hz),
+            params.noise_density_rad_s_rt_hz.to_degrees() * 60.0,
+            gyro_analysis::noise::export::sci(params.random_walk_rad_s2_rt_hz),
+            params.update_rate_hz
+        );
+        Ok(())
+    }
 }
 
 /// Print a warning about the input on stderr.

@@ -75,6 +75,8 @@ pub struct Args {
     #[arg(long, value_parser = gyro_report::plot::parse_plot_path)]
     plot: Option<PathBuf>,
     #[command(flatten)]
+    noise_yaml: super::NoiseYamlArgs,
+    #[command(flatten)]
     grid: log::GridOptions,
     #[command(flatten)]
     input: log::LogOptions,
@@ -113,7 +115,10 @@ fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<NoiseLog
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    for out in [&args.model_out, &args.psd_out].into_iter().flatten() {
+    for out in [&args.model_out, &args.psd_out, &args.noise_yaml.noise_yaml]
+        .into_iter()
+        .flatten()
+    {
         let inputs = args.logs.iter().map(PathBuf::as_path);
         super::refuse_to_overwrite(out, inputs.chain(args.model.as_deref()))?;
     }
@@ -186,6 +191,27 @@ pub fn run(args: &Args) -> Result<()> {
             s.gm_tau_s,
             s.lsb_dps
         );
+    }
+
+    if let Some(out) = &args.noise_yaml.noise_yaml {
+        let Some(fitted) = run.single() else {
+            bail!("--noise-yaml needs one log, or logs of one sample rate to pool")
+        };
+        let files: Vec<&str> = loaded.iter().map(|l| l.file.as_str()).collect();
+        let source = format!(
+            "static Allan deviation (gyro-cli noise) of {}{}",
+            match files.as_slice() {
+                [one] => one.to_string(),
+                all => format!("{} logs pooled: {}", all.len(), all.join(", ")),
+            },
+            if args.static_only {
+                ", rest stretches only (--static-only)"
+            } else {
+                ""
+            }
+        );
+        let params = noise::NoiseParams::from_allan(fitted, source)?;
+        args.noise_yaml.write(out, &params)?;
     }
 
     if let Some(out) = &args.psd_out {

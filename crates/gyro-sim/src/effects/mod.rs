@@ -166,6 +166,14 @@ effect_enum! {
 /// of f_c; it delays slow motion by 2/(2π · ratio · f_c).
 pub const LOW_PASS_POLE_RATIO: f64 = 1.5538;
 
+/// The `bias_instability` effect of standard deviation `sigma_dps` as the sum of its six
+/// first-order Gauss-Markov processes: `(σ_i, τ_i)` with τ_i = 10^(0.6 i) s, i = 0..5
+/// (1 s to 1000 s), each σ_i = σ/√6, so that the variances add up to σ².
+pub fn bias_instability_components(sigma_dps: f64) -> [(f64, f64); 6] {
+    let each = sigma_dps / 6f64.sqrt();
+    core::array::from_fn(|i| (each, 10f64.powf(0.6 * i as f64)))
+}
+
 /// Static description of an effect kind: everything the simulator, the diagnosis, the
 /// self-test and the command line know about it.
 #[derive(Clone, Copy, Debug)]
