@@ -67,35 +67,75 @@ pub fn corrected_model(base: &ModelFile, effects: &[Effect]) -> (ModelFile, Vec<
 /// Significance of a correction's held-out improvement (bootstrap over runs).
 pub const CORRECTION_P: f64 = 0.05;
 
-/// Stage 5: the corrections of the selected effects that lower the held-out angle
-/// error, each on top of those accepted before it (in selection order): paired over the
-/// held-out runs, the total max abs error must fall with bootstrap P <
-/// [`CORRECTION_P`]. The others are named, not corrected. Returns the summary (when any
-/// selected effect is correctable) and the model to write (when a correction is kept).
+/// Id of the bias correction in [`CompensationSummary`]: the nominal model's bias.
+pub const BIAS_ID: &str = "bias";
+
+/// A correction to try.
+#[derive(Clone, Copy)]
+enum Try {
+    /// The nominal model's bias (deg/s), as the starting bias of the rest detector and the
+    /// Kalman filter's bias mean: what the pipeline uses until a rest says otherwise.
+    Bias(f64),
+    /// A selected correctable effect.
+    Effect(Effect),
+}
+
+/// `base` with the corrections of `tries`, and the ids corrected.
+fn with_tries(base: &ModelFile, tries: &[Try]) -> (ModelFile, Vec<&'static str>) {
+    let effects: Vec<Effect> = tries
+        .iter()
+        .filter_map(|t| match t {
+            Try::Effect(e) => Some(*e),
+            Try::Bias(_) => None,
+        })
+        .collect();
+    let (mut model, mut ids) = corrected_model(base, &effects);
+    for t in tries {
+        if let Try::Bias(b) = t {
+            model.config.motion.initial_bias_dps += *b as f32;
+            model.config.kalman.bias_mean_dps += *b as f32;
+            ids.insert(0, BIAS_ID);
+        }
+    }
+    (model, ids)
+}
+
+/// Stage 5: the corrections that lower the held-out angle error, each on top of those
+/// kept before it: first the nominal model's bias (`bias_dps`, fitted on the training
+/// runs; skipped when zero), then the selected correctable effects in selection order.
+/// Paired over the held-out runs, the total max abs error must fall with bootstrap P <
+/// [`CORRECTION_P`]; the others are named, not corrected. Returns the summary (when there
+/// is anything to try) and the model to write (when a correction is kept).
 pub(crate) fn compensate(
     holdout: &[RealRun],
     options: &super::Options,
+    bias_dps: f64,
     selected: &[Effect],
     progress: &dyn super::Progress,
 ) -> (Option<CompensationSummary>, Option<ModelFile>) {
     let base = &options.base_model;
-    let correctable: Vec<Effect> = selected
-        .iter()
-        .filter(|e| !matches!(e.info().correction, CoreCorrection::None))
-        .copied()
-        .collect();
-    if correctable.is_empty() {
+    let mut tries: Vec<Try> = Vec::new();
+    if bias_dps.is_finite() && bias_dps != 0.0 {
+        tries.push(Try::Bias(bias_dps));
+    }
+    tries.extend(
+        selected
+            .iter()
+            .filter(|e| !matches!(e.info().correction, CoreCorrection::None))
+            .map(|e| Try::Effect(*e)),
+    );
+    if tries.is_empty() {
         return (None, None);
     }
     progress.stage("compensated replays of held-out runs", 0);
     let before = max_abs_errors(holdout, base);
-    let mut kept: Vec<Effect> = Vec::new();
+    let mut kept: Vec<Try> = Vec::new();
     let mut current = before.clone();
     let mut not_corrected = Vec::new();
-    for (k, effect) in correctable.iter().enumerate() {
+    for (k, t) in tries.iter().enumerate() {
         let mut trial = kept.clone();
-        trial.push(*effect);
-        let (model, _) = corrected_model(base, &trial);
+        trial.push(*t);
+        let (model, _) = with_tries(base, &trial);
         let after = max_abs_errors(holdout, &model);
         let paired: Vec<f64> = current
             .iter()
@@ -110,7 +150,10 @@ pub(crate) fn compensate(
             current = after;
         } else {
             not_corrected.push(NotCorrected {
-                id: effect.id(),
+                id: match t {
+                    Try::Bias(_) => BIAS_ID,
+                    Try::Effect(e) => e.id(),
+                },
                 median_max_abs_error_without_deg: median(&current),
                 median_max_abs_error_with_deg: median(&after),
                 runs_better: paired.iter().filter(|d| **d > 0.0).count(),
@@ -119,7 +162,7 @@ pub(crate) fn compensate(
             });
         }
     }
-    let (corrected, ids) = corrected_model(base, &kept);
+    let (corrected, ids) = with_tries(base, &kept);
     let runs = holdout
         .iter()
         .zip(before.iter().zip(&current))

@@ -43,6 +43,7 @@ pub mod selftest;
 pub(crate) mod stats;
 mod summarise;
 
+pub use compensate::BIAS_ID;
 pub use diagnosis::{
     CompensationRun, CompensationSummary, Diagnosis, EffectResult, GapSummary, InputEntry,
     ModelSummary, NotCorrected, RunSummary, UntestableEntry, Verdict, Where,
@@ -216,8 +217,18 @@ pub fn diagnose(
     let selected_sensor = fit::model_with(&base.nominal, &selected_effects, base.white_target);
 
     // 5. Compensate the correctable effects.
-    let (compensation, corrected_model) =
-        compensate::compensate(holdout, options, &selected_effects, progress);
+    let (compensation, corrected_model) = compensate::compensate(
+        holdout,
+        options,
+        // The nominal model's bias is fitted on the training runs unless it was given.
+        if options.fixed_model {
+            0.0
+        } else {
+            base.nominal.bias_dps
+        },
+        &selected_effects,
+        progress,
+    );
 
     // 6. Summarise.
     let train_after = summarise::train_after(

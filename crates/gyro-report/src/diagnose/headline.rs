@@ -153,9 +153,23 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
                 .iter()
                 .filter(|r| r.max_abs_error_after_deg < r.max_abs_error_before_deg)
                 .count();
+            let ids: Vec<String> = c
+                .corrected
+                .iter()
+                .map(|id| {
+                    if *id == gyro_analysis::diagnose::BIAS_ID {
+                        format!(
+                            "the bias ({:.3} deg/s, fitted on the training runs)",
+                            d.model.sensor.bias_dps
+                        )
+                    } else {
+                        id.to_string()
+                    }
+                })
+                .collect();
             lines.push(format!(
                 "the written model corrects {}: held-out median max |angle error| {before:.2} -> {after:.2} deg, better on {better} of {} runs",
-                c.corrected.join(", "),
+                ids.join(", "),
                 c.runs.len()
             ));
         }

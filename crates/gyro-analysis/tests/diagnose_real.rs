@@ -1,0 +1,80 @@
+//! `diagnose` on a real sensor (the ssong yaw recordings, ../shared/data/real beside the
+//! workspace, when present): trained on the slow trial, held out on the medium one (another
+//! speed). The gyro lags its encoder by about 12 ms (the plain estimate of
+//! `scripts/ssong_plain.py`: 12.0 ms slow, 12.1 ms medium); a two-pole bandwidth fitted to
+//! the same signature puts the cross-correlation peak at more than twice that, so it must
+//! fail its posterior check and the latency be named; and the written model must not make
+//! the held-out angles worse. A few 50 s windows and small ensembles keep it quick; the
+//! README's figures come from the full recordings.
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+use gyro_analysis::diagnose::{diagnose, split, Options, RealRun, Silent};
+use gyro_log::{load, GridOptions, LogOptions};
+use std::path::PathBuf;
+
+fn windows(file: &str, take: usize) -> Option<Vec<RealRun>> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/real")
+        .join(file);
+    if !path.exists() {
+        eprintln!("skipped: {} not present", path.display());
+        return None;
+    }
+    let log = load(
+        &path,
+        &LogOptions::default(),
+        &GridOptions::default(),
+        &mut |_| {},
+    )
+    .unwrap();
+    Some(
+        split(&log, 50.0)
+            .into_iter()
+            .take(take)
+            .enumerate()
+            .map(|(i, w)| RealRun::prepare(format!("{file}#{}", i + 1), w).unwrap())
+            .collect(),
+    )
+}
+
+#[test]
+fn latency_is_named_on_real_yaw_and_its_correction_does_not_hurt() {
+    let (Some(train), Some(holdout)) = (
+        windows("ssong_z_slow.csv", 4),
+        windows("ssong_z_medium.csv", 4),
+    ) else {
+        return;
+    };
+    let options = Options {
+        members: 8,
+        candidate_members: 4,
+        bootstrap: 300,
+        ..Options::default()
+    };
+    let d = diagnose(&train, &holdout, &options, &Silent).unwrap();
+    let named: Vec<&str> = d.verdict.unmodelled.clone();
+    assert!(named.contains(&"latency"), "named {named:?}");
+    assert!(!named.contains(&"bandwidth"), "named {named:?}");
+    let latency = d.effects.iter().find(|e| e.id == "latency").unwrap();
+    let delay_ms = latency.params["delay_s"] * 1e3;
+    assert!((9.0..15.0).contains(&delay_ms), "{delay_ms} ms");
+    let check = latency.posterior_check.as_ref().unwrap();
+    assert!(check.passes && !check.statistics.is_empty(), "{check:?}");
+    if let Some(bw) = d.effects.iter().find(|e| e.id == "bandwidth") {
+        if let Some(c) = &bw.posterior_check {
+            assert!(c.statistics.is_empty() || !c.passes || !bw.significant);
+        }
+    }
+    // What is written lowers the held-out error; what would not is named, not corrected.
+    let c = d.compensation.as_ref().unwrap();
+    let total = |f: &dyn Fn(&gyro_analysis::diagnose::CompensationRun) -> f64| -> f64 {
+        c.runs.iter().map(f).sum()
+    };
+    let before = total(&|r| r.max_abs_error_before_deg);
+    let after = total(&|r| r.max_abs_error_after_deg);
+    assert!(after <= before, "{before} -> {after}");
+    assert!(c.corrected.contains(&"latency"), "{:?}", c.corrected);
+    for n in &c.not_corrected {
+        assert!(!c.corrected.contains(&n.id));
+    }
+}

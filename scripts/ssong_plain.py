@@ -1,0 +1,43 @@
+#!/usr/bin/env python3
+"""The plain analyst's estimate on the ssong recordings, to set beside `gyro-cli diagnose`.
+
+For each recording: drop duplicate stamps, interpolate gyro and encoder onto a 1 ms grid,
+low-pass both with the same zero-phase 4th-order 5 Hz Butterworth (so no lag is added),
+differentiate the encoder angle, then
+- lag: the shift of the gyro (1 ms steps, refined by a parabola) that minimises the
+  residual of the least-squares fit gyro = (1 + k) * encoder_rate + b;
+- k: the gyro's scale against the encoder at that lag (the encoder itself reads
+  351/360 of the shaft angle, see the data README);
+- b: the bias (deg/s).
+Usage: scripts/ssong_plain.py [DATA_DIR]   (needs numpy, pandas, scipy)
+"""
+import sys
+import numpy as np
+import pandas as pd
+from scipy.signal import butter, sosfiltfilt
+
+root = sys.argv[1] if len(sys.argv) > 1 else "../shared/data/real"
+sos = butter(4, 5.0, fs=1000.0, output="sos")
+print("recording            lag_ms   k_vs_encoder   bias_dps")
+for axis in "xyz":
+    for speed in ("slow", "medium"):
+        d = pd.read_csv(f"{root}/ssong_{axis}_{speed}.csv", comment="#").drop_duplicates("time_s")
+        t, g, ref = d.time_s.values, d.rate_dps.values, d.reference_deg.values
+        grid = np.arange(t[0], t[-1], 0.001)
+        gyro = sosfiltfilt(sos, np.interp(grid, t, g))
+        enc = sosfiltfilt(sos, np.gradient(np.interp(grid, t, ref), 0.001))
+        n, m = len(grid), 2000
+        def fit(lag):
+            a, b = gyro[m + lag:n - m + lag], enc[m:n - m]
+            design = np.c_[b, np.ones_like(b)]
+            c = np.linalg.lstsq(design, a, rcond=None)[0]
+            return np.sum((a - design @ c) ** 2), c
+        lags = range(-10, 40)
+        res = [fit(lag)[0] for lag in lags]
+        i = int(np.argmin(res))
+        best = lags[i]
+        if 0 < i < len(res) - 1:  # parabola through the minimum and its neighbours
+            y0, y1, y2 = res[i - 1], res[i], res[i + 1]
+            best = lags[i] + 0.5 * (y0 - y2) / (y0 - 2 * y1 + y2)
+        _, (scale, bias) = fit(lags[i])
+        print(f"ssong_{axis}_{speed:<8} {best:8.2f}   {100 * (scale - 1):+8.2f} %   {bias:+8.3f}")
