@@ -41,8 +41,8 @@ pub const REGRESSORS: [&str; 8] = [
 ];
 /// Index of each regressor.
 pub mod reg {
-    /// Intercept (deg/s).
-    pub const INTERCEPT: usize = 0;
+    /// Intercept (deg/s) is regressor 0; a run's bias is read from its mean residual
+    /// ([`super::Features::mean_residual_dps`]), which the odd rate terms do not trade with.
     /// ω (1).
     pub const RATE: usize = 1;
     /// |ω| (1).
@@ -86,6 +86,11 @@ pub struct Features {
     /// Mean of the smoothed-gyro residual's first differences squared / 2 on static
     /// samples ((deg/s)²) and how many differences (white-noise level).
     pub static_diff_var: (f64, usize),
+    /// Mean residual (gyro − reference rate, deg/s) over the static samples when there
+    /// are at least 2 s of them, else over every sample with a residual: the plain bias
+    /// estimate (odd rate-dependent errors average out over back-and-forth motion). NaN
+    /// when no sample has a residual.
+    pub mean_residual_dps: f64,
 }
 
 /// The features of `r`; `plateau_tol_dps` is the tolerance of the clip plateau (e.g. an
@@ -242,6 +247,29 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
         plateau_samples,
         temperature_varies,
         static_diff_var,
+        mean_residual_dps: mean_residual(r),
+    }
+}
+
+/// See [`Features::mean_residual_dps`].
+fn mean_residual(r: &Residuals) -> f64 {
+    let mean = |only_static: bool| -> (f64, usize) {
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (v, st) in r.residual_dps.iter().zip(&r.is_static) {
+            if v.is_finite() && (*st || !only_static) {
+                sum += v;
+                count += 1;
+            }
+        }
+        (sum / count.max(1) as f64, count)
+    };
+    let (m, n) = mean(true);
+    if n as f64 >= 2.0 * r.sample_rate_hz {
+        return m;
+    }
+    match mean(false) {
+        (m, n) if n > 0 => m,
+        _ => f64::NAN,
     }
 }
 

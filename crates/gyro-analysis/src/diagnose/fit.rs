@@ -90,14 +90,15 @@ pub fn direct_evidence(
     }
 }
 
-/// The between-run spread of the bias (the regression intercept) of `runs` against
+/// The between-run spread of the bias (each run's mean residual,
+/// [`super::features::Features::mean_residual_dps`]) of `runs` against
 /// their null ensembles: `(n−1) s²/v0` is χ²(n−1) without a turn-on bias (s²: the runs'
 /// sample variance, v0: the mean of the replicas'). Returns (its Wilson–Hilferty
 /// z-score, s², v0, n−1).
 fn bias_spread(runs: &[&RealRun], null: &[Vec<Member>]) -> (f64, f64, f64, f64) {
     let real: Vec<f64> = runs
         .iter()
-        .map(|r| r.features.coef[reg::INTERCEPT])
+        .map(|r| r.features.mean_residual_dps)
         .collect();
     let s2 = sample_var(&real);
     let members = null.iter().map(Vec::len).min().unwrap_or(0);
@@ -105,7 +106,7 @@ fn bias_spread(runs: &[&RealRun], null: &[Vec<Member>]) -> (f64, f64, f64, f64) 
         .map(|j| {
             let v: Vec<f64> = null
                 .iter()
-                .map(|m| m[j].features.coef[reg::INTERCEPT])
+                .map(|m| m[j].features.mean_residual_dps)
                 .collect();
             sample_var(&v)
         })
@@ -152,15 +153,15 @@ pub fn nominal_model(
     if let Some(run) = train.first() {
         model.sample_rate_hz = run.sample_rate_hz;
     }
-    let intercepts: Vec<f64> = train
+    let means: Vec<f64> = train
         .iter()
-        .map(|r| r.features.coef[reg::INTERCEPT])
+        .map(|r| r.features.mean_residual_dps)
         .filter(|c| c.is_finite())
         .collect();
-    if !intercepts.is_empty() {
-        model.bias_dps = intercepts.iter().sum::<f64>() / intercepts.len() as f64;
+    if !means.is_empty() {
+        model.bias_dps = means.iter().sum::<f64>() / means.len() as f64;
         notes.push(format!(
-            "bias {:.4} deg/s: mean regression intercept of the training runs",
+            "bias {:.4} deg/s: mean residual (gyro - reference rate) of the training runs, on static samples where a run has 2 s of them, on all samples otherwise",
             model.bias_dps
         ));
     }
