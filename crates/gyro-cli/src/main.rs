@@ -1,5 +1,22 @@
 //! `gyro-cli`: rotation angle from a single-axis gyro; replay, simulate, calibrate, diagnose.
 
+/// `eprintln!` that ignores a stderr that cannot be written (`2>/dev/full`, a closed
+/// descriptor): a message that cannot be shown must not turn into a panic (exit 101).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr().lock(), $($arg)*);
+    }};
+}
+
+/// `eprint!` that ignores a stderr that cannot be written, as `say!`.
+macro_rules! say_part {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stderr().lock(), $($arg)*);
+    }};
+}
+
 mod cmd;
 
 use clap::{Parser, Subcommand};
@@ -59,7 +76,7 @@ fn main() -> ExitCode {
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             let hint = flag_hint(&e).unwrap_or_default();
-            eprintln!("error: {}{hint}", one_line(&format!("{e:#}")));
+            say!("error: {}{hint}", one_line(&format!("{e:#}")));
             ExitCode::FAILURE
         }
     }

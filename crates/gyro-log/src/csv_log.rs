@@ -324,8 +324,8 @@ impl CsvRows {
             find(name).ok_or_else(|| LogError::MissingColumn {
                 path: path.to_path_buf(),
                 line: header_line,
-                column: name.to_string(),
-                available: names.join(", "),
+                column: excerpt(name.as_bytes()),
+                available: column_list(&names),
             })
         };
         let time = required(&columns.time_column)?;
@@ -439,9 +439,30 @@ impl CsvRows {
     }
 }
 
+/// The header's columns as an error lists them: the first few, each as [`excerpt`]
+/// shows it, then how many there are.
+fn column_list(names: &[String]) -> String {
+    const LISTED: usize = 6;
+    let mut list = names
+        .iter()
+        .take(LISTED)
+        .map(|n| excerpt(n.as_bytes()))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if names.len() > LISTED {
+        list.push_str(&format!(", … ({} columns)", names.len()));
+    }
+    list
+}
+
 /// A field as an error shows it: at most 40 characters (a longer one cut, with its length),
 /// control characters escaped, so that a corrupt line cannot flood the terminal.
-pub(crate) fn excerpt(raw: &[u8]) -> String {
+///
+/// ```
+/// assert_eq!(gyro_log::excerpt(b"a\0b"), "a\\u{0}b");
+/// assert!(gyro_log::excerpt("x".repeat(100).as_bytes()).ends_with("… (100 characters)"));
+/// ```
+pub fn excerpt(raw: &[u8]) -> String {
     const SHOWN: usize = 40;
     let text = String::from_utf8_lossy(raw);
     let chars = text.chars().count();

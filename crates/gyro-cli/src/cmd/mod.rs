@@ -94,7 +94,7 @@ pub fn to_stdout(write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> R
 
 /// Print a warning about the input on stderr.
 pub fn warn(warning: &str) {
-    eprintln!("warning: {warning}");
+    say!("warning: {warning}");
 }
 
 /// Read a log, warnings printed ([`gyro_log::read_log_with_warnings`]).
