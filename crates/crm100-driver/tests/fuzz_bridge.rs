@@ -14,8 +14,8 @@ use proptest::test_runner::RngSeed;
 use std::io;
 use std::path::Path;
 
-/// Cases per property; the four properties together run in well under a second.
-const CASES: u32 = 512;
+/// Cases per property.
+const CASES: u32 = 2048;
 
 /// A bridge stream of the first `frames` rate words of `fixtures/firmware/bench_run_20s.i16be`
 /// (big-endian i16 words, as the firmware reads them), one frame per millisecond.

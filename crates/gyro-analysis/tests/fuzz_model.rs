@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// Cases of the mutation property (the random-bytes one runs a quarter as many).
-const CASES: u32 = 1000;
+const CASES: u32 = 3000;
 
 /// Longest error message accepted beyond the path (see `gyro-log`'s fuzz tests).
 const MAX_ERROR_CHARS: usize = 400;

@@ -93,22 +93,28 @@ fn is_broken_pipe(error: &anyhow::Error) -> bool {
 
 /// The option that settles a library error, named as this command line spells it (the
 /// libraries name no flags), to append to its message.
-fn flag_hint(error: &anyhow::Error) -> Option<&'static str> {
+fn flag_hint(error: &anyhow::Error) -> Option<String> {
     use gyro_log::LogError;
-    error
+    let error = error
         .chain()
-        .find_map(|cause| cause.downcast_ref::<LogError>())
-        .and_then(|e| match e {
-            LogError::SampleRateInvalid { .. } => Some(" (--sample-rate-hz)"),
-            LogError::SampleRateUnknown { .. } => Some(" with --sample-rate-hz"),
-            LogError::SampleRateDisagrees { .. } => {
-                Some(" (fix --sample-rate-hz or the metadata, or leave it out)")
-            }
-            LogError::Gap { .. } | LogError::MaxGapInvalid { .. } => Some(" (--max-gap-s)"),
-            LogError::McapSecondRate { .. } => Some(" with --topic"),
-            LogError::McapZeroStamp { .. } => Some(": --time-source log-time"),
-            _ => None,
-        })
+        .find_map(|cause| cause.downcast_ref::<LogError>())?;
+    if let LogError::NotApplicable { setting, .. } = error {
+        // The settings are the options' field names: `reference_column` is given as
+        // --reference-column.
+        return Some(format!(" (--{})", setting.replace('_', "-")));
+    }
+    match error {
+        LogError::SampleRateInvalid { .. } => Some(" (--sample-rate-hz)"),
+        LogError::SampleRateUnknown { .. } => Some(" with --sample-rate-hz"),
+        LogError::SampleRateDisagrees { .. } => {
+            Some(" (fix --sample-rate-hz or the metadata, or leave it out)")
+        }
+        LogError::Gap { .. } | LogError::MaxGapInvalid { .. } => Some(" (--max-gap-s)"),
+        LogError::McapSecondRate { .. } => Some(" with --topic"),
+        LogError::McapZeroStamp { .. } => Some(": --time-source log-time"),
+        _ => None,
+    }
+    .map(str::to_string)
 }
 
 /// An error message on one line (a cause that spans lines is joined with "; ").

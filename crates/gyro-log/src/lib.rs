@@ -100,13 +100,61 @@ pub struct LogOptions {
     pub mcap: McapOptions,
 }
 
+impl LogOptions {
+    /// The format of `path` ([`LogFormat::detect`]), refusing a setting given for the
+    /// other format ([`LogError::NotApplicable`]): it would be ignored.
+    pub fn format_of(&self, path: &Path) -> Result<LogFormat, LogError> {
+        let format = LogFormat::detect(path);
+        let (csv, mcap) = (ColumnOptions::default(), McapOptions::default());
+        let given: &[(&'static str, bool)] = match format {
+            LogFormat::Mcap => {
+                let c = &self.columns;
+                &[
+                    ("time_column", c.time_column != csv.time_column),
+                    ("time_unit", c.time_unit != csv.time_unit),
+                    ("rate_column", c.rate_column != csv.rate_column),
+                    ("rate_unit", c.rate_unit != csv.rate_unit),
+                    ("reference_column", c.reference_column.is_some()),
+                    ("temperature_column", c.temperature_column.is_some()),
+                ]
+            }
+            LogFormat::Csv => {
+                let m = &self.mcap;
+                &[
+                    ("topic", m.topic.is_some()),
+                    ("reference_topic", m.reference_topic != mcap.reference_topic),
+                    ("axis", m.axis != mcap.axis),
+                    ("flip", m.flip != mcap.flip),
+                    ("time_source", m.time_source != mcap.time_source),
+                ]
+            }
+        };
+        match given.iter().find(|(_, given)| *given) {
+            None => Ok(format),
+            Some((setting, _)) => Err(LogError::NotApplicable {
+                path: path.to_path_buf(),
+                format: match format {
+                    LogFormat::Csv => "a CSV log",
+                    LogFormat::Mcap => "an MCAP log",
+                },
+                setting: *setting,
+                other: match format {
+                    LogFormat::Csv => "MCAP",
+                    LogFormat::Mcap => "CSV",
+                },
+            }),
+        }
+    }
+}
+
 /// Read a CSV or MCAP log (format from [`LogFormat::detect`]). MCAP damage that did not
-/// stop reading (an interrupted recording) is returned as warnings, one line each.
+/// stop reading (an interrupted recording) is returned as warnings, one line each. A
+/// setting of the other format is refused ([`LogOptions::format_of`]).
 pub fn read_log_with_warnings(
     path: &Path,
     options: &LogOptions,
 ) -> Result<(Log, Vec<String>), LogError> {
-    match LogFormat::detect(path) {
+    match options.format_of(path)? {
         LogFormat::Csv => Ok((read_csv(path, &options.columns)?, Vec::new())),
         LogFormat::Mcap => {
             let read = read_mcap(path, &options.mcap)?;
@@ -521,6 +569,19 @@ pub enum LogError {
         index: u64,
         /// What is wrong.
         message: String,
+    },
+    /// A setting of the other format was given: CSV columns and units for an MCAP log, MCAP
+    /// channels and ROS 2 options for a CSV log. It would be ignored, so it is refused.
+    #[error("{path}: is {format}; the setting `{setting}` applies only to {other} logs")]
+    NotApplicable {
+        /// File.
+        path: PathBuf,
+        /// The file's format ("an MCAP log", "a CSV log").
+        format: &'static str,
+        /// The setting given ([`ColumnOptions`] or [`McapOptions`] field name).
+        setting: &'static str,
+        /// The format it applies to.
+        other: &'static str,
     },
     /// The file format is unknown or unsupported.
     #[error("{path}: {message}")]

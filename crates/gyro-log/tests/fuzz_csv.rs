@@ -15,7 +15,7 @@ use proptest::test_runner::RngSeed;
 use std::path::Path;
 
 /// Cases of the mutation property (the random-bytes one runs a quarter as many).
-const CASES: u32 = 400;
+const CASES: u32 = 1600;
 
 /// The first `lines` lines of a fixture.
 fn fixture_head(path: &str, lines: usize) -> String {

@@ -15,7 +15,7 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 /// Cases of the mutation property (the random-bytes one runs a quarter as many).
-const CASES: u32 = 400;
+const CASES: u32 = 2000;
 
 /// The MCAP magic every file starts with.
 const MAGIC: &[u8] = b"\x89MCAP0\r\n";
