@@ -85,7 +85,11 @@ cp in/good.csv in/csv_named.mcap
 size=$(stat -c %s in/good.mcap)
 head -c $((size / 2)) in/good.mcap >in/truncated.mcap
 cp in/good.mcap in/corrupt.mcap
-printf 'XXXXXXXXXXXXXXXX' | dd of=in/corrupt.mcap bs=1 seek=$((size / 2)) conv=notrunc status=none
+printf 'XXXXXXXXXXXXXXXX' | dd of=in/corrupt.mcap bs=1 seek=$((size * 3 / 10)) conv=notrunc status=none
+# The same bytes at 60% land in a message index, which the reader does not need (it
+# walks the records and reads the chunks, whose CRCs hold): the data are intact.
+cp in/good.mcap in/corrupt_index.mcap
+printf 'XXXXXXXXXXXXXXXX' | dd of=in/corrupt_index.mcap bs=1 seek=$((size * 6 / 10)) conv=notrunc status=none
 { printf 'NOTMCAP!'; tail -c +9 in/good.mcap; } >in/bad_magic.mcap
 head -c 20 in/good.mcap >in/header_only.mcap
 echo '{"format": "gyro-model", "version": 1}' >in/model.json
@@ -104,7 +108,8 @@ echo 'placeholder' >in/existing_recording.mcap
 
 # ---------------------------------------------------------------------------------------
 # Cases: `c NAME EXPECT NEEDLE COMMAND`. EXPECT: refuse (one `error:` line containing
-# NEEDLE), ok (exit 0), quiet (non-zero exit, stderr unusable: no panic). COMMAND runs in
+# NEEDLE), late (the same, after a complete output file was written), ok (exit 0), quiet
+# (non-zero exit, stderr unusable: no panic). COMMAND runs in
 # bash from the work folder with $G the binary; outputs go to out/.
 declare -a NAMES EXPECTS NEEDLES CMDS
 c() { NAMES+=("$1"); EXPECTS+=("$2"); NEEDLES+=("$3"); CMDS+=("$4"); }
@@ -142,6 +147,7 @@ for f in empty corrupt bad_magic header_only csv_named; do
     c "convert $f.mcap" refuse "$f.mcap" "\$G convert in/$f.mcap out/c.csv"
 done
 c "run truncated.mcap (read up to the cut, warned)" ok "" "\$G run in/truncated.mcap"
+c "run corrupt_index.mcap (damage outside the data)" ok "" "\$G run in/corrupt_index.mcap"
 c "run two_imus.mcap (two rate channels)" refuse "--topic" "\$G run in/two_imus.mcap"
 c "run ros2.mcap --topic /nope" refuse "/nope" "\$G run in/ros2.mcap --topic /nope"
 c "noise corrupt.mcap" refuse "corrupt.mcap" "\$G noise in/corrupt.mcap"
@@ -203,8 +209,8 @@ c "calibrate --tau-s nan" refuse "--tau-s" "\$G calibrate in/good.csv --tau-s na
 c "diagnose --members 0 --holdout in/other.csv" refuse "--members" "\$G diagnose --train in/good.csv --members 0 --holdout in/other.csv"
 c "diagnose --seed -1" refuse "--seed" "\$G diagnose --train in/good.csv --seed=-1 --holdout in/other.csv"
 c "diagnose --split-s nan --holdout in/other.csv" refuse "--split-s" "\$G diagnose --train in/good.csv --split-s nan --holdout in/other.csv"
-c "diagnose --only no_such_effect --holdout in/other.csv" refuse "no_such_effect" "\$G diagnose --train in/good.csv --only no_such_effect --holdout in/other.csv"
-c "diagnose without --train" refuse "--train" "\$G diagnose --holdout in/other.csv"
+c "diagnose --self-test --only no_such_effect" refuse "no_such_effect" "\$G diagnose --self-test --only no_such_effect"
+c "diagnose without --train" refuse "required arguments" "\$G diagnose --holdout in/other.csv"
 c "simulate --duration-s -1" refuse "--duration-s" "\$G simulate --duration-s=-1 -o out/s.csv"
 c "simulate --duration-s nan" refuse "--duration-s" "\$G simulate --duration-s nan -o out/s.csv"
 c "simulate --sample-rate-hz 1e6 --duration-s 86400" refuse "samples" "\$G simulate --sample-rate-hz 1e6 --duration-s 86400 -o out/s.csv"
@@ -262,7 +268,7 @@ c "record --port missing" refuse "/dev/no-such-port" "\$G record --port /dev/no-
 c "emulate --port missing folder" refuse "no-such-dir" "\$G emulate --port /no-such-dir/tty --duration-s 1"
 c "emulate --create-pty, nobody reads" refuse "" "\$G emulate --create-pty --duration-s 2 --write-timeout-s 1"
 c "run > /dev/full" refuse "stdout" "\$G run in/good.csv >/dev/full"
-c "calibrate > /dev/full" refuse "stdout" "\$G calibrate in/good.csv --no-leave-one-out -o out/m.json >/dev/full"
+c "calibrate > /dev/full" late "stdout" "\$G calibrate in/good.csv --no-leave-one-out -o out/m.json >/dev/full"
 c "noise > /dev/full" refuse "stdout" "\$G noise in/good.csv >/dev/full"
 c "simulate --list-effects > /dev/full" refuse "stdout" "\$G simulate --list-effects >/dev/full"
 c "run --out /dev/full" refuse "/dev/full" "\$G run in/good.csv --out /dev/full"
@@ -295,6 +301,7 @@ for i in "${!NAMES[@]}"; do
     elif [[ $rc -eq 0 ]]; then outcome=silent-accept
     elif [[ -n $(ls -A out) && $expect == refuse ]]; then outcome=leftover
     elif [[ $expect == quiet ]]; then outcome=clean
+    elif [[ $expect == late && $errors -eq 1 && $first == *"$needle"* ]]; then outcome=clean
     elif [[ $errors -eq 1 && ( -z $needle || $first == *"$needle"* ) ]]; then outcome=clean
     else outcome=unhelpful
     fi
