@@ -202,7 +202,7 @@ fn json_message(error: &serde_json::Error) -> String {
         rest = &rest[open + 1..];
         match rest.find(quote) {
             Some(close) => {
-                out.push_str(&gyro_log::excerpt(rest[..close].as_bytes()));
+                out.push_str(&gyro_log::excerpt(&rest.as_bytes()[..close]));
                 out.push_str(quote);
                 rest = &rest[close + 1..];
             }

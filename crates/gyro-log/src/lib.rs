@@ -137,7 +137,7 @@ impl LogOptions {
                     LogFormat::Csv => "a CSV log",
                     LogFormat::Mcap => "an MCAP log",
                 },
-                setting: *setting,
+                setting,
                 other: match format {
                     LogFormat::Csv => "MCAP",
                     LogFormat::Mcap => "CSV",
@@ -284,7 +284,7 @@ pub(crate) fn check_rate_metadata(value: &str, previous: Option<&str>) -> Result
 /// A rate as errors show it: at most three decimals, no trailing zeros (`1000`, `108.509`);
 /// beyond [`SHOWN_LIMIT`] as [`num`] shows it.
 pub(crate) fn hz(rate_hz: f64) -> String {
-    if !(rate_hz.abs() < SHOWN_LIMIT) {
+    if rate_hz.abs() >= SHOWN_LIMIT || rate_hz.is_nan() {
         return num(rate_hz);
     }
     let text = format!("{rate_hz:.3}");
