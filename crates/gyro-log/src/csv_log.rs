@@ -466,18 +466,24 @@ pub fn excerpt(raw: &[u8]) -> String {
     const SHOWN: usize = 40;
     let text = String::from_utf8_lossy(raw);
     let chars = text.chars().count();
-    let mut shown: String = text
-        .chars()
-        .take(SHOWN)
-        .flat_map(|c| {
-            if c.is_control() {
-                c.escape_default().collect::<Vec<_>>()
-            } else {
-                vec![c]
-            }
-        })
-        .collect();
-    if chars > SHOWN {
+    // At most SHOWN characters as shown: an escaped control character counts as its
+    // escape (`\u{0}`, five).
+    let mut shown = String::new();
+    let (mut width, mut taken) = (0, 0);
+    for c in text.chars() {
+        let piece: String = if c.is_control() {
+            c.escape_default().collect()
+        } else {
+            c.to_string()
+        };
+        width += piece.chars().count();
+        if width > SHOWN {
+            break;
+        }
+        shown.push_str(&piece);
+        taken += 1;
+    }
+    if taken < chars {
         shown.push_str(&format!("… ({chars} characters)"));
     }
     shown
