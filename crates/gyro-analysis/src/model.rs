@@ -111,7 +111,7 @@ pub enum ModelError {
     Version {
         /// File.
         path: PathBuf,
-        /// Format found.
+        /// Format found (as [`gyro_log::excerpt`] shows it).
         format: String,
         /// Version found.
         version: u32,
@@ -155,12 +155,12 @@ pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
         path: path.to_path_buf(),
         line: e.line(),
         column: e.column(),
-        message: e.to_string(),
+        message: json_message(&e),
     })?;
     if model.format != FORMAT || model.version != VERSION {
         return Err(ModelError::Version {
             path: path.to_path_buf(),
-            format: model.format,
+            format: gyro_log::excerpt(model.format.as_bytes()),
             version: model.version,
         });
     }
@@ -185,6 +185,32 @@ pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
         });
     }
     Ok(model)
+}
+
+/// serde_json's message without the position (the error gives it in front) and with every
+/// quoted value longer than [`gyro_log::excerpt`] shows cut to that: a corrupt file must
+/// not make a message hundreds of characters long.
+fn json_message(error: &serde_json::Error) -> String {
+    let full = error.to_string();
+    let suffix = format!(" at line {} column {}", error.line(), error.column());
+    let message = full.strip_suffix(&suffix).unwrap_or(&full);
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(open) = rest.find(['"', '`']) {
+        let quote = &rest[open..=open];
+        out.push_str(&rest[..=open]);
+        rest = &rest[open + 1..];
+        match rest.find(quote) {
+            Some(close) => {
+                out.push_str(&gyro_log::excerpt(&rest.as_bytes()[..close]));
+                out.push_str(quote);
+                rest = &rest[close + 1..];
+            }
+            None => break,
+        }
+    }
+    out.push_str(rest);
+    out
 }
 
 /// Write a model file (pretty JSON).

@@ -1,5 +1,22 @@
 //! `gyro-cli`: rotation angle from a single-axis gyro; replay, simulate, calibrate, diagnose.
 
+/// `eprintln!` that ignores a stderr that cannot be written (`2>/dev/full`, a closed
+/// descriptor): a message that cannot be shown must not turn into a panic (exit 101).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr().lock(), $($arg)*);
+    }};
+}
+
+/// `eprint!` that ignores a stderr that cannot be written, as `say!`.
+macro_rules! say_part {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stderr().lock(), $($arg)*);
+    }};
+}
+
 mod cmd;
 
 use clap::{Parser, Subcommand};
@@ -59,7 +76,7 @@ fn main() -> ExitCode {
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             let hint = flag_hint(&e).unwrap_or_default();
-            eprintln!("error: {}{hint}", one_line(&format!("{e:#}")));
+            say!("error: {}{hint}", one_line(&format!("{e:#}")));
             ExitCode::FAILURE
         }
     }
@@ -76,22 +93,28 @@ fn is_broken_pipe(error: &anyhow::Error) -> bool {
 
 /// The option that settles a library error, named as this command line spells it (the
 /// libraries name no flags), to append to its message.
-fn flag_hint(error: &anyhow::Error) -> Option<&'static str> {
+fn flag_hint(error: &anyhow::Error) -> Option<String> {
     use gyro_log::LogError;
-    error
+    let error = error
         .chain()
-        .find_map(|cause| cause.downcast_ref::<LogError>())
-        .and_then(|e| match e {
-            LogError::SampleRateInvalid { .. } => Some(" (--sample-rate-hz)"),
-            LogError::SampleRateUnknown { .. } => Some(" with --sample-rate-hz"),
-            LogError::SampleRateDisagrees { .. } => {
-                Some(" (fix --sample-rate-hz or the metadata, or leave it out)")
-            }
-            LogError::Gap { .. } | LogError::MaxGapInvalid { .. } => Some(" (--max-gap-s)"),
-            LogError::McapSecondRate { .. } => Some(" with --topic"),
-            LogError::McapZeroStamp { .. } => Some(": --time-source log-time"),
-            _ => None,
-        })
+        .find_map(|cause| cause.downcast_ref::<LogError>())?;
+    if let LogError::NotApplicable { setting, .. } = error {
+        // The settings are the options' field names: `reference_column` is given as
+        // --reference-column.
+        return Some(format!(" (--{})", setting.replace('_', "-")));
+    }
+    match error {
+        LogError::SampleRateInvalid { .. } => Some(" (--sample-rate-hz)"),
+        LogError::SampleRateUnknown { .. } => Some(" with --sample-rate-hz"),
+        LogError::SampleRateDisagrees { .. } => {
+            Some(" (fix --sample-rate-hz or the metadata, or leave it out)")
+        }
+        LogError::Gap { .. } | LogError::MaxGapInvalid { .. } => Some(" (--max-gap-s)"),
+        LogError::McapSecondRate { .. } => Some(" with --topic"),
+        LogError::McapZeroStamp { .. } => Some(": --time-source log-time"),
+        _ => None,
+    }
+    .map(str::to_string)
 }
 
 /// An error message on one line (a cause that spans lines is joined with "; ").

@@ -447,3 +447,43 @@ fn nothing_bad_is_accepted_silently() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A setting of the other format (CSV columns on an MCAP log, MCAP channels on a CSV log)
+/// would be ignored: it is refused, naming the file and the flag.
+#[test]
+fn options_of_the_other_format_are_refused() {
+    let dir = temp_dir("not-applicable");
+    let csv = write(&dir, "log.csv", &log_text("", 3000, 0.001));
+    let mcap = dir.join("log.mcap");
+    ok(&gyro(&["convert", &csv, mcap.to_str().unwrap()]));
+    let mcap = mcap.to_str().unwrap();
+    for (log, flag, value) in [
+        (mcap, "--reference-column", "ref_deg"),
+        (mcap, "--temperature-column", "temp"),
+        (mcap, "--time-unit", "ms"),
+        (csv.as_str(), "--topic", "/gyro"),
+        (csv.as_str(), "--time-source", "log-time"),
+    ] {
+        let out = gyro(&["run", log, flag, value]);
+        refused(&out, 1, flag);
+        refused(&out, 1, log);
+    }
+    ok(&gyro(&["run", mcap]));
+}
+
+/// A stderr that cannot be written (`2>/dev/full`) ends the command with its exit code,
+/// never a panic through `eprintln!`.
+#[test]
+fn a_full_stderr_does_not_panic() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        return; // no /dev/full on this system
+    };
+    let dir = temp_dir("full-stderr");
+    let empty = write(&dir, "empty.csv", "");
+    let out = Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
+        .args(["run", &empty])
+        .stderr(full)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+}

@@ -324,8 +324,8 @@ impl CsvRows {
             find(name).ok_or_else(|| LogError::MissingColumn {
                 path: path.to_path_buf(),
                 line: header_line,
-                column: name.to_string(),
-                available: names.join(", "),
+                column: excerpt(name.as_bytes()),
+                available: column_list(&names),
             })
         };
         let time = required(&columns.time_column)?;
@@ -439,24 +439,51 @@ impl CsvRows {
     }
 }
 
+/// The header's columns as an error lists them: the first few, each as [`excerpt`]
+/// shows it, then how many there are.
+fn column_list(names: &[String]) -> String {
+    const LISTED: usize = 6;
+    let mut list = names
+        .iter()
+        .take(LISTED)
+        .map(|n| excerpt(n.as_bytes()))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if names.len() > LISTED {
+        list.push_str(&format!(", … ({} columns)", names.len()));
+    }
+    list
+}
+
 /// A field as an error shows it: at most 40 characters (a longer one cut, with its length),
 /// control characters escaped, so that a corrupt line cannot flood the terminal.
-pub(crate) fn excerpt(raw: &[u8]) -> String {
+///
+/// ```
+/// assert_eq!(gyro_log::excerpt(b"a\0b"), "a\\u{0}b");
+/// assert!(gyro_log::excerpt("x".repeat(100).as_bytes()).ends_with("… (100 characters)"));
+/// ```
+pub fn excerpt(raw: &[u8]) -> String {
     const SHOWN: usize = 40;
     let text = String::from_utf8_lossy(raw);
     let chars = text.chars().count();
-    let mut shown: String = text
-        .chars()
-        .take(SHOWN)
-        .flat_map(|c| {
-            if c.is_control() {
-                c.escape_default().collect::<Vec<_>>()
-            } else {
-                vec![c]
-            }
-        })
-        .collect();
-    if chars > SHOWN {
+    // At most SHOWN characters as shown: an escaped control character counts as its
+    // escape (`\u{0}`, five).
+    let mut shown = String::new();
+    let (mut width, mut taken) = (0, 0);
+    for c in text.chars() {
+        let piece: String = if c.is_control() {
+            c.escape_default().collect()
+        } else {
+            c.to_string()
+        };
+        width += piece.chars().count();
+        if width > SHOWN {
+            break;
+        }
+        shown.push_str(&piece);
+        taken += 1;
+    }
+    if taken < chars {
         shown.push_str(&format!("… ({chars} characters)"));
     }
     shown

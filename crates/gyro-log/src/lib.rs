@@ -30,7 +30,7 @@ pub(crate) use ahead::read_ahead;
 pub use bursts::Bursts;
 pub(crate) use csv_log::CsvRows;
 pub use csv_log::{
-    read_csv, write_csv, ColumnOptions, RateUnit, TimeUnit, DEFAULT_REFERENCE_COLUMN,
+    excerpt, read_csv, write_csv, ColumnOptions, RateUnit, TimeUnit, DEFAULT_REFERENCE_COLUMN,
     DEFAULT_TEMPERATURE_COLUMN,
 };
 pub use load::{load, stream};
@@ -100,13 +100,61 @@ pub struct LogOptions {
     pub mcap: McapOptions,
 }
 
+impl LogOptions {
+    /// The format of `path` ([`LogFormat::detect`]), refusing a setting given for the
+    /// other format ([`LogError::NotApplicable`]): it would be ignored.
+    pub fn format_of(&self, path: &Path) -> Result<LogFormat, LogError> {
+        let format = LogFormat::detect(path);
+        let (csv, mcap) = (ColumnOptions::default(), McapOptions::default());
+        let given: &[(&'static str, bool)] = match format {
+            LogFormat::Mcap => {
+                let c = &self.columns;
+                &[
+                    ("time_column", c.time_column != csv.time_column),
+                    ("time_unit", c.time_unit != csv.time_unit),
+                    ("rate_column", c.rate_column != csv.rate_column),
+                    ("rate_unit", c.rate_unit != csv.rate_unit),
+                    ("reference_column", c.reference_column.is_some()),
+                    ("temperature_column", c.temperature_column.is_some()),
+                ]
+            }
+            LogFormat::Csv => {
+                let m = &self.mcap;
+                &[
+                    ("topic", m.topic.is_some()),
+                    ("reference_topic", m.reference_topic != mcap.reference_topic),
+                    ("axis", m.axis != mcap.axis),
+                    ("flip", m.flip != mcap.flip),
+                    ("time_source", m.time_source != mcap.time_source),
+                ]
+            }
+        };
+        match given.iter().find(|(_, given)| *given) {
+            None => Ok(format),
+            Some((setting, _)) => Err(LogError::NotApplicable {
+                path: path.to_path_buf(),
+                format: match format {
+                    LogFormat::Csv => "a CSV log",
+                    LogFormat::Mcap => "an MCAP log",
+                },
+                setting,
+                other: match format {
+                    LogFormat::Csv => "MCAP",
+                    LogFormat::Mcap => "CSV",
+                },
+            }),
+        }
+    }
+}
+
 /// Read a CSV or MCAP log (format from [`LogFormat::detect`]). MCAP damage that did not
-/// stop reading (an interrupted recording) is returned as warnings, one line each.
+/// stop reading (an interrupted recording) is returned as warnings, one line each. A
+/// setting of the other format is refused ([`LogOptions::format_of`]).
 pub fn read_log_with_warnings(
     path: &Path,
     options: &LogOptions,
 ) -> Result<(Log, Vec<String>), LogError> {
-    match LogFormat::detect(path) {
+    match options.format_of(path)? {
         LogFormat::Csv => Ok((read_csv(path, &options.columns)?, Vec::new())),
         LogFormat::Mcap => {
             let read = read_mcap(path, &options.mcap)?;
@@ -233,10 +281,39 @@ pub(crate) fn check_rate_metadata(value: &str, previous: Option<&str>) -> Result
     }
 }
 
-/// A rate as errors show it: at most three decimals, no trailing zeros (`1000`, `108.509`).
+/// A rate as errors show it: at most three decimals, no trailing zeros (`1000`, `108.509`);
+/// beyond [`SHOWN_LIMIT`] as [`num`] shows it.
 pub(crate) fn hz(rate_hz: f64) -> String {
+    if rate_hz.abs() >= SHOWN_LIMIT || rate_hz.is_nan() {
+        return num(rate_hz);
+    }
     let text = format!("{rate_hz:.3}");
     text.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// Magnitude from which messages show a number in exponent form.
+const SHOWN_LIMIT: f64 = 1e15;
+
+/// A number as messages show it: the shortest form that reads back the same (`0.5`,
+/// `1000`), in exponent form from 1e15 on (`1e300`), so that a corrupt value cannot make a
+/// message hundreds of digits long.
+pub(crate) fn num(value: f64) -> String {
+    if value.abs() < SHOWN_LIMIT || !value.is_finite() {
+        format!("{value}")
+    } else {
+        format!("{value:e}")
+    }
+}
+
+/// `value` with `decimals` decimals (`0.290000`), in exponent form from 1e15 on
+/// (`-1.000000e300`) and below what the decimals show (`1.0000e-6`).
+pub(crate) fn fixed(value: f64, decimals: usize) -> String {
+    let shown = (0.1_f64.powi(decimals as i32)..SHOWN_LIMIT).contains(&value.abs());
+    if shown || value == 0.0 || !value.is_finite() {
+        format!("{value:.decimals$}")
+    } else {
+        format!("{value:.decimals$e}")
+    }
 }
 
 /// The memory `slots` grid slots take (GiB).
@@ -330,7 +407,7 @@ pub enum LogError {
         message: String,
     },
     /// The sample rate given ([`GridOptions::sample_rate_hz`]) is not a positive number.
-    #[error("{path}: the sample rate {rate_hz} Hz is not a positive number")]
+    #[error("{path}: the sample rate {} Hz is not a positive number", num(*rate_hz))]
     SampleRateInvalid {
         /// File.
         path: PathBuf,
@@ -347,7 +424,8 @@ pub enum LogError {
     },
     /// The longest gap to bridge ([`GridOptions::max_gap_s`]) is not a finite number ≥ 0.
     #[error(
-        "{path}: the longest gap to bridge, {max_gap_s} s, is not a finite number of seconds >= 0"
+        "{path}: the longest gap to bridge, {} s, is not a finite number of seconds >= 0",
+        num(*max_gap_s)
     )]
     MaxGapInvalid {
         /// File.
@@ -357,7 +435,10 @@ pub enum LogError {
     },
     /// The sample rate given (option or metadata) disagrees with the time stamps.
     #[error(
-        "{path}: the {source_name} gives {rate_hz} Hz but the time stamps say {measured_hz:.6} Hz ({ratio:.4} times that); on the given rate every angle would be off by that factor"
+        "{path}: the {source_name} gives {} Hz but the time stamps say {} Hz ({} times that); on the given rate every angle would be off by that factor",
+        num(*rate_hz),
+        fixed(*measured_hz, 6),
+        fixed(*ratio, 4)
     )]
     SampleRateDisagrees {
         /// File.
@@ -375,8 +456,9 @@ pub enum LogError {
     /// The grid would need more memory than allowed ([`MAX_BRIDGED_SLOTS`],
     /// [`MAX_HELD_SLOTS`]); refused before it is made.
     #[error(
-        "{path}: {what} {samples} samples ({:.1} GiB), more than the limit of {limit} ({:.1} GiB)",
-        gib(*samples),
+        "{path}: {what} {} samples ({} GiB), more than the limit of {limit} ({:.1} GiB)",
+        num(*samples),
+        fixed(gib(*samples), 1),
         gib(*limit as f64)
     )]
     TooLarge {
@@ -399,7 +481,10 @@ pub enum LogError {
     },
     /// Time runs backwards by more than the tolerated amount.
     #[error(
-        "{path}:{line}: time goes back by {back_s:.6} s (from {previous_s:.6} s at line {previous_line} to {time_s:.6} s); concatenated or corrupt log?"
+        "{path}:{line}: time goes back by {} s (from {} s at line {previous_line} to {} s); concatenated or corrupt log?",
+        fixed(*back_s, 6),
+        fixed(*previous_s, 6),
+        fixed(*time_s, 6)
     )]
     TimeBackwards {
         /// File.
@@ -417,7 +502,9 @@ pub enum LogError {
     },
     /// A gap in time longer than the longest one bridged by interpolation.
     #[error(
-        "{path}:{line}: gap of {gap_s:.3} s in the data (after line {previous_line}) exceeds the longest gap bridged, {max_gap_s} s; the rotation during it cannot be recovered"
+        "{path}:{line}: gap of {} s in the data (after line {previous_line}) exceeds the longest gap bridged, {} s; the rotation during it cannot be recovered",
+        fixed(*gap_s, 3),
+        num(*max_gap_s)
     )]
     Gap {
         /// File.
@@ -482,6 +569,19 @@ pub enum LogError {
         index: u64,
         /// What is wrong.
         message: String,
+    },
+    /// A setting of the other format was given: CSV columns and units for an MCAP log, MCAP
+    /// channels and ROS 2 options for a CSV log. It would be ignored, so it is refused.
+    #[error("{path}: is {format}; the setting `{setting}` applies only to {other} logs")]
+    NotApplicable {
+        /// File.
+        path: PathBuf,
+        /// The file's format ("an MCAP log", "a CSV log").
+        format: &'static str,
+        /// The setting given ([`ColumnOptions`] or [`McapOptions`] field name).
+        setting: &'static str,
+        /// The format it applies to.
+        other: &'static str,
     },
     /// The file format is unknown or unsupported.
     #[error("{path}: {message}")]

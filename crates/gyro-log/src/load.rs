@@ -89,7 +89,7 @@ pub fn stream<S: SlotSink + ?Sized>(
     sink: &mut S,
     warn: &mut dyn FnMut(&str),
 ) -> Result<Quality, LogError> {
-    match LogFormat::detect(path) {
+    match options.format_of(path)? {
         LogFormat::Csv => {
             let rows = CsvRows::open(path, &options.columns)?;
             let info = LogInfo {

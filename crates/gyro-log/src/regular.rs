@@ -277,10 +277,13 @@ pub(crate) fn check_given_rate(
     }
     Ok(((ratio - 1.0).abs() > RATE_WARNING_SHARE).then(|| {
         format!(
-            "{}: the {source_name} gives {rate_hz} Hz but the time stamps say {measured_hz:.3} Hz \
-             ({ratio:.4} times that); the grid follows the given rate, so angles are off by up \
-             to that factor if the stamps are right",
-            path.display()
+            "{}: the {source_name} gives {} Hz but the time stamps say {} Hz ({} times \
+             that); the grid follows the given rate, so angles are off by up to that factor if \
+             the stamps are right",
+            path.display(),
+            crate::num(rate_hz),
+            crate::fixed(measured_hz, 3),
+            crate::fixed(ratio, 4)
         )
     }))
 }

@@ -118,17 +118,17 @@ pub fn run(args: &Args) -> Result<()> {
         ),
     };
     super::to_stdout(|out| out.write_all(text.as_bytes()))?;
-    eprintln!(
+    say!(
         "wrote {}: {}",
         args.out.display(),
         gyro_report::calibrate::choice_text(&result)
     );
     if result.choice.reason == ChoiceReason::NoRefits && args.no_leave_one_out {
-        eprintln!("drop --no-leave-one-out to let calibrate write a fitted model");
+        say!("drop --no-leave-one-out to let calibrate write a fitted model");
     }
     if let Some(path) = &args.plot {
         gyro_report::plot::calibrate_plot(path, &result)?;
-        eprintln!("wrote {}", path.display());
+        say!("wrote {}", path.display());
     }
     Ok(())
 }

@@ -23,7 +23,7 @@ pub fn run(args: &Args) -> Result<()> {
     let log = super::read(&args.input, &args.input_options)?;
     log::write_log(&args.output, &log, args.to)?;
     let yes_no = |b: bool| if b { "yes" } else { "no" };
-    eprintln!(
+    say!(
         "{} -> {}: {} rows, reference: {}, temperature: {}",
         args.input.display(),
         args.output.display(),

@@ -214,7 +214,7 @@ pub fn run(args: &Args) -> Result<()> {
             .clone()
             .unwrap_or_else(|| options.base_model.clone());
         model::save(out, &file)?;
-        eprintln!(
+        say!(
             "wrote {} ({})",
             out.display(),
             match &result.compensation {
@@ -318,6 +318,6 @@ fn write_report(
 ) -> Result<()> {
     let envelopes = diagnose::envelopes::envelopes(result, train, holdout, options);
     gyro_report::diagnose::write_report(dir, result, envelopes.as_ref(), options)?;
-    eprintln!("wrote {}", dir.join("index.html").display());
+    say!("wrote {}", dir.join("index.html").display());
     Ok(())
 }

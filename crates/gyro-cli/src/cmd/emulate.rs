@@ -119,7 +119,7 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         Pacing::RealTime
     };
-    eprintln!(
+    say!(
         "emulating a CRM100 bridge: {} samples from the {what}, range {}, {:?}",
         samples.len(),
         args.range,
@@ -141,9 +141,9 @@ pub fn run(args: &Args) -> Result<()> {
     // reader has not read yet: wait until it has.
     let unread = drain(&mut *port, _pty_slave.as_ref(), &stop);
     if unread > 0 {
-        eprintln!("warning: {unread} bytes were still unread when the port was closed");
+        say!("warning: {unread} bytes were still unread when the port was closed");
     }
-    eprintln!(
+    say!(
         "sent {} frames in {:.1} s ({} bytes){}: intact {}, dropped {}, byte loss {}, bit flips {}, bad checksums {}, status faults {}, stalls {} ({} ms), clipped {}, source gaps {}",
         report.frames,
         report.elapsed_s,
@@ -236,7 +236,7 @@ fn open_pty(keep: &mut Option<PtySlave>) -> Result<Box<dyn serialport::SerialPor
         serialport::TTYPort::pair().context("cannot create a pseudo-terminal pair")?;
     let name = slave.name().context("the pseudo-terminal has no name")?;
     super::to_stdout(|out| writeln!(out, "{name}"))?;
-    eprintln!("record from {name}, e.g.: gyro-cli record --port {name} -o run.mcap");
+    say!("record from {name}, e.g.: gyro-cli record --port {name} -o run.mcap");
     *keep = Some(slave);
     Ok(Box::new(master))
 }

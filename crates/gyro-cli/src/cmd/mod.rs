@@ -131,7 +131,7 @@ impl NoiseYamlArgs {
 
 /// Print a warning about the input on stderr.
 pub fn warn(warning: &str) {
-    eprintln!("warning: {warning}");
+    say!("warning: {warning}");
 }
 
 /// Read a log, warnings printed ([`gyro_log::read_log_with_warnings`]).

@@ -162,7 +162,7 @@ pub fn run(args: &Args) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let run = noise::characterize_logs(&loaded, &options)?;
     if run.rates_differ {
-        eprintln!("note: the logs differ in sample rate; no pooled result");
+        say!("note: the logs differ in sample rate; no pooled result");
     }
 
     if let Some(out) = &args.model_out {
@@ -181,7 +181,7 @@ pub fn run(args: &Args) -> Result<()> {
         };
         model::save(out, &file)?;
         let s = &file.sensor;
-        eprintln!(
+        say!(
             "wrote {}: sensor at {} Hz, bias {:.5} deg/s, ARW {:.4} deg/√h, Gauss-Markov σ {:.4e} deg/s T {:.4} s, step {} deg/s",
             out.display(),
             s.sample_rate_hz,

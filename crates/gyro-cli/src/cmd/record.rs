@@ -110,7 +110,7 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         Box::new(McapSink::create(&args.out, &options)?)
     };
-    eprintln!(
+    say!(
         "recording {} ({} Bd, range {}) to {}; Ctrl-C to stop",
         args.port,
         args.baud,
@@ -125,7 +125,7 @@ pub fn run(args: &Args) -> Result<()> {
     let summary = bridge::record(&mut reader, sink, &options, &stop, &mut show);
     bar.finish_and_clear();
     let summary = summary?;
-    eprintln!("{summary}");
-    eprintln!("wrote {}", args.out.display());
+    say!("{summary}");
+    say!("wrote {}", args.out.display());
     Ok(())
 }

@@ -100,7 +100,7 @@ pub fn run(args: &Args) -> Result<()> {
                 &log::GridOptions::default(),
             )?;
             // What was read of it, as every command that reads a log shows it.
-            eprint!(
+            say_part!(
                 "{}",
                 gyro_report::input::tables([(
                     path.display().to_string().as_str(),
@@ -162,7 +162,7 @@ pub fn run(args: &Args) -> Result<()> {
     // MCAP for a `.mcap` name, else CSV (the format the command always wrote).
     let format = log::LogFormat::from_extension(out).unwrap_or(log::LogFormat::Csv);
     log::write_log(out, &log, Some(format))?;
-    eprintln!(
+    say!(
         "wrote {} samples ({:.1} s at {} Hz, {} rotations, effects: {}) to {}",
         log.rows.len(),
         motion.duration_s(),
