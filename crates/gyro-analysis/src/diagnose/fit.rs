@@ -96,10 +96,7 @@ pub fn direct_evidence(
 /// sample variance, v0: the mean of the replicas'). Returns (its Wilson–Hilferty
 /// z-score, s², v0, n−1).
 fn bias_spread(runs: &[&RealRun], null: &[Vec<Member>]) -> (f64, f64, f64, f64) {
-    let real: Vec<f64> = runs
-        .iter()
-        .map(|r| r.features.mean_residual_dps)
-        .collect();
+    let real: Vec<f64> = runs.iter().map(|r| r.features.mean_residual_dps).collect();
     let s2 = sample_var(&real);
     let members = null.iter().map(Vec::len).min().unwrap_or(0);
     let null_vars: Vec<f64> = (0..members)

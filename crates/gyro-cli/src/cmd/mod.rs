@@ -112,7 +112,7 @@ impl NoiseYamlArgs {
     pub fn write(&self, out: &Path, params: &NoiseParams) -> Result<()> {
         std::fs::write(out, params.to_yaml(self.noise_yaml_format))
             .with_context(|| format!("cannot write {}", out.display()))?;
-        eprintln!(
+        say!(
             "wrote {} ({}): gyroscope_noise_density {} rad/s/√Hz ({:.4} deg/√h), gyroscope_random_walk {} rad/s²/√Hz, update_rate {} Hz",
             out.display(),
             match self.noise_yaml_format {
