@@ -4,20 +4,28 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The static library cargo built beside this test's executable (`<target>/<profile>/`).
+/// The host static library, built for this test by cargo into a target folder of its own:
+/// `cargo test` builds the crate's rlib for its tests but not always its staticlib, and a
+/// `libgyro_ffi.a` left beside the test executable may be stale. Cargo's own build lock is
+/// on the main target folder, so building into another one from a test cannot deadlock;
+/// after the first run it is incremental.
 fn staticlib() -> PathBuf {
-    let exe = std::env::current_exe().expect("the test's own path");
-    // <target>/<profile>/deps/c_api-<hash>
-    let profile_dir = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("the test runs from <target>/<profile>/deps");
-    let lib = profile_dir.join("libgyro_ffi.a");
+    let crate_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let target = Path::new(env!("CARGO_TARGET_TMPDIR")).join("gyro-ffi-staticlib");
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let status = Command::new(cargo)
+        .args(["build", "--quiet", "--lib", "--manifest-path"])
+        .arg(crate_dir.join("Cargo.toml"))
+        .arg("--target-dir")
+        .arg(&target)
+        .status()
+        .expect("run cargo to build the staticlib");
     assert!(
-        lib.is_file(),
-        "{} not found: cargo builds it with the crate (crate-type staticlib)",
-        lib.display()
+        status.success(),
+        "cargo build of gyro-ffi's staticlib failed"
     );
+    let lib = target.join("debug").join("libgyro_ffi.a");
+    assert!(lib.is_file(), "{} not found after the build", lib.display());
     lib
 }
 
