@@ -372,7 +372,7 @@ pub fn simulate_member(
                 plateau_samples: 0,
                 temperature_varies: false,
                 static_diff_var: (f64::NAN, 0),
-                mean_residual_dps: f64::NAN,
+                bias_dps: f64::NAN,
             },
         },
     }

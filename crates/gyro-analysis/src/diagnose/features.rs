@@ -41,8 +41,8 @@ pub const REGRESSORS: [&str; 8] = [
 ];
 /// Index of each regressor.
 pub mod reg {
-    /// Intercept (deg/s) is regressor 0; a run's bias is read from its mean residual
-    /// ([`super::Features::mean_residual_dps`]), which the odd rate terms do not trade with.
+    /// Intercept (deg/s); a run's bias is [`super::Features::bias_dps`].
+    pub const INTERCEPT: usize = 0;
     /// ω (1).
     pub const RATE: usize = 1;
     /// |ω| (1).
@@ -86,11 +86,13 @@ pub struct Features {
     /// Mean of the smoothed-gyro residual's first differences squared / 2 on static
     /// samples ((deg/s)²) and how many differences (white-noise level).
     pub static_diff_var: (f64, usize),
-    /// Mean residual (gyro − reference rate, deg/s) over the static samples when there
-    /// are at least 2 s of them, else over every sample with a residual: the plain bias
-    /// estimate (odd rate-dependent errors average out over back-and-forth motion). NaN
-    /// when no sample has a residual.
-    pub mean_residual_dps: f64,
+    /// The run's bias (deg/s): the regression intercept (the bias at zero rate and the
+    /// starting temperature) when at least 2 s of static samples pin it; on continuous
+    /// motion the intercept trades with the |rate| and rate³ terms (at a near-constant
+    /// speed |rate| is nearly constant), so the mean residual over every sample instead
+    /// (odd rate-dependent errors average out over back-and-forth motion). NaN when no
+    /// sample has a residual.
+    pub bias_dps: f64,
 }
 
 /// The features of `r`; `plateau_tol_dps` is the tolerance of the clip plateau (e.g. an
@@ -247,29 +249,30 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
         plateau_samples,
         temperature_varies,
         static_diff_var,
-        mean_residual_dps: mean_residual(r),
+        bias_dps: run_bias(r, coef[reg::INTERCEPT]),
     }
 }
 
-/// See [`Features::mean_residual_dps`].
-fn mean_residual(r: &Residuals) -> f64 {
-    let mean = |only_static: bool| -> (f64, usize) {
-        let (mut sum, mut count) = (0.0, 0usize);
-        for (v, st) in r.residual_dps.iter().zip(&r.is_static) {
-            if v.is_finite() && (*st || !only_static) {
-                sum += v;
-                count += 1;
-            }
-        }
-        (sum / count.max(1) as f64, count)
-    };
-    let (m, n) = mean(true);
-    if n as f64 >= 2.0 * r.sample_rate_hz {
-        return m;
+/// See [`Features::bias_dps`].
+fn run_bias(r: &Residuals, intercept: f64) -> f64 {
+    let static_samples = r
+        .residual_dps
+        .iter()
+        .zip(&r.is_static)
+        .filter(|(v, st)| **st && v.is_finite())
+        .count();
+    if static_samples as f64 >= 2.0 * r.sample_rate_hz && intercept.is_finite() {
+        return intercept;
     }
-    match mean(false) {
-        (m, n) if n > 0 => m,
-        _ => f64::NAN,
+    let (sum, count) = r
+        .residual_dps
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
+    if count > 0 {
+        sum / count as f64
+    } else {
+        f64::NAN
     }
 }
 

@@ -90,21 +90,18 @@ pub fn direct_evidence(
     }
 }
 
-/// The between-run spread of the bias (each run's mean residual,
-/// [`super::features::Features::mean_residual_dps`]) of `runs` against
+/// The between-run spread of the bias ([`super::features::Features::bias_dps`]) of
+/// `runs` against
 /// their null ensembles: `(n−1) s²/v0` is χ²(n−1) without a turn-on bias (s²: the runs'
 /// sample variance, v0: the mean of the replicas'). Returns (its Wilson–Hilferty
 /// z-score, s², v0, n−1).
 fn bias_spread(runs: &[&RealRun], null: &[Vec<Member>]) -> (f64, f64, f64, f64) {
-    let real: Vec<f64> = runs.iter().map(|r| r.features.mean_residual_dps).collect();
+    let real: Vec<f64> = runs.iter().map(|r| r.features.bias_dps).collect();
     let s2 = sample_var(&real);
     let members = null.iter().map(Vec::len).min().unwrap_or(0);
     let null_vars: Vec<f64> = (0..members)
         .map(|j| {
-            let v: Vec<f64> = null
-                .iter()
-                .map(|m| m[j].features.mean_residual_dps)
-                .collect();
+            let v: Vec<f64> = null.iter().map(|m| m[j].features.bias_dps).collect();
             sample_var(&v)
         })
         .collect();
@@ -152,13 +149,13 @@ pub fn nominal_model(
     }
     let means: Vec<f64> = train
         .iter()
-        .map(|r| r.features.mean_residual_dps)
+        .map(|r| r.features.bias_dps)
         .filter(|c| c.is_finite())
         .collect();
     if !means.is_empty() {
         model.bias_dps = means.iter().sum::<f64>() / means.len() as f64;
         notes.push(format!(
-            "bias {:.4} deg/s: mean residual (gyro - reference rate) of the training runs, on static samples where a run has 2 s of them, on all samples otherwise",
+            "bias {:.4} deg/s: mean over the training runs of each run's regression intercept (runs with 2 s of static samples) or mean residual, gyro - reference rate (runs in continuous motion)",
             model.bias_dps
         ));
     }

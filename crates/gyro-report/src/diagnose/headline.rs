@@ -174,10 +174,17 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
             ));
         }
         for n in &c.not_corrected {
-            lines.push(format!(
-                "{}: named, not corrected (its correction did not lower the held-out error)",
-                n.id
-            ));
+            if n.id == gyro_analysis::diagnose::BIAS_ID {
+                lines.push(format!(
+                    "the bias ({:.3} deg/s, fitted on the training runs) is not written: it did not lower the held-out error",
+                    d.model.sensor.bias_dps
+                ));
+            } else {
+                lines.push(format!(
+                    "{}: named, not corrected (its correction did not lower the held-out error)",
+                    n.id
+                ));
+            }
         }
     }
     lines

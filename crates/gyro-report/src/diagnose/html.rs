@@ -669,7 +669,13 @@ fn effect_row(s: &mut String, e: &EffectResult) {
         "<tr{}><td><code>{}</code></td><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td><td>{}</td></tr>",
         if e.significant { " class=\"sig\"" } else { "" },
         esc(e.id),
-        if e.significant { "yes" } else { "no" },
+        if e.significant {
+            "yes"
+        } else if super::text::fails_posterior(e) {
+            "no: fails its posterior check"
+        } else {
+            "no"
+        },
         params.join("<br>"),
         e.z.map_or("exact".to_string(), |z| format!("{z:.2}")),
         format_args!(

@@ -110,6 +110,11 @@ fn num(x: f64) -> String {
     }
 }
 
+/// Not named because its simulation does not reproduce its signature statistics.
+pub(super) fn fails_posterior(e: &gyro_analysis::diagnose::EffectResult) -> bool {
+    e.posterior_check.as_ref().is_some_and(|c| !c.passes)
+}
+
 /// The held-out runs' files, each once, by name.
 fn holdout_names(d: &Diagnosis) -> String {
     let mut files: Vec<&str> = d
@@ -196,6 +201,10 @@ pub fn table(d: &Diagnosis) -> String {
                 String::new()
             } else {
                 format!("  (confounded with {})", e.confounded_with.join(", "))
+            } + if fails_posterior(e) {
+                "  (fails its posterior check)"
+            } else {
+                ""
             }
         );
     }
