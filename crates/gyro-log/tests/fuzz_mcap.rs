@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{assert_error, byte_mutation, temp_dir, workspace_root};
+use common::{byte_mutation, check_load, temp_dir, workspace_root};
 use gyro_log::{ColumnOptions, GridOptions, LogOptions, McapOptions, TimeSource};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
@@ -47,22 +47,7 @@ fn seeds() -> &'static [Vec<u8>] {
 
 /// Load `bytes` as an MCAP log: no panic, a one-line error naming the file, or finite slots.
 fn check(path: &Path, bytes: &[u8], options: &LogOptions) -> Result<(), TestCaseError> {
-    std::fs::write(path, bytes).unwrap();
-    let mut warn = |w: &str| assert_error(w, None);
-    match gyro_log::load(path, options, &GridOptions::default(), &mut warn) {
-        Ok(log) => {
-            prop_assert!(!log.slots.is_empty());
-            prop_assert!(log.sample_rate_hz.is_finite() && log.sample_rate_hz > 0.0);
-            for slot in &log.slots {
-                prop_assert!(
-                    slot.time_s.is_finite() && slot.rate_dps.is_finite(),
-                    "{slot:?}"
-                );
-            }
-        }
-        Err(error) => assert_error(&error.to_string(), Some(path)),
-    }
-    Ok(())
+    check_load(path, bytes, options, &GridOptions::default())
 }
 
 fn options() -> impl Strategy<Value = LogOptions> {

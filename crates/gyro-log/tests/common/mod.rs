@@ -117,3 +117,30 @@ pub fn byte_mutation() -> impl proptest::strategy::Strategy<Value = ByteMutation
         2 => (any::<usize>(), value).prop_map(|(at, value)| ByteMutation::Overwrite { at, value }),
     ]
 }
+
+/// Load `bytes` (written to `path`) with `options` and `grid`: no panic, a one-line error
+/// naming the file, or a non-empty log of finite slots at a positive rate.
+pub fn check_load(
+    path: &Path,
+    bytes: &[u8],
+    options: &gyro_log::LogOptions,
+    grid: &gyro_log::GridOptions,
+) -> Result<(), proptest::test_runner::TestCaseError> {
+    use proptest::prop_assert;
+    std::fs::write(path, bytes).unwrap();
+    let mut warn = |w: &str| assert_error(w, None);
+    match gyro_log::load(path, options, grid, &mut warn) {
+        Ok(log) => {
+            prop_assert!(!log.slots.is_empty());
+            prop_assert!(log.sample_rate_hz.is_finite() && log.sample_rate_hz > 0.0);
+            for slot in &log.slots {
+                prop_assert!(
+                    slot.time_s.is_finite() && slot.rate_dps.is_finite(),
+                    "{slot:?}"
+                );
+            }
+        }
+        Err(error) => assert_error(&error.to_string(), Some(path)),
+    }
+    Ok(())
+}
