@@ -515,14 +515,6 @@ fn stats(values: &[f64]) -> [f64; 4] {
     [mean, var.sqrt(), min, max]
 }
 
-fn median(mut values: Vec<f64>) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    values.sort_by(f64::total_cmp);
-    Some(values[values.len() / 2])
-}
-
 /// Fit (β, b0, o0) on `traces`; `progress` is called after each evaluation with the best
 /// objective so far.
 fn fit_paper(
@@ -780,7 +772,7 @@ fn fit_motion(
 /// mean's source (the rests under the starting motion thresholds).
 fn kalman_from_rests(base: KalmanConfig, rest_means: &[f64], traces: &[Trace]) -> KalmanConfig {
     let mut kalman = base;
-    if let Some(mean) = median(rest_means.to_vec()) {
+    if let Some(mean) = crate::median(rest_means) {
         kalman.bias_mean_dps = mean as f32;
     }
     let (mut within_sq, mut within_n, mut run_means) = (0.0, 0_usize, Vec::new());
@@ -807,7 +799,7 @@ fn kalman_from_rests(base: KalmanConfig, rest_means: &[f64], traces: &[Trace]) -
         kalman.initial_bias_sigma_dps = (stats(&run_means)[1] as f32).max(kalman.bias_sigma_dps);
     }
     let noises: Vec<f64> = traces.iter().filter_map(|t| t.rest_noise_dps).collect();
-    if let Some(noise) = median(noises) {
+    if let Some(noise) = crate::median(&noises) {
         kalman.rate_noise_dps = noise.max(1e-4) as f32;
     }
     kalman
@@ -837,7 +829,7 @@ fn fit(
         .collect();
     let start = GaussMarkov {
         beta_per_s: (1.0 / tau_s) as f32,
-        b0_dps: median(rest_means.clone()).unwrap_or(0.0) as f32,
+        b0_dps: crate::median(&rest_means).unwrap_or(0.0) as f32,
         o0_deg: 0.0,
     };
     let (motion, traces) = if options.fit_motion {

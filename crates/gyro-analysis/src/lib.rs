@@ -18,3 +18,12 @@ pub mod noise;
 pub mod replay;
 pub mod rest_mean;
 pub mod seed;
+
+/// The median of `values` as the upper of the two middle values for an even count (an
+/// observed value, never an average of two); `None` when empty. Callers drop what they
+/// do not want counted (NaN sorts last).
+pub fn median(values: &[f64]) -> Option<f64> {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied()
+}

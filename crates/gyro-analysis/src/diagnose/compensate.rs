@@ -182,17 +182,8 @@ pub(crate) fn compensate(
 
 /// Median of the finite values (NaN when none).
 fn median(values: &[f64]) -> f64 {
-    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
+    let finite: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    crate::median(&finite).unwrap_or(f64::NAN)
 }
 
 /// Max abs angle error of every held-out run replayed with `model` (NaN when a run

@@ -137,9 +137,8 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
     }
     if let Some(c) = &d.compensation {
         let median = |f: &dyn Fn(&gyro_analysis::diagnose::CompensationRun) -> f64| {
-            let mut v: Vec<f64> = c.runs.iter().map(f).filter(|x| x.is_finite()).collect();
-            v.sort_by(f64::total_cmp);
-            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+            let v: Vec<f64> = c.runs.iter().map(f).filter(|x| x.is_finite()).collect();
+            gyro_analysis::median(&v).unwrap_or(f64::NAN)
         };
         let before = median(&|r| r.max_abs_error_before_deg);
         let after = median(&|r| r.max_abs_error_after_deg);
