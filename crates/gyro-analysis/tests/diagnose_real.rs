@@ -77,4 +77,12 @@ fn latency_is_named_on_real_yaw_and_its_correction_does_not_hurt() {
     for n in &c.not_corrected {
         assert!(!c.corrected.contains(&n.id));
     }
+    // The stepper's vibration is in the motion (both sensors see it), near 12.9 Hz: said,
+    // and not named as a sensor's vibration.
+    assert!(!named.contains(&"vibration"), "named {named:?}");
+    for runs in ["training", "held-out"] {
+        let line = d.motion_lines.iter().find(|m| m.runs == runs);
+        let f = line.map(|m| m.frequency_hz);
+        assert!(f.is_some_and(|f| (12.0..14.0).contains(&f)), "{runs}: {f:?}");
+    }
 }

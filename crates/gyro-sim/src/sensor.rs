@@ -324,7 +324,12 @@ pub fn simulate_series(
         let pole_hz = cutoff_hz / (2f64.sqrt() - 1.0).sqrt();
         1.0 - (-2.0 * std::f64::consts::PI * pole_hz * dt).exp()
     });
-    let (scale_k, asym_k, k3) = (terms.scale_k, terms.asymmetry_k, terms.k3_per_dps2);
+    let (scale_k, asym_k, k3, k2) = (
+        terms.scale_k,
+        terms.asymmetry_k,
+        terms.k3_per_dps2,
+        terms.k2_per_dps,
+    );
     let (temp_bias, temp_scale) = (terms.bias_dps_per_c, terms.scale_per_c);
     let (delay_s, clock_ppm) = (terms.delay_s, terms.clock_ppm);
     let (turn_on_sigma, walk_k, extra_lsb) = (
@@ -335,6 +340,10 @@ pub fn simulate_series(
     let turn_on_draw: f64 = StandardNormal.sample(&mut turn_on_rng);
     let turn_on = turn_on_sigma * turn_on_draw;
     let clock = 1.0 + clock_ppm * 1e-6;
+    // Rows stamped by the sensor's count: the gyro's sample k is taken earlier (a fast
+    // clock) than the reference of its row.
+    let count_clock = 1.0 + terms.count_clock_ppm * 1e-6;
+    let vibration = terms.vibration;
     let mut walk = 0.0;
     let mut stages = [motion.rate_dps(-delay_s); 2];
     let mut dropout_left = false;
@@ -372,14 +381,18 @@ pub fn simulate_series(
             }
         };
 
-        let mut rate = motion.rate_dps(true_s - delay_s);
+        let gyro_s = true_s / count_clock;
+        let mut rate = motion.rate_dps(gyro_s - delay_s);
         if let Some(alpha) = bandwidth_alpha {
             stages[0] += alpha * (rate - stages[0]);
             stages[1] += alpha * (stages[0] - stages[1]);
             rate = stages[1];
         }
         let scale = 1.0 + scale_k + asym_k * rate.signum() + temp_scale * delta_c;
-        let mut measured = rate * scale + k3 * rate * rate * rate;
+        let mut measured = rate * scale + k3 * rate * rate * rate + k2 * rate * rate;
+        if let Some((amplitude_dps, frequency_hz)) = vibration {
+            measured += amplitude_dps * (2.0 * std::f64::consts::PI * frequency_hz * gyro_s).sin();
+        }
 
         let flicker_dps: f64 = flicker.iter_mut().map(|p| p.step(&mut flicker_rng)).sum();
         if walk_k > 0.0 {

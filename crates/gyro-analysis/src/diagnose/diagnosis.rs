@@ -103,6 +103,9 @@ pub struct Diagnosis {
     pub runs: Vec<RunSummary>,
     /// Angle error with the correctable effects compensated, if any were selected.
     pub compensation: Option<CompensationSummary>,
+    /// Lines in the motion itself (the reference rate), training and held-out runs.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub motion_lines: Vec<super::line::MotionLine>,
     /// What was read of each log and what was irregular in it (filled in by the caller,
     /// which read the logs; empty for the self-check's simulated runs).
     #[serde(skip_serializing_if = "Vec::is_empty")]

@@ -6,7 +6,7 @@
 //! Dropped samples are filled by linear interpolation, as the grid placement fills a
 //! real log's gaps.
 
-use super::features::{features, Features, REGRESSORS, WANDER_TAUS_S};
+use super::features::{features, Features, N_REG, REGRESSORS, WANDER_TAUS_S};
 use super::stats::{residuals, residuals_of, stats_of, Residuals, Stat, StatsError};
 use crate::seed::derive_seed;
 use gyro_log::RegularLog;
@@ -365,7 +365,7 @@ pub fn simulate_member(
         Err(_) => Member {
             stats: Vec::new(),
             features: Features {
-                coef: [f64::NAN; 8],
+                coef: [f64::NAN; N_REG],
                 samples: 0,
                 wander_avar: [f64::NAN; 3],
                 max_abs_rate_dps: f64::NAN,
@@ -373,6 +373,8 @@ pub fn simulate_member(
                 temperature_varies: false,
                 static_diff_var: (f64::NAN, 0),
                 bias_dps: f64::NAN,
+                incoherent_psd: Vec::new(),
+                reference_psd: Vec::new(),
             },
         },
     }
@@ -385,10 +387,10 @@ pub fn simulate_features(
     model: &SensorModel,
     effects: &[Effect],
     seed: u64,
-) -> [f64; 8] {
+) -> [f64; N_REG] {
     simulate_residuals(run, model, effects, seed)
         .map(|r| features(&r, 1e-9).coef)
-        .unwrap_or([f64::NAN; 8])
+        .unwrap_or([f64::NAN; N_REG])
 }
 
 /// Linear interpolation over NaN runs (held at the ends).

@@ -8,11 +8,13 @@
 //! - **Joint regression** (one per run): the gyro averaged over the reference
 //!   derivative's window (trapezoid over ±h samples, so both sides see the same
 //!   smoothing and no lag is introduced) minus the reference rate ω, regressed on
-//!   `[1, ω, |ω|, (ω/100)³, α, dα/dt, ΔT, ω·ΔT]` (α: reference angular acceleration, ΔT:
-//!   temperature change since the run's first sample; the last two only when the run's
-//!   temperature varies). One regression separates effects that act together:
-//!   `scale_factor` (and, on the nominal grid, `clock_error`) → ω, `scale_asymmetry` → |ω|, `nonlinearity` →
-//!   ω³, `latency` and `bandwidth` → −α (a delay d gives −d·α + d²/2·dα/dt; a two-pole
+//!   `[1, ω, |ω|, (ω/100)³, α, dα/dt, (ω/100)², t·α, ΔT, ω·ΔT]` (α: reference angular
+//!   acceleration, t: time from the middle of the run, ΔT: temperature change since the
+//!   run's first sample; the last two only when the run's temperature varies). One
+//!   regression separates effects that act together: `scale_factor` (and, on the nominal
+//!   grid, `clock_error`) → ω, `scale_asymmetry` → |ω|, `nonlinearity` → ω³,
+//!   `nonlinearity_even` → ω², `clock_error_count_stamped` → −t·α (a lag ε·t growing
+//!   over the run), `latency` and `bandwidth` → −α (a delay d gives −d·α + d²/2·dα/dt; a two-pole
 //!   low-pass of time constant τ gives −2τ·α + 3τ²·dα/dt, which is how they differ),
 //!   `temperature_bias` → ΔT, `temperature_scale` → ω·ΔT; the intercept is the run's
 //!   bias (`turn_on_bias` spreads it between runs). Samples on a clipped plateau are
@@ -21,21 +23,31 @@
 //!   wander not explained by the regressors: `bias_instability`, `rate_random_walk`).
 //! - **Plateau**: the largest |rate| and how many samples sit on it while the reference
 //!   is faster (`saturation`).
+//! - **Line spectrum**: Welch spectra on segments of [`LINE_SEGMENT_S`]: the part of the
+//!   gyro's PSD not coherent with the reference rate, `S_gg − |S_gr|²/S_rr` (`vibration`:
+//!   a line the reference does not see; a latency or a low-pass is a linear response to
+//!   the motion, coherent with it, and leaves none), and the reference rate's PSD (the
+//!   motion's own lines).
 
 // Small dense linear algebra reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
 use super::stats::{stretches, Residuals, SMOOTH_WINDOW_S};
+use crate::noise::fft::fft_in_place;
 use crate::noise::AllanDeviation;
 
+/// Number of regressors.
+pub const N_REG: usize = 10;
 /// Regressor names, in coefficient order.
-pub const REGRESSORS: [&str; 8] = [
+pub const REGRESSORS: [&str; N_REG] = [
     "intercept",
     "rate",
     "abs_rate",
     "rate_cubed",
     "acceleration",
     "jerk",
+    "rate_squared",
+    "time_acceleration",
     "delta_temperature",
     "rate_delta_temperature",
 ];
@@ -54,13 +66,19 @@ pub mod reg {
     /// dα/dt (s²).
     #[allow(dead_code)] // no fit reads this column alone; it names the layout's sixth column
     pub const JERK: usize = 5;
+    /// (ω/100)² (deg/s).
+    pub const RATE_SQUARED: usize = 6;
+    /// t·α, t the time from the middle of the run (deg/s).
+    pub const TIME_ACCELERATION: usize = 7;
     /// ΔT (deg/s/°C).
-    pub const DELTA_T: usize = 6;
+    pub const DELTA_T: usize = 8;
     /// ω·ΔT (1/°C).
-    pub const RATE_DELTA_T: usize = 7;
+    pub const RATE_DELTA_T: usize = 9;
 }
 /// Scale of ω inside the cubic regressor (deg/s), for conditioning.
 pub const CUBIC_SCALE_DPS: f64 = 100.0;
+/// Length of the line spectrum's Welch segments (s; rounded to a power of two samples).
+pub const LINE_SEGMENT_S: f64 = 2.0;
 /// Averaging times of the wander feature (s).
 pub const WANDER_TAUS_S: [f64; 3] = [1.0, 4.0, 16.0];
 /// A run's temperature "varies" when its range exceeds this (°C).
@@ -70,7 +88,7 @@ pub const MIN_TEMPERATURE_RANGE_C: f64 = 0.5;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Features {
     /// Regression coefficients ([`REGRESSORS`] order); NaN where the regressor was not used.
-    pub coef: [f64; 8],
+    pub coef: [f64; N_REG],
     /// Samples in the regression.
     pub samples: usize,
     /// Allan variance of the regression residual at [`WANDER_TAUS_S`] ((deg/s)²); NaN
@@ -93,6 +111,83 @@ pub struct Features {
     /// (odd rate-dependent errors average out over back-and-forth motion). NaN when no
     /// sample has a residual.
     pub bias_dps: f64,
+    /// The gyro's PSD not coherent with the reference rate ((deg/s)²/Hz per bin of
+    /// [`line_resolution_hz`], from 0 Hz); empty when no stretch holds a segment.
+    pub incoherent_psd: Vec<f64>,
+    /// The reference rate's PSD, on the same bins.
+    pub reference_psd: Vec<f64>,
+}
+
+/// Samples of a line-spectrum segment at `sample_rate_hz` (a power of two).
+pub fn line_segment_len(sample_rate_hz: f64) -> usize {
+    let target = (LINE_SEGMENT_S * sample_rate_hz).max(16.0);
+    1usize << (target.log2().round() as u32).min(24)
+}
+
+/// Bin width of the line spectrum at `sample_rate_hz` (Hz).
+pub fn line_resolution_hz(sample_rate_hz: f64) -> f64 {
+    sample_rate_hz / line_segment_len(sample_rate_hz) as f64
+}
+
+/// Welch cross-spectra of `r`'s gyro rate `g` and reference rate `w` (Hann window, half
+/// overlap, on the stretches where both are defined): (incoherent PSD of g, PSD of w),
+/// both empty when no stretch holds a segment.
+fn line_spectra(r: &Residuals) -> (Vec<f64>, Vec<f64>) {
+    let len = line_segment_len(r.sample_rate_hz);
+    let both = |i: usize| r.rate_dps[i].is_finite() && r.reference_rate_dps[i].is_finite();
+    let window: Vec<f64> = (0..len)
+        .map(|n| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * n as f64 / len as f64).cos())
+        .collect();
+    let bins = len / 2 + 1;
+    let (mut sgg, mut srr) = (vec![0.0; bins], vec![0.0; bins]);
+    let (mut sgr_re, mut sgr_im) = (vec![0.0; bins], vec![0.0; bins]);
+    let (mut re, mut im) = (vec![0.0; len], vec![0.0; len]);
+    let mut count = 0usize;
+    for run in stretches(r.rate_dps.len(), both) {
+        let mut start = run.start;
+        while start + len <= run.end {
+            let g = &r.rate_dps[start..start + len];
+            let w = &r.reference_rate_dps[start..start + len];
+            let (mg, mw) = (
+                g.iter().sum::<f64>() / len as f64,
+                w.iter().sum::<f64>() / len as f64,
+            );
+            // Both real signals in one complex transform: z = g + i·w.
+            for i in 0..len {
+                re[i] = (g[i] - mg) * window[i];
+                im[i] = (w[i] - mw) * window[i];
+            }
+            fft_in_place(&mut re, &mut im);
+            for k in 0..bins {
+                let j = (len - k) % len;
+                // G_k = (Z_k + conj Z_{N−k}) / 2, W_k = (Z_k − conj Z_{N−k}) / 2i.
+                let (gr, gi) = (0.5 * (re[k] + re[j]), 0.5 * (im[k] - im[j]));
+                let (wr, wi) = (0.5 * (im[k] + im[j]), -0.5 * (re[k] - re[j]));
+                sgg[k] += gr * gr + gi * gi;
+                srr[k] += wr * wr + wi * wi;
+                // G · conj W.
+                sgr_re[k] += gr * wr + gi * wi;
+                sgr_im[k] += gi * wr - gr * wi;
+            }
+            count += 1;
+            start += len / 2;
+        }
+    }
+    if count == 0 {
+        return (Vec::new(), Vec::new());
+    }
+    let window_power: f64 = window.iter().map(|w| w * w).sum();
+    let scale = 1.0 / (r.sample_rate_hz * window_power * count as f64);
+    let one_sided = |k: usize| if k == 0 || k == len / 2 { 1.0 } else { 2.0 };
+    let incoherent = (0..bins)
+        .map(|k| {
+            let cross2 = sgr_re[k] * sgr_re[k] + sgr_im[k] * sgr_im[k];
+            let explained = if srr[k] > 0.0 { cross2 / srr[k] } else { 0.0 };
+            (sgg[k] - explained).max(0.0) * scale * one_sided(k)
+        })
+        .collect();
+    let reference = (0..bins).map(|k| srr[k] * scale * one_sided(k)).collect();
+    (incoherent, reference)
 }
 
 /// The features of `r`; `plateau_tol_dps` is the tolerance of the clip plateau (e.g. an
@@ -138,7 +233,11 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
             (a.min(t), b.max(t))
         });
     let temperature_varies = t_first.is_some() && t_max - t_min >= MIN_TEMPERATURE_RANGE_C;
-    let used: usize = if temperature_varies { 8 } else { 6 };
+    let used: usize = if temperature_varies { N_REG } else { N_REG - 2 };
+    let t_mid = match (r.time_s.first(), r.time_s.last()) {
+        (Some(a), Some(b)) => 0.5 * (a + b),
+        _ => 0.0,
+    };
 
     // Jerk: the centred difference of the acceleration, like the acceleration of the rate.
     let mut jerk = vec![f64::NAN; n];
@@ -147,7 +246,7 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
             * fs
             / (2 * h) as f64;
     }
-    let row = |i: usize| -> Option<([f64; 8], f64)> {
+    let row = |i: usize| -> Option<([f64; N_REG], f64)> {
         let (g, w, a, j) = (
             smooth[i],
             r.reference_rate_dps[i],
@@ -171,10 +270,14 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
             _ => 0.0,
         };
         let u = w / CUBIC_SCALE_DPS;
-        Some(([1.0, w, w.abs(), u * u * u, a, j, dt, w * dt], g - w))
+        let tau = r.time_s[i] - t_mid;
+        Some((
+            [1.0, w, w.abs(), u * u * u, a, j, u * u, tau * a, dt, w * dt],
+            g - w,
+        ))
     };
-    let mut xtx = [[0.0f64; 8]; 8];
-    let mut xty = [0.0f64; 8];
+    let mut xtx = [[0.0f64; N_REG]; N_REG];
+    let mut xty = [0.0f64; N_REG];
     let mut samples = 0usize;
     for i in 0..n {
         if let Some((x, y)) = row(i) {
@@ -192,7 +295,7 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
             xtx[a][b] = xtx[b][a];
         }
     }
-    let mut coef = [f64::NAN; 8];
+    let mut coef = [f64::NAN; N_REG];
     if samples > used + 2 {
         if let Some(c) = solve_spd(&xtx, &xty, used) {
             coef[..used].copy_from_slice(&c[..used]);
@@ -241,6 +344,7 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
         (f64::NAN, 0)
     };
 
+    let (incoherent_psd, reference_psd) = line_spectra(r);
     Features {
         coef,
         samples,
@@ -250,6 +354,8 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
         temperature_varies,
         static_diff_var,
         bias_dps: run_bias(r, coef[reg::INTERCEPT]),
+        incoherent_psd,
+        reference_psd,
     }
 }
 
@@ -278,15 +384,15 @@ fn run_bias(r: &Residuals, intercept: f64) -> f64 {
 
 /// Solve the leading `n`×`n` block of a symmetric positive definite system by Cholesky
 /// with the regressors scaled to unit diagonal; `None` if it is singular.
-fn solve_spd(a: &[[f64; 8]; 8], b: &[f64; 8], n: usize) -> Option<[f64; 8]> {
-    let mut d = [1.0f64; 8];
+fn solve_spd(a: &[[f64; N_REG]; N_REG], b: &[f64; N_REG], n: usize) -> Option<[f64; N_REG]> {
+    let mut d = [1.0f64; N_REG];
     for i in 0..n {
         if a[i][i] <= 0.0 || !a[i][i].is_finite() {
             return None;
         }
         d[i] = a[i][i].sqrt();
     }
-    let mut l = [[0.0f64; 8]; 8];
+    let mut l = [[0.0f64; N_REG]; N_REG];
     for i in 0..n {
         for j in 0..=i {
             let mut s = a[i][j] / (d[i] * d[j]);
@@ -303,7 +409,7 @@ fn solve_spd(a: &[[f64; 8]; 8], b: &[f64; 8], n: usize) -> Option<[f64; 8]> {
             }
         }
     }
-    let mut y = [0.0f64; 8];
+    let mut y = [0.0f64; N_REG];
     for i in 0..n {
         let mut s = b[i] / d[i];
         for k in 0..i {
@@ -311,7 +417,7 @@ fn solve_spd(a: &[[f64; 8]; 8], b: &[f64; 8], n: usize) -> Option<[f64; 8]> {
         }
         y[i] = s / l[i][i];
     }
-    let mut x = [0.0f64; 8];
+    let mut x = [0.0f64; N_REG];
     for i in (0..n).rev() {
         let mut s = y[i];
         for k in i + 1..n {
@@ -348,7 +454,7 @@ mod tests {
     #[test]
     fn regression_reads_each_deterministic_effect() {
         let nominal = run_features(&[], 1);
-        let cases: [(Effect, usize, f64, f64); 6] = [
+        let cases: [(Effect, usize, f64, f64); 9] = [
             (Effect::ScaleFactor { k: 0.01 }, reg::RATE, 0.01, 1e-3),
             (
                 Effect::ScaleAsymmetry { k: 0.005 },
@@ -363,10 +469,28 @@ mod tests {
                 0.3,
             ),
             (
+                Effect::NonlinearityEven { k2_per_dps: 2e-5 },
+                reg::RATE_SQUARED,
+                2e-5 * 1e4,
+                0.03,
+            ),
+            (
                 Effect::Latency { delay_s: 0.005 },
                 reg::ACCELERATION,
                 -0.005,
                 1e-3,
+            ),
+            (
+                Effect::Latency { delay_s: -0.005 },
+                reg::ACCELERATION,
+                0.005,
+                1e-3,
+            ),
+            (
+                Effect::ClockErrorCountStamped { ppm: 500.0 },
+                reg::TIME_ACCELERATION,
+                -500e-6,
+                1e-4,
             ),
             (
                 Effect::TemperatureBias { dps_per_c: 0.05 },
@@ -399,6 +523,41 @@ mod tests {
         let f = run_features(&[Effect::Saturation { limit_dps: 100.0 }], 1);
         assert!(f.plateau_samples > 100, "{}", f.plateau_samples);
         assert!((f.max_abs_rate_dps - 100.0).abs() < 1e-9);
+    }
+
+    /// The peak of `psd` at least `from_hz` and the bin width.
+    fn peak_hz(psd: &[f64], from_hz: f64) -> f64 {
+        let res = line_resolution_hz(1000.0);
+        let k0 = (from_hz / res) as usize;
+        let k = (k0..psd.len())
+            .max_by(|a, b| psd[*a].total_cmp(&psd[*b]))
+            .unwrap();
+        k as f64 * res
+    }
+
+    #[test]
+    fn a_vibration_is_incoherent_with_the_reference_and_a_latency_is_not() {
+        let nominal = run_features(&[], 1);
+        let vib = run_features(
+            &[Effect::Vibration {
+                amplitude_dps: 0.2,
+                frequency_hz: 37.0,
+            }],
+            1,
+        );
+        let res = line_resolution_hz(1000.0);
+        assert!((peak_hz(&vib.incoherent_psd, 2.0) - 37.0).abs() <= res);
+        let k = (37.0 / res).round() as usize;
+        assert!(vib.incoherent_psd[k] > 50.0 * nominal.incoherent_psd[k]);
+        // The motion's spectrum does not change.
+        assert!(
+            (vib.reference_psd[k] - nominal.reference_psd[k]).abs()
+                <= 1e-9 + 1e-6 * nominal.reference_psd[k]
+        );
+        // A latency changes the residual but is a linear response to the motion.
+        let late = run_features(&[Effect::Latency { delay_s: 0.02 }], 1);
+        let sum = |p: &[f64]| p.iter().skip(4).sum::<f64>();
+        assert!(sum(&late.incoherent_psd) < 1.2 * sum(&nominal.incoherent_psd));
     }
 
     #[test]

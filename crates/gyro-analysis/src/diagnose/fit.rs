@@ -11,7 +11,7 @@
 //! ±1.96 null standard deviations of the variance (wander), mapped to the parameter.
 
 use super::ensemble::{simulate_features, simulate_member, Member, RealRun, StampedClock};
-use super::features::{reg, CUBIC_SCALE_DPS, WANDER_TAUS_S};
+use super::features::{reg, CUBIC_SCALE_DPS, N_REG, WANDER_TAUS_S};
 use crate::noise::fit::gauss_markov_avar_continuous;
 use crate::noise::{chi2_quantile, rate_step};
 use gyro_sim::{
@@ -21,7 +21,7 @@ use gyro_sim::{
 use rayon::prelude::*;
 
 /// |z| of the parameter test above which an effect is a candidate (Bonferroni over the
-/// 14 effects at a family-wise 0.1% is 3.9).
+/// 17 effects at a family-wise 0.1% is 4.0).
 pub const Z_CRITICAL: f64 = 4.0;
 /// Quantisation is named when the output grid is this many times coarser than the
 /// nominal step.
@@ -84,6 +84,12 @@ pub fn direct_evidence(
             rate_step(&values).is_some_and(|s| s >= QUANT_RATIO * model.lsb_dps && s > 0.0)
         }
         FitProcedure::Gaps => runs.iter().map(|r| r.gaps).sum::<u64>() >= MIN_GAPS,
+        FitProcedure::SpectralLine => match effect.params().as_slice() {
+            [amplitude_dps, frequency_hz] if *amplitude_dps > 0.0 => {
+                super::line::at(runs, null, *frequency_hz).is_some_and(|l| l.z >= Z_CRITICAL)
+            }
+            _ => false,
+        },
         FitProcedure::Regression { .. } | FitProcedure::StampedClock | FitProcedure::Wander(_) => {
             false
         }
@@ -325,14 +331,14 @@ impl FitInput<'_> {
     }
 
     /// Pooled regression coefficients of noise-free simulations with `effects`.
-    fn noise_free(&self, effects: &[Effect]) -> [f64; 8] {
+    fn noise_free(&self, effects: &[Effect]) -> [f64; N_REG] {
         let quiet = SensorModel {
             arw_deg_per_rt_h: 0.0,
             gm_sigma_dps: 0.0,
             lsb_dps: 0.0,
             ..*self.model
         };
-        let coefs: Vec<[f64; 8]> = self
+        let coefs: Vec<[f64; N_REG]> = self
             .train
             .par_iter()
             .map(|r| simulate_features(r, &quiet, effects, 1))
@@ -345,14 +351,14 @@ impl FitInput<'_> {
 /// the effects already established from direct evidence (a clock error from the time
 /// stamps), on top of which the others are fitted.
 struct Known {
-    quiet: [f64; 8],
+    quiet: [f64; N_REG],
     effects: Vec<Effect>,
     /// Noise-free coefficients with `effects`.
-    with_effects: [f64; 8],
+    with_effects: [f64; N_REG],
 }
 
 impl Known {
-    fn new(input: &FitInput, quiet: [f64; 8], effects: Vec<Effect>) -> Self {
+    fn new(input: &FitInput, quiet: [f64; N_REG], effects: Vec<Effect>) -> Self {
         let with_effects = if effects.is_empty() {
             quiet
         } else {
@@ -386,7 +392,7 @@ fn deterministic(effect: &Effect) -> bool {
 /// differences, so sets are scored with their joint fits. Cached per set.
 pub struct Joint<'a> {
     input: &'a FitInput<'a>,
-    quiet: [f64; 8],
+    quiet: [f64; N_REG],
     clock: Vec<Effect>,
     cache: std::sync::Mutex<std::collections::BTreeMap<String, Vec<Option<Fit>>>>,
 }
@@ -607,6 +613,12 @@ pub(crate) enum FitError {
         /// What the regressor is.
         regressor: &'static str,
     },
+    /// No run has a stretch of residuals long enough for the line spectrum.
+    #[error("needs stretches of at least {segment_s} s of residuals in every run (the line spectrum's segment)")]
+    NoSpectrum {
+        /// Segment length (s).
+        segment_s: f64,
+    },
     /// The fit gave a parameter or a bound that is not a number.
     #[error("the fit gives no finite estimate on these runs (too short, or too little motion)")]
     NotFinite,
@@ -669,7 +681,9 @@ fn regressor_name(index: usize) -> &'static str {
         reg::RATE => "the reference rate",
         reg::ABS_RATE => "the absolute reference rate",
         reg::RATE_CUBED => "the cubed reference rate",
+        reg::RATE_SQUARED => "the squared reference rate",
         reg::ACCELERATION => "the angular acceleration",
+        reg::TIME_ACCELERATION => "time times the angular acceleration",
         reg::DELTA_T => "the temperature change",
         reg::RATE_DELTA_T => "the rate times the temperature change",
         _ => "its regressor",
@@ -682,7 +696,9 @@ fn regressor_index(regressor: Regressor) -> usize {
         Regressor::Rate => reg::RATE,
         Regressor::AbsRate => reg::ABS_RATE,
         Regressor::RateCubed => reg::RATE_CUBED,
+        Regressor::RateSquared => reg::RATE_SQUARED,
         Regressor::Acceleration => reg::ACCELERATION,
+        Regressor::TimeAcceleration => reg::TIME_ACCELERATION,
         Regressor::DeltaT => reg::DELTA_T,
         Regressor::RateDeltaT => reg::RATE_DELTA_T,
     }
@@ -709,6 +725,7 @@ fn fit_one(input: &FitInput, known: &Known, info: &'static EffectInfo) -> Result
         FitProcedure::Plateau => plateau_fit(input, info),
         FitProcedure::OutputGrid => grid_fit(input, info),
         FitProcedure::Gaps => gaps_fit(input, info),
+        FitProcedure::SpectralLine => line_fit(input, info),
     }
 }
 
@@ -742,11 +759,22 @@ fn regression_procedure(
             let (e, z, ci) = regression_fit(input, known, index, &make, &|x| x / scale);
             judged(e, z, ordered(ci), true, test)
         }
+        Reading::SquareCoefficient => {
+            let scale = CUBIC_SCALE_DPS.powi(2);
+            let (e, z, ci) = regression_fit(input, known, index, &make, &|x| x / scale);
+            judged(e, z, ordered(ci), true, test)
+        }
         Reading::Delay => {
             let range = info.params[0].range;
             let make = |d: f64| make(range.clamp(d));
             let (e, z, ci) = regression_fit(input, known, index, &make, &|x| -x);
-            judged(e, -z, ordered(ci), false, test)
+            judged(e, -z, ordered(ci), true, test)
+        }
+        Reading::ClockPpm => {
+            let range = info.params[0].range;
+            let make = |p: f64| make(range.clamp(p));
+            let (e, z, ci) = regression_fit(input, known, index, &make, &|x| -x * 1e6);
+            judged(e, -z, ordered(ci), true, test)
         }
         Reading::LowPassDelay => {
             // A two-pole low-pass delays slow motion by 2/(2π f_pole), f_pole = 1.554 f_c:
@@ -1018,5 +1046,49 @@ fn gaps_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
         passes: gaps >= MIN_GAPS,
         direct: true,
         test: format!("{gaps} gaps ({filled} samples filled) in the training runs; the nominal model has none (named from {MIN_GAPS})"),
+    })
+}
+
+/// A vibration from the strongest line of the training runs' residual spectrum against
+/// the null replicas' strongest ([`super::line`]); replicated on the held-out runs.
+fn line_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError> {
+    let line = super::line::search(input.train, input.null).ok_or(FitError::NoSpectrum {
+        segment_s: super::features::LINE_SEGMENT_S,
+    })?;
+    let effect = info
+        .typical
+        .with_params(&[line.amplitude_dps, line.frequency_hz])
+        .ok_or(FitError::ParamCount {
+            id: info.id,
+            expected: 2,
+        })?;
+    let per_run = super::line::amplitudes(input.train, line.frequency_hz);
+    let (_, sd) = mean_sd(&per_run);
+    let half = if sd.is_finite() {
+        t95(per_run.len().saturating_sub(1)) * sd / (per_run.len() as f64).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    let amplitude_half = (half * half + (0.1 * line.amplitude_dps).powi(2)).sqrt();
+    Ok(Fit {
+        effect,
+        ci95: vec![
+            (
+                Some((line.amplitude_dps - amplitude_half).max(0.0)),
+                Some(line.amplitude_dps + amplitude_half),
+            ),
+            (
+                Some(line.frequency_hz - line.resolution_hz),
+                Some(line.frequency_hz + line.resolution_hz),
+            ),
+        ],
+        z: line.z,
+        passes: line.z >= Z_CRITICAL,
+        direct: true,
+        test: format!(
+            "strongest line of the residual spectrum above {} Hz ({:.1} times its local floor) vs the null replicas' strongest (one-sided; replicated on the held-out runs)",
+            super::line::MIN_LINE_HZ,
+            line.ratio
+        ),
     })
 }

@@ -35,6 +35,7 @@ pub(crate) mod ensemble;
 pub mod envelopes;
 pub(crate) mod features;
 pub(crate) mod fit;
+pub mod line;
 mod locate;
 pub mod posterior;
 pub(crate) mod score;

@@ -36,7 +36,9 @@ pub fn signature(id: &str) -> &'static [(&'static str, &'static str)] {
             ("dynamic/negative", "slope_vs_rate"),
         ],
         "nonlinearity" => &[("dynamic", "cubic_vs_rate")],
+        "nonlinearity_even" => &[("dynamic", "quadratic_vs_rate")],
         "latency" | "bandwidth" => &[("all", "xcorr_peak_lag_s")],
+        "clock_error_count_stamped" => &[("all", "xcorr_lag_trend")],
         "bias_instability" | "rate_random_walk" => &[("all", "angle_error_rms_20s")],
         _ => &[],
     }
@@ -202,8 +204,10 @@ mod tests {
             "scale_factor",
             "scale_asymmetry",
             "nonlinearity",
+            "nonlinearity_even",
             "latency",
             "bandwidth",
+            "clock_error_count_stamped",
             "bias_instability",
             "rate_random_walk",
         ] {

@@ -2,7 +2,8 @@
 //! lacks, diagnosed blind by the same code, scored against what was injected.
 //!
 //! Cases: every effect alone at [`magnitudes`] (a realistic size for a low-cost MEMS
-//! gyro on a torque-wrench bench, stated in the output), the pairs of [`PAIRS`], and
+//! gyro on a torque-wrench bench, stated in the output), the physical variants of
+//! [`VARIANTS`] alone (a gyro ahead of its reference), the pairs of [`PAIRS`], and
 //! [`NULL_CASES`] runs with nothing injected. Each case has [`TRAIN_RUNS`] training and
 //! [`HOLDOUT_RUNS`] held-out runs of [`RUN_S`] s of bench-like motion at 1 kHz with a
 //! 5 °C warm-up, each run its own motion and noise seeds (derived from the case seed).
@@ -29,8 +30,10 @@ pub const HOLDOUT_RUNS: usize = 5;
 pub const RUN_S: f64 = 60.0;
 /// Cases with nothing injected.
 pub const NULL_CASES: usize = 7;
+/// Variants of an effect injected alone besides its self-test magnitude.
+pub const VARIANTS: [Effect; 1] = [Effect::Latency { delay_s: -0.005 }];
 /// Effects injected together.
-pub const PAIRS: [(&str, &str); 7] = [
+pub const PAIRS: [(&str, &str); 9] = [
     ("scale_factor", "latency"),
     ("scale_asymmetry", "temperature_bias"),
     ("nonlinearity", "turn_on_bias"),
@@ -38,6 +41,8 @@ pub const PAIRS: [(&str, &str); 7] = [
     ("temperature_scale", "bias_instability"),
     ("saturation", "dropouts"),
     ("rate_random_walk", "scale_factor"),
+    ("clock_error_count_stamped", "turn_on_bias"),
+    ("vibration", "nonlinearity_even"),
 ];
 /// Effects whose simulator terms leave nearly the same signature (a two-pole sensor
 /// bandwidth delays slow hand motion like a pure latency; only the second-order term
@@ -196,7 +201,7 @@ pub fn run(
     progress: &dyn Fn(usize, usize, &str),
 ) -> Result<SelfTest, super::DiagnoseError> {
     let mut plan: Vec<(&'static str, Vec<Effect>)> = Vec::new();
-    for e in magnitudes() {
+    for e in magnitudes().into_iter().chain(VARIANTS) {
         plan.push(("single", vec![e]));
     }
     for (a, b) in PAIRS {

@@ -26,8 +26,9 @@
 //! - `slope_vs_acceleration` (s): least-squares slope of residual on reference angular
 //!   acceleration (the same centred difference, applied to the reference rate), with
 //!   intercept: `dynamic`. A gyro lagging the reference by `d` gives ≈ −`d`.
-//! - `cubic_vs_rate` (1/(deg/s)²): cubic coefficient of a least-squares cubic polynomial
-//!   of residual on reference rate: `dynamic`.
+//! - `cubic_vs_rate` (1/(deg/s)²), `quadratic_vs_rate` (1/(deg/s)): cubic and quadratic
+//!   coefficients of a least-squares cubic polynomial of residual on reference rate:
+//!   `dynamic`.
 //! - `allan_log10_adev_<lo>_<hi>s` (log10 deg/s): mean log10 of the overlapping Allan
 //!   deviation of the static residual (each static run its own segment, mean removed) at
 //!   [`ALLAN_FACTORS_PER_BAND`] log-spaced τ in each band of [`ALLAN_BANDS_S`]: `static`.
@@ -37,6 +38,9 @@
 //! - `xcorr_peak_lag_s` (s): lag of the peak of the cross-correlation of gyro rate and
 //!   reference rate (means removed) within ±[`MAX_LAG_S`], refined by a parabola through
 //!   the peak and its neighbours; positive when the gyro lags the reference: `all`.
+//! - `xcorr_lag_trend` (s/s): the same lag in the last third of the run less that in the
+//!   first third, over the time between their starts (a sample clock stamped by its own
+//!   count lags more and more): `all`.
 //! - `angle_error_rms_<H>s` (deg): RMS over non-overlapping windows of `H` s
 //!   ([`HORIZONS_S`]) of the residual integrated over the window, after removing the
 //!   static residual mean (the bias; the mean over all samples when there is no static
@@ -306,8 +310,8 @@ fn solve<const N: usize>(mut a: [[f64; N]; N], mut b: [f64; N]) -> Option<[f64; 
     Some(x)
 }
 
-/// Cubic coefficient of the least-squares cubic of y on x.
-fn cubic(points: &[(f64, f64)]) -> Option<f64> {
+/// Quadratic and cubic coefficients of the least-squares cubic of y on x.
+fn cubic(points: &[(f64, f64)]) -> Option<[f64; 2]> {
     if points.len() < 5 {
         return None;
     }
@@ -328,7 +332,7 @@ fn cubic(points: &[(f64, f64)]) -> Option<f64> {
             b[i] += powers[i] * y;
         }
     }
-    solve(a, b).map(|c| c[3] / (scale * scale * scale))
+    solve(a, b).map(|c| [c[2] / (scale * scale), c[3] / (scale * scale * scale)])
 }
 
 /// Pooled lag-1 autocorrelation over `runs` of `x`, mean removed per run.
@@ -346,6 +350,19 @@ fn lag1(x: &[f64], runs: &[std::ops::Range<usize>]) -> Option<f64> {
         den += seg.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>();
     }
     (den > 0.0).then(|| num / den)
+}
+
+/// Change of the cross-correlation peak lag over the run (s per s): the lag of the last
+/// third less that of the first, over the time between their centres.
+fn xcorr_lag_trend(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
+    let third = gyro.len() / 3;
+    if third < 3 {
+        return None;
+    }
+    let first = xcorr_peak_lag(&gyro[..third], &reference[..third], fs)?;
+    let start = gyro.len() - third;
+    let last = xcorr_peak_lag(&gyro[start..], &reference[start..], fs)?;
+    Some((last - first) / (start as f64 / fs))
 }
 
 /// Cross-correlation peak lag (s) of `gyro` against `reference` within ±`max_lag` samples.
@@ -604,8 +621,9 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
     if let Some(s) = slope(&accel_points) {
         out.push("dynamic", "slope_vs_acceleration", s);
     }
-    if let Some(c) = cubic(&all_points) {
-        out.push("dynamic", "cubic_vs_rate", c);
+    if let Some([c2, c3]) = cubic(&all_points) {
+        out.push("dynamic", "quadratic_vs_rate", c2);
+        out.push("dynamic", "cubic_vs_rate", c3);
     }
 
     // Static Allan deviation per τ band.
@@ -640,6 +658,9 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
     }
     if let Some(lag) = xcorr_peak_lag(&r.rate_dps, &r.reference_rate_dps, fs) {
         out.push("all", "xcorr_peak_lag_s", lag);
+    }
+    if let Some(trend) = xcorr_lag_trend(&r.rate_dps, &r.reference_rate_dps, fs) {
+        out.push("all", "xcorr_lag_trend", trend);
     }
 
     // Angle error growth.

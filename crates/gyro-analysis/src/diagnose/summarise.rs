@@ -204,6 +204,13 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         },
         runs,
         compensation: f.compensation,
+        motion_lines: [
+            super::line::motion_line(&f.runs.train, "training"),
+            super::line::motion_line(&f.runs.holdout, "held-out"),
+        ]
+        .into_iter()
+        .flatten()
+        .collect(),
         inputs: Vec::new(),
         corrected_model: f.corrected_model,
         selected_sensor: f.selected_sensor,

@@ -33,7 +33,7 @@
 pub mod allan;
 mod chi2;
 pub mod export;
-mod fft;
+pub(crate) mod fft;
 pub mod fit;
 mod logs;
 pub mod psd;

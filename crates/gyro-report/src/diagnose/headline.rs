@@ -45,7 +45,7 @@ fn value(e: &EffectResult, name: &str, unit: f64) -> Option<String> {
     let ci = e.ci95.get(name).copied().unwrap_or([None, None]);
     Some(match ci {
         [Some(lo), Some(hi)] => {
-            let (lo, hi) = (lo * unit, hi * unit);
+            let (lo, hi) = ((lo * unit).min(hi * unit), (lo * unit).max(hi * unit));
             let half = 0.5 * (hi - lo).abs();
             format!(
                 "{} [{}, {}]",
@@ -62,6 +62,10 @@ fn value(e: &EffectResult, name: &str, unit: f64) -> Option<String> {
 pub fn sentence(e: &EffectResult) -> String {
     let v = |name: &str, unit: f64| value(e, name, unit).unwrap_or_else(|| "-".into());
     match e.id {
+        "latency" if e.params.get("delay_s").is_some_and(|d| *d < 0.0) => format!(
+            "the gyro leads the reference (the reference lags) by {} ms",
+            v("delay_s", -1e3)
+        ),
         "latency" => format!("the gyro lags the reference by {} ms", v("delay_s", 1e3)),
         "bandwidth" => format!(
             "the gyro's response is low-passed (two poles) at {} Hz",
@@ -79,6 +83,21 @@ pub fn sentence(e: &EffectResult) -> String {
             "odd (cubic) nonlinearity {} per (deg/s)², i.e. {} % of the rate at 100 deg/s",
             v("k3_per_dps2", 1.0),
             v("k3_per_dps2", 1e6)
+        ),
+        "nonlinearity_even" => format!(
+            "even (quadratic) nonlinearity {} per deg/s, i.e. {} % of the rate at 100 deg/s, the same sign both ways",
+            v("k2_per_dps", 1.0),
+            v("k2_per_dps", 1e4)
+        ),
+        "clock_error_count_stamped" => format!(
+            "the sensor's clock is off by {} ppm and the rows are stamped by its sample count: the lag behind the reference grows by {} ms per minute",
+            v("ppm", 1.0),
+            v("ppm", 0.06)
+        ),
+        "vibration" => format!(
+            "a vibration the reference does not see: {} deg/s at {} Hz",
+            v("amplitude_dps", 1.0),
+            v("frequency_hz", 1.0)
         ),
         "saturation" => format!("the output clips at ±{} deg/s", v("limit_dps", 1.0)),
         "quantization" => format!("the output moves in steps of {} deg/s", v("lsb_dps", 1.0)),
@@ -185,6 +204,15 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
                 ));
             }
         }
+    }
+    for m in &d.motion_lines {
+        lines.push(format!(
+            "seen in the data, not a sensor effect: the motion of the {} runs has a line at {:.1} Hz ({} deg/s in the reference rate, {:.0} times its local floor): the rig vibrates and both sensors see it",
+            m.runs,
+            m.frequency_hz,
+            rounded(m.amplitude_dps, 0.05 * m.amplitude_dps),
+            m.ratio
+        ));
     }
     lines
 }

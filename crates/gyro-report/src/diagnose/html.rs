@@ -1168,6 +1168,7 @@ mod tests {
                     max_abs_error_after_deg: 0.2,
                 }],
             }),
+            motion_lines: Vec::new(),
             inputs: Vec::new(),
             corrected_model: None,
             selected_sensor: SensorModel::default(),

@@ -94,10 +94,15 @@ effect_enum! {
         /// Half the difference between the positive and negative scales.
         k,
     },
-    /// Cubic nonlinearity: rate + k3·rate³.
+    /// Cubic (odd) nonlinearity: rate + k3·rate³.
     Nonlinearity {
         /// Cubic coefficient (1/(deg/s)²).
         k3_per_dps2,
+    },
+    /// Quadratic (even) nonlinearity: rate + k2·rate², the same sign in both directions.
+    NonlinearityEven {
+        /// Quadratic coefficient (1/(deg/s)).
+        k2_per_dps,
     },
     /// Output clipped at ±limit.
     Saturation {
@@ -109,7 +114,8 @@ effect_enum! {
         /// Step (deg/s).
         lsb_dps,
     },
-    /// The gyro lags the true motion (and the reference).
+    /// The gyro lags the true motion (and the reference) by `delay_s`; a negative delay
+    /// is a gyro ahead of the reference (a reference that lags).
     Latency {
         /// Delay (s).
         delay_s,
@@ -119,6 +125,14 @@ effect_enum! {
     /// stays the nominal fs the firmware integrates with. The rate is right at its stamp;
     /// integrated over nominal periods, the angle gains ε × the angle turned.
     ClockError {
+        /// Clock error (parts per million).
+        ppm,
+    },
+    /// The sensor's sample clock runs fast by `ppm` and the rows are stamped by the
+    /// sensor's own sample count (k / fs): sample k is taken at k/(fs(1+ε)) but logged at
+    /// k/fs beside a reference sampled at k/fs. The gyro's time base stretches against the
+    /// reference: it lags by ε·t, a lag growing linearly over the run.
+    ClockErrorCountStamped {
         /// Clock error (parts per million).
         ppm,
     },
@@ -159,6 +173,14 @@ effect_enum! {
     Bandwidth {
         /// -3 dB bandwidth (Hz).
         cutoff_hz,
+    },
+    /// A vibration the reference does not see (a stepper motor, a fan): a sinusoid of
+    /// `amplitude_dps` at `frequency_hz` added to the gyro's rate.
+    Vibration {
+        /// Peak amplitude (deg/s).
+        amplitude_dps,
+        /// Frequency (Hz).
+        frequency_hz,
     },
 }
 
@@ -260,6 +282,22 @@ pub const EFFECTS: &[EffectInfo] = &[
         neutral: |p, _| p[0] == 0.0,
     },
     EffectInfo {
+        id: "nonlinearity_even",
+        params: &[ParamSpec::any("k2_per_dps", "1/(deg/s)")],
+        signature: "residual curved (quadratic, the same sign both ways) in the rate",
+        typical: Effect::NonlinearityEven { k2_per_dps: 2e-5 },
+        self_test: Effect::NonlinearityEven { k2_per_dps: 2e-5 },
+        fit: FitProcedure::Regression {
+            regressor: Regressor::RateSquared,
+            reading: Reading::SquareCoefficient,
+            needs_temperature: false,
+            test: "regression on rate^2 vs null replicas",
+        },
+        correction: CoreCorrection::None,
+        term: |p, t| t.k2_per_dps += p[0],
+        neutral: |p, _| p[0] == 0.0,
+    },
+    EffectInfo {
         id: "saturation",
         params: &[positive("limit_dps", "deg/s")],
         signature: "raw values clipped at a level",
@@ -283,15 +321,15 @@ pub const EFFECTS: &[EffectInfo] = &[
     },
     EffectInfo {
         id: "latency",
-        params: &[ParamSpec::within("delay_s", "s", Inclusive(0.0), Inclusive(1.0))],
-        signature: "residual proportional to angular acceleration; cross-correlation peak off zero",
+        params: &[ParamSpec::within("delay_s", "s", Inclusive(-1.0), Inclusive(1.0))],
+        signature: "residual proportional to angular acceleration; cross-correlation peak off zero (either side)",
         typical: Effect::Latency { delay_s: 0.005 },
         self_test: Effect::Latency { delay_s: 0.005 },
         fit: FitProcedure::Regression {
             regressor: Regressor::Acceleration,
             reading: Reading::Delay,
             needs_temperature: false,
-            test: "regression on angular acceleration vs null replicas (one-sided)",
+            test: "regression on angular acceleration vs null replicas",
         },
         correction: CoreCorrection::ReferenceDelay,
         term: |p, t| t.delay_s += p[0],
@@ -308,6 +346,24 @@ pub const EFFECTS: &[EffectInfo] = &[
         // exactly like a scale factor.
         correction: CoreCorrection::ScaleK { per_unit: 1e-6 },
         term: |p, t| t.clock_ppm += p[0],
+        neutral: |p, _| p[0] == 0.0,
+    },
+    EffectInfo {
+        id: "clock_error_count_stamped",
+        params: &[ParamSpec::within("ppm", "ppm", Exclusive(-1e5), Exclusive(1e5))],
+        signature: "rows stamped by the sensor's sample count: stamps on the nominal grid, the lag behind the reference growing linearly over the run (residual proportional to time x angular acceleration)",
+        typical: Effect::ClockErrorCountStamped { ppm: 500.0 },
+        self_test: Effect::ClockErrorCountStamped { ppm: 500.0 },
+        fit: FitProcedure::Regression {
+            regressor: Regressor::TimeAcceleration,
+            reading: Reading::ClockPpm,
+            needs_temperature: false,
+            test: "regression on time x angular acceleration vs null replicas",
+        },
+        // Integrated over nominal periods, the angle of a movement is 1 + ε times the
+        // true one, as with the logger-stamped clock.
+        correction: CoreCorrection::ScaleK { per_unit: 1e-6 },
+        term: |p, t| t.count_clock_ppm += p[0],
         neutral: |p, _| p[0] == 0.0,
     },
     EffectInfo {
@@ -416,6 +472,26 @@ pub const EFFECTS: &[EffectInfo] = &[
         // The fit's stand-in for "no limit".
         neutral: |p, model| p[0] >= 0.5 * model.sample_rate_hz,
     },
+    EffectInfo {
+        id: "vibration",
+        params: &[
+            non_negative("amplitude_dps", "deg/s"),
+            positive("frequency_hz", "Hz"),
+        ],
+        signature: "a narrow line in the residual's spectrum (gyro minus reference rate) that the nominal sensor does not have",
+        typical: Effect::Vibration {
+            amplitude_dps: 0.5,
+            frequency_hz: 13.0,
+        },
+        self_test: Effect::Vibration {
+            amplitude_dps: 0.2,
+            frequency_hz: 37.0,
+        },
+        fit: FitProcedure::SpectralLine,
+        correction: CoreCorrection::None,
+        term: |p, t| t.vibration = Some((p[0], p[1])),
+        neutral: |p, _| p[0] == 0.0,
+    },
 ];
 
 /// The table entry of `id`.
@@ -521,10 +597,12 @@ mod tests {
             "scale_factor",
             "scale_asymmetry",
             "nonlinearity",
+            "nonlinearity_even",
             "saturation",
             "quantization",
             "latency",
             "clock_error",
+            "clock_error_count_stamped",
             "dropouts",
             "temperature_bias",
             "temperature_scale",
@@ -532,6 +610,7 @@ mod tests {
             "rate_random_walk",
             "turn_on_bias",
             "bandwidth",
+            "vibration",
         ];
         assert_eq!(EFFECTS.len(), ids.len());
         for (info, id) in EFFECTS.iter().zip(ids) {
@@ -568,7 +647,7 @@ mod tests {
         );
         check(
             "latency:delay_s=2",
-            "effect `latency`: delay_s must be in [0, 1]",
+            "effect `latency`: delay_s must be in [-1, 1]",
         );
         check(
             "dropouts:mean_samples=0.5",

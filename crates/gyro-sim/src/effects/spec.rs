@@ -122,8 +122,12 @@ pub enum Regressor {
     AbsRate,
     /// (rate / 100 deg/s)³.
     RateCubed,
+    /// (rate / 100 deg/s)².
+    RateSquared,
     /// Angular acceleration.
     Acceleration,
+    /// Time from the middle of the run × angular acceleration.
+    TimeAcceleration,
     /// Temperature change from the start of the run.
     DeltaT,
     /// Rate × temperature change.
@@ -137,8 +141,12 @@ pub enum Reading {
     Coefficient,
     /// The coefficient of (rate / scale)³: the parameter is it over scale³ (two-sided).
     CubicCoefficient,
-    /// Minus the coefficient is a delay (s), the parameter (one-sided test).
+    /// The coefficient of (rate / scale)²: the parameter is it over scale² (two-sided).
+    SquareCoefficient,
+    /// Minus the coefficient is a delay (s), the parameter (two-sided: either sign).
     Delay,
+    /// Minus the coefficient is a clock error (×10⁶: ppm), the parameter (two-sided).
+    ClockPpm,
     /// Minus the coefficient is the low-frequency delay of a two-pole low-pass whose
     /// cutoff (Hz) is the parameter (one-sided test).
     LowPassDelay,
@@ -172,6 +180,9 @@ pub enum FitProcedure {
     OutputGrid,
     /// Gaps in the time stamps (seen directly in the data).
     Gaps,
+    /// A narrow line in the residual's spectrum against the null replicas (its
+    /// frequency and amplitude), replicated on the held-out runs.
+    SpectralLine,
 }
 
 /// The Allan-variance shape of a bias wander per unit of its parameter squared.

@@ -12,14 +12,18 @@ pub(crate) struct SimTerms {
     pub(crate) asymmetry_k: f64,
     /// Cubic coefficient (1/(deg/s)²).
     pub(crate) k3_per_dps2: f64,
+    /// Quadratic coefficient (1/(deg/s)).
+    pub(crate) k2_per_dps: f64,
     /// Clip level (deg/s); infinite for none (the sensor's range still applies).
     pub(crate) limit_dps: f64,
     /// Extra output rounding (deg/s); 0 for none.
     pub(crate) extra_lsb_dps: f64,
     /// Delay of the gyro behind the motion (s).
     pub(crate) delay_s: f64,
-    /// Sample-clock error (ppm).
+    /// Sample-clock error, rows stamped by the logger's clock (ppm).
     pub(crate) clock_ppm: f64,
+    /// Sample-clock error, rows stamped by the sensor's sample count (ppm).
+    pub(crate) count_clock_ppm: f64,
     /// Dropout events per second and mean samples lost per event.
     pub(crate) dropouts: Option<(f64, f64)>,
     /// Bias per °C of temperature change (deg/s/°C).
@@ -34,6 +38,8 @@ pub(crate) struct SimTerms {
     pub(crate) turn_on_sigma_dps: f64,
     /// The sensor's own low-pass (-3 dB, Hz).
     pub(crate) bandwidth_hz: Option<f64>,
+    /// A vibration: peak amplitude (deg/s) and frequency (Hz).
+    pub(crate) vibration: Option<(f64, f64)>,
 }
 
 impl Default for SimTerms {
@@ -42,10 +48,12 @@ impl Default for SimTerms {
             scale_k: 0.0,
             asymmetry_k: 0.0,
             k3_per_dps2: 0.0,
+            k2_per_dps: 0.0,
             limit_dps: f64::INFINITY,
             extra_lsb_dps: 0.0,
             delay_s: 0.0,
             clock_ppm: 0.0,
+            count_clock_ppm: 0.0,
             dropouts: None,
             bias_dps_per_c: 0.0,
             scale_per_c: 0.0,
@@ -53,6 +61,7 @@ impl Default for SimTerms {
             walk_dps_per_rt_s: 0.0,
             turn_on_sigma_dps: 0.0,
             bandwidth_hz: None,
+            vibration: None,
         }
     }
 }
