@@ -97,13 +97,15 @@ pub fn write_report(
         path: json_path.clone(),
         source,
     })?;
-    std::fs::write(&json_path, json).map_err(|source| ReportError::Write {
+    let write = |w: &mut _| std::io::Write::write_all(w, json.as_bytes());
+    gyro_log::whole::write(&json_path, write).map_err(|source| ReportError::Write {
         path: json_path.clone(),
         source,
     })?;
     let html_path = dir.join("index.html");
     let html = page(d, envelopes, options, &html_path)?;
-    std::fs::write(&html_path, html).map_err(|source| ReportError::Write {
+    let write = |w: &mut _| std::io::Write::write_all(w, html.as_bytes());
+    gyro_log::whole::write(&html_path, write).map_err(|source| ReportError::Write {
         path: html_path.clone(),
         source,
     })
