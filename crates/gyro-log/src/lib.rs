@@ -184,7 +184,7 @@ pub fn write_log(path: &Path, log: &Log, format: Option<LogFormat>) -> Result<()
         path: path.to_path_buf(),
         cause,
     };
-    let (partial, _) = whole::Partial::beside(path).map_err(io_err)?;
+    let partial = whole::Partial::beside(path).map_err(io_err)?;
     match write_log_as(partial.path(), log, format) {
         Ok(()) => partial.finish().map_err(io_err),
         Err(e) => {

@@ -1,6 +1,8 @@
 //! Files written whole: the content goes to a partial file beside the target, which is
 //! renamed over the target only once everything was written. A failure leaves no
-//! half-written file that looks finished, and a file that was there is kept.
+//! half-written file that looks finished, and a file that was there is kept. A target
+//! that is a device or a pipe (`/dev/stdout`, `/dev/null`) holds nothing to keep and cannot
+//! be renamed over: it is written in place.
 //!
 //! ```
 //! let dir = std::env::temp_dir().join(format!("gyro-log-whole-doc-{}", std::process::id()));
@@ -27,13 +29,29 @@ use std::path::{Path, PathBuf};
 pub struct Partial {
     path: PathBuf,
     target: PathBuf,
+    /// The target is a device or a pipe, written in place.
+    in_place: bool,
+}
+
+/// True if `path` is a device, a pipe or a socket (after following links): a stream, not
+/// a file whose content could be kept.
+pub fn is_stream(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
 impl Partial {
     /// Reserve a new, empty partial file in `target`'s folder: `NAME.partial.EXT` for
     /// `NAME.EXT` (the extension kept, so the format it names is the same), or
-    /// `NAME.partial-2.EXT`, … if that exists: a file already there is never touched.
-    pub fn beside(target: &Path) -> io::Result<(Self, File)> {
+    /// `NAME.partial-2.EXT`, … if that exists: a file already there is never touched. A
+    /// target that is a stream ([`is_stream`]) is its own partial file.
+    pub fn beside(target: &Path) -> io::Result<Self> {
+        if is_stream(target) {
+            return Ok(Self {
+                path: target.to_path_buf(),
+                target: target.to_path_buf(),
+                in_place: true,
+            });
+        }
         let stem = target
             .file_stem()
             .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "not a file name"))?;
@@ -50,12 +68,12 @@ impl Partial {
             }
             let path = target.with_file_name(name);
             match File::options().write(true).create_new(true).open(&path) {
-                Ok(file) => {
-                    let partial = Self {
+                Ok(_) => {
+                    return Ok(Self {
                         path,
                         target: target.to_path_buf(),
-                    };
-                    return Ok((partial, file));
+                        in_place: false,
+                    })
                 }
                 Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
                 Err(e) => return Err(e),
@@ -80,6 +98,9 @@ impl Partial {
     /// Flush the partial file to the disk and rename it over the target. On failure the
     /// partial file is removed.
     pub fn finish(self) -> io::Result<()> {
+        if self.in_place {
+            return Ok(());
+        }
         let done = File::open(&self.path)
             .and_then(|file| file.sync_all())
             .and_then(|()| std::fs::rename(&self.path, &self.target));
@@ -91,7 +112,9 @@ impl Partial {
 
     /// Remove the partial file (best effort: it is not the target).
     pub fn discard(self) {
-        let _ = std::fs::remove_file(&self.path);
+        if !self.in_place {
+            let _ = std::fs::remove_file(&self.path);
+        }
     }
 }
 
@@ -101,10 +124,12 @@ pub fn write(
     target: &Path,
     write: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
 ) -> io::Result<()> {
-    let (partial, file) = Partial::beside(target)?;
-    let mut out = BufWriter::new(file);
-    let written = write(&mut out).and_then(|()| out.flush());
-    drop(out);
+    let partial = Partial::beside(target)?;
+    let written = File::create(partial.path()).and_then(|file| {
+        let mut out = BufWriter::new(file);
+        write(&mut out)?;
+        out.flush()
+    });
     match written {
         Ok(()) => partial.finish(),
         Err(e) => {
@@ -132,7 +157,7 @@ mod tests {
         let dir = dir("names");
         let target = dir.join("run.mcap");
         std::fs::write(dir.join("run.partial.mcap"), b"mine").unwrap();
-        let (partial, _) = Partial::beside(&target).unwrap();
+        let partial = Partial::beside(&target).unwrap();
         assert_eq!(partial.path(), dir.join("run.partial-2.mcap"));
         assert_eq!(
             std::fs::read(dir.join("run.partial.mcap")).unwrap(),
@@ -141,7 +166,7 @@ mod tests {
         std::fs::write(partial.path(), b"new").unwrap();
         partial.finish().unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"new");
-        let (plain, _) = Partial::beside(&dir.join("model")).unwrap();
+        let plain = Partial::beside(&dir.join("model")).unwrap();
         assert_eq!(plain.path(), dir.join("model.partial"));
         plain.discard();
         assert!(!dir.join("model.partial").exists());
@@ -165,6 +190,15 @@ mod tests {
         assert_eq!(std::fs::read(&target).unwrap(), b"after");
         // A folder that does not exist: an error, nothing made.
         assert!(write(&dir.join("none/out.csv"), |w| w.write_all(b"x")).is_err());
+        // A device is written in place, never renamed over.
+        #[cfg(unix)]
+        {
+            let null = Path::new("/dev/null");
+            assert!(is_stream(null));
+            assert_eq!(Partial::beside(null).unwrap().path(), null);
+            write(null, |w| w.write_all(b"x")).unwrap();
+            assert!(is_stream(null));
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
