@@ -4,7 +4,7 @@
 //! [`load`] is the one way in for a command: read either format (by content, else by
 //! extension), pass on the warnings, place the rows on the grid; [`stream`] does the same
 //! slot by slot. [`read_log`] reads without placing; [`write_log`] writes either format by
-//! extension.
+//! extension, whole ([`whole`]: a partial file beside the target, renamed when complete).
 //!
 //! ```
 //! let regular = gyro_log::load(

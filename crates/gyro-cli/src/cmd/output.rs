@@ -79,7 +79,7 @@ pub fn write(
 /// Refuse to write `output` if it is one of `inputs` (the same file by device and inode
 /// on Unix, whatever the spelling: `./in.csv`, an absolute path, a symlink, a hard link),
 /// so that nothing already recorded is lost. An output that does not exist yet is fine.
-pub fn refuse_to_overwrite<'a>(
+fn refuse_to_overwrite<'a>(
     output: &Path,
     inputs: impl IntoIterator<Item = &'a Path>,
 ) -> Result<()> {
