@@ -18,9 +18,9 @@ cargo build --release -q -p gyro-cli
 gyro=target/release/gyro-cli
 for seed in $(seq 101 120); do
     # shellcheck disable=SC2086
-    "$gyro" simulate -o "$out/run$seed.csv" --seed "$seed" --duration-s 90 $effects 2>/dev/null
+    "$gyro" simulate --force -o "$out/run$seed.csv" --seed "$seed" --duration-s 90 $effects 2>/dev/null
 done
 train=$(for s in $(seq 101 110); do echo "$out/run$s.csv"; done)
 holdout=$(for s in $(seq 111 120); do echo "$out/run$s.csv"; done)
 # shellcheck disable=SC2086
-time "$gyro" calibrate $train --holdout $holdout -o "$out/model.json"
+time "$gyro" calibrate $train --holdout $holdout --force -o "$out/model.json"

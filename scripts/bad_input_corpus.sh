@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The project's bad-input corpus: ~130 bad inputs and mistaken arguments across all eight
+# The project's bad-input corpus: ~210 bad inputs and mistaken arguments across all eight
 # gyro-cli commands, each run with a timeout and classified (see docs/bad-input-corpus.md):
 #   clean          non-zero exit with exactly one `error:` line (naming what it must), or
 #                  a documented success
@@ -105,6 +105,11 @@ mkdir -p in/a_directory
 ln -s good.csv in/link_to_good.csv
 ln in/good.csv in/hardlink_to_good.csv
 echo 'placeholder' >in/existing_recording.mcap
+# Outputs that exist already (kept unless --force; the inputs' checksum sees any change)
+mkdir -p in/existing/report
+for f in out.csv plot.svg model.json psd.csv imu.yaml faults.json copy.mcap report/index.html; do
+    echo 'an earlier output' >"in/existing/$f"
+done
 
 # ---------------------------------------------------------------------------------------
 # Cases: `c NAME EXPECT NEEDLE COMMAND`. EXPECT: refuse (one `error:` line containing
@@ -235,6 +240,9 @@ c "run good.mcap --time-unit ms" refuse "--time-unit" "\$G run in/good.mcap --ti
 c "run good.csv --topic /gyro" refuse "--topic" "\$G run in/good.csv --topic /gyro"
 c "run good.csv --axis x" refuse "--axis" "\$G run in/good.csv --axis x"
 c "noise good.mcap --rate-column r" refuse "--rate-column" "\$G noise in/good.mcap --rate-column r"
+c "noise --temperature-column (noise reads no temperature)" refuse "--temperature-column" "\$G noise in/good.csv --temperature-column temperature_c"
+c "noise --reference-column (noise reads no reference)" refuse "--reference-column" "\$G noise in/good.csv --reference-column reference_deg"
+c "run no_reference.csv --temperature-column temperature_c (missing)" refuse "temperature_c" "\$G run in/no_reference.csv --temperature-column temperature_c"
 
 # Runs given twice
 c "calibrate the same run twice" refuse "twice" "\$G calibrate in/good.csv ./in/good.csv -o out/m.json"
@@ -259,9 +267,31 @@ c "simulate -o over --motion-from" refuse "good.csv" "\$G simulate --motion-from
 c "simulate -o over --model" refuse "model.json" "\$G simulate --model in/model.json -o in/model.json"
 c "convert in → same file" refuse "good.csv" "\$G convert in/good.csv in/good.csv"
 c "convert in → symlink to it" refuse "link_to_good.csv" "\$G convert in/good.csv in/link_to_good.csv"
-c "convert corrupt.mcap over existing file" refuse "corrupt.mcap" "\$G convert in/corrupt.mcap in/existing_recording.mcap"
+c "convert corrupt.mcap over existing file --force" refuse "corrupt.mcap" "\$G convert in/corrupt.mcap in/existing_recording.mcap --force"
 c "emulate --fault-log over --log" refuse "good.csv" "\$G emulate --log in/good.csv --port out/nowhere --fault-log in/good.csv"
 c "record -o existing without --force" refuse "existing_recording.mcap" "\$G record --port /dev/null -o in/existing_recording.mcap"
+
+# Outputs that exist: refused without --force, replaced with it
+E=in/existing
+c "run --out existing" refuse "out.csv: exists" "\$G run in/good.csv --out $E/out.csv"
+c "run --plot existing" refuse "plot.svg: exists" "\$G run in/good.csv --plot $E/plot.svg"
+c "calibrate -o existing" refuse "model.json: exists" "\$G calibrate in/good.csv -o $E/model.json"
+c "noise --psd-out existing" refuse "psd.csv: exists" "\$G noise in/good.csv --psd-out $E/psd.csv"
+c "noise --model-out existing" refuse "model.json: exists" "\$G noise in/good.csv --model-out $E/model.json"
+c "noise --noise-yaml existing" refuse "imu.yaml: exists" "\$G noise in/good.csv --noise-yaml $E/imu.yaml"
+c "noise --plot existing" refuse "plot.svg: exists" "\$G noise in/good.csv --plot $E/plot.svg"
+c "diagnose -o existing" refuse "model.json: exists" "\$G diagnose --train in/good.csv --holdout in/other.csv -o $E/model.json"
+c "diagnose --noise-yaml existing" refuse "imu.yaml: exists" "\$G diagnose --train in/good.csv --holdout in/other.csv --noise-yaml $E/imu.yaml"
+c "diagnose --report over an earlier report" refuse "index.html: exists" "\$G diagnose --train in/good.csv --holdout in/other.csv --report $E/report"
+c "simulate -o existing" refuse "out.csv: exists" "\$G simulate --duration-s 2 -o $E/out.csv"
+c "convert to an existing file" refuse "copy.mcap: exists" "\$G convert in/good.csv $E/copy.mcap"
+c "emulate --fault-log existing" refuse "faults.json: exists" "\$G emulate --port out/nowhere --fault-log $E/faults.json"
+c "noise: one file for two outputs" refuse "named for two outputs" "\$G noise in/good.csv --psd-out out/a.csv --model-out ./out/a.csv"
+c "run --out over its input with --force" refuse "good.csv" "\$G run in/good.csv --out in/good.csv --force"
+c "run --out existing --force" ok "" "echo old >out/s.csv && \$G run in/good.csv --out out/s.csv --force >/dev/null && ! grep -q old out/s.csv"
+c "simulate -o existing --force" ok "" "echo old >out/s.csv && \$G simulate --duration-s 2 -o out/s.csv --force && ! grep -q old out/s.csv"
+c "convert to an existing file --force" ok "" "echo old >out/c.mcap && \$G convert in/good.csv out/c.mcap --force && head -c 5 out/c.mcap | grep -q MCAP"
+c "run --out /dev/stdout (a device: written, not refused)" ok "" "\$G run in/good.csv --format json --out /dev/stdout >/dev/null"
 
 # Ports, pipes, full disks
 c "record --port missing" refuse "/dev/no-such-port" "\$G record --port /dev/no-such-port -o out/r.mcap"

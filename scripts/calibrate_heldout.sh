@@ -23,11 +23,11 @@ fi
 first="${FIRST:-201}"
 for seed in $(seq "$first" $((first + 19))); do
     # shellcheck disable=SC2086
-    "$GYRO" simulate -o "$out/run$seed.csv" --seed "$seed" --duration-s 90 $effects 2>/dev/null
+    "$GYRO" simulate --force -o "$out/run$seed.csv" --seed "$seed" --duration-s 90 $effects 2>/dev/null
 done
 train=$(for s in $(seq "$first" $((first + 9))); do echo "$out/run$s.csv"; done)
 # shellcheck disable=SC2086
-"$GYRO" calibrate $train -o "$out/model.json" >"$out/calibrate.txt" 2>"$out/calibrate.err"
+"$GYRO" calibrate $train --force -o "$out/model.json" >"$out/calibrate.txt" 2>"$out/calibrate.err"
 median_max_abs() {
     for s in $(seq $((first + 10)) $((first + 19))); do
         "$GYRO" run "$out/run$s.csv" --format json "$@" 2>/dev/null |

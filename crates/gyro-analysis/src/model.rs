@@ -213,14 +213,17 @@ fn json_message(error: &serde_json::Error) -> String {
     out
 }
 
-/// Write a model file (pretty JSON).
+/// Write a model file (pretty JSON), whole ([`gyro_log::whole`]).
 pub fn save(path: &Path, model: &ModelFile) -> Result<(), ModelError> {
     let io = |cause| ModelError::Io {
         path: path.to_path_buf(),
         cause,
     };
     let text = serde_json::to_string_pretty(model).map_err(|e| io(std::io::Error::other(e)))?;
-    std::fs::write(path, text + "\n").map_err(io)
+    gyro_log::whole::write(path, |w| {
+        std::io::Write::write_all(w, (text + "\n").as_bytes())
+    })
+    .map_err(io)
 }
 
 #[cfg(test)]

@@ -428,6 +428,7 @@ fn nothing_bad_is_accepted_silently() {
         "--no-leave-one-out",
         "--format",
         "json",
+        "--force",
     ])))
     .unwrap();
     assert_eq!(json["inputs"][0]["file"], bench);
@@ -486,4 +487,323 @@ fn a_full_stderr_does_not_panic() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
+}
+
+/// The files in `dir`, with their bytes, sorted by name.
+fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|entry| {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            let bytes = std::fs::read(&path).unwrap_or_default(); // a folder: no bytes
+            (name, bytes)
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// Clobber: every option that writes a file refuses one that exists, unless --force; the
+/// file keeps its bytes and nothing else is written.
+#[test]
+fn existing_outputs_are_refused_without_force() {
+    let dir = temp_dir("existing");
+    let good = write(&dir, "good.csv", &log_text("", 3000, 0.001));
+    let other = write(&dir, "other.csv", &log_text("", 3000, 0.001));
+    let bench = bench_log();
+    let bench = s(&bench);
+    let out = dir.join("out");
+    let report = dir.join("report");
+    let cases: Vec<(&str, Vec<&str>)> = vec![
+        ("series.csv", vec!["run", &good, "--out"]),
+        ("run.svg", vec!["run", &good, "--plot"]),
+        ("model.json", vec!["calibrate", bench, "-o"]),
+        (
+            "calibration.png",
+            vec!["calibrate", bench, "-o", "new-model.json", "--plot"],
+        ),
+        ("psd.csv", vec!["noise", &good, "--psd-out"]),
+        ("model.json", vec!["noise", &good, "--model-out"]),
+        ("imu.yaml", vec!["noise", &good, "--noise-yaml"]),
+        ("allan.svg", vec!["noise", &good, "--plot"]),
+        (
+            "corrected.json",
+            vec!["diagnose", "--train", &good, "--holdout", &other, "-o"],
+        ),
+        (
+            "imu.yaml",
+            vec![
+                "diagnose",
+                "--train",
+                &good,
+                "--holdout",
+                &other,
+                "--noise-yaml",
+            ],
+        ),
+        ("sim.csv", vec!["simulate", "--duration-s", "2", "-o"]),
+        ("copy.mcap", vec!["convert", &good]),
+        (
+            "faults.json",
+            vec!["emulate", "--port", "/nonexistent/port", "--fault-log"],
+        ),
+        (
+            "run.mcap",
+            vec!["record", "--port", "/nonexistent/port", "-o"],
+        ),
+    ];
+    for (name, args) in cases {
+        std::fs::create_dir_all(&out).unwrap();
+        let existing = out.join(name);
+        std::fs::write(&existing, b"an earlier output\n").unwrap();
+        let before = contents(&out);
+        let mut args = args.clone();
+        args.push(s(&existing));
+        let output = Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
+            .args(&args)
+            .current_dir(&out)
+            .output()
+            .unwrap();
+        refused(
+            &output,
+            1,
+            &format!(
+                "{}: exists; choose another name, or --force to replace it",
+                s(&existing)
+            ),
+        );
+        assert_eq!(contents(&out), before, "{args:?}");
+        std::fs::remove_dir_all(&out).unwrap();
+    }
+    // The report's two files: either one there refuses the report.
+    for name in ["index.html", "diagnosis.json"] {
+        std::fs::create_dir_all(&report).unwrap();
+        std::fs::write(report.join(name), b"an earlier report\n").unwrap();
+        let before = contents(&report);
+        let output = gyro(&[
+            "diagnose",
+            "--train",
+            &good,
+            "--holdout",
+            &other,
+            "--report",
+            s(&report),
+        ]);
+        refused(&output, 1, &format!("{name}: exists"));
+        assert_eq!(contents(&report), before);
+        std::fs::remove_dir_all(&report).unwrap();
+    }
+    // One file named for two outputs: refused before either is written.
+    let twice = dir.join("twice.csv");
+    let twice_too = format!("{}/./twice.csv", dir.display());
+    refused(
+        &gyro(&[
+            "noise",
+            &good,
+            "--psd-out",
+            s(&twice),
+            "--model-out",
+            &twice_too,
+        ]),
+        1,
+        "named for two outputs",
+    );
+    assert!(!twice.exists());
+    // An output that is an input is refused even with --force.
+    let before = std::fs::read(&good).unwrap();
+    refused(
+        &gyro(&["run", &good, "--out", &good, "--force"]),
+        1,
+        "refusing to overwrite it",
+    );
+    assert_eq!(std::fs::read(&good).unwrap(), before);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// With --force, every output that exists is replaced, whole (no partial file is left).
+#[test]
+fn force_replaces_existing_outputs() {
+    let dir = temp_dir("force");
+    let earlier = b"an earlier output\n";
+    let existing = |name: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, earlier).unwrap();
+        s(&path).to_string()
+    };
+    let replaced = |path: &str| {
+        let bytes = std::fs::read(path).unwrap();
+        assert!(
+            !bytes.is_empty() && bytes != earlier,
+            "{path} was not replaced"
+        );
+    };
+    let good = write(&dir, "good.csv", &log_text("", 3000, 0.001));
+    let bench = bench_log();
+    let bench = s(&bench);
+
+    let (series, plot) = (existing("series.csv"), existing("run.svg"));
+    ok(&gyro(&[
+        "run", bench, "--out", &series, "--plot", &plot, "--force",
+    ]));
+    let (model, calibration) = (existing("model.json"), existing("calibration.png"));
+    ok(&gyro(&[
+        "calibrate",
+        bench,
+        "-o",
+        &model,
+        "--plot",
+        &calibration,
+        "--no-leave-one-out",
+        "--force",
+    ]));
+    let noise_outputs = [
+        existing("psd.csv"),
+        existing("noise-model.json"),
+        existing("imu.yaml"),
+        existing("allan.svg"),
+    ];
+    let [psd, noise_model, yaml, allan] = &noise_outputs;
+    ok(&gyro(&[
+        "noise",
+        &good,
+        "--psd-out",
+        psd,
+        "--model-out",
+        noise_model,
+        "--noise-yaml",
+        yaml,
+        "--plot",
+        allan,
+        "--force",
+    ]));
+    let runs: Vec<String> = (1..=4)
+        .map(|seed| {
+            let run = existing(&format!("run{seed}.csv"));
+            let seed = seed.to_string();
+            ok(&gyro(&[
+                "simulate",
+                "-o",
+                &run,
+                "--seed",
+                &seed,
+                "--duration-s",
+                "15",
+                "--force",
+            ]));
+            run
+        })
+        .collect();
+    let mcap = existing("copy.mcap");
+    ok(&gyro(&["convert", &runs[0], &mcap, "--force"]));
+    let (corrected, diagnosed_yaml) = (existing("corrected.json"), existing("diagnosed.yaml"));
+    let report = dir.join("report");
+    std::fs::create_dir_all(&report).unwrap();
+    std::fs::write(report.join("index.html"), earlier).unwrap();
+    ok(&gyro(&[
+        "diagnose",
+        "--train",
+        &runs[0],
+        &runs[1],
+        "--holdout",
+        &runs[2],
+        &runs[3],
+        "--members",
+        "6",
+        "--candidate-members",
+        "3",
+        "-o",
+        &corrected,
+        "--noise-yaml",
+        &diagnosed_yaml,
+        "--report",
+        s(&report),
+        "--force",
+    ]));
+    let html = s(&report.join("index.html")).to_string();
+    for path in [&series, &plot, &model, &calibration, &mcap, &corrected]
+        .into_iter()
+        .chain(&noise_outputs)
+        .chain(&runs)
+        .chain([&diagnosed_yaml, &html])
+    {
+        replaced(path);
+    }
+    assert!(std::fs::read(&mcap).unwrap().starts_with(b"\x89MCAP0\r\n"));
+    #[cfg(unix)]
+    {
+        let faults = existing("faults.json");
+        let recording = existing("recording.mcap");
+        let emulate_args = [
+            "--seed",
+            "3",
+            "--duration-s",
+            "2",
+            "--as-fast-as-possible",
+            "--fault-log",
+            &faults,
+            "--force",
+        ];
+        let emulate_args: Vec<&std::ffi::OsStr> =
+            emulate_args.iter().map(std::ffi::OsStr::new).collect();
+        let (emulated, recorded) =
+            common::emulate_into_record_with(&emulate_args, &["--force"], Path::new(&recording));
+        ok(&emulated);
+        ok(&recorded);
+        replaced(&faults);
+        replaced(&recording);
+        assert!(std::fs::read(&recording)
+            .unwrap()
+            .starts_with(b"\x89MCAP0\r\n"));
+    }
+    let left: Vec<String> = contents(&dir)
+        .into_iter()
+        .map(|(name, _)| name)
+        .filter(|name| name.contains(".partial"))
+        .collect();
+    assert!(left.is_empty(), "partial files left: {left:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Silent accept: a column option of a column the command does not read (noise reads the
+/// rate alone) or that the log lacks is refused, naming the option or the column.
+#[test]
+fn temperature_and_reference_columns_that_are_not_used_are_refused() {
+    let dir = temp_dir("unused-columns");
+    let bench = bench_log();
+    let bench = s(&bench);
+    for (flag, value) in [
+        ("--temperature-column", "temperature_c"),
+        ("--reference-column", "reference_deg"),
+        ("--reference-topic", "/encoder"),
+    ] {
+        refused(
+            &gyro(&["noise", bench, flag, value]),
+            1,
+            &format!("{flag} {value}: noise reads only the time and the rate"),
+        );
+    }
+    // A log without a temperature column: the column named is not there.
+    let plain = write(&dir, "plain.csv", &log_text("", 3000, 0.001));
+    for command in ["run", "convert"] {
+        let mut args = vec![command, &plain, "--temperature-column", "temperature_c"];
+        let copy = dir.join("copy.csv");
+        if command == "convert" {
+            args.push(s(&copy));
+        }
+        refused(
+            &gyro(&args),
+            1,
+            "plain.csv:1: no column `temperature_c` in the header",
+        );
+        assert!(!copy.exists());
+    }
+    // Where it is read, it is taken.
+    ok(&gyro(&[
+        "run",
+        bench,
+        "--temperature-column",
+        "temperature_c",
+    ]));
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -266,13 +266,15 @@ fn calibrate_and_noise_take_mcap_and_refuse_logs_without_reference() {
         "noref.csv",
         "time_s,rate_dps\n0.000,0.1\n0.001,0.1\n0.002,0.1\n",
     );
-    let out = gyro(&["calibrate", &no_reference, "-o", model.to_str().unwrap()]);
+    let not_made = dir.join("noref-model.json");
+    let out = gyro(&["calibrate", &no_reference, "-o", not_made.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(
         stderr.contains("noref.csv: no reference_deg column"),
         "{stderr}"
     );
+    assert!(!not_made.exists());
 }
 
 /// A declared rate the stamps contradict is refused, not turned into angles off by the

@@ -94,7 +94,8 @@ fn convert_ros2_bag_with_axis_options_and_errors() {
 
     // Errors are one line naming the file.
     let two = workspace_root().join("fixtures/mcap/ros2_two_imus.mcap");
-    let out = gyro(&["convert", two.to_str().unwrap(), out_csv]);
+    let two_csv = dir.join("two.csv");
+    let out = gyro(&["convert", two.to_str().unwrap(), two_csv.to_str().unwrap()]);
     assert!(!out.status.success());
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -102,6 +103,7 @@ fn convert_ros2_bag_with_axis_options_and_errors() {
         "{e}"
     );
     assert_eq!(e.trim_end().lines().count(), 1, "{e}");
+    assert!(!two_csv.exists());
 
     let out = gyro(&["convert", bag, dir.join("x.txt").to_str().unwrap()]);
     let e = String::from_utf8_lossy(&out.stderr);

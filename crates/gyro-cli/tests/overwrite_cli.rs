@@ -52,8 +52,8 @@ fn outputs_never_overwrite_inputs() {
     assert!(series.exists());
 }
 
-/// `record` keeps an earlier recording unless told `--force`; a failed `convert` leaves
-/// the file that was there and no partial one; `simulate -o x.mcap` writes MCAP.
+/// `record` keeps an earlier recording unless told `--force`; a failed `convert --force`
+/// leaves the file that was there and no partial one; `simulate -o x.mcap` writes MCAP.
 #[test]
 fn recordings_and_outputs_are_kept_or_written_whole() {
     let dir = temp_dir("kept");
@@ -73,10 +73,20 @@ fn recordings_and_outputs_are_kept_or_written_whole() {
 
     let bad = dir.join("bad.csv");
     std::fs::write(&bad, "time_s,rate_dps\n0.0,x\n").unwrap();
-    let out = gyro(&["convert", bad.to_str().unwrap(), earlier.to_str().unwrap()]);
+    let out = gyro(&[
+        "convert",
+        bad.to_str().unwrap(),
+        earlier.to_str().unwrap(),
+        "--force",
+    ]);
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(std::fs::read(&earlier).unwrap(), b"an earlier recording");
-    assert!(!dir.join("earlier.mcap.partial").exists());
+    let mut left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["bad.csv", "earlier.mcap"], "no partial file is left");
 
     let simulated = dir.join("sim.mcap");
     let out = gyro(&[

@@ -23,6 +23,7 @@ const BIN: &str = env!("CARGO_BIN_EXE_gyro-cli");
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("gyro-record-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
@@ -102,12 +103,15 @@ fn assert_prefix(rows: &[log::Row]) {
     }
 }
 
+/// A recording killed part-way is left under its partial name (`killed.partial.mcap` for
+/// `-o killed.mcap`): readable up to the kill, and never mistaken for a finished one.
 #[test]
 fn sigkill_loses_under_half_a_second() {
     let dir = temp_dir("kill");
-    let out = dir.join("killed.mcap");
+    let finished = dir.join("killed.mcap");
+    let out = dir.join("killed.partial.mcap");
     let bridge = start_bridge(60);
-    let mut child = spawn_record(&bridge.name, &out);
+    let mut child = spawn_record(&bridge.name, &finished);
     wait_for_file(&out);
     std::thread::sleep(Duration::from_millis(3500));
     child.kill().unwrap(); // SIGKILL
@@ -115,6 +119,7 @@ fn sigkill_loses_under_half_a_second() {
     child.wait().unwrap();
     bridge.stop.store(true, Ordering::Relaxed);
     let _ports = bridge.thread.join().unwrap();
+    assert!(!finished.exists());
 
     let read = log::read_mcap(&out, &McapOptions::default()).unwrap();
     let rows = read.log.rows.len() as u64;
@@ -139,20 +144,20 @@ fn sigkill_loses_under_half_a_second() {
     );
 
     // Recovery (README): `convert` writes a finished copy of everything before the damage.
-    let recovered = dir.join("recovered.mcap");
+    let recovered = &finished;
     let status = Command::new(BIN)
         .arg("convert")
-        .args([&out, &recovered])
+        .args([&out, recovered])
         .stderr(Stdio::null())
         .status()
         .unwrap();
     assert!(status.success());
-    let bytes = std::fs::read(&recovered).unwrap();
+    let bytes = std::fs::read(recovered).unwrap();
     assert!(
         mcap::Summary::read(&bytes).unwrap().is_some(),
         "indexed readers open it"
     );
-    let again = log::read_mcap(&recovered, &McapOptions::default()).unwrap();
+    let again = log::read_mcap(recovered, &McapOptions::default()).unwrap();
     assert!(again.warnings.is_empty());
     assert_eq!(again.log.rows.len(), read.log.rows.len());
     std::fs::remove_dir_all(&dir).unwrap();
@@ -164,7 +169,7 @@ fn sigint_finishes_the_file_and_prints_a_summary() {
     let out = dir.join("interrupted.mcap");
     let bridge = start_bridge(60);
     let child = spawn_record(&bridge.name, &out);
-    wait_for_file(&out);
+    wait_for_file(&dir.join("interrupted.partial.mcap"));
     std::thread::sleep(Duration::from_millis(2500));
     let status = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
@@ -181,6 +186,7 @@ fn sigint_finishes_the_file_and_prints_a_summary() {
     assert!(stderr.contains("stopped: interrupted"), "{stderr}");
     assert!(stderr.contains("lost 0 in 0 gaps"), "{stderr}");
     assert!(stderr.contains("CRC errors 0"), "{stderr}");
+    assert!(!dir.join("interrupted.partial.mcap").exists());
 
     let bytes = std::fs::read(&out).unwrap();
     assert!(bytes.ends_with(log::mcap::MAGIC), "finished with a footer");

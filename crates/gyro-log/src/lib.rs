@@ -4,7 +4,7 @@
 //! [`load`] is the one way in for a command: read either format (by content, else by
 //! extension), pass on the warnings, place the rows on the grid; [`stream`] does the same
 //! slot by slot. [`read_log`] reads without placing; [`write_log`] writes either format by
-//! extension.
+//! extension, whole ([`whole`]: a partial file beside the target, renamed when complete).
 //!
 //! ```
 //! let regular = gyro_log::load(
@@ -25,6 +25,7 @@ mod load;
 pub mod mcap;
 mod regular;
 pub mod value;
+pub mod whole;
 
 pub(crate) use ahead::read_ahead;
 pub use bursts::Bursts;
@@ -177,21 +178,20 @@ pub fn write_log(path: &Path, log: &Log, format: Option<LogFormat>) -> Result<()
             path: path.to_path_buf(),
             message: "unknown output format: name it .csv or .mcap".into(),
         })?;
-    // Written beside the target, then renamed over it: a failure leaves no half-written
-    // file that looks finished, and a file that was there is kept.
-    let mut partial_name = path.file_name().unwrap_or_default().to_os_string();
-    partial_name.push(".partial");
-    let partial = path.with_file_name(partial_name);
-    let written = write_log_as(&partial, log, format).and_then(|()| {
-        std::fs::rename(&partial, path).map_err(|cause| LogError::Io {
-            path: path.to_path_buf(),
-            cause,
-        })
-    });
-    if written.is_err() {
-        let _ = std::fs::remove_file(&partial);
+    // Written whole ([`whole`]): a failure leaves no half-written file that looks
+    // finished, and a file that was there is kept.
+    let io_err = |cause| LogError::Io {
+        path: path.to_path_buf(),
+        cause,
+    };
+    let partial = whole::Partial::beside(path).map_err(io_err)?;
+    match write_log_as(partial.path(), log, format) {
+        Ok(()) => partial.finish().map_err(io_err),
+        Err(e) => {
+            partial.discard();
+            Err(e)
+        }
     }
-    written
 }
 
 /// [`write_log`]'s writing, straight to `path`.

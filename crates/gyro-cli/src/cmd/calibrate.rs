@@ -43,6 +43,8 @@ pub struct Args {
     /// Output format on stdout.
     #[arg(long, value_enum, default_value_t = super::run::Format::Table)]
     format: super::run::Format,
+    #[command(flatten)]
+    force: super::output::Force,
     /// Plot each run's max abs error without compensation, with the paper model and the
     /// Kalman form (training and hold-out runs) to this file: .svg or .png.
     #[arg(long, value_parser = gyro_report::plot::parse_plot_path)]
@@ -65,7 +67,10 @@ fn load_runs(paths: &[PathBuf], args: &Args) -> Result<Vec<BenchRun>> {
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
     let inputs = args.logs.iter().chain(&args.holdout).map(PathBuf::as_path);
-    super::refuse_to_overwrite(&args.out, inputs.chain(args.model.as_deref()))?;
+    args.force.check(
+        [args.out.as_path()].into_iter().chain(args.plot.as_deref()),
+        inputs.chain(args.model.as_deref()),
+    )?;
     super::refuse_repeated_runs(&[("training", &args.logs), ("hold-out", &args.holdout)])?;
     let base = match &args.model {
         Some(path) => model::load(path)?,

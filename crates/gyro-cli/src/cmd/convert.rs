@@ -14,12 +14,15 @@ pub struct Args {
     #[arg(long, value_enum)]
     to: Option<log::LogFormat>,
     #[command(flatten)]
+    force: super::output::Force,
+    #[command(flatten)]
     input_options: log::LogOptions,
 }
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    super::refuse_to_overwrite(&args.output, [args.input.as_path()])?;
+    args.force
+        .check([args.output.as_path()], [args.input.as_path()])?;
     let log = super::read(&args.input, &args.input_options)?;
     log::write_log(&args.output, &log, args.to)?;
     let yes_no = |b: bool| if b { "yes" } else { "no" };

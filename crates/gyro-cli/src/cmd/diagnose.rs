@@ -38,13 +38,14 @@ pub struct Args {
     model: Option<PathBuf>,
     /// Write a model file with the corrections of the selected correctable effects
     /// (scale, asymmetry, temperature, latency, turn-on bias), for `run --model`.
-    #[arg(short, long)]
+    #[arg(short, long, conflicts_with = "self_test")]
     out: Option<PathBuf>,
     /// Output format on stdout.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
-    /// Write an HTML report with plots into this directory.
-    #[arg(long)]
+    /// Write an HTML report with plots into this directory: index.html and diagnosis.json
+    /// (with --force if they exist).
+    #[arg(long, value_name = "DIR", conflicts_with = "self_test")]
     report: Option<PathBuf>,
     /// Seed of the simulated ensembles.
     #[arg(long, default_value_t = 1)]
@@ -65,6 +66,8 @@ pub struct Args {
     only: Option<String>,
     #[command(flatten)]
     noise_yaml: super::NoiseYamlArgs,
+    #[command(flatten)]
+    force: super::output::Force,
     #[command(flatten)]
     grid: log::GridOptions,
     #[command(flatten)]
@@ -158,17 +161,26 @@ fn load(
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    if let Some(out) = &args.out {
-        let inputs = args.train.iter().chain(&args.holdout).map(PathBuf::as_path);
-        super::refuse_to_overwrite(out, inputs.chain(args.model.as_deref()))?;
+    if args.self_test && args.noise_yaml.noise_yaml.is_some() {
+        bail!("--noise-yaml writes the noise of diagnosed logs, not of --self-test");
     }
-    if let Some(out) = &args.noise_yaml.noise_yaml {
-        if args.self_test {
-            bail!("--noise-yaml writes the noise of diagnosed logs, not of --self-test");
-        }
-        let inputs = args.train.iter().chain(&args.holdout).map(PathBuf::as_path);
-        super::refuse_to_overwrite(out, inputs.chain(args.model.as_deref()))?;
-    }
+    let report_files = args.report.iter().flat_map(|dir| {
+        gyro_report::diagnose::REPORT_FILES
+            .iter()
+            .map(|name| dir.join(name))
+    });
+    let outputs: Vec<PathBuf> = args
+        .out
+        .iter()
+        .chain(&args.noise_yaml.noise_yaml)
+        .cloned()
+        .chain(report_files)
+        .collect();
+    let inputs = args.train.iter().chain(&args.holdout).map(PathBuf::as_path);
+    args.force.check(
+        outputs.iter().map(PathBuf::as_path),
+        inputs.chain(args.model.as_deref()),
+    )?;
     if args.self_test {
         return self_test(args);
     }

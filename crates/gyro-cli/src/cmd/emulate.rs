@@ -60,6 +60,8 @@ pub struct Args {
     /// Write the fault log (the report, with every lost sequence number) as JSON here.
     #[arg(long)]
     fault_log: Option<PathBuf>,
+    #[command(flatten)]
+    force: super::output::Force,
 }
 
 fn samples(args: &Args) -> Result<(Vec<Sample>, String)> {
@@ -91,9 +93,8 @@ fn samples(args: &Args) -> Result<(Vec<Sample>, String)> {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    if let Some(fault_log) = &args.fault_log {
-        super::refuse_to_overwrite(fault_log, args.log.as_deref())?;
-    }
+    args.force
+        .check(args.fault_log.as_deref(), args.log.as_deref())?;
     if let Some(rate) = args.rate_hz {
         if !(rate > 0.0 && rate <= 1e6) {
             bail!("--rate-hz must be in (0, 1e6]");
@@ -161,13 +162,10 @@ pub fn run(args: &Args) -> Result<()> {
         emulator.source_gaps(),
     );
     if let Some(path) = &args.fault_log {
-        let mut out = std::io::BufWriter::new(
-            std::fs::File::create(path)
-                .with_context(|| format!("cannot create {}", path.display()))?,
-        );
-        serde_json::to_writer_pretty(&mut out, &report)?;
-        writeln!(out)?;
-        out.flush()?;
+        super::output::write(path, |out| {
+            serde_json::to_writer_pretty(&mut *out, &report)?;
+            writeln!(out)
+        })?;
     }
     Ok(())
 }

@@ -5,6 +5,7 @@ pub mod convert;
 pub mod diagnose;
 pub mod emulate;
 pub mod noise;
+pub mod output;
 pub mod record;
 pub mod run;
 pub mod simulate;
@@ -17,31 +18,6 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-/// Refuse to write `output` if it is one of `inputs` (the same file by device and inode
-/// on Unix, whatever the spelling: `./in.csv`, an absolute path, a symlink, a hard link),
-/// so that nothing already recorded is lost. An output that does not exist yet is fine.
-pub fn refuse_to_overwrite<'a>(
-    output: &Path,
-    inputs: impl IntoIterator<Item = &'a Path>,
-) -> Result<()> {
-    let Ok(written) = std::fs::metadata(output) else {
-        return Ok(());
-    };
-    for input in inputs {
-        let Ok(read) = std::fs::metadata(input) else {
-            continue;
-        };
-        if same_file(&written, &read, output, input) {
-            anyhow::bail!(
-                "{}: is also an input ({}); refusing to overwrite it",
-                output.display(),
-                input.display()
-            );
-        }
-    }
-    Ok(())
-}
-
 /// Refuse a run given twice: the same file (by device and inode, whatever the spelling)
 /// twice in one list, or in two lists (`names` say which: "training", "hold-out"), would
 /// count as independent evidence twice, or score a fit on the runs it was fitted to.
@@ -52,8 +28,9 @@ pub fn refuse_repeated_runs(lists: &[(&str, &[PathBuf])]) -> Result<()> {
             let Ok(meta) = std::fs::metadata(path) else {
                 continue; // reading it reports the error
             };
-            if let Some((_, first, first_list)) =
-                seen.iter().find(|(m, p, _)| same_file(m, &meta, p, path))
+            if let Some((_, first, first_list)) = seen
+                .iter()
+                .find(|(m, p, _)| output::same_file(m, &meta, p, path))
             {
                 let where_ = if first_list == name {
                     format!("twice among the {name} runs")
@@ -70,17 +47,6 @@ pub fn refuse_repeated_runs(lists: &[(&str, &[PathBuf])]) -> Result<()> {
         }
     }
     Ok(())
-}
-
-#[cfg(unix)]
-fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata, _: &Path, _: &Path) -> bool {
-    use std::os::unix::fs::MetadataExt;
-    a.dev() == b.dev() && a.ino() == b.ino()
-}
-
-#[cfg(not(unix))]
-fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata, a: &Path, b: &Path) -> bool {
-    matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
 }
 
 /// Write a command's output to stdout with `write`, then flush: any failure is one error
@@ -110,8 +76,8 @@ pub struct NoiseYamlArgs {
 impl NoiseYamlArgs {
     /// Write `params` to `--noise-yaml` in the chosen format, saying so on stderr.
     pub fn write(&self, out: &Path, params: &NoiseParams) -> Result<()> {
-        std::fs::write(out, params.to_yaml(self.noise_yaml_format))
-            .with_context(|| format!("cannot write {}", out.display()))?;
+        let yaml = params.to_yaml(self.noise_yaml_format);
+        output::write(out, |w| w.write_all(yaml.as_bytes()))?;
         say!(
             "wrote {} ({}): gyroscope_noise_density {} rad/s/√Hz ({:.4} deg/√h), gyroscope_random_walk {} rad/s²/√Hz, update_rate {} Hz",
             out.display(),

@@ -77,6 +77,8 @@ pub struct Args {
     #[command(flatten)]
     noise_yaml: super::NoiseYamlArgs,
     #[command(flatten)]
+    force: super::output::Force,
+    #[command(flatten)]
     grid: log::GridOptions,
     #[command(flatten)]
     input: log::LogOptions,
@@ -113,15 +115,51 @@ fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<NoiseLog
     })
 }
 
+/// Refuse the input settings of columns and channels noise does not read (it takes the
+/// rate alone): given, they would be ignored.
+fn refuse_unused_inputs(input: &log::LogOptions) -> Result<()> {
+    let reference_topic = (input.mcap.reference_topic
+        != log::McapOptions::default().reference_topic)
+        .then_some(&input.mcap.reference_topic);
+    let unused = [
+        (
+            "--reference-column",
+            input.columns.reference_column.as_ref(),
+        ),
+        (
+            "--temperature-column",
+            input.columns.temperature_column.as_ref(),
+        ),
+        ("--reference-topic", reference_topic),
+    ];
+    if let Some((flag, value)) = unused
+        .into_iter()
+        .find_map(|(flag, value)| Some((flag, value?)))
+    {
+        bail!(
+            "{flag} {}: noise reads only the time and the rate of a log, so it would be ignored; leave it out",
+            log::excerpt(value.as_bytes())
+        );
+    }
+    Ok(())
+}
+
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    for out in [&args.model_out, &args.psd_out, &args.noise_yaml.noise_yaml]
-        .into_iter()
-        .flatten()
-    {
-        let inputs = args.logs.iter().map(PathBuf::as_path);
-        super::refuse_to_overwrite(out, inputs.chain(args.model.as_deref()))?;
-    }
+    refuse_unused_inputs(&args.input)?;
+    let outputs = [
+        &args.model_out,
+        &args.psd_out,
+        &args.noise_yaml.noise_yaml,
+        &args.plot,
+    ];
+    args.force.check(
+        outputs.into_iter().flatten().map(PathBuf::as_path),
+        args.logs
+            .iter()
+            .map(PathBuf::as_path)
+            .chain(args.model.as_deref()),
+    )?;
     super::refuse_repeated_runs(&[("static", &args.logs)])?;
     if !(args.confidence > 0.0 && args.confidence < 1.0) {
         bail!("--confidence must be in (0, 1)");
@@ -215,18 +253,16 @@ pub fn run(args: &Args) -> Result<()> {
     }
 
     if let Some(out) = &args.psd_out {
-        let write = || -> std::io::Result<()> {
-            let mut w = std::io::BufWriter::new(std::fs::File::create(out)?);
+        super::output::write(out, |w| {
             writeln!(w, "log,frequency_hz,psd_dps2_per_hz")?;
             for (l, r) in loaded.iter().zip(&run.results) {
-                gyro_report::noise::psd_csv(&mut w, &l.file, r)?;
+                gyro_report::noise::psd_csv(w, &l.file, r)?;
             }
             if let Some(c) = &run.combined {
-                gyro_report::noise::psd_csv(&mut w, "combined", c)?;
+                gyro_report::noise::psd_csv(w, "combined", c)?;
             }
-            w.flush()
-        };
-        write().with_context(|| format!("cannot write {}", out.display()))?;
+            Ok(())
+        })?;
     }
 
     if let Some(path) = &args.plot {

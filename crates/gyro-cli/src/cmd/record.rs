@@ -4,6 +4,7 @@
 use anyhow::{Context, Result};
 use crm100_driver::{serial, Range};
 use gyro_bridge::{self as bridge, CsvSink, LiveStatus, McapSink, RecordOptions, RecordSink};
+use gyro_log::whole;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Duration;
@@ -17,12 +18,12 @@ pub struct Args {
     #[arg(long, default_value_t = serial::DEFAULT_BAUD, value_parser = clap::value_parser!(u32).range(1..))]
     baud: u32,
     /// Output log: MCAP (default) or, with --csv, CSV. An existing file is kept unless
-    /// --force: a recording is not replaced by accident.
+    /// --force: a recording is not replaced by accident. It is written as OUT's name with
+    /// `.partial` before the extension and renamed to OUT when the recording ends.
     #[arg(short, long)]
     out: PathBuf,
-    /// Replace OUT if it exists.
-    #[arg(long)]
-    force: bool,
+    #[command(flatten)]
+    force: super::output::Force,
     /// Stop after this many seconds (default: until Ctrl-C or the port closes).
     #[arg(long, value_parser = gyro_log::value::positive::<f64>)]
     duration: Option<f64>,
@@ -83,12 +84,7 @@ fn status_line(s: &LiveStatus) -> String {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    if !args.force && args.out.exists() {
-        anyhow::bail!(
-            "{}: exists (an earlier recording?); choose another name, or --force to replace it",
-            args.out.display()
-        );
-    }
+    args.force.check([args.out.as_path()], [])?;
     let stop = super::stop_flag()?;
     let options = RecordOptions {
         range: args.range,
@@ -105,10 +101,20 @@ pub fn run(args: &Args) -> Result<()> {
         Duration::from_millis(args.timeout_ms.max(1)),
     )
     .with_context(|| format!("cannot open {}", args.port))?;
-    let sink: Box<dyn RecordSink> = if args.csv {
-        Box::new(CsvSink::create(&args.out, &options)?)
+    // Recorded beside OUT, which an earlier recording (--force) keeps until the end.
+    let partial = whole::Partial::beside(&args.out)
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    let sink: Result<Box<dyn RecordSink>, _> = if args.csv {
+        CsvSink::create(partial.path(), &options).map(|s| Box::new(s) as _)
     } else {
-        Box::new(McapSink::create(&args.out, &options)?)
+        McapSink::create(partial.path(), &options).map(|s| Box::new(s) as _)
+    };
+    let sink = match sink {
+        Ok(sink) => sink,
+        Err(e) => {
+            partial.discard();
+            return Err(e.into());
+        }
     };
     say!(
         "recording {} ({} Bd, range {}) to {}; Ctrl-C to stop",
@@ -124,7 +130,13 @@ pub fn run(args: &Args) -> Result<()> {
     let mut show = |s: &LiveStatus| bar.set_message(status_line(s));
     let summary = bridge::record(&mut reader, sink, &options, &stop, &mut show);
     bar.finish_and_clear();
-    let summary = summary?;
+    // A recording that failed part-way (a full disk) keeps what it holds, under its
+    // partial name: it is readable, and it replaces nothing.
+    let summary = summary
+        .with_context(|| format!("the recording so far is in {}", partial.path().display()))?;
+    partial
+        .finish()
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
     say!("{summary}");
     say!("wrote {}", args.out.display());
     Ok(())

@@ -1,6 +1,6 @@
 //! `gyro-cli run`: replay a log through the pipeline and score it against the reference.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::ValueEnum;
 use gyro_analysis::model;
 use gyro_analysis::replay;
@@ -8,7 +8,6 @@ use gyro_core::{Compensation, Config, Direction, Tightening};
 use gyro_log as log;
 use gyro_log::value;
 use gyro_report::run as report;
-use std::io::Write;
 use std::path::PathBuf;
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -83,6 +82,8 @@ pub struct Args {
     #[arg(long, value_parser = gyro_report::plot::parse_plot_path)]
     plot: Option<PathBuf>,
     #[command(flatten)]
+    force: super::output::Force,
+    #[command(flatten)]
     grid: log::GridOptions,
     #[command(flatten)]
     input: log::LogOptions,
@@ -90,14 +91,12 @@ pub struct Args {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    if let Some(out) = &args.out {
-        super::refuse_to_overwrite(
-            out,
-            [args.log.as_path()]
-                .into_iter()
-                .chain(args.model.as_deref()),
-        )?;
-    }
+    args.force.check(
+        args.out.iter().chain(&args.plot).map(PathBuf::as_path),
+        [args.log.as_path()]
+            .into_iter()
+            .chain(args.model.as_deref()),
+    )?;
     let (mut config, options) = match &args.model {
         Some(path) => {
             let model = model::load(path)?;
@@ -161,12 +160,7 @@ pub fn run(args: &Args) -> Result<()> {
         Format::Csv => report::movements_csv(&mut &mut *out, &result.movements),
     })?;
     if let Some(out) = &args.out {
-        let write = || -> std::io::Result<()> {
-            let mut w = std::io::BufWriter::new(std::fs::File::create(out)?);
-            report::series_csv(&mut w, &result)?;
-            w.flush()
-        };
-        write().with_context(|| format!("cannot write {}", out.display()))?;
+        super::output::write(out, |w| report::series_csv(w, &result))?;
     }
     if let Some(path) = &args.plot {
         let name = args

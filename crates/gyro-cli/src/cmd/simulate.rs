@@ -39,6 +39,8 @@ pub struct Args {
     /// Temperature rise during the run (°C, warm-up with a 120 s time constant).
     #[arg(long, default_value_t = 5.0, value_parser = value::finite::<f64>)]
     temperature_rise_c: f64,
+    #[command(flatten)]
+    force: super::output::Force,
     /// Quantise the reference like an encoder with this many counts per revolution.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     encoder_counts: Option<u32>,
@@ -66,15 +68,13 @@ fn list_effects(out: &mut dyn Write) -> std::io::Result<()> {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    if let Some(out) = &args.out {
-        super::refuse_to_overwrite(
-            out,
-            args.motion_from
-                .as_deref()
-                .into_iter()
-                .chain(args.model.as_deref()),
-        )?;
-    }
+    args.force.check(
+        args.out.as_deref(),
+        args.motion_from
+            .as_deref()
+            .into_iter()
+            .chain(args.model.as_deref()),
+    )?;
     if args.list_effects {
         super::to_stdout(|out| list_effects(out))?;
         return Ok(());

@@ -22,9 +22,12 @@ pub fn gyro(args: &[&str]) -> Output {
         .expect("gyro-cli runs")
 }
 
-/// A fresh folder for one test (each test binary is its own process: the pid separates them).
+/// A fresh folder for one test (each test binary is its own process: the pid separates them;
+/// what an earlier process of the same pid left there is removed, since outputs that exist
+/// are refused).
 pub fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("gyro-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
@@ -41,6 +44,16 @@ pub fn write(dir: &Path, name: &str, text: &str) -> String {
 /// quiet. Returns (emulate, record) as they ended.
 #[cfg(unix)]
 pub fn emulate_into_record(emulate_args: &[&std::ffi::OsStr], out: &Path) -> (Output, Output) {
+    emulate_into_record_with(emulate_args, &[], out)
+}
+
+/// [`emulate_into_record`] with `record_args` added to `record`'s command line.
+#[cfg(unix)]
+pub fn emulate_into_record_with(
+    emulate_args: &[&std::ffi::OsStr],
+    record_args: &[&str],
+    out: &Path,
+) -> (Output, Output) {
     use std::io::{BufRead, BufReader};
     use std::process::Stdio;
     let mut emulate = Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
@@ -55,7 +68,9 @@ pub fn emulate_into_record(emulate_args: &[&std::ffi::OsStr], out: &Path) -> (Ou
         .read_line(&mut port)
         .unwrap();
     let record = Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
-        .args(["record", "--port", port.trim(), "--idle-stop", "1", "-o"])
+        .args(["record", "--port", port.trim(), "--idle-stop", "1"])
+        .args(record_args)
+        .arg("-o")
         .arg(out)
         .output()
         .unwrap();

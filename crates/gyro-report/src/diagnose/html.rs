@@ -79,9 +79,12 @@ pub enum ReportError {
 /// Fewest real samples for a bin to be shown.
 pub const MIN_BIN_SAMPLES: f64 = 20.0;
 
-/// Write `dir/diagnosis.json` and `dir/index.html` for the diagnosis `d` computed with
-/// `options`, its figures drawn from `envelopes` (none: the page says there is no run
-/// to draw).
+/// The files [`write_report`] writes into its folder: the diagnosis as JSON, the page.
+pub const REPORT_FILES: [&str; 2] = ["diagnosis.json", "index.html"];
+
+/// Write `dir/diagnosis.json` and `dir/index.html` ([`REPORT_FILES`]), each whole, for the
+/// diagnosis `d` computed with `options`, its figures drawn from `envelopes` (none: the
+/// page says there is no run to draw).
 pub fn write_report(
     dir: &Path,
     d: &Diagnosis,
@@ -92,18 +95,21 @@ pub fn write_report(
         path: dir.to_path_buf(),
         source,
     })?;
-    let json_path = dir.join("diagnosis.json");
+    let [json_name, html_name] = REPORT_FILES;
+    let json_path = dir.join(json_name);
     let json = serde_json::to_string_pretty(d).map_err(|source| ReportError::Json {
         path: json_path.clone(),
         source,
     })?;
-    std::fs::write(&json_path, json).map_err(|source| ReportError::Write {
+    let write = |w: &mut _| std::io::Write::write_all(w, json.as_bytes());
+    gyro_log::whole::write(&json_path, write).map_err(|source| ReportError::Write {
         path: json_path.clone(),
         source,
     })?;
-    let html_path = dir.join("index.html");
+    let html_path = dir.join(html_name);
     let html = page(d, envelopes, options, &html_path)?;
-    std::fs::write(&html_path, html).map_err(|source| ReportError::Write {
+    let write = |w: &mut _| std::io::Write::write_all(w, html.as_bytes());
+    gyro_log::whole::write(&html_path, write).map_err(|source| ReportError::Write {
         path: html_path.clone(),
         source,
     })

@@ -8,6 +8,7 @@ mod text;
 pub use headline::{evidence, headline, rounded, sentence};
 
 pub use html::{
-    write_report, ReportError, GAP_MAP_CLIP, GAP_MAP_COLUMNS, MIN_BIN_SAMPLES, WHERE_ROWS,
+    write_report, ReportError, GAP_MAP_CLIP, GAP_MAP_COLUMNS, MIN_BIN_SAMPLES, REPORT_FILES,
+    WHERE_ROWS,
 };
 pub use text::{self_test_table, table};

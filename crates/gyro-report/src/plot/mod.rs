@@ -185,14 +185,15 @@ pub fn render(figure: &impl Figure, format: ImageFormat) -> Result<Vec<u8>, Rend
 }
 
 /// Write `figure` to `path`, as SVG or PNG by its extension. Nothing is written unless the
-/// figure was drawn completely.
+/// figure was drawn completely, and then whole ([`gyro_log::whole`]).
 pub fn save(path: &Path, figure: &impl Figure) -> Result<(), PlotError> {
     let format = ImageFormat::from_path(path)?;
     let bytes = render(figure, format).map_err(|source| PlotError::Render {
         path: path.to_path_buf(),
         source,
     })?;
-    std::fs::write(path, bytes).map_err(|source| PlotError::Write {
+    let write = |w: &mut _| std::io::Write::write_all(w, &bytes);
+    gyro_log::whole::write(path, write).map_err(|source| PlotError::Write {
         path: path.to_path_buf(),
         source,
     })
