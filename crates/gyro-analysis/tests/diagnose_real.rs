@@ -83,6 +83,9 @@ fn latency_is_named_on_real_yaw_and_its_correction_does_not_hurt() {
     for runs in ["training", "held-out"] {
         let line = d.motion_lines.iter().find(|m| m.runs == runs);
         let f = line.map(|m| m.frequency_hz);
-        assert!(f.is_some_and(|f| (12.0..14.0).contains(&f)), "{runs}: {f:?}");
+        assert!(
+            f.is_some_and(|f| (12.0..14.0).contains(&f)),
+            "{runs}: {f:?}"
+        );
     }
 }

@@ -6,7 +6,9 @@
 //! Dropped samples are filled by linear interpolation, as the grid placement fills a
 //! real log's gaps.
 
-use super::features::{features, Features, N_REG, REGRESSORS, WANDER_TAUS_S};
+use super::features::{
+    coefficients, features, features_with_spectra, Features, N_REG, REGRESSORS, WANDER_TAUS_S,
+};
 use super::stats::{residuals, residuals_of, stats_of, Residuals, Stat, StatsError};
 use crate::seed::derive_seed;
 use gyro_log::RegularLog;
@@ -134,7 +136,7 @@ impl RealRun {
     /// Prepare `log` (named `name`).
     pub fn prepare(name: String, log: RegularLog) -> Result<Self, StatsError> {
         let r = residuals(&log)?;
-        let features = features(&r, 1e-9);
+        let features = features_with_spectra(&r, 1e-9);
         let mut stats = stats_of(&r);
         stats.extend(feature_stats(&features));
         let fs = log.sample_rate_hz;
@@ -347,7 +349,8 @@ pub fn simulate_residuals(
     residuals_of(fs, time, s.rate_dps, &s.reference_deg, temperature)
 }
 
-/// Simulate `run` with `model` and `effects` and `seed`, and measure it.
+/// Simulate `run` with `model` and `effects` and `seed`, and measure it; the line
+/// spectra only for the nominal model (`effects` empty: the null replicas).
 pub fn simulate_member(
     run: &RealRun,
     model: &SensorModel,
@@ -356,7 +359,11 @@ pub fn simulate_member(
 ) -> Member {
     match simulate_residuals(run, model, effects, seed) {
         Ok(r) => {
-            let features = features(&r, 1e-9);
+            let features = if effects.is_empty() {
+                features_with_spectra(&r, 1e-9)
+            } else {
+                features(&r, 1e-9)
+            };
             let mut stats = stats_of(&r);
             stats.extend(feature_stats(&features));
             Member { stats, features }
@@ -389,7 +396,7 @@ pub fn simulate_features(
     seed: u64,
 ) -> [f64; N_REG] {
     simulate_residuals(run, model, effects, seed)
-        .map(|r| features(&r, 1e-9).coef)
+        .map(|r| coefficients(&r))
         .unwrap_or([f64::NAN; N_REG])
 }
 

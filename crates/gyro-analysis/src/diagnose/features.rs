@@ -129,6 +129,18 @@ pub fn line_resolution_hz(sample_rate_hz: f64) -> f64 {
     sample_rate_hz / line_segment_len(sample_rate_hz) as f64
 }
 
+/// The features of `r` with the line spectra: for real runs and the null ensembles,
+/// which are all the `vibration` fit and the motion lines read (the spectra of every
+/// candidate ensemble would cost a transform per segment for nothing).
+pub fn features_with_spectra(r: &Residuals, plateau_tol_dps: f64) -> Features {
+    let (incoherent_psd, reference_psd) = line_spectra(r);
+    Features {
+        incoherent_psd,
+        reference_psd,
+        ..features(r, plateau_tol_dps)
+    }
+}
+
 /// Welch cross-spectra of `r`'s gyro rate `g` and reference rate `w` (Hann window, half
 /// overlap, on the stretches where both are defined): (incoherent PSD of g, PSD of w),
 /// both empty when no stretch holds a segment.
@@ -190,9 +202,20 @@ fn line_spectra(r: &Residuals) -> (Vec<f64>, Vec<f64>) {
     (incoherent, reference)
 }
 
-/// The features of `r`; `plateau_tol_dps` is the tolerance of the clip plateau (e.g. an
-/// output step).
+/// The features of `r` without the line spectra (empty); `plateau_tol_dps` is the
+/// tolerance of the clip plateau (e.g. an output step).
 pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
+    features_of(r, plateau_tol_dps, true)
+}
+
+/// The regression coefficients of `r` alone ([`Features::coef`]; the noise-free
+/// calibrations read nothing else).
+pub fn coefficients(r: &Residuals) -> [f64; N_REG] {
+    features_of(r, 1e-9, false).coef
+}
+
+/// The features of `r`, the residual's wander only when `wander`.
+fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> Features {
     let n = r.rate_dps.len();
     let fs = r.sample_rate_hz;
     let h = ((fs * SMOOTH_WINDOW_S / 2.0).round() as usize).max(1);
@@ -279,20 +302,18 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
     let mut xtx = [[0.0f64; N_REG]; N_REG];
     let mut xty = [0.0f64; N_REG];
     let mut samples = 0usize;
+    // The whole square at a fixed size (the temperature columns are zero when unused):
+    // a loop the compiler vectorises, and both halves are the same products.
     for i in 0..n {
         if let Some((x, y)) = row(i) {
             samples += 1;
-            for a in 0..used {
-                for b in a..used {
-                    xtx[a][b] += x[a] * x[b];
+            for a in 0..N_REG {
+                let xa = x[a];
+                for b in 0..N_REG {
+                    xtx[a][b] += xa * x[b];
                 }
-                xty[a] += x[a] * y;
+                xty[a] += xa * y;
             }
-        }
-    }
-    for a in 0..used {
-        for b in 0..a {
-            xtx[a][b] = xtx[b][a];
         }
     }
     let mut coef = [f64::NAN; N_REG];
@@ -304,7 +325,7 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
 
     // Regression residual → wander.
     let mut wander_avar = [f64::NAN; 3];
-    if coef[0].is_finite() {
+    if wander && coef[0].is_finite() {
         let residual: Vec<f64> = (0..n)
             .map(|i| match row(i) {
                 Some((x, y)) => y - (0..used).map(|k| coef[k] * x[k]).sum::<f64>(),
@@ -344,7 +365,6 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
         (f64::NAN, 0)
     };
 
-    let (incoherent_psd, reference_psd) = line_spectra(r);
     Features {
         coef,
         samples,
@@ -354,8 +374,8 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
         temperature_varies,
         static_diff_var,
         bias_dps: run_bias(r, coef[reg::INTERCEPT]),
-        incoherent_psd,
-        reference_psd,
+        incoherent_psd: Vec::new(),
+        reference_psd: Vec::new(),
     }
 }
 
@@ -448,7 +468,7 @@ mod tests {
         let fs = s.sample_rate_hz;
         let time: Vec<f64> = (0..s.rate_dps.len()).map(|k| k as f64 / fs).collect();
         let r = residuals_of(fs, time, s.rate_dps, &s.reference_deg, s.temperature_c).unwrap();
-        features(&r, model.lsb_dps)
+        features_with_spectra(&r, model.lsb_dps)
     }
 
     #[test]

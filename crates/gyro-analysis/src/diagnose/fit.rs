@@ -86,7 +86,8 @@ pub fn direct_evidence(
         FitProcedure::Gaps => runs.iter().map(|r| r.gaps).sum::<u64>() >= MIN_GAPS,
         FitProcedure::SpectralLine => match effect.params().as_slice() {
             [amplitude_dps, frequency_hz] if *amplitude_dps > 0.0 => {
-                super::line::at(runs, null, *frequency_hz).is_some_and(|l| l.z >= Z_CRITICAL)
+                super::line::at(runs, null, *frequency_hz)
+                    .is_some_and(|l| l.z >= Z_CRITICAL && l.ratio >= super::line::LINE_MIN_RATIO)
             }
             _ => false,
         },
@@ -1083,12 +1084,13 @@ fn line_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
             ),
         ],
         z: line.z,
-        passes: line.z >= Z_CRITICAL,
+        passes: line.z >= Z_CRITICAL && line.ratio >= super::line::LINE_MIN_RATIO,
         direct: true,
         test: format!(
-            "strongest line of the residual spectrum above {} Hz ({:.1} times its local floor) vs the null replicas' strongest (one-sided; replicated on the held-out runs)",
+            "strongest line of the gyro's spectrum not coherent with the reference, above {} Hz ({:.1} times its local floor, at least {}) vs the null replicas' strongest (one-sided; replicated on the held-out runs)",
             super::line::MIN_LINE_HZ,
-            line.ratio
+            line.ratio,
+            super::line::LINE_MIN_RATIO
         ),
     })
 }

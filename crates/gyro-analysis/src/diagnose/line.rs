@@ -10,7 +10,8 @@
 //! own harmonics, times any scale error, make lines of their own) to 95% of the Nyquist
 //! frequency; the strongest ratio is tested against the same search on each null replica
 //! (the largest ratio a nominal sensor shows by chance), so the look-elsewhere effect is
-//! in the null distribution.
+//! in the null distribution. A line must also stand [`LINE_MIN_RATIO`] times above its
+//! floor, on the training runs and again on the held-out runs.
 //!
 //! A sinusoid of amplitude A has power A²/2: the excess over the floor, summed over the
 //! line's bins (the Hann window spreads it over ±[`GUARD_BINS`]) times the bin width,
@@ -20,6 +21,11 @@ use super::ensemble::{Member, RealRun};
 use super::features::{line_resolution_hz, Features};
 use crate::median;
 
+/// A line must also stand this many times above its local floor (on the training runs to
+/// be found, on the held-out runs to replicate): the null replicas' spectra are smooth,
+/// a real sensor's have texture (an encoder's steps, the motion), so a ratio of 1.1 can
+/// be many null standard deviations without being a line.
+pub const LINE_MIN_RATIO: f64 = 3.0;
 /// A line of the motion is reported when it stands this many times above its floor.
 pub const MOTION_LINE_RATIO: f64 = 20.0;
 /// Lowest frequency searched for a line (Hz).
