@@ -77,15 +77,12 @@ fn latency_is_named_on_real_yaw_and_its_correction_does_not_hurt() {
     for n in &c.not_corrected {
         assert!(!c.corrected.contains(&n.id));
     }
-    // The stepper's vibration is in the motion (both sensors see it), near 12.9 Hz: said,
-    // and not named as a sensor's vibration.
+    // The stepper's vibration is in the motion (both sensors see it), near 12.8 Hz in the
+    // slow trial and 40.5 Hz in the medium one: said, and not named as a sensor's.
     assert!(!named.contains(&"vibration"), "named {named:?}");
-    for runs in ["training", "held-out"] {
+    for (runs, band) in [("training", 12.0..14.0), ("held-out", 39.0..42.0)] {
         let line = d.motion_lines.iter().find(|m| m.runs == runs);
         let f = line.map(|m| m.frequency_hz);
-        assert!(
-            f.is_some_and(|f| (12.0..14.0).contains(&f)),
-            "{runs}: {f:?}"
-        );
+        assert!(f.is_some_and(|f| band.contains(&f)), "{runs}: {f:?}");
     }
 }
