@@ -36,11 +36,13 @@ impl Decimator {
     }
 
     /// How many samples of the current block have been pushed.
+    #[inline]
     pub const fn pending(&self) -> u16 {
         self.count
     }
 
     /// Push one input sample; returns the block mean after every `factor`-th sample.
+    #[inline]
     pub fn push(&mut self, x: f32) -> Option<f32> {
         self.sum.add(x);
         self.count += 1;
@@ -53,6 +55,7 @@ impl Decimator {
     }
 
     /// Drop the partial block.
+    #[inline]
     pub fn reset(&mut self) {
         self.count = 0;
         self.sum = KahanSum::ZERO;
