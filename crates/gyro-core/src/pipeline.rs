@@ -355,7 +355,6 @@ pub struct Pipeline {
     track: Option<Track>,
     block_start_time_s: f64,
     last_time_s: f64,
-    last_valid_rate_dps: f32,
     /// The previous output step's rate and corrected rate; meaningful from index 1 on
     /// (a tuple rather than an `Option`, whose tag costs 4 bytes of the state budget).
     previous: (f32, f32),
@@ -414,7 +413,6 @@ impl Pipeline {
             track: None,
             block_start_time_s: f64::NAN,
             last_time_s: f64::NAN,
-            last_valid_rate_dps: 0.0,
             previous: (0.0, 0.0),
             index: 0,
             rejected: 0,
@@ -504,26 +502,25 @@ impl Pipeline {
             self.observe_clip(rate_dps);
             // The identity returns the reading, a zero's sign aside (−0 − 0·ΔT may give +0),
             // which the decimator's sum does not see: both zeros leave it the same.
-            let corrected = if !self.corrects {
+            if !self.corrects {
                 rate_dps
             } else if with_temperature {
                 self.corrector.correct_at_temperature(rate_dps)
             } else {
                 self.corrector.correct(rate_dps)
-            };
-            self.last_valid_rate_dps = corrected;
-            corrected
+            }
         } else {
             self.reject()
         }
     }
 
-    /// Count a rejected reading; its replacement.
+    /// Count a rejected reading; its replacement, the last rate the decimator took (the
+    /// last valid one, corrected, or 0 before the first).
     #[cold]
     #[inline(never)]
     fn reject(&mut self) -> f32 {
         self.rejected = self.rejected.saturating_add(1);
-        self.last_valid_rate_dps
+        self.decimator.last()
     }
 
     /// Add an accepted rate to the decimator's block; at the block's end, one output step.
