@@ -159,6 +159,7 @@ impl Correction {
 }
 
 /// −1, 0 or +1 (0 for ±0 and NaN).
+#[inline]
 fn sign(x: f32) -> f32 {
     if x > 0.0 {
         1.0
@@ -170,6 +171,7 @@ fn sign(x: f32) -> f32 {
 }
 
 /// ΔT clamped to ±[`MAX_DELTA_C`] (NaN becomes 0).
+#[inline]
 fn clamp_delta(delta_c: f32) -> f32 {
     if delta_c.is_nan() {
         0.0
@@ -237,6 +239,7 @@ impl Corrector {
     /// Take a temperature reading (°C). The first valid one becomes the reference if the
     /// settings have none. Returns false (and changes nothing) if the reading is not finite
     /// or outside [`TEMPERATURE_RANGE_C`].
+    #[inline]
     pub fn observe_temperature(&mut self, temperature_c: f32) -> bool {
         let (lo, hi) = TEMPERATURE_RANGE_C;
         // `contains` is false for NaN; infinities are outside the range.

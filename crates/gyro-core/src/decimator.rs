@@ -15,6 +15,9 @@ pub struct Decimator {
     factor: u16,
     count: u16,
     sum: KahanSum,
+    /// The latest sample pushed (0 before the first); while the block's count is odd, it
+    /// is not yet in `sum`.
+    last: f32,
 }
 
 impl Decimator {
@@ -27,6 +30,7 @@ impl Decimator {
             factor,
             count: 0,
             sum: KahanSum::ZERO,
+            last: 0.0,
         })
     }
 
@@ -35,24 +39,47 @@ impl Decimator {
         self.factor
     }
 
+    /// The latest sample pushed (0 before the first), whether its block is complete or not.
+    #[inline]
+    pub const fn last(&self) -> f32 {
+        self.last
+    }
+
     /// How many samples of the current block have been pushed.
+    #[inline]
     pub const fn pending(&self) -> u16 {
         self.count
     }
 
     /// Push one input sample; returns the block mean after every `factor`-th sample.
+    ///
+    /// The samples go into the compensated sum in pairs, in their order: the same sum, bit
+    /// for bit, as one at a time, with half the trips of the sum through memory from one
+    /// call to the next (a store and a reload on the sum's dependency chain each).
+    #[inline]
     pub fn push(&mut self, x: f32) -> Option<f32> {
-        self.sum.add(x);
         self.count += 1;
+        let pair_ends = self.count % 2 == 0;
         if self.count < self.factor {
+            if pair_ends {
+                self.sum.add(self.last);
+                self.sum.add(x);
+            }
+            self.last = x;
             return None;
         }
+        if pair_ends {
+            self.sum.add(self.last);
+        }
+        self.sum.add(x);
+        self.last = x;
         let mean = self.sum.value() / f32::from(self.factor);
         self.reset();
         Some(mean)
     }
 
-    /// Drop the partial block.
+    /// Drop the partial block (the latest sample stays known).
+    #[inline]
     pub fn reset(&mut self) {
         self.count = 0;
         self.sum = KahanSum::ZERO;

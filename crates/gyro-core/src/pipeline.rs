@@ -334,6 +334,10 @@ pub struct Pipeline {
     /// run that may become a movement.
     clip_pending: bool,
     corrector: Corrector,
+    /// The correction is not the identity: with the identity (the default) the per-sample
+    /// path skips it, since it would return every accepted reading unchanged (in the one
+    /// byte the state's alignment leaves free).
+    corrects: bool,
     compensation: Compensation,
     paper: GaussMarkov,
     output_period_s: f32,
@@ -351,7 +355,6 @@ pub struct Pipeline {
     track: Option<Track>,
     block_start_time_s: f64,
     last_time_s: f64,
-    last_valid_rate_dps: f32,
     /// The previous output step's rate and corrected rate; meaningful from index 1 on
     /// (a tuple rather than an `Option`, whose tag costs 4 bytes of the state budget).
     previous: (f32, f32),
@@ -392,6 +395,7 @@ impl Pipeline {
             clip_run: 0,
             clip_pending: false,
             corrector: Corrector::try_new(&config.correction)?,
+            corrects: !config.correction.is_identity(),
             compensation: config.compensation,
             paper: config.paper,
             output_period_s,
@@ -409,7 +413,6 @@ impl Pipeline {
             track: None,
             block_start_time_s: f64::NAN,
             last_time_s: f64::NAN,
-            last_valid_rate_dps: 0.0,
             previous: (0.0, 0.0),
             index: 0,
             rejected: 0,
@@ -460,8 +463,10 @@ impl Pipeline {
     /// The configured [`Correction`]'s scale and asymmetry are applied; its temperature
     /// terms are not (as if ΔT were 0): use [`Self::push_with_temperature`] where the
     /// sensor's temperature is known.
+    #[inline]
     pub fn push(&mut self, time_s: f64, rate_dps: f32) -> Option<Output> {
-        self.push_corrected(time_s, rate_dps, false)
+        let rate_dps = self.accept(rate_dps, false);
+        self.decimate(time_s, rate_dps)
     }
 
     /// Push one input sample with the sensor's temperature `temperature_c` (°C): the whole
@@ -472,6 +477,7 @@ impl Pipeline {
     /// one has been seen the temperature terms are 0. The first valid temperature is the
     /// reference of ΔT unless the correction sets one (`temperature_ref_c`). With the identity
     /// correction this gives exactly what [`Self::push`] gives.
+    #[inline]
     pub fn push_with_temperature(
         &mut self,
         time_s: f64,
@@ -479,51 +485,83 @@ impl Pipeline {
         temperature_c: f32,
     ) -> Option<Output> {
         self.corrector.observe_temperature(temperature_c);
-        self.push_corrected(time_s, rate_dps, true)
+        let rate_dps = self.accept(rate_dps, true);
+        self.decimate(time_s, rate_dps)
     }
 
-    /// Accept or reject the sample, correct it, decimate it.
-    fn push_corrected(
-        &mut self,
-        time_s: f64,
-        rate_dps: f32,
-        with_temperature: bool,
-    ) -> Option<Output> {
-        let time_s = if time_s.is_finite() {
-            time_s
-        } else if self.last_time_s.is_finite() {
-            // One input period on from the last time (the output period over the factor).
-            self.last_time_s + f64::from(self.output_period_s) / f64::from(self.decimator.factor())
-        } else {
-            0.0
-        };
-        // Plausibility is judged on the reading; a rejected sample is replaced by the last
-        // valid one, corrected as it was then.
-        let rate_dps = if rate_dps.is_finite() && libm::fabsf(rate_dps) <= self.max_abs_rate_dps {
+    // The per-sample path, `accept` then `decimate`, is inlined into the caller and does
+    // only what each input sample needs: plausibility, the clip watch, the correction and
+    // the decimator's sum. Everything else runs once per output sample, in `step`.
+
+    /// Accept or reject a reading and correct it. Plausibility is judged on the reading; a
+    /// rejected one is replaced by the last valid one, corrected as it was then.
+    #[inline(always)]
+    fn accept(&mut self, rate_dps: f32, with_temperature: bool) -> f32 {
+        // `max_abs_rate_dps` is finite (validated): NaN and the infinities fail this test.
+        if libm::fabsf(rate_dps) <= self.max_abs_rate_dps {
             self.observe_clip(rate_dps);
-            let corrected = if with_temperature {
+            // The identity returns the reading, a zero's sign aside (−0 − 0·ΔT may give +0),
+            // which the decimator's sum does not see: both zeros leave it the same.
+            if !self.corrects {
+                rate_dps
+            } else if with_temperature {
                 self.corrector.correct_at_temperature(rate_dps)
             } else {
                 self.corrector.correct(rate_dps)
-            };
-            self.last_valid_rate_dps = corrected;
-            corrected
+            }
         } else {
-            self.rejected = self.rejected.saturating_add(1);
-            self.last_valid_rate_dps
+            self.reject()
+        }
+    }
+
+    /// Count a rejected reading; its replacement, the last rate the decimator took (the
+    /// last valid one, corrected, or 0 before the first).
+    #[cold]
+    #[inline(never)]
+    fn reject(&mut self) -> f32 {
+        self.rejected = self.rejected.saturating_add(1);
+        self.decimator.last()
+    }
+
+    /// Add an accepted rate to the decimator's block; at the block's end, one output step.
+    #[inline(always)]
+    fn decimate(&mut self, time_s: f64, rate_dps: f32) -> Option<Output> {
+        let time_s = if time_s.is_finite() {
+            time_s
+        } else {
+            self.substitute_time()
         };
         if self.decimator.pending() == 0 {
             self.block_start_time_s = time_s;
         }
         self.last_time_s = time_s;
         let mean_dps = self.decimator.push(rate_dps)?;
+        Some(self.end_block(time_s, mean_dps))
+    }
+
+    /// The time of a sample whose stamp is not finite: one input period on from the last
+    /// time (the output period over the factor), or 0 if there is none.
+    #[cold]
+    #[inline(never)]
+    fn substitute_time(&self) -> f64 {
+        if self.last_time_s.is_finite() {
+            self.last_time_s + f64::from(self.output_period_s) / f64::from(self.decimator.factor())
+        } else {
+            0.0
+        }
+    }
+
+    /// The output step of a completed block whose last sample came at `time_s`.
+    #[inline(never)]
+    fn end_block(&mut self, time_s: f64, mean_dps: f32) -> Output {
         // Halves first: the sum of two huge times would overflow.
         let centre_s = 0.5 * self.block_start_time_s + 0.5 * time_s;
-        Some(self.step(centre_s, mean_dps))
+        self.step(centre_s, mean_dps)
     }
 
     /// Flag a reading that reaches the range or completes a clip plateau (see
     /// [`Movement::saturated`]). Judged on the reading, before correction.
+    #[inline(always)]
     fn observe_clip(&mut self, reading_dps: f32) {
         self.clip_run = if reading_dps == self.clip_last_dps {
             self.clip_run.saturating_add(1)
@@ -743,9 +781,10 @@ mod size_tests {
     use super::Pipeline;
 
     /// The firmware budget: the whole pipeline state in 512 bytes at most. It is exactly
-    /// 512 (511 of fields): `Track` gave up 8 bytes of `Option` padding for the corrector,
-    /// and the saturation state (10 bytes) is paid for by `previous` without an `Option` tag
-    /// and the sample rate kept as f32 instead of the period as f64.
+    /// 512, every byte a field: `Track` gave up 8 bytes of `Option` padding for the
+    /// corrector, the saturation state (10 bytes) is paid for by `previous` without an
+    /// `Option` tag and the sample rate kept as f32 instead of the period as f64, and the
+    /// last free byte says whether the correction is the identity.
     #[test]
     fn pipeline_state_fits_in_512_bytes() {
         use core::mem::size_of;

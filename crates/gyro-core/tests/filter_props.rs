@@ -6,7 +6,7 @@
 // Helpers outside #[test] fns unwrap too: the strategies only produce valid designs.
 #![allow(clippy::unwrap_used)]
 
-use gyro_core::{Butterworth, Decimator, Sos, SosDesign, SosState, MAX_ORDER};
+use gyro_core::{Butterworth, Decimator, KahanSum, Sos, SosDesign, SosState, MAX_ORDER};
 use proptest::prelude::*;
 
 /// Unit roundoff of f32.
@@ -165,6 +165,29 @@ proptest! {
             (total_out - total_in).abs() <= total_tol + 1e-12 * total_in.abs(),
             "Σ outputs × factor {} vs Σ inputs of completed blocks {}", total_out, total_in
         );
+    }
+
+    /// The decimator adds its samples in pairs: each output is, bit for bit, the block's
+    /// compensated sum taken one sample at a time over the factor, for odd and even
+    /// factors; `last` is the latest sample pushed.
+    #[test]
+    fn pairs_give_the_one_at_a_time_sum(
+        factor in 1_u16..=25,
+        x in decimator_sequence(),
+    ) {
+        let mut d = Decimator::try_new(factor).unwrap();
+        let mut blocks = x.chunks_exact(usize::from(factor));
+        for &v in &x {
+            if let Some(mean) = d.push(v) {
+                let mut sum = KahanSum::ZERO;
+                for &b in blocks.next().unwrap() {
+                    sum.add(b);
+                }
+                let expected = sum.value() / f32::from(factor);
+                prop_assert_eq!(mean.to_bits(), expected.to_bits(), "{} vs {}", mean, expected);
+            }
+            prop_assert_eq!(d.last().to_bits(), v.to_bits());
+        }
     }
 }
 
