@@ -478,7 +478,7 @@ pub const EFFECTS: &[EffectInfo] = &[
             non_negative("amplitude_dps", "deg/s"),
             positive("frequency_hz", "Hz"),
         ],
-        signature: "a narrow line in the residual's spectrum (gyro minus reference rate) that the nominal sensor does not have",
+        signature: "a narrow line in the part of the gyro's spectrum not coherent with the reference rate, which the nominal sensor does not have",
         typical: Effect::Vibration {
             amplitude_dps: 0.5,
             frequency_hz: 13.0,
