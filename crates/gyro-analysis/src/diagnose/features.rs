@@ -147,9 +147,7 @@ pub fn features_with_spectra(r: &Residuals, plateau_tol_dps: f64) -> Features {
 fn line_spectra(r: &Residuals) -> (Vec<f64>, Vec<f64>) {
     let len = line_segment_len(r.sample_rate_hz);
     let both = |i: usize| r.rate_dps[i].is_finite() && r.reference_rate_dps[i].is_finite();
-    let window: Vec<f64> = (0..len)
-        .map(|n| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * n as f64 / len as f64).cos())
-        .collect();
+    let window = crate::noise::psd::hann(len);
     let bins = len / 2 + 1;
     let (mut sgg, mut srr) = (vec![0.0; bins], vec![0.0; bins]);
     let (mut sgr_re, mut sgr_im) = (vec![0.0; bins], vec![0.0; bins]);

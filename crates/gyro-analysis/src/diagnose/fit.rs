@@ -288,7 +288,8 @@ fn mean(v: impl Iterator<Item = f64>) -> f64 {
     }
 }
 
-fn mean_sd(v: &[f64]) -> (f64, f64) {
+/// Mean and sample standard deviation of the finite values (NaN for fewer than two).
+pub(super) fn mean_sd(v: &[f64]) -> (f64, f64) {
     let f: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
     if f.len() < 2 {
         return (f64::NAN, f64::NAN);

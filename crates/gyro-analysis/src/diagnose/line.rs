@@ -19,6 +19,7 @@
 
 use super::ensemble::{Member, RealRun};
 use super::features::{line_resolution_hz, Features};
+use super::fit::mean_sd;
 use crate::median;
 
 /// A line must also stand this many times above its local floor (on the training runs to
@@ -132,16 +133,6 @@ fn measure(psd: &[f64], k: usize, resolution_hz: f64) -> (f64, f64) {
     (centre * resolution_hz, (2.0 * power).sqrt())
 }
 
-fn mean_sd(v: &[f64]) -> (f64, f64) {
-    let f: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
-    if f.len() < 2 {
-        return (f64::NAN, f64::NAN);
-    }
-    let m = f.iter().sum::<f64>() / f.len() as f64;
-    let var = f.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (f.len() - 1) as f64;
-    (m, var.sqrt())
-}
-
 /// Replica `j`'s pooled spectrum of `null`.
 fn replica(null: &[Vec<Member>], j: usize) -> Vec<f64> {
     pooled(null.iter().filter_map(|m| m.get(j)).map(|m| &m.features))
@@ -158,11 +149,17 @@ pub fn search(runs: &[&RealRun], null: &[Vec<Member>]) -> Option<Line> {
     let maxima: Vec<f64> = (0..members)
         .filter_map(|j| strongest(&replica(null, j), resolution_hz).map(|x| x.1))
         .collect();
-    let (m0, s0) = mean_sd(&maxima);
-    if !m0.is_finite() {
+    judged(&psd, k, ratio, &maxima, resolution_hz)
+}
+
+/// The line at bin `k` of `psd`, of line ratio `ratio`, with its z-score against the
+/// null replicas' values of the same statistic; `None` if either is not a number.
+fn judged(psd: &[f64], k: usize, ratio: f64, null: &[f64], resolution_hz: f64) -> Option<Line> {
+    let (m0, s0) = mean_sd(null);
+    if !(m0.is_finite() && ratio.is_finite()) {
         return None;
     }
-    let (frequency_hz, amplitude_dps) = measure(&psd, k, resolution_hz);
+    let (frequency_hz, amplitude_dps) = measure(psd, k, resolution_hz);
     Some(Line {
         frequency_hz,
         amplitude_dps,
@@ -194,18 +191,7 @@ pub fn at(runs: &[&RealRun], null: &[Vec<Member>], frequency_hz: f64) -> Option<
             }
         })
         .collect();
-    let (m0, s0) = mean_sd(&replicas);
-    if !(m0.is_finite() && ratio.is_finite()) {
-        return None;
-    }
-    let (frequency_hz, amplitude_dps) = measure(&psd, k, resolution_hz);
-    Some(Line {
-        frequency_hz,
-        amplitude_dps,
-        ratio,
-        z: (ratio - m0) / s0.max(1e-3 * m0),
-        resolution_hz,
-    })
+    judged(&psd, k, ratio, &replicas, resolution_hz)
 }
 
 /// A line in the motion itself (the reference rate's spectrum), which the gyro sees with

@@ -77,6 +77,13 @@ pub fn default_segment_len(longest: usize) -> usize {
     1usize << (usize::BITS - 1 - target.leading_zeros())
 }
 
+/// The periodic Hann window of `len` samples (Welch's segments).
+pub(crate) fn hann(len: usize) -> Vec<f64> {
+    (0..len)
+        .map(|n| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * n as f64 / len as f64).cos())
+        .collect()
+}
+
 /// Welch PSD of rate `segments` (deg/s) at `sample_rate_hz`; `None` if no segment holds
 /// one window (or the length is not a power of two ≥ 2).
 pub fn welch(segments: &[&[f64]], sample_rate_hz: f64, options: &PsdOptions) -> Option<Psd> {
@@ -87,9 +94,7 @@ pub fn welch(segments: &[&[f64]], sample_rate_hz: f64, options: &PsdOptions) -> 
     if len < 2 || !len.is_power_of_two() || len > longest {
         return None;
     }
-    let window: Vec<f64> = (0..len)
-        .map(|n| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * n as f64 / len as f64).cos())
-        .collect();
+    let window = hann(len);
     let window_power: f64 = window.iter().map(|w| w * w).sum();
     let bins = len / 2 + 1;
     let mut acc = vec![0.0_f64; bins];
