@@ -16,7 +16,7 @@ pub struct Decimator {
     count: u16,
     sum: KahanSum,
     /// The latest sample pushed (0 before the first); while the block's count is odd, it
-    /// is not yet in `sum`.
+    /// is not yet in `sum` (see [`Decimator::run`]).
     last: f32,
 }
 
@@ -53,27 +53,58 @@ impl Decimator {
 
     /// Push one input sample; returns the block mean after every `factor`-th sample.
     ///
-    /// The samples go into the compensated sum in pairs, in their order: the same sum, bit
-    /// for bit, as one at a time, with half the trips of the sum through memory from one
-    /// call to the next (a store and a reload on the sum's dependency chain each).
+    /// One sample is a run of one: [`Self::run`], [`BlockRun::add`], [`Self::close`].
     #[inline]
     pub fn push(&mut self, x: f32) -> Option<f32> {
-        self.count += 1;
-        let pair_ends = self.count % 2 == 0;
-        if self.count < self.factor {
-            if pair_ends {
-                self.sum.add(self.last);
-                self.sum.add(x);
-            }
-            self.last = x;
+        let mut run = self.run();
+        run.add(x);
+        self.close(run)
+    }
+
+    /// How many more samples complete the current block.
+    #[inline]
+    pub const fn remaining(&self) -> u16 {
+        self.factor - self.count
+    }
+
+    /// Open the current block for a run of samples, to be added with [`BlockRun::add`]
+    /// (at most [`Self::remaining`] of them) and handed back with [`Self::close`].
+    ///
+    /// A run keeps the sum in registers from one sample to the next; between calls the
+    /// decimator keeps it in memory. The samples go into the compensated sum one at a time
+    /// in their order, so that any split of a block into runs gives the same sum, bit for
+    /// bit. Stored, a block of odd count leaves its latest sample out of the sum (it goes
+    /// in with the next one): a run of one sample then trips the sum through memory only
+    /// every other sample.
+    #[inline(always)]
+    pub fn run(&self) -> BlockRun {
+        let mut sum = self.sum;
+        if self.count % 2 == 1 {
+            sum.add(self.last);
+        }
+        BlockRun {
+            sum,
+            before: sum,
+            last: self.last,
+            count: self.count,
+        }
+    }
+
+    /// Take back a run: its samples stay in the block; returns the block's mean and starts
+    /// the next block if the run completed it.
+    #[inline(always)]
+    pub fn close(&mut self, run: BlockRun) -> Option<f32> {
+        self.last = run.last;
+        if run.count < self.factor {
+            self.count = run.count;
+            self.sum = if run.count % 2 == 1 {
+                run.before
+            } else {
+                run.sum
+            };
             return None;
         }
-        if pair_ends {
-            self.sum.add(self.last);
-        }
-        self.sum.add(x);
-        self.last = x;
-        let mean = self.sum.value() / f32::from(self.factor);
+        let mean = run.sum.value() / f32::from(self.factor);
         self.reset();
         Some(mean)
     }
@@ -83,6 +114,35 @@ impl Decimator {
     pub fn reset(&mut self) {
         self.count = 0;
         self.sum = KahanSum::ZERO;
+    }
+}
+
+/// The current block of a [`Decimator`] while a run of samples is added to it
+/// ([`Decimator::run`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BlockRun {
+    /// Every sample of the block so far.
+    sum: KahanSum,
+    /// The sum before the latest sample.
+    before: KahanSum,
+    last: f32,
+    count: u16,
+}
+
+impl BlockRun {
+    /// Add one sample.
+    #[inline(always)]
+    pub fn add(&mut self, x: f32) {
+        self.before = self.sum;
+        self.sum.add(x);
+        self.last = x;
+        self.count += 1;
+    }
+
+    /// The latest sample added (the decimator's [`Decimator::last`] before any).
+    #[inline(always)]
+    pub const fn last(&self) -> f32 {
+        self.last
     }
 }
 

@@ -50,7 +50,7 @@ mod sos;
 
 pub use butterworth::{Butterworth, SosDesign, MAX_ORDER};
 pub use correction::{Correction, Corrector, MAX_DELTA_C, MIN_SCALE, TEMPERATURE_RANGE_C};
-pub use decimator::Decimator;
+pub use decimator::{BlockRun, Decimator};
 pub use decision::{decide, Direction, Tightening, Verdict};
 pub use error::Error;
 pub use gauss_markov::GaussMarkov;

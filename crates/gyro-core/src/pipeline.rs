@@ -304,6 +304,25 @@ impl RestBlocks {
     }
 }
 
+/// How many whole blocks [`Pipeline::push_block`] sums side by side.
+const SIDE_BY_SIDE: usize = 4;
+
+/// One reading through the clip watch: `last` and `run` (the last reading and how many
+/// times in a row it came, up to the plateau) move on; true if it reaches the range
+/// (`level_dps`) or completes a clip plateau (see [`Movement::saturated`]). Judged on the
+/// reading, before correction.
+#[inline(always)]
+fn clip_seen(level_dps: f32, last: &mut f32, run: &mut u8, reading_dps: f32) -> bool {
+    *run = if reading_dps == *last {
+        run.saturating_add(1)
+    } else {
+        1
+    };
+    *last = reading_dps;
+    let magnitude = libm::fabsf(reading_dps);
+    magnitude >= level_dps || (*run >= CLIP_PLATEAU_SAMPLES && magnitude >= CLIP_PLATEAU_MIN_DPS)
+}
+
 /// Group delay at DC of a cascade (output samples): for each section `B/A`,
 /// `Σ k b_k / Σ b_k − Σ k a_k / Σ a_k`. Zero if not finite (no DC gain).
 fn dc_group_delay_samples(design: &SosDesign) -> f64 {
@@ -462,11 +481,13 @@ impl Pipeline {
     ///
     /// The configured [`Correction`]'s scale and asymmetry are applied; its temperature
     /// terms are not (as if ΔT were 0): use [`Self::push_with_temperature`] where the
-    /// sensor's temperature is known.
+    /// sensor's temperature is known. [`Self::push_block`] takes many samples at once, with
+    /// the same outputs.
     #[inline]
     pub fn push(&mut self, time_s: f64, rate_dps: f32) -> Option<Output> {
-        let rate_dps = self.accept(rate_dps, false);
-        self.decimate(time_s, rate_dps)
+        let mut output = None;
+        self.run::<false>(&[time_s], &[rate_dps], &[], &mut |out| output = Some(out));
+        output
     }
 
     /// Push one input sample with the sensor's temperature `temperature_c` (°C): the whole
@@ -484,68 +505,305 @@ impl Pipeline {
         rate_dps: f32,
         temperature_c: f32,
     ) -> Option<Output> {
-        self.corrector.observe_temperature(temperature_c);
-        let rate_dps = self.accept(rate_dps, true);
-        self.decimate(time_s, rate_dps)
+        let mut output = None;
+        self.run::<true>(&[time_s], &[rate_dps], &[temperature_c], &mut |out| {
+            output = Some(out)
+        });
+        output
     }
 
-    // The per-sample path, `accept` then `decimate`, is inlined into the caller and does
-    // only what each input sample needs: plausibility, the clip watch, the correction and
-    // the decimator's sum. Everything else runs once per output sample, in `step`.
+    /// Push a block of input samples, `times_s[i]` (s) and `rates_dps[i]` (deg/s), handing
+    /// each output to `sink` as it comes (one per completed decimation block; a block may
+    /// span calls).
+    ///
+    /// The outputs and the state left are those of [`Self::push`] on the same samples one
+    /// by one, bit for bit, however the samples are split into calls. What differs is the
+    /// cost: the decimator's sum and the per-sample checks stay in registers through the
+    /// block, the block's times and counters are kept once per block, and whole blocks of
+    /// plausible samples have their sums added side by side (see `sums`).
+    ///
+    /// Refused, with nothing pushed, if the slices' lengths differ
+    /// ([`Error::OutOfRange`]`("rates_dps")`).
+    ///
+    /// ```
+    /// use gyro_core::{Config, Pipeline};
+    ///
+    /// let config = Config::default(); // 1 kHz in, 50 Hz out
+    /// let times_s: Vec<f64> = (0..1000).map(|i| i as f64 * 1e-3).collect();
+    /// let rates_dps = vec![0.5_f32; 1000];
+    ///
+    /// let mut by_block = Pipeline::try_new(&config)?;
+    /// let mut outputs = Vec::new();
+    /// // Blocks of any length: here 300 samples, 15 outputs per full call.
+    /// for (times, rates) in times_s.chunks(300).zip(rates_dps.chunks(300)) {
+    ///     by_block.push_block(times, rates, |out| outputs.push(out))?;
+    /// }
+    ///
+    /// let mut one_by_one = Pipeline::try_new(&config)?;
+    /// let expected: Vec<_> = (0..1000)
+    ///     .filter_map(|i| one_by_one.push(times_s[i], rates_dps[i]))
+    ///     .collect();
+    /// assert_eq!(outputs.len(), 50);
+    /// assert_eq!(outputs, expected);
+    /// # Ok::<(), gyro_core::Error>(())
+    /// ```
+    pub fn push_block(
+        &mut self,
+        times_s: &[f64],
+        rates_dps: &[f32],
+        mut sink: impl FnMut(Output),
+    ) -> Result<(), Error> {
+        if rates_dps.len() != times_s.len() {
+            return Err(Error::OutOfRange("rates_dps"));
+        }
+        self.run::<false>(times_s, rates_dps, &[], &mut sink);
+        Ok(())
+    }
 
-    /// Accept or reject a reading and correct it. Plausibility is judged on the reading; a
-    /// rejected one is replaced by the last valid one, corrected as it was then.
+    /// [`Self::push_block`] with the sensor's temperature per sample, `temperatures_c[i]`
+    /// (°C), as [`Self::push_with_temperature`] takes it.
+    ///
+    /// Refused, with nothing pushed, if the slices' lengths differ
+    /// ([`Error::OutOfRange`] naming `rates_dps` or `temperatures_c`).
+    pub fn push_block_with_temperature(
+        &mut self,
+        times_s: &[f64],
+        rates_dps: &[f32],
+        temperatures_c: &[f32],
+        mut sink: impl FnMut(Output),
+    ) -> Result<(), Error> {
+        if rates_dps.len() != times_s.len() {
+            return Err(Error::OutOfRange("rates_dps"));
+        }
+        if temperatures_c.len() != times_s.len() {
+            return Err(Error::OutOfRange("temperatures_c"));
+        }
+        self.run::<true>(times_s, rates_dps, temperatures_c, &mut sink);
+        Ok(())
+    }
+
+    // The input path. Per sample it does only what each sample needs: plausibility, the clip
+    // watch, the correction and the decimator's sum, all in registers through a block
+    // (`segment`), or for whole blocks side by side (`sums`). The block's times and the
+    // output step run once per block (`end_block`, `step`).
+
+    /// Push samples (with their temperatures if `TEMPERATURE`; the slices' lengths agree).
     #[inline(always)]
-    fn accept(&mut self, rate_dps: f32, with_temperature: bool) -> f32 {
-        // `max_abs_rate_dps` is finite (validated): NaN and the infinities fail this test.
-        if libm::fabsf(rate_dps) <= self.max_abs_rate_dps {
-            self.observe_clip(rate_dps);
-            // The identity returns the reading, a zero's sign aside (−0 − 0·ΔT may give +0),
-            // which the decimator's sum does not see: both zeros leave it the same.
-            if !self.corrects {
-                rate_dps
-            } else if with_temperature {
-                self.corrector.correct_at_temperature(rate_dps)
-            } else {
-                self.corrector.correct(rate_dps)
+    fn run<const TEMPERATURE: bool>(
+        &mut self,
+        times_s: &[f64],
+        rates_dps: &[f32],
+        temperatures_c: &[f32],
+        sink: &mut impl FnMut(Output),
+    ) {
+        let factor = usize::from(self.decimator.factor());
+        let mut start = 0;
+        while start < rates_dps.len() {
+            let left = rates_dps.len() - start;
+            // Whole blocks side by side, when the temperature changes no rate.
+            if self.decimator.pending() == 0
+                && left >= SIDE_BY_SIDE * factor
+                && !(TEMPERATURE && self.corrects)
+            {
+                let end = start + SIDE_BY_SIDE * factor;
+                let temperatures = if TEMPERATURE {
+                    &temperatures_c[start..end]
+                } else {
+                    &[]
+                };
+                if self.sums(
+                    &times_s[start..end],
+                    &rates_dps[start..end],
+                    temperatures,
+                    sink,
+                ) {
+                    start = end;
+                    continue;
+                }
             }
-        } else {
-            self.reject()
+            let end = start + left.min(usize::from(self.decimator.remaining()));
+            let temperatures = if TEMPERATURE {
+                &temperatures_c[start..end]
+            } else {
+                &[]
+            };
+            if let Some(output) = self.segment::<TEMPERATURE>(
+                &times_s[start..end],
+                &rates_dps[start..end],
+                temperatures,
+            ) {
+                sink(output);
+            }
+            start = end;
         }
     }
 
-    /// Count a rejected reading; its replacement, the last rate the decimator took (the
-    /// last valid one, corrected, or 0 before the first).
-    #[cold]
-    #[inline(never)]
-    fn reject(&mut self) -> f32 {
-        self.rejected = self.rejected.saturating_add(1);
-        self.decimator.last()
+    /// Push the samples of one block's run (at most the block's remaining samples, at least
+    /// one), one after the other; the output if they complete the block.
+    #[inline(always)]
+    fn segment<const TEMPERATURE: bool>(
+        &mut self,
+        times_s: &[f64],
+        rates_dps: &[f32],
+        temperatures_c: &[f32],
+    ) -> Option<Output> {
+        let first_s = self.time_of(times_s, 0);
+        if self.decimator.pending() == 0 {
+            self.block_start_time_s = first_s;
+        }
+        let last_s = self.time_of_last(times_s, first_s);
+        self.last_time_s = last_s;
+
+        let mut block = self.decimator.run();
+        let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
+        let mut clipped = false;
+        for (i, &reading) in rates_dps.iter().enumerate() {
+            if TEMPERATURE {
+                self.corrector.observe_temperature(temperatures_c[i]);
+            }
+            let rate = if self.plausible(reading) {
+                clipped |= clip_seen(self.clip_level_dps, &mut clip_last, &mut clip_run, reading);
+                self.corrected::<TEMPERATURE>(reading)
+            } else {
+                // Replaced by the last rate the decimator took (0 before the first).
+                self.reject();
+                block.last()
+            };
+            block.add(rate);
+        }
+        (self.clip_last_dps, self.clip_run) = (clip_last, clip_run);
+        self.clip_pending |= clipped;
+        let mean_dps = self.decimator.close(block)?;
+        Some(self.end_block(last_s, mean_dps))
     }
 
-    /// Add an accepted rate to the decimator's block; at the block's end, one output step.
+    /// Push [`SIDE_BY_SIDE`] whole blocks starting at a block boundary: first the
+    /// plausibility test, the clip watch (and the temperatures) over all samples in order,
+    /// then the blocks' sums side by side, each in its samples' order (the sums are
+    /// independent: interleaved, they keep the floating-point units busy rather than wait
+    /// on one sum's chain of additions), then the output steps in order. False, with
+    /// nothing pushed, if a sample is implausible: its replacement depends on the sample
+    /// before, so those blocks go one sample after the other (`segment`).
+    #[inline(never)]
+    fn sums(
+        &mut self,
+        times_s: &[f64],
+        rates_dps: &[f32],
+        temperatures_c: &[f32],
+        sink: &mut impl FnMut(Output),
+    ) -> bool {
+        let factor = usize::from(self.decimator.factor());
+        debug_assert_eq!(self.decimator.pending(), 0);
+        debug_assert_eq!(rates_dps.len(), SIDE_BY_SIDE * factor);
+        let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
+        let mut plausible = true;
+        let mut clipped = [false; SIDE_BY_SIDE];
+        for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
+            for &reading in block {
+                plausible &= self.plausible(reading);
+                *clipped |= clip_seen(self.clip_level_dps, &mut clip_last, &mut clip_run, reading);
+            }
+        }
+        if !plausible {
+            return false;
+        }
+        (self.clip_last_dps, self.clip_run) = (clip_last, clip_run);
+        for &temperature_c in temperatures_c {
+            self.corrector.observe_temperature(temperature_c);
+        }
+
+        let mut blocks = [self.decimator.run(); SIDE_BY_SIDE];
+        for i in 0..factor {
+            for (k, block) in blocks.iter_mut().enumerate() {
+                // Without temperature: a temperature that would change the rate keeps the
+                // blocks out of here.
+                block.add(self.corrected::<false>(rates_dps[k * factor + i]));
+            }
+        }
+
+        for (k, block) in blocks.into_iter().enumerate() {
+            let times_s = &times_s[k * factor..(k + 1) * factor];
+            self.block_start_time_s = self.time_of(times_s, 0);
+            self.last_time_s = self.time_of_last(times_s, self.block_start_time_s);
+            self.clip_pending |= clipped[k];
+            if let Some(mean_dps) = self.decimator.close(block) {
+                sink(self.end_block(self.last_time_s, mean_dps));
+            }
+        }
+        true
+    }
+
+    /// Plausible: finite and within `max_abs_rate_dps`.
     #[inline(always)]
-    fn decimate(&mut self, time_s: f64, rate_dps: f32) -> Option<Output> {
-        let time_s = if time_s.is_finite() {
+    fn plausible(&self, reading_dps: f32) -> bool {
+        // `max_abs_rate_dps` is finite (validated): NaN and the infinities fail this test.
+        libm::fabsf(reading_dps) <= self.max_abs_rate_dps
+    }
+
+    /// A plausible reading corrected (with the temperature change in use if `TEMPERATURE`).
+    #[inline(always)]
+    fn corrected<const TEMPERATURE: bool>(&self, reading_dps: f32) -> f32 {
+        // The identity returns the reading, a zero's sign aside (−0 − 0·ΔT may give +0),
+        // which the decimator's sum does not see: both zeros leave it the same.
+        if !self.corrects {
+            reading_dps
+        } else if TEMPERATURE {
+            self.corrector.correct_at_temperature(reading_dps)
+        } else {
+            self.corrector.correct(reading_dps)
+        }
+    }
+
+    /// Count a rejected reading (its replacement is the caller's).
+    #[cold]
+    #[inline(never)]
+    fn reject(&mut self) {
+        self.rejected = self.rejected.saturating_add(1);
+    }
+
+    /// The time of `times_s[i]` (s), the stamps before it taken one after the other from
+    /// the last time: the stamp if finite, else [`Self::substitute_time`] of the one before.
+    #[inline(always)]
+    fn time_of(&self, times_s: &[f64], i: usize) -> f64 {
+        let time_s = times_s[i];
+        if time_s.is_finite() {
             time_s
         } else {
-            self.substitute_time()
-        };
-        if self.decimator.pending() == 0 {
-            self.block_start_time_s = time_s;
+            self.time_walked(times_s, i)
         }
-        self.last_time_s = time_s;
-        let mean_dps = self.decimator.push(rate_dps)?;
-        Some(self.end_block(time_s, mean_dps))
     }
 
-    /// The time of a sample whose stamp is not finite: one input period on from the last
-    /// time (the output period over the factor), or 0 if there is none.
+    /// The time of the last of `times_s` (non-empty), the first's being `first_s`.
+    #[inline(always)]
+    fn time_of_last(&self, times_s: &[f64], first_s: f64) -> f64 {
+        let last = times_s.len() - 1;
+        if last == 0 {
+            first_s
+        } else {
+            self.time_of(times_s, last)
+        }
+    }
+
+    /// [`Self::time_of`] for a stamp that is not finite: walk from the last time.
     #[cold]
     #[inline(never)]
-    fn substitute_time(&self) -> f64 {
-        if self.last_time_s.is_finite() {
-            self.last_time_s + f64::from(self.output_period_s) / f64::from(self.decimator.factor())
+    fn time_walked(&self, times_s: &[f64], i: usize) -> f64 {
+        times_s[..=i]
+            .iter()
+            .fold(self.last_time_s, |before_s, &time_s| {
+                if time_s.is_finite() {
+                    time_s
+                } else {
+                    self.substitute_time(before_s)
+                }
+            })
+    }
+
+    /// The time of a sample whose stamp is not finite: one input period on from the time
+    /// before it (the output period over the factor), or 0 if there is none.
+    fn substitute_time(&self, before_s: f64) -> f64 {
+        if before_s.is_finite() {
+            before_s + f64::from(self.output_period_s) / f64::from(self.decimator.factor())
         } else {
             0.0
         }
@@ -557,24 +815,6 @@ impl Pipeline {
         // Halves first: the sum of two huge times would overflow.
         let centre_s = 0.5 * self.block_start_time_s + 0.5 * time_s;
         self.step(centre_s, mean_dps)
-    }
-
-    /// Flag a reading that reaches the range or completes a clip plateau (see
-    /// [`Movement::saturated`]). Judged on the reading, before correction.
-    #[inline(always)]
-    fn observe_clip(&mut self, reading_dps: f32) {
-        self.clip_run = if reading_dps == self.clip_last_dps {
-            self.clip_run.saturating_add(1)
-        } else {
-            1
-        };
-        self.clip_last_dps = reading_dps;
-        let magnitude = libm::fabsf(reading_dps);
-        if magnitude >= self.clip_level_dps
-            || (self.clip_run >= CLIP_PLATEAU_SAMPLES && magnitude >= CLIP_PLATEAU_MIN_DPS)
-        {
-            self.clip_pending = true;
-        }
     }
 
     /// Whether the movement in progress (its confirming run included) is saturated so far;
