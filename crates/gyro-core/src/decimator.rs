@@ -71,20 +71,14 @@ impl Decimator {
     /// (at most [`Self::remaining`] of them) and handed back with [`Self::close`].
     ///
     /// A run keeps the sum in registers from one sample to the next; between calls the
-    /// decimator keeps it in memory. The samples go into the compensated sum one at a time
-    /// in their order, so that any split of a block into runs gives the same sum, bit for
-    /// bit. Stored, a block of odd count leaves its latest sample out of the sum (it goes
-    /// in with the next one): a run of one sample then trips the sum through memory only
-    /// every other sample.
+    /// decimator keeps it in memory. The samples go into the compensated sum in pairs, in
+    /// their order: the same sum, bit for bit, as one at a time, however a block is split
+    /// into runs; a run of one sample (a [`Self::push`]) then trips the sum through memory
+    /// only every other sample (a store and a reload on the sum's chain of additions).
     #[inline(always)]
-    pub fn run(&self) -> BlockRun {
-        let mut sum = self.sum;
-        if self.count % 2 == 1 {
-            sum.add(self.last);
-        }
+    pub const fn run(&self) -> BlockRun {
         BlockRun {
-            sum,
-            before: sum,
+            sum: self.sum,
             last: self.last,
             count: self.count,
         }
@@ -94,19 +88,36 @@ impl Decimator {
     /// the next block if the run completed it.
     #[inline(always)]
     pub fn close(&mut self, run: BlockRun) -> Option<f32> {
-        self.last = run.last;
         if run.count < self.factor {
+            // Stored only if a pair went in: a run of one leaves it alone every other time,
+            // and the next sample's reload then waits on no store.
+            if run.count / 2 != self.count / 2 {
+                self.sum = run.sum;
+            }
+            self.last = run.last;
             self.count = run.count;
-            self.sum = if run.count % 2 == 1 {
-                run.before
-            } else {
-                run.sum
-            };
             return None;
         }
-        let mean = run.sum.value() / f32::from(self.factor);
+        let mut sum = run.sum;
+        if run.count % 2 == 1 {
+            sum.add(run.last);
+        }
+        Some(self.complete(sum, run.last))
+    }
+
+    /// Complete a whole block summed elsewhere: `sum` of its `factor` samples, from
+    /// [`KahanSum::ZERO`] in their order, the latest `last`; the block must be empty
+    /// (no sample pending). Returns the block's mean, as [`Self::close`] would.
+    ///
+    /// For blocks summed side by side: independent sums keep the floating-point units busy
+    /// rather than wait on one sum's chain of additions.
+    #[inline(always)]
+    pub fn complete(&mut self, sum: KahanSum, last: f32) -> f32 {
+        debug_assert_eq!(self.count, 0);
+        self.last = last;
+        let mean = sum.value() / f32::from(self.factor);
         self.reset();
-        Some(mean)
+        mean
     }
 
     /// Drop the partial block (the latest sample stays known).
@@ -121,10 +132,8 @@ impl Decimator {
 /// ([`Decimator::run`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BlockRun {
-    /// Every sample of the block so far.
+    /// The block's samples but the latest while their count is odd.
     sum: KahanSum,
-    /// The sum before the latest sample.
-    before: KahanSum,
     last: f32,
     count: u16,
 }
@@ -133,10 +142,12 @@ impl BlockRun {
     /// Add one sample.
     #[inline(always)]
     pub fn add(&mut self, x: f32) {
-        self.before = self.sum;
-        self.sum.add(x);
-        self.last = x;
         self.count += 1;
+        if self.count % 2 == 0 {
+            self.sum.add(self.last);
+            self.sum.add(x);
+        }
+        self.last = x;
     }
 
     /// The latest sample added (the decimator's [`Decimator::last`] before any).

@@ -7,7 +7,7 @@ use crate::decision::Tightening;
 use crate::error::{check_range, Error};
 use crate::gauss_markov::GaussMarkov;
 use crate::integrator::Integrator;
-use crate::kahan::KahanSum;
+use crate::kahan::{KahanLanes, KahanSum};
 use crate::kalman::{KalmanBias, KalmanConfig};
 use crate::motion::{MotionConfig, MotionDetector, MotionState, Phase};
 use crate::sos::{Sos, SosState};
@@ -304,8 +304,10 @@ impl RestBlocks {
     }
 }
 
-/// How many whole blocks [`Pipeline::push_block`] sums side by side.
-const SIDE_BY_SIDE: usize = 4;
+/// How many whole blocks [`Pipeline::push_block`] sums side by side (half as many when
+/// fewer are at hand): 8 lanes, two 4-lane vector registers of sums and two of
+/// compensations, whose chains of additions overlap.
+const SIDE_BY_SIDE: usize = 8;
 
 /// One reading through the clip watch: `last` and `run` (the last reading and how many
 /// times in a row it came, up to the plateau) move on; true if it reaches the range
@@ -313,14 +315,13 @@ const SIDE_BY_SIDE: usize = 4;
 /// reading, before correction.
 #[inline(always)]
 fn clip_seen(level_dps: f32, last: &mut f32, run: &mut u8, reading_dps: f32) -> bool {
-    *run = if reading_dps == *last {
-        run.saturating_add(1)
-    } else {
-        1
-    };
+    // Without branches: whether a reading repeats is a coin toss on a quantised sensor.
+    let repeat = u8::from(reading_dps == *last);
+    *run = (run.saturating_add(1) & 0_u8.wrapping_sub(repeat)) | (1 - repeat);
     *last = reading_dps;
     let magnitude = libm::fabsf(reading_dps);
-    magnitude >= level_dps || (*run >= CLIP_PLATEAU_SAMPLES && magnitude >= CLIP_PLATEAU_MIN_DPS)
+    (magnitude >= level_dps)
+        | ((*run >= CLIP_PLATEAU_SAMPLES) & (magnitude >= CLIP_PLATEAU_MIN_DPS))
 }
 
 /// Group delay at DC of a cascade (output samples): for each section `B/A`,
@@ -485,9 +486,7 @@ impl Pipeline {
     /// the same outputs.
     #[inline]
     pub fn push(&mut self, time_s: f64, rate_dps: f32) -> Option<Output> {
-        let mut output = None;
-        self.run::<false>(&[time_s], &[rate_dps], &[], &mut |out| output = Some(out));
-        output
+        self.segment::<false>(&[time_s], &[rate_dps], &[])
     }
 
     /// Push one input sample with the sensor's temperature `temperature_c` (°C): the whole
@@ -505,11 +504,7 @@ impl Pipeline {
         rate_dps: f32,
         temperature_c: f32,
     ) -> Option<Output> {
-        let mut output = None;
-        self.run::<true>(&[time_s], &[rate_dps], &[temperature_c], &mut |out| {
-            output = Some(out)
-        });
-        output
+        self.segment::<true>(&[time_s], &[rate_dps], &[temperature_c])
     }
 
     /// Push a block of input samples, `times_s[i]` (s) and `rates_dps[i]` (deg/s), handing
@@ -600,25 +595,31 @@ impl Pipeline {
         let mut start = 0;
         while start < rates_dps.len() {
             let left = rates_dps.len() - start;
-            // Whole blocks side by side, when the temperature changes no rate.
-            if self.decimator.pending() == 0
-                && left >= SIDE_BY_SIDE * factor
-                && !(TEMPERATURE && self.corrects)
-            {
-                let end = start + SIDE_BY_SIDE * factor;
-                let temperatures = if TEMPERATURE {
-                    &temperatures_c[start..end]
+            // Whole blocks side by side, when the temperature changes no rate: as many as
+            // the lanes hold, else fewer.
+            if self.decimator.pending() == 0 && !(TEMPERATURE && self.corrects) {
+                let lanes = if left >= SIDE_BY_SIDE * factor {
+                    SIDE_BY_SIDE
                 } else {
-                    &[]
+                    SIDE_BY_SIDE / 2
                 };
-                if self.sums(
-                    &times_s[start..end],
-                    &rates_dps[start..end],
-                    temperatures,
-                    sink,
-                ) {
-                    start = end;
-                    continue;
+                let end = start + lanes * factor;
+                if left >= lanes * factor {
+                    let temperatures = if TEMPERATURE {
+                        &temperatures_c[start..end]
+                    } else {
+                        &[]
+                    };
+                    let (times, rates) = (&times_s[start..end], &rates_dps[start..end]);
+                    let pushed = if lanes == SIDE_BY_SIDE {
+                        self.sums::<SIDE_BY_SIDE>(times, rates, temperatures, sink)
+                    } else {
+                        self.sums::<{ SIDE_BY_SIDE / 2 }>(times, rates, temperatures, sink)
+                    };
+                    if pushed {
+                        start = end;
+                        continue;
+                    }
                 }
             }
             let end = start + left.min(usize::from(self.decimator.remaining()));
@@ -677,7 +678,7 @@ impl Pipeline {
         Some(self.end_block(last_s, mean_dps))
     }
 
-    /// Push [`SIDE_BY_SIDE`] whole blocks starting at a block boundary: first the
+    /// Push `LANES` whole blocks starting at a block boundary: first the
     /// plausibility test, the clip watch (and the temperatures) over all samples in order,
     /// then the blocks' sums side by side, each in its samples' order (the sums are
     /// independent: interleaved, they keep the floating-point units busy rather than wait
@@ -685,7 +686,7 @@ impl Pipeline {
     /// nothing pushed, if a sample is implausible: its replacement depends on the sample
     /// before, so those blocks go one sample after the other (`segment`).
     #[inline(never)]
-    fn sums(
+    fn sums<const LANES: usize>(
         &mut self,
         times_s: &[f64],
         rates_dps: &[f32],
@@ -694,43 +695,94 @@ impl Pipeline {
     ) -> bool {
         let factor = usize::from(self.decimator.factor());
         debug_assert_eq!(self.decimator.pending(), 0);
-        debug_assert_eq!(rates_dps.len(), SIDE_BY_SIDE * factor);
-        let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
-        let mut plausible = true;
-        let mut clipped = [false; SIDE_BY_SIDE];
-        for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
-            for &reading in block {
-                plausible &= self.plausible(reading);
-                *clipped |= clip_seen(self.clip_level_dps, &mut clip_last, &mut clip_run, reading);
-            }
-        }
-        if !plausible {
+        if rates_dps.len() != LANES * factor {
             return false;
         }
-        (self.clip_last_dps, self.clip_run) = (clip_last, clip_run);
+        let mut rows = [&rates_dps[..0]; LANES];
+        for (row, block) in rows.iter_mut().zip(rates_dps.chunks_exact(factor)) {
+            *row = block;
+        }
+        let Some(clipped) = self.clip_watch::<LANES>(rates_dps, factor) else {
+            return false;
+        };
         for &temperature_c in temperatures_c {
             self.corrector.observe_temperature(temperature_c);
         }
 
-        let mut blocks = [self.decimator.run(); SIDE_BY_SIDE];
+        let mut sums = KahanLanes::<LANES>::ZERO;
         for i in 0..factor {
-            for (k, block) in blocks.iter_mut().enumerate() {
-                // Without temperature: a temperature that would change the rate keeps the
-                // blocks out of here.
-                block.add(self.corrected::<false>(rates_dps[k * factor + i]));
+            // Without temperature: a temperature that would change the rate keeps the
+            // blocks out of here.
+            let mut column = [0.0; LANES];
+            for (x, row) in column.iter_mut().zip(&rows) {
+                *x = self.corrected::<false>(row[i]);
             }
+            sums.add(column);
         }
 
-        for (k, block) in blocks.into_iter().enumerate() {
+        for (k, row) in rows.into_iter().enumerate() {
+            let sum = sums.lane(k);
             let times_s = &times_s[k * factor..(k + 1) * factor];
             self.block_start_time_s = self.time_of(times_s, 0);
             self.last_time_s = self.time_of_last(times_s, self.block_start_time_s);
             self.clip_pending |= clipped[k];
-            if let Some(mean_dps) = self.decimator.close(block) {
-                sink(self.end_block(self.last_time_s, mean_dps));
-            }
+            let last = self.corrected::<false>(row[factor - 1]);
+            let mean_dps = self.decimator.complete(sum, last);
+            sink(self.end_block(self.last_time_s, mean_dps));
         }
         true
+    }
+
+    /// The plausibility test and the clip watch over whole blocks of `factor` samples in
+    /// order: each block's clip flag, or `None` (and nothing changed) if a sample is
+    /// implausible.
+    ///
+    /// Blocks that stay below both the clip plateau's level and the range, as rests do,
+    /// need no watch sample by sample: their test reads all samples at once, and the watch
+    /// moves on to their last reading and its run of repeats.
+    #[inline(always)]
+    fn clip_watch<const LANES: usize>(
+        &mut self,
+        rates_dps: &[f32],
+        factor: usize,
+    ) -> Option<[bool; LANES]> {
+        let quiet_dps = self.clip_level_dps.min(CLIP_PLATEAU_MIN_DPS);
+        let max_dps = self.max_abs_rate_dps;
+        // Below the quiet level (and plausible): NaN fails both.
+        let (quiet, plausible) = rates_dps
+            .iter()
+            .fold((true, true), |(quiet, plausible), &x| {
+                let magnitude = libm::fabsf(x);
+                (
+                    quiet & (magnitude < quiet_dps),
+                    plausible & (magnitude <= max_dps),
+                )
+            });
+        if !plausible {
+            return None;
+        }
+        let mut clipped = [false; LANES];
+        if quiet {
+            let (&last, before) = rates_dps.split_last()?;
+            let repeats = before.iter().rev().take_while(|&&x| x == last).count();
+            self.clip_run = if repeats == before.len() && last == self.clip_last_dps {
+                self.clip_run
+                    .saturating_add(u8::try_from(rates_dps.len()).unwrap_or(u8::MAX))
+            } else {
+                u8::try_from(repeats + 1).unwrap_or(u8::MAX)
+            };
+            self.clip_last_dps = last;
+        } else {
+            let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
+            for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
+                for &reading in block {
+                    *clipped |=
+                        clip_seen(self.clip_level_dps, &mut clip_last, &mut clip_run, reading);
+                }
+            }
+            (self.clip_last_dps, self.clip_run) = (clip_last, clip_run);
+        }
+        Some(clipped)
     }
 
     /// Plausible: finite and within `max_abs_rate_dps`.
