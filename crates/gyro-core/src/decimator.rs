@@ -181,6 +181,29 @@ mod tests {
     }
 
     #[test]
+    fn runs_give_the_bits_of_pushes() {
+        let xs: Vec<f32> = (0..200).map(|i| (i as f32 * 0.37).sin() * 1e3 + 1e-3).collect();
+        let mut one = Decimator::try_new(7).unwrap();
+        let expected: Vec<u32> = xs.iter().filter_map(|&x| one.push(x)).map(f32::to_bits).collect();
+        for cut in [2, 3, 5, 7, 11] {
+            let mut d = Decimator::try_new(7).unwrap();
+            let mut got = Vec::new();
+            let mut rest = &xs[..];
+            while !rest.is_empty() {
+                let take = rest.len().min(cut).min(usize::from(d.remaining()));
+                let mut run = d.run();
+                for &x in &rest[..take] {
+                    run.add(x);
+                }
+                got.extend(d.close(run).map(f32::to_bits));
+                rest = &rest[take..];
+            }
+            assert_eq!(got, expected, "runs of {cut}");
+            assert_eq!(d, one, "runs of {cut}");
+        }
+    }
+
+    #[test]
     fn factor_one_passes_through() {
         let mut d = Decimator::try_new(1).unwrap();
         assert_eq!(d.push(2.5), Some(2.5));

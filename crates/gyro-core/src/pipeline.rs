@@ -342,6 +342,7 @@ fn dc_group_delay_samples(design: &SosDesign) -> f64 {
 }
 
 /// The pipeline. Push input samples; every `decimation_factor`-th push returns an output.
+/// [`Pipeline::push_block`] takes them in blocks, with the same outputs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pipeline {
     max_abs_rate_dps: f32,
@@ -514,8 +515,10 @@ impl Pipeline {
     /// The outputs and the state left are those of [`Self::push`] on the same samples one
     /// by one, bit for bit, however the samples are split into calls. What differs is the
     /// cost: the decimator's sum and the per-sample checks stay in registers through the
-    /// block, the block's times and counters are kept once per block, and whole blocks of
-    /// plausible samples have their sums added side by side (see `sums`).
+    /// block, the block's times and counters are kept once per block, and runs of 4 or 8
+    /// whole decimation blocks of plausible samples have their sums added side by side
+    /// (each in its own order, so that the bits stay those of one sum at a time). Longer
+    /// calls gain more: a call of fewer than 4 blocks goes sample by sample.
     ///
     /// Refused, with nothing pushed, if the slices' lengths differ
     /// ([`Error::OutOfRange`]`("rates_dps")`).
