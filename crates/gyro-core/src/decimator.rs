@@ -182,9 +182,15 @@ mod tests {
 
     #[test]
     fn runs_give_the_bits_of_pushes() {
-        let xs: Vec<f32> = (0..200).map(|i| (i as f32 * 0.37).sin() * 1e3 + 1e-3).collect();
+        let xs: Vec<f32> = (0..200)
+            .map(|i| (i as f32 * 0.37).sin() * 1e3 + 1e-3)
+            .collect();
         let mut one = Decimator::try_new(7).unwrap();
-        let expected: Vec<u32> = xs.iter().filter_map(|&x| one.push(x)).map(f32::to_bits).collect();
+        let expected: Vec<u32> = xs
+            .iter()
+            .filter_map(|&x| one.push(x))
+            .map(f32::to_bits)
+            .collect();
         for cut in [2, 3, 5, 7, 11] {
             let mut d = Decimator::try_new(7).unwrap();
             let mut got = Vec::new();

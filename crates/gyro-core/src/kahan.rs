@@ -65,8 +65,9 @@ impl<const N: usize> KahanLanes<N> {
     /// Add `x[k]` to lane `k`.
     #[inline(always)]
     pub fn add(&mut self, x: [f32; N]) {
-        for k in 0..N {
-            (self.sums[k], self.compensations[k]) = step(self.sums[k], self.compensations[k], x[k]);
+        let lanes = self.sums.iter_mut().zip(&mut self.compensations);
+        for ((sum, compensation), x) in lanes.zip(x) {
+            (*sum, *compensation) = step(*sum, *compensation, x);
         }
     }
 

@@ -145,7 +145,7 @@ fn bits(outputs: &[Output], pipeline: &Pipeline) -> (String, String) {
 /// Push `input` one by one; and in blocks of the lengths `cuts` (cycled; empty ones
 /// included), with a single push for every length 1. Both must agree on every bit.
 fn compare(config: &Config, input: &[(f64, f32, f32)], cuts: &[usize], temperature: bool) {
-    let mut one = Pipeline::try_new(config).unwrap();
+    let mut one = Pipeline::try_new(config).expect("valid config");
     let mut expected = Vec::new();
     for &(t, r, c) in input {
         let out = if temperature {
@@ -159,7 +159,7 @@ fn compare(config: &Config, input: &[(f64, f32, f32)], cuts: &[usize], temperatu
     let times: Vec<f64> = input.iter().map(|s| s.0).collect();
     let rates: Vec<f32> = input.iter().map(|s| s.1).collect();
     let temps: Vec<f32> = input.iter().map(|s| s.2).collect();
-    let mut block = Pipeline::try_new(config).unwrap();
+    let mut block = Pipeline::try_new(config).expect("valid config");
     let mut got = Vec::new();
     let mut start = 0;
     // Empty blocks are pushed too, but some cut must move on.
@@ -188,11 +188,11 @@ fn compare(config: &Config, input: &[(f64, f32, f32)], cuts: &[usize], temperatu
                     &temps[start..end],
                     |out| got.push(out),
                 )
-                .unwrap();
+                .expect("same lengths");
         } else {
             block
                 .push_block(&times[start..end], &rates[start..end], |out| got.push(out))
-                .unwrap();
+                .expect("same lengths");
         }
         start = end;
     }
@@ -250,7 +250,7 @@ fn long_blocks_give_the_bits_of_one_by_one() {
 
 #[test]
 fn slices_of_different_lengths_are_refused() {
-    let mut pipeline = Pipeline::try_new(&Config::default()).unwrap();
+    let mut pipeline = Pipeline::try_new(&Config::default()).expect("default config");
     let before = format!("{pipeline:?}");
     assert_eq!(
         pipeline.push_block(&[0.0, 1e-3], &[1.0], |_| {}),
