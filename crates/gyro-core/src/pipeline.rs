@@ -521,7 +521,7 @@ impl Pipeline {
     /// calls gain more: a call of fewer than 4 blocks goes sample by sample.
     ///
     /// Refused, with nothing pushed, if the slices' lengths differ
-    /// ([`Error::OutOfRange`]`("rates_dps")`).
+    /// ([`Error::LengthMismatch`]`("rates_dps")`).
     ///
     /// ```
     /// use gyro_core::{Config, Pipeline};
@@ -552,7 +552,7 @@ impl Pipeline {
         mut sink: impl FnMut(Output),
     ) -> Result<(), Error> {
         if rates_dps.len() != times_s.len() {
-            return Err(Error::OutOfRange("rates_dps"));
+            return Err(Error::LengthMismatch("rates_dps"));
         }
         self.run::<false>(times_s, rates_dps, &[], &mut sink);
         Ok(())
@@ -562,7 +562,7 @@ impl Pipeline {
     /// (°C), as [`Self::push_with_temperature`] takes it.
     ///
     /// Refused, with nothing pushed, if the slices' lengths differ
-    /// ([`Error::OutOfRange`] naming `rates_dps` or `temperatures_c`).
+    /// ([`Error::LengthMismatch`] naming `rates_dps` or `temperatures_c`).
     pub fn push_block_with_temperature(
         &mut self,
         times_s: &[f64],
@@ -571,10 +571,10 @@ impl Pipeline {
         mut sink: impl FnMut(Output),
     ) -> Result<(), Error> {
         if rates_dps.len() != times_s.len() {
-            return Err(Error::OutOfRange("rates_dps"));
+            return Err(Error::LengthMismatch("rates_dps"));
         }
         if temperatures_c.len() != times_s.len() {
-            return Err(Error::OutOfRange("temperatures_c"));
+            return Err(Error::LengthMismatch("temperatures_c"));
         }
         self.run::<true>(times_s, rates_dps, temperatures_c, &mut sink);
         Ok(())

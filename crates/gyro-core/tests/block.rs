@@ -254,11 +254,11 @@ fn slices_of_different_lengths_are_refused() {
     let before = format!("{pipeline:?}");
     assert_eq!(
         pipeline.push_block(&[0.0, 1e-3], &[1.0], |_| {}),
-        Err(Error::OutOfRange("rates_dps"))
+        Err(Error::LengthMismatch("rates_dps"))
     );
     assert_eq!(
         pipeline.push_block_with_temperature(&[0.0], &[1.0], &[], |_| {}),
-        Err(Error::OutOfRange("temperatures_c"))
+        Err(Error::LengthMismatch("temperatures_c"))
     );
     assert_eq!(format!("{pipeline:?}"), before);
 }
