@@ -106,14 +106,14 @@ impl Decimator {
     }
 
     /// Complete a whole block summed elsewhere: `sum` of its `factor` samples, from
-    /// [`KahanSum::ZERO`] in their order, the latest `last`; the block must be empty
-    /// (no sample pending). Returns the block's mean, as [`Self::close`] would.
+    /// [`KahanSum::ZERO`] in their order, the latest `last`, in place of the current
+    /// block, which must be empty (no sample pending) unless it is the one summed. Returns
+    /// the block's mean, as [`Self::close`] would.
     ///
     /// For blocks summed side by side: independent sums keep the floating-point units busy
     /// rather than wait on one sum's chain of additions.
     #[inline(always)]
     pub fn complete(&mut self, sum: KahanSum, last: f32) -> f32 {
-        debug_assert_eq!(self.count, 0);
         self.last = last;
         let mean = sum.value() / f32::from(self.factor);
         self.reset();
