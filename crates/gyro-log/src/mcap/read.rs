@@ -48,7 +48,7 @@
 use super::attach::Attacher;
 use super::layout::{self, Layout};
 use super::ros2::{decode_imu, Axis, TimeSource, IMU_SCHEMA_NAME};
-use super::unit::{Event, UnitError, Units};
+use super::unit::{Event, UnitError, Units, UnitsAhead};
 use super::{json, ns_to_seconds, GYRO_TOPIC, METADATA_NAME, REFERENCE_TOPIC};
 use crate::{metadata_rate_hz, Log, LogError, Row, RATE_WINDOW_STEPS};
 use mcap::records::{op, Record};
@@ -173,7 +173,7 @@ struct Stop {
 /// read around.
 pub struct McapRows {
     state: State,
-    units: Units,
+    units: UnitsAhead,
     finished: bool,
     /// Damage the walk over the file met (reading stops there).
     scan_damage: Option<layout::Damage>,
@@ -250,7 +250,7 @@ impl McapRows {
         }
         Ok(Self {
             state,
-            units: Units::new(file, units),
+            units: UnitsAhead::new(Units::new(file, units)),
             finished,
             scan_damage: damage,
             stop: None,

@@ -8,6 +8,9 @@ use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::McapError;
 use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom};
+use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
 
 /// What the stream of units gives.
 pub(super) enum Event<'a> {
@@ -144,5 +147,203 @@ impl Units {
             e => e.to_string(),
         };
         UnitError::Damaged { offset, what }
+    }
+}
+
+/// Units per batch in flight between the threads of [`UnitsAhead`] (the memory held: about
+/// this many decompressed chunks more than [`Units`] holds).
+const UNITS_AHEAD: usize = 2;
+
+/// The records of one unit, as [`Units`] gave them, and what came after them.
+#[derive(Default)]
+struct Batch {
+    data: Vec<u8>,
+    /// Opcode, range in `data`, and [`Units::current_offset`] when the record was given.
+    records: Vec<(u8, std::ops::Range<usize>, u64)>,
+    /// After the records: a unit done (`Some(Ok(next_start_ns))`), an error, or the end.
+    end: Option<Result<u64, UnitError>>,
+    /// [`Units::current_offset`] when `end` was given.
+    end_offset: u64,
+}
+
+/// [`Units`] read on a thread of its own: the file is read, CRC-checked and decompressed a
+/// unit or two ahead while the caller decodes the records. The same events in the same
+/// order, with the same offsets; if the thread cannot be started, the units are read on
+/// the caller's thread.
+pub(super) struct UnitsAhead {
+    units: Vec<Unit>,
+    file_len: u64,
+    source: Source,
+    current: Batch,
+    /// Next record of `current` to give; `current.end` given.
+    position: usize,
+    end_given: bool,
+    /// The stream has ended (an error or the end was given).
+    done: bool,
+    offset: u64,
+}
+
+enum Source {
+    Thread {
+        batches: Option<Receiver<Batch>>,
+        spare: SyncSender<Batch>,
+        thread: Option<JoinHandle<()>>,
+    },
+    Here(Box<Units>),
+}
+
+impl UnitsAhead {
+    pub fn new(units: Units) -> Self {
+        let list = units.units().to_vec();
+        let file_len = units.file_len();
+        let shared = Arc::new(Mutex::new(Some(units)));
+        let (sender, batches) = sync_channel::<Batch>(UNITS_AHEAD - 1);
+        let (spare, spares) = sync_channel::<Batch>(UNITS_AHEAD + 1);
+        let theirs = Arc::clone(&shared);
+        let thread = std::thread::Builder::new()
+            .name("gyro-mcap-units".into())
+            .spawn(move || {
+                let Some(units) = theirs.lock().ok().and_then(|mut u| u.take()) else {
+                    return;
+                };
+                produce(units, &sender, &spares);
+            });
+        let source = match thread {
+            Ok(thread) => Source::Thread {
+                batches: Some(batches),
+                spare,
+                thread: Some(thread),
+            },
+            Err(_) => match shared.lock().ok().and_then(|mut u| u.take()) {
+                Some(units) => Source::Here(Box::new(units)),
+                // Not reached: the closure that would have taken them was not run.
+                None => Source::Thread {
+                    batches: None,
+                    spare,
+                    thread: None,
+                },
+            },
+        };
+        Self {
+            units: list,
+            file_len,
+            source,
+            current: Batch::default(),
+            position: 0,
+            end_given: true,
+            done: false,
+            offset: 0,
+        }
+    }
+
+    /// Length of the file (bytes).
+    pub fn file_len(&self) -> u64 {
+        self.file_len
+    }
+
+    /// [`Units::current_offset`] when the last event was given.
+    pub fn current_offset(&self) -> u64 {
+        match &self.source {
+            Source::Here(units) => units.current_offset(),
+            Source::Thread { .. } => self.offset,
+        }
+    }
+
+    /// The units, in reading order.
+    pub fn units(&self) -> &[Unit] {
+        &self.units
+    }
+
+    /// [`Units::next_event`].
+    pub fn next_event(&mut self) -> Option<Result<Event<'_>, UnitError>> {
+        let (batches, spare) = match &mut self.source {
+            Source::Here(units) => return units.next_event(),
+            Source::Thread { batches, spare, .. } => (batches, spare),
+        };
+        loop {
+            if let Some((opcode, range, offset)) = self.current.records.get(self.position) {
+                self.position += 1;
+                self.offset = *offset;
+                let data = self.current.data.get(range.clone()).unwrap_or_default();
+                return Some(Ok(Event::Record {
+                    opcode: *opcode,
+                    data,
+                }));
+            }
+            if !self.end_given {
+                self.end_given = true;
+                self.offset = self.current.end_offset;
+                return match self.current.end.take() {
+                    Some(Ok(next_start_ns)) => Some(Ok(Event::UnitDone { next_start_ns })),
+                    Some(Err(e)) => {
+                        self.done = true;
+                        Some(Err(e))
+                    }
+                    None => {
+                        self.done = true;
+                        None
+                    }
+                };
+            }
+            if self.done {
+                return None;
+            }
+            let Some(next) = batches.as_ref().and_then(|b| b.recv().ok()) else {
+                self.done = true;
+                return Some(Err(UnitError::Io(io::Error::other(
+                    "the thread reading the file stopped",
+                ))));
+            };
+            let used = std::mem::replace(&mut self.current, next);
+            let _ = spare.try_send(used);
+            self.position = 0;
+            self.end_given = false;
+        }
+    }
+}
+
+impl Drop for UnitsAhead {
+    /// The thread stops at its next batch once nobody receives them.
+    fn drop(&mut self) {
+        if let Source::Thread {
+            batches, thread, ..
+        } = &mut self.source
+        {
+            *batches = None;
+            if let Some(thread) = thread.take() {
+                let _ = thread.join();
+            }
+        }
+    }
+}
+
+/// The thread of [`UnitsAhead`]: every event of `units`, a unit per batch, until the end,
+/// an error, or nobody receives.
+fn produce(mut units: Units, sender: &SyncSender<Batch>, spares: &Receiver<Batch>) {
+    loop {
+        let mut batch = spares.try_recv().unwrap_or_default();
+        batch.data.clear();
+        batch.records.clear();
+        let end = loop {
+            match units.next_event() {
+                Some(Ok(Event::Record { opcode, data })) => {
+                    let start = batch.data.len();
+                    batch.data.extend_from_slice(data);
+                    let offset = units.current_offset();
+                    batch
+                        .records
+                        .push((opcode, start..batch.data.len(), offset));
+                }
+                Some(Ok(Event::UnitDone { next_start_ns })) => break Some(Ok(next_start_ns)),
+                Some(Err(e)) => break Some(Err(e)),
+                None => break None,
+            }
+        };
+        let last = !matches!(end, Some(Ok(_)));
+        batch.end = end;
+        batch.end_offset = units.current_offset();
+        if sender.send(batch).is_err() || last {
+            return;
+        }
     }
 }
