@@ -42,8 +42,13 @@ pub(super) struct Units {
     announced: bool,
     reader: LinearReader,
     /// The last record given, copied out of the reader.
-    opcode: u8,
     record: Vec<u8>,
+}
+
+/// An [`Event`] whose record was copied out.
+enum Next {
+    Record { opcode: u8 },
+    UnitDone { next_start_ns: u64 },
 }
 
 impl Units {
@@ -61,7 +66,6 @@ impl Units {
                     .with_prevalidate_chunk_crcs(true)
                     .with_record_length_limit(RECORD_LENGTH_LIMIT as usize),
             ),
-            opcode: 0,
             record: Vec::new(),
         }
     }
@@ -86,14 +90,31 @@ impl Units {
 
     /// The next event; `None` once every unit has been read.
     pub fn next_event(&mut self) -> Option<Result<Event<'_>, UnitError>> {
+        let mut record = std::mem::take(&mut self.record);
+        record.clear();
+        let next = self.next_into(&mut record);
+        self.record = record;
+        Some(next?.map(|next| match next {
+            Next::Record { opcode } => Event::Record {
+                opcode,
+                data: &self.record,
+            },
+            Next::UnitDone { next_start_ns } => Event::UnitDone { next_start_ns },
+        }))
+    }
+
+    /// The next event, a record's bytes appended to `data`; `None` once every unit has
+    /// been read.
+    fn next_into(&mut self, data: &mut Vec<u8>) -> Option<Result<Next, UnitError>> {
         loop {
             let need = match self.reader.next_event()? {
                 Ok(LinearReadEvent::ReadRequest(need)) => need,
-                Ok(LinearReadEvent::Record { opcode, data }) => {
-                    self.opcode = opcode;
-                    self.record.clear();
-                    self.record.extend_from_slice(data);
-                    break;
+                Ok(LinearReadEvent::Record {
+                    opcode,
+                    data: record,
+                }) => {
+                    data.extend_from_slice(record);
+                    return Some(Ok(Next::Record { opcode }));
                 }
                 Err(e) => return Some(Err(self.damaged(&e))),
             };
@@ -103,7 +124,7 @@ impl Units {
                 if !self.announced {
                     self.announced = true;
                     let next_start_ns = self.units.get(self.next).map_or(u64::MAX, |u| u.start_ns);
-                    return Some(Ok(Event::UnitDone { next_start_ns }));
+                    return Some(Ok(Next::UnitDone { next_start_ns }));
                 }
                 let Some(unit) = self.units.get(self.next) else {
                     self.reader.notify_read(0); // the end
@@ -131,10 +152,6 @@ impl Units {
             self.remaining -= read as u64;
             self.reader.notify_read(read);
         }
-        Some(Ok(Event::Record {
-            opcode: self.opcode,
-            data: &self.record,
-        }))
     }
 
     fn damaged(&self, e: &McapError) -> UnitError {
