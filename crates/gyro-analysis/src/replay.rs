@@ -693,9 +693,8 @@ impl Replayer {
         let mut movements = self.movements;
         if let (Some(open), Some(last)) = (self.open, last) {
             let samples = (open.start_index, self.outputs - 1);
-            let start_reference = open
-                .reference_at_start
-                .unwrap_or_else(|| last.reference_deg);
+            // Unresolved: no output reached the start's time, the last is the nearest.
+            let start_reference = open.reference_at_start.unwrap_or(last.reference_deg);
             let first = open.start.unwrap_or(last);
             let filled_samples = last.filled_before - open.start.map_or(0, |h| h.filled_before);
             movements.push(movement_result(
