@@ -19,9 +19,10 @@
 //! headers finds the chunks (with or without a summary section), then the chunks are read
 //! in order of their first log time (`message_start_time`; equal ones in file order), so
 //! chunks written out of time order are read in time order; the messages of a chunk in
-//! their order in the file. Memory holds a chunk and the rows waiting for their reference
-//! (in a file whose channels share chunks in time order, at most a chunk's worth), never
-//! the log.
+//! their order in the file. The chunks are read, CRC-checked and decompressed on a thread
+//! of their own, a chunk or two ahead of the decoding (`UnitsAhead`).
+//! Memory holds those few chunks and the rows waiting for their reference (in a file whose
+//! channels share chunks in time order, at most a chunk's worth), never the log.
 //!
 //! # Reference attachment
 //! Reference samples (`/reference`, `{"angle_deg": f64|null}`) are attached to rate rows by
