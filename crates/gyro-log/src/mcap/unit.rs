@@ -8,6 +8,7 @@ use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::McapError;
 use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom};
+use std::ops::Range;
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
@@ -167,24 +168,39 @@ impl Units {
     }
 }
 
-/// Units per batch in flight between the threads of [`UnitsAhead`] (the memory held: about
-/// this many decompressed chunks more than [`Units`] holds).
-const UNITS_AHEAD: usize = 2;
+/// Batches in flight between the threads of [`UnitsAhead`].
+const BATCHES_AHEAD: usize = 2;
+/// A batch is sent once its records hold this many bytes, at the end of a unit (fewer
+/// hand-overs between the threads than one per chunk; the memory held is about
+/// `BATCHES_AHEAD + 2` batches).
+const BATCH_BYTES: usize = 1 << 18;
 
-/// The records of one unit, as [`Units`] gave them, and what came after them.
+/// One event of a batch.
+enum Item {
+    /// A record: its opcode and its bytes in the batch's `data`.
+    Record {
+        opcode: u8,
+        range: Range<usize>,
+    },
+    UnitDone {
+        next_start_ns: u64,
+    },
+}
+
+/// Events of one or more units, as [`Units`] gave them.
 #[derive(Default)]
 struct Batch {
     data: Vec<u8>,
-    /// Opcode, range in `data`, and [`Units::current_offset`] when the record was given.
-    records: Vec<(u8, std::ops::Range<usize>, u64)>,
-    /// After the records: a unit done (`Some(Ok(next_start_ns))`), an error, or the end.
-    end: Option<Result<u64, UnitError>>,
-    /// [`Units::current_offset`] when `end` was given.
-    end_offset: u64,
+    /// The events, each with [`Units::current_offset`] when it was given.
+    items: Vec<(Item, u64)>,
+    /// After the items: nothing (more batches follow), the end (`Some(None)`) or an error.
+    last: Option<Option<UnitError>>,
+    /// [`Units::current_offset`] when `last` was given.
+    last_offset: u64,
 }
 
 /// [`Units`] read on a thread of its own: the file is read, CRC-checked and decompressed a
-/// unit or two ahead while the caller decodes the records. The same events in the same
+/// few units ahead while the caller decodes the records. The same events in the same
 /// order, with the same offsets; if the thread cannot be started, the units are read on
 /// the caller's thread.
 pub(super) struct UnitsAhead {
@@ -192,9 +208,8 @@ pub(super) struct UnitsAhead {
     file_len: u64,
     source: Source,
     current: Batch,
-    /// Next record of `current` to give; `current.end` given.
+    /// Next item of `current` to give.
     position: usize,
-    end_given: bool,
     /// The stream has ended (an error or the end was given).
     done: bool,
     offset: u64,
@@ -214,8 +229,8 @@ impl UnitsAhead {
         let list = units.units().to_vec();
         let file_len = units.file_len();
         let shared = Arc::new(Mutex::new(Some(units)));
-        let (sender, batches) = sync_channel::<Batch>(UNITS_AHEAD - 1);
-        let (spare, spares) = sync_channel::<Batch>(UNITS_AHEAD + 1);
+        let (sender, batches) = sync_channel::<Batch>(BATCHES_AHEAD);
+        let (spare, spares) = sync_channel::<Batch>(BATCHES_AHEAD + 2);
         let theirs = Arc::clone(&shared);
         let thread = std::thread::Builder::new()
             .name("gyro-mcap-units".into())
@@ -247,7 +262,6 @@ impl UnitsAhead {
             source,
             current: Batch::default(),
             position: 0,
-            end_given: true,
             done: false,
             offset: 0,
         }
@@ -278,32 +292,26 @@ impl UnitsAhead {
             Source::Thread { batches, spare, .. } => (batches, spare),
         };
         loop {
-            if let Some((opcode, range, offset)) = self.current.records.get(self.position) {
+            if let Some((item, offset)) = self.current.items.get(self.position) {
                 self.position += 1;
                 self.offset = *offset;
-                let data = self.current.data.get(range.clone()).unwrap_or_default();
-                return Some(Ok(Event::Record {
-                    opcode: *opcode,
-                    data,
+                return Some(Ok(match item {
+                    Item::Record { opcode, range } => Event::Record {
+                        opcode: *opcode,
+                        data: self.current.data.get(range.clone()).unwrap_or_default(),
+                    },
+                    Item::UnitDone { next_start_ns } => Event::UnitDone {
+                        next_start_ns: *next_start_ns,
+                    },
                 }));
-            }
-            if !self.end_given {
-                self.end_given = true;
-                self.offset = self.current.end_offset;
-                return match self.current.end.take() {
-                    Some(Ok(next_start_ns)) => Some(Ok(Event::UnitDone { next_start_ns })),
-                    Some(Err(e)) => {
-                        self.done = true;
-                        Some(Err(e))
-                    }
-                    None => {
-                        self.done = true;
-                        None
-                    }
-                };
             }
             if self.done {
                 return None;
+            }
+            if let Some(last) = self.current.last.take() {
+                self.done = true;
+                self.offset = self.current.last_offset;
+                return last.map(Err);
             }
             let Some(next) = batches.as_ref().and_then(|b| b.recv().ok()) else {
                 self.done = true;
@@ -314,7 +322,6 @@ impl UnitsAhead {
             let used = std::mem::replace(&mut self.current, next);
             let _ = spare.try_send(used);
             self.position = 0;
-            self.end_given = false;
         }
     }
 }
@@ -334,31 +341,39 @@ impl Drop for UnitsAhead {
     }
 }
 
-/// The thread of [`UnitsAhead`]: every event of `units`, a unit per batch, until the end,
-/// an error, or nobody receives.
+/// The thread of [`UnitsAhead`]: every event of `units`, in batches of whole units, until
+/// the end, an error, or nobody receives.
 fn produce(mut units: Units, sender: &SyncSender<Batch>, spares: &Receiver<Batch>) {
     loop {
         let mut batch = spares.try_recv().unwrap_or_default();
         batch.data.clear();
-        batch.records.clear();
-        let end = loop {
-            match units.next_event() {
-                Some(Ok(Event::Record { opcode, data })) => {
-                    let start = batch.data.len();
-                    batch.data.extend_from_slice(data);
-                    let offset = units.current_offset();
-                    batch
-                        .records
-                        .push((opcode, start..batch.data.len(), offset));
+        batch.items.clear();
+        batch.last = None;
+        loop {
+            let start = batch.data.len();
+            let item = match units.next_into(&mut batch.data) {
+                Some(Ok(Next::Record { opcode })) => Item::Record {
+                    opcode,
+                    range: start..batch.data.len(),
+                },
+                Some(Ok(Next::UnitDone { next_start_ns })) => Item::UnitDone { next_start_ns },
+                Some(Err(e)) => {
+                    batch.last = Some(Some(e));
+                    break;
                 }
-                Some(Ok(Event::UnitDone { next_start_ns })) => break Some(Ok(next_start_ns)),
-                Some(Err(e)) => break Some(Err(e)),
-                None => break None,
+                None => {
+                    batch.last = Some(None);
+                    break;
+                }
+            };
+            let unit_done = matches!(item, Item::UnitDone { .. });
+            batch.items.push((item, units.current_offset()));
+            if unit_done && batch.data.len() >= BATCH_BYTES {
+                break;
             }
-        };
-        let last = !matches!(end, Some(Ok(_)));
-        batch.end = end;
-        batch.end_offset = units.current_offset();
+        }
+        batch.last_offset = units.current_offset();
+        let last = batch.last.is_some();
         if sender.send(batch).is_err() || last {
             return;
         }
