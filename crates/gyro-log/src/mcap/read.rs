@@ -430,7 +430,7 @@ impl McapRows {
             cause,
         })?;
         let options = &self.state.options;
-        let mut units = Units::new(file, self.units.units().to_vec());
+        let mut units = Units::new(file, self.units.units());
         let mut earliest = u64::MAX;
         while let Some(event) = units.next_event() {
             let Ok(Event::Record { opcode, data }) = event else {

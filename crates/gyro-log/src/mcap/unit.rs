@@ -34,7 +34,7 @@ pub(super) enum UnitError {
 /// The data section's units as one stream of records.
 pub(super) struct Units {
     file: File,
-    units: Vec<Unit>,
+    units: Arc<[Unit]>,
     /// Index of the next unit to feed to the reader.
     next: usize,
     /// Bytes of the current unit not yet fed.
@@ -53,10 +53,10 @@ enum Next {
 }
 
 impl Units {
-    pub fn new(file: File, units: Vec<Unit>) -> Self {
+    pub fn new(file: File, units: impl Into<Arc<[Unit]>>) -> Self {
         Self {
             file,
-            units,
+            units: units.into(),
             next: 0,
             remaining: 0,
             announced: true,
@@ -85,8 +85,8 @@ impl Units {
     }
 
     /// The units, in reading order.
-    pub fn units(&self) -> &[Unit] {
-        &self.units
+    pub fn units(&self) -> Arc<[Unit]> {
+        Arc::clone(&self.units)
     }
 
     /// The next event; `None` once every unit has been read.
@@ -204,7 +204,7 @@ struct Batch {
 /// order, with the same offsets; if the thread cannot be started, the units are read on
 /// the caller's thread.
 pub(super) struct UnitsAhead {
-    units: Vec<Unit>,
+    units: Arc<[Unit]>,
     file_len: u64,
     source: Source,
     current: Batch,
@@ -226,7 +226,7 @@ enum Source {
 
 impl UnitsAhead {
     pub fn new(units: Units) -> Self {
-        let list = units.units().to_vec();
+        let list = units.units();
         let file_len = units.file_len();
         let shared = Arc::new(Mutex::new(Some(units)));
         let (sender, batches) = sync_channel::<Batch>(BATCHES_AHEAD);
@@ -281,8 +281,8 @@ impl UnitsAhead {
     }
 
     /// The units, in reading order.
-    pub fn units(&self) -> &[Unit] {
-        &self.units
+    pub fn units(&self) -> Arc<[Unit]> {
+        Arc::clone(&self.units)
     }
 
     /// [`Units::next_event`].
