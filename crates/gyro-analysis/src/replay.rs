@@ -17,6 +17,7 @@ use gyro_core::{
 };
 use gyro_log::{GridOptions, LogError, LogOptions, Quality, RegularLog, Slot, SlotSink};
 use serde::Serialize;
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
 /// One output sample of the run, with the reference where present.
@@ -84,9 +85,10 @@ pub struct MovementResult {
     /// the movement saturated, was cut off by the end of the log, or has filled samples.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub verdict: Option<Verdict>,
-    /// The output samples (indices into [`RunReport::series`]) that bound the movement, as
-    /// the core published them: its last quiet sample before and first quiet sample after
-    /// (the last sample if the log ends while moving). Not in the JSON.
+    /// The output samples (0-based output indices, into [`RunReport::series`] when it is
+    /// kept) that bound the movement, as the core published them: its last quiet sample
+    /// before and first quiet sample after (the last sample if the log ends while moving).
+    /// Not in the JSON.
     #[serde(skip)]
     pub samples: (usize, usize),
 }
@@ -164,24 +166,60 @@ pub struct RunReport {
     pub summary: Summary,
     /// The movements.
     pub movements: Vec<MovementResult>,
-    /// The output series (written by `--out`, not in JSON).
+    /// The output series (written by `--out`, not in JSON); empty when it went to a
+    /// [`SeriesSink`] instead ([`replay_file_into`]).
     #[serde(skip)]
     pub series: Vec<SeriesPoint>,
 }
 
-/// Max |e|, RMS and last value of a series of errors.
-fn error_stats(errors: impl Iterator<Item = f64>) -> (Option<f64>, Option<f64>, Option<f64>) {
-    let (mut max_abs, mut sum_sq, mut n, mut last) = (0.0_f64, 0.0_f64, 0_usize, None);
-    for e in errors {
-        max_abs = max_abs.max(e.abs());
-        sum_sq += e * e;
-        n += 1;
-        last = Some(e);
+/// Where the output series goes as it is made, so that a replay need not hold it.
+pub trait SeriesSink {
+    /// Outputs come at `output_rate_hz`: called once, before the first point.
+    fn start(&mut self, _output_rate_hz: f32) {}
+    /// The next output sample.
+    fn point(&mut self, point: &SeriesPoint);
+}
+
+/// Keeps the whole series.
+impl SeriesSink for Vec<SeriesPoint> {
+    fn point(&mut self, point: &SeriesPoint) {
+        self.push(*point);
     }
-    if n == 0 {
-        (None, None, None)
-    } else {
-        (Some(max_abs), Some((sum_sq / n as f64).sqrt()), last)
+}
+
+/// Drops the series: the report's movements and summary only.
+impl SeriesSink for () {
+    fn point(&mut self, _point: &SeriesPoint) {}
+}
+
+/// Max |e|, RMS and last value of a series of errors, one error at a time.
+#[derive(Clone, Copy, Debug, Default)]
+struct ErrorStats {
+    max_abs: f64,
+    sum_sq: f64,
+    n: usize,
+    last: Option<f64>,
+}
+
+impl ErrorStats {
+    fn add(&mut self, e: f64) {
+        self.max_abs = self.max_abs.max(e.abs());
+        self.sum_sq += e * e;
+        self.n += 1;
+        self.last = Some(e);
+    }
+
+    /// Max |e|, RMS, last; all `None` without errors.
+    fn get(&self) -> (Option<f64>, Option<f64>, Option<f64>) {
+        if self.n == 0 {
+            (None, None, None)
+        } else {
+            (
+                Some(self.max_abs),
+                Some((self.sum_sq / self.n as f64).sqrt()),
+                self.last,
+            )
+        }
     }
 }
 
@@ -205,18 +243,22 @@ pub fn replay_with(
     } else {
         0.0
     };
+    let mut series = Vec::new();
     if shift_slots == 0.0 {
         for slot in &log.slots {
-            replayer.push(slot);
+            series.extend(replayer.push(slot));
         }
     } else {
         // The reference at other slots, ahead or behind: the whole log is at hand.
         replayer.reference_origin = log.slots.iter().find_map(|s| s.reference_deg);
         for (i, slot) in log.slots.iter().enumerate() {
-            replayer.push_scored(slot, shifted_reference(&log.slots, i, shift_slots));
+            series
+                .extend(replayer.push_scored(slot, shifted_reference(&log.slots, i, shift_slots)));
         }
     }
-    Ok(replayer.finish(log.quality.clone()))
+    let mut report = replayer.finish(log.quality.clone());
+    report.series = series;
+    Ok(report)
 }
 
 /// Why [`replay_file`] failed.
@@ -238,10 +280,7 @@ pub enum ReplayFileError {
 
 /// Read, place on the grid and replay a log: what [`gyro_log::load`] and [`replay_with`]
 /// do, with the same result and the same errors, in one pass without holding the log
-/// ([`gyro_log::stream`]; memory: the rate look-ahead, the output series). Scoring against
-/// a reference shifted by a delay needs the reference ahead: then the log is loaded whole
-/// and replayed by [`replay_with`]. MCAP warnings go to `warn` before anything else is
-/// reported.
+/// ([`replay_file_into`] keeping the series in the report).
 pub fn replay_file(
     path: &Path,
     options: &LogOptions,
@@ -250,6 +289,36 @@ pub fn replay_file(
     replay_options: &ReplayOptions,
     warn: &mut dyn FnMut(&str),
 ) -> Result<RunReport, ReplayFileError> {
+    let mut series = Vec::new();
+    let mut report = replay_file_into(
+        path,
+        options,
+        grid,
+        config,
+        replay_options,
+        warn,
+        &mut series,
+    )?;
+    report.series = series;
+    Ok(report)
+}
+
+/// [`replay_file`] with the output series given to `series` as it is made instead of
+/// kept: the report's series is empty. Memory does not grow with the log
+/// ([`gyro_log::stream`]; the rate look-ahead, and at most [`Replayer::max_held_outputs`]
+/// recent outputs), except when scoring against a reference shifted by a delay: that
+/// needs the reference ahead, so the log is then loaded whole and replayed by
+/// [`replay_with`] (its series still goes to `series`). MCAP warnings go to `warn` before
+/// anything else is reported.
+pub fn replay_file_into(
+    path: &Path,
+    options: &LogOptions,
+    grid: &GridOptions,
+    config: &Config,
+    replay_options: &ReplayOptions,
+    warn: &mut dyn FnMut(&str),
+    series: &mut dyn SeriesSink,
+) -> Result<RunReport, ReplayFileError> {
     let config_error = |cause| ReplayFileError::Config {
         path: path.to_path_buf(),
         cause,
@@ -257,13 +326,19 @@ pub fn replay_file(
     let delay = replay_options.reference_delay_s;
     if delay.is_finite() && delay != 0.0 {
         let regular = gyro_log::load(path, options, grid, warn)?;
-        return replay_with(&regular, config, replay_options).map_err(config_error);
+        let mut report = replay_with(&regular, config, replay_options).map_err(config_error)?;
+        series.start(report.output_rate_hz);
+        for point in std::mem::take(&mut report.series) {
+            series.point(&point);
+        }
+        return Ok(report);
     }
     let mut sink = ReplaySink {
         config,
         options: replay_options,
         has_temperature: false,
         replayer: None,
+        series,
     };
     let quality = gyro_log::stream(path, options, grid, &mut sink, warn)?;
     match sink.replayer {
@@ -276,18 +351,23 @@ pub fn replay_file(
             replay_options,
             sink.has_temperature,
         )
-        .map(|replayer| replayer.finish(quality))
+        .map(|replayer| {
+            sink.series.start(replayer.output_rate_hz);
+            replayer.finish(quality)
+        })
         .map_err(config_error),
     }
 }
 
-/// The sink of [`replay_file`]: a replayer built once the rate is known. If the pipeline
-/// cannot be configured, the error waits until the log has been read (its errors first).
+/// The sink of [`replay_file_into`]: a replayer built once the rate is known. If the
+/// pipeline cannot be configured, the error waits until the log has been read (its errors
+/// first).
 struct ReplaySink<'c> {
     config: &'c Config,
     options: &'c ReplayOptions,
     has_temperature: bool,
     replayer: Option<Result<Replayer, gyro_core::Error>>,
+    series: &'c mut dyn SeriesSink,
 }
 
 impl SlotSink for ReplaySink<'_> {
@@ -296,23 +376,31 @@ impl SlotSink for ReplaySink<'_> {
     }
 
     fn start(&mut self, sample_rate_hz: f64) {
-        self.replayer = Some(Replayer::new(
+        let replayer = Replayer::new(
             sample_rate_hz,
             self.config,
             self.options,
             self.has_temperature,
-        ));
+        );
+        if let Ok(replayer) = &replayer {
+            self.series.start(replayer.output_rate_hz);
+        }
+        self.replayer = Some(replayer);
     }
 
     fn slot(&mut self, slot: &Slot) {
         if let Some(Ok(replayer)) = &mut self.replayer {
-            replayer.push(slot);
+            if let Some(point) = replayer.push(slot) {
+                self.series.point(&point);
+            }
         }
     }
 }
 
-/// Replays slots one at a time: the state of [`replay_with`] between two slots. Holds the
-/// output series (decimated), not the input.
+/// Replays slots one at a time: the state of [`replay_with`] between two slots. Holds
+/// neither the input nor the output series: each output goes back to the caller
+/// ([`Replayer::push`]), and only the last [`Replayer::max_held_outputs`] outputs are kept,
+/// for the movements' ends.
 pub struct Replayer {
     sample_rate_hz: f64,
     config: Config,
@@ -329,13 +417,42 @@ pub struct Replayer {
     ref_state: SosState,
     ref_last: f32,
     ref_block_complete: bool,
-    series: Vec<SeriesPoint>,
+    /// The latest outputs, oldest first: `held[0]` is output number `outputs - held.len()`.
+    held: VecDeque<Held>,
+    /// How many outputs `held` keeps at most.
+    max_held: usize,
+    /// Outputs so far.
+    outputs: usize,
+    first_time_s: Option<f64>,
+    errors: ErrorStats,
+    raw_errors: ErrorStats,
     movements: Vec<MovementResult>,
-    open: Option<(f64, usize)>,
-    /// Filled input slots (gaps, missing rates) before each output sample, counted up to
-    /// the slot that completed it.
-    filled_before: Vec<u32>,
+    open: Option<OpenMovement>,
+    /// Filled input slots (gaps, missing rates) so far.
     filled_total: u32,
+}
+
+/// What the replay keeps of a recent output: what a movement's ends read.
+#[derive(Clone, Copy, Debug)]
+struct Held {
+    time_s: f64,
+    angle_deg: f32,
+    raw_angle_deg: f32,
+    reference_deg: Option<f64>,
+    /// Filled input slots before this output, counted up to the slot that completed it.
+    filled_before: u32,
+}
+
+/// A movement the core confirmed and has not ended yet.
+#[derive(Clone, Copy, Debug)]
+struct OpenMovement {
+    start_time_s: f64,
+    start_index: usize,
+    /// The output at `start_index`.
+    start: Option<Held>,
+    /// The reference at the output nearest `start_time_s` ([`Replayer::nearest`]), once an
+    /// output at or after that time has come (until then the latest output is the nearest).
+    reference_at_start: Option<Option<f64>>,
 }
 
 impl Replayer {
@@ -357,6 +474,16 @@ impl Replayer {
         let output_rate_hz = config.effective_output_rate_hz()?;
         let ref_decimator = Decimator::try_new(factor)?;
         let ref_sos: Sos = config.filter.sos(output_rate_hz.into())?;
+        // A movement's end names an output at most a confirming run (a `u16` of outputs in
+        // the core) plus the filter delay before the output that reports it; two more for
+        // the neighbour `nearest` compares with and rounding.
+        let delay_outputs = pipeline.filter_delay_s() * f64::from(output_rate_hz);
+        let delay_outputs = if delay_outputs.is_finite() && delay_outputs > 0.0 {
+            delay_outputs.ceil().min(1e6) as usize
+        } else {
+            0
+        };
+        let max_held = usize::from(u16::MAX) + delay_outputs + 4;
         Ok(Self {
             sample_rate_hz,
             config,
@@ -371,28 +498,48 @@ impl Replayer {
             ref_state: SosState::new(),
             ref_last: 0.0,
             ref_block_complete: true,
-            series: Vec::new(),
+            held: VecDeque::new(),
+            max_held,
+            outputs: 0,
+            first_time_s: None,
+            errors: ErrorStats::default(),
+            raw_errors: ErrorStats::default(),
             movements: Vec::new(),
             open: None,
-            filled_before: Vec::new(),
             filled_total: 0,
         })
     }
 
-    /// One slot of the grid, scored against its own reference.
+    /// The output rate (Hz).
+    pub fn output_rate_hz(&self) -> f32 {
+        self.output_rate_hz
+    }
+
+    /// How many recent outputs the replayer holds at most, whatever the log's length.
+    pub fn max_held_outputs(&self) -> usize {
+        self.max_held
+    }
+
+    /// How many recent outputs it holds now.
+    pub fn held_outputs(&self) -> usize {
+        self.held.len()
+    }
+
+    /// One slot of the grid, scored against its own reference; the output sample it
+    /// completed, if any.
     ///
     /// The reference origin is the first reference value. Until it comes, every block is
     /// incomplete (no reference) and the reference filter sees zeros: running it then is
     /// the same as not running it when the log has no reference at all.
-    pub fn push(&mut self, slot: &Slot) {
+    pub fn push(&mut self, slot: &Slot) -> Option<SeriesPoint> {
         if self.reference_origin.is_none() {
             self.reference_origin = slot.reference_deg;
         }
-        self.push_scored(slot, slot.reference_deg);
+        self.push_scored(slot, slot.reference_deg)
     }
 
     /// One slot, scored against `reference` (deg; the origin is set).
-    fn push_scored(&mut self, slot: &Slot, reference: Option<f64>) {
+    fn push_scored(&mut self, slot: &Slot, reference: Option<f64>) -> Option<SeriesPoint> {
         let reference = match (reference, self.reference_origin) {
             (Some(r), Some(origin)) => {
                 self.ref_last = (r - origin) as f32;
@@ -413,13 +560,10 @@ impl Replayer {
                 .push_with_temperature(slot.time_s, slot.rate_dps as f32, temperature_c)
         } else {
             self.pipeline.push(slot.time_s, slot.rate_dps as f32)
-        };
-        let Some(out) = out else {
-            return;
-        };
+        }?;
         let reference_deg = match ref_mean {
             Some(mean) => {
-                if self.series.is_empty() {
+                if self.outputs == 0 {
                     self.ref_sos.settle(&mut self.ref_state, mean);
                 }
                 let filtered = self.ref_sos.process(&mut self.ref_state, mean);
@@ -429,9 +573,7 @@ impl Replayer {
             }
             None => None,
         };
-        self.filled_before.push(self.filled_total);
-        let series = &mut self.series;
-        series.push(SeriesPoint {
+        let point = SeriesPoint {
             time_s: out.time_s,
             rate_dps: out.rate_dps,
             motion: out.motion,
@@ -440,24 +582,48 @@ impl Replayer {
             angle_std_deg: out.angle_std_deg,
             bias_dps: out.bias_dps,
             reference_deg,
-        });
+        };
+        self.hold(&point);
         match out.event {
             Some(Event::MovementStarted {
                 start_time_s,
                 start_index,
             }) => {
-                self.open = Some((start_time_s, start_index as usize));
+                let start_index = start_index as usize;
+                let mut open = OpenMovement {
+                    start_time_s,
+                    start_index,
+                    start: self.held(start_index).copied(),
+                    reference_at_start: None,
+                };
+                if point.time_s >= start_time_s {
+                    open.reference_at_start = Some(self.reference_near(start_time_s));
+                }
+                self.open = Some(open);
             }
             Some(Event::MovementEnded(m)) => {
-                self.open = None;
+                let open = self.open.take();
                 let samples = (m.start_index as usize, m.end_index as usize);
-                let at_times = (
-                    index_at(series, m.start_time_s),
-                    index_at(series, m.end_time_s),
-                );
-                let filled = &self.filled_before;
-                let filled_samples = filled.get(samples.1).copied().unwrap_or(0)
-                    - filled.get(samples.0).copied().unwrap_or(0);
+                // The core ends the movement it started: its start was read then.
+                let (start_filled, start_reference) = match open {
+                    Some(open)
+                        if open.start_index == samples.0
+                            && open.start_time_s.to_bits() == m.start_time_s.to_bits() =>
+                    {
+                        (
+                            open.start.map_or(0, |h| h.filled_before),
+                            open.reference_at_start
+                                .unwrap_or_else(|| self.reference_near(open.start_time_s)),
+                        )
+                    }
+                    _ => (
+                        self.held(samples.0).map_or(0, |h| h.filled_before),
+                        self.reference_near(m.start_time_s),
+                    ),
+                };
+                let filled_samples =
+                    self.held(samples.1).map_or(0, |h| h.filled_before) - start_filled;
+                let end_reference = self.reference_near(m.end_time_s);
                 self.movements.push(movement_result(
                     self.movements.len() + 1,
                     (m.start_time_s, m.end_time_s),
@@ -469,71 +635,100 @@ impl Replayer {
                         angle_std_deg: m.angle_std_deg,
                     },
                     samples,
-                    reference_change(series, at_times),
+                    reference_change(start_reference, end_reference),
                     self.config.tightening.as_ref(),
                 ));
             }
             None => {}
         }
+        Some(point)
     }
 
-    /// The report, with `input` the quality of the grid the slots came from.
+    /// Count `point` into the summary and hold it (dropping the oldest held output past
+    /// `max_held`); resolve the open movement's start once an output reaches its time.
+    fn hold(&mut self, point: &SeriesPoint) {
+        if let Some(e) = point.error_deg() {
+            self.errors.add(e);
+        }
+        if let Some(r) = point.reference_deg {
+            self.raw_errors.add(f64::from(point.raw_angle_deg) - r);
+        }
+        self.first_time_s.get_or_insert(point.time_s);
+        if self.held.len() >= self.max_held {
+            self.held.pop_front();
+        }
+        self.held.push_back(Held {
+            time_s: point.time_s,
+            angle_deg: point.angle_deg,
+            raw_angle_deg: point.raw_angle_deg,
+            reference_deg: point.reference_deg,
+            filled_before: self.filled_total,
+        });
+        self.outputs += 1;
+        if let Some(open) = self.open {
+            if open.reference_at_start.is_none() && point.time_s >= open.start_time_s {
+                let reference = self.reference_near(open.start_time_s);
+                if let Some(open) = &mut self.open {
+                    open.reference_at_start = Some(reference);
+                }
+            }
+        }
+    }
+
+    /// Output number `index`, if held.
+    fn held(&self, index: usize) -> Option<&Held> {
+        let first = self.outputs - self.held.len();
+        self.held.get(index.checked_sub(first)?)
+    }
+
+    /// The reference at the output nearest `time_s` ([`nearest`]).
+    fn reference_near(&self, time_s: f64) -> Option<f64> {
+        nearest(&self.held, self.outputs, time_s)?.reference_deg
+    }
+
+    /// The report, with `input` the quality of the grid the slots came from; its series is
+    /// empty (the caller has had every point from [`Replayer::push`]).
     pub fn finish(self, input: Quality) -> RunReport {
-        let Self {
-            sample_rate_hz,
-            config,
-            reference_delay_s,
-            pipeline,
-            factor,
-            output_rate_hz,
-            series,
-            mut movements,
-            open,
-            filled_before,
-            ..
-        } = self;
-        if let (Some((start_time_s, start)), Some(last)) = (open, series.last()) {
-            let first = &series[start];
-            let samples = (start, series.len() - 1);
-            let at_times = (index_at(&series, start_time_s), series.len() - 1);
-            let filled_samples = filled_before.last().copied().unwrap_or(0)
-                - filled_before.get(start).copied().unwrap_or(0);
+        let last = self.held.back().copied();
+        let mut movements = self.movements;
+        if let (Some(open), Some(last)) = (self.open, last) {
+            let samples = (open.start_index, self.outputs - 1);
+            // Unresolved: no output reached the start's time, the last is the nearest.
+            let start_reference = open.reference_at_start.unwrap_or(last.reference_deg);
+            let first = open.start.unwrap_or(last);
+            let filled_samples = last.filled_before - open.start.map_or(0, |h| h.filled_before);
             movements.push(movement_result(
                 movements.len() + 1,
-                (start_time_s, last.time_s),
+                (open.start_time_s, last.time_s),
                 (
                     last.angle_deg - first.angle_deg,
                     last.raw_angle_deg - first.raw_angle_deg,
                 ),
                 Flags {
                     complete: false,
-                    saturated: pipeline.movement_saturated(),
+                    saturated: self.pipeline.movement_saturated(),
                     filled_samples,
                     angle_std_deg: None,
                 },
                 samples,
-                reference_change(&series, at_times),
-                config.tightening.as_ref(),
+                reference_change(start_reference, last.reference_deg),
+                self.config.tightening.as_ref(),
             ));
         }
 
-        let (max_abs, rms, final_e) = error_stats(series.iter().filter_map(SeriesPoint::error_deg));
-        let (raw_max_abs, raw_rms, raw_final) = error_stats(
-            series
-                .iter()
-                .filter_map(|p| p.reference_deg.map(|r| f64::from(p.raw_angle_deg) - r)),
-        );
+        let (max_abs, rms, final_e) = self.errors.get();
+        let (raw_max_abs, raw_rms, raw_final) = self.raw_errors.get();
         let summary = Summary {
-            compensation: config.compensation,
-            outputs: series.len(),
-            duration_s: match (series.first(), series.last()) {
-                (Some(a), Some(b)) => b.time_s - a.time_s,
+            compensation: self.config.compensation,
+            outputs: self.outputs,
+            duration_s: match (self.first_time_s, last) {
+                (Some(a), Some(b)) => b.time_s - a,
                 _ => 0.0,
             },
             movements: movements.len(),
-            rejected_samples: pipeline.rejected_samples(),
-            final_angle_deg: series.last().map_or(0.0, |p| p.angle_deg),
-            final_raw_angle_deg: series.last().map_or(0.0, |p| p.raw_angle_deg),
+            rejected_samples: self.pipeline.rejected_samples(),
+            final_angle_deg: last.map_or(0.0, |p| p.angle_deg),
+            final_raw_angle_deg: last.map_or(0.0, |p| p.raw_angle_deg),
             max_abs_error_deg: max_abs,
             rms_error_deg: rms,
             final_error_deg: final_e,
@@ -542,16 +737,16 @@ impl Replayer {
             raw_final_error_deg: raw_final,
         };
         RunReport {
-            sample_rate_hz,
-            decimation_factor: factor,
-            output_rate_hz,
+            sample_rate_hz: self.sample_rate_hz,
+            decimation_factor: self.factor,
+            output_rate_hz: self.output_rate_hz,
             input,
-            config,
-            reference_delay_s,
-            temperature_reference_c: pipeline.corrector().reference_c(),
+            config: self.config,
+            reference_delay_s: self.reference_delay_s,
+            temperature_reference_c: self.pipeline.corrector().reference_c(),
             summary,
             movements,
-            series,
+            series: Vec::new(),
         }
     }
 }
@@ -579,27 +774,35 @@ fn shifted_reference(slots: &[Slot], i: usize, shift_slots: f64) -> Option<f64> 
     Some(a + fraction * (b - a))
 }
 
-/// The output sample nearest to `time_s`: where the reference is read at a movement's time
-/// on the input's time line (the filtered reference at the movement's own samples,
-/// [`MovementResult::samples`], is a filter delay later: see [`gyro_core::Event`]).
-fn index_at(series: &[SeriesPoint], time_s: f64) -> usize {
-    let i = series.partition_point(|p| p.time_s < time_s);
+/// The output nearest to `time_s` among the held outputs (the last `held.len()` of
+/// `outputs`, times rising): where the reference is read at a movement's time on the
+/// input's time line (the filtered reference at the movement's own samples,
+/// [`MovementResult::samples`], is a filter delay later: see [`gyro_core::Event`]). Before
+/// the first output, the first; past the last, the last; between two, the nearer (the
+/// earlier on a tie). `None` without outputs, or if the nearest may be one no longer held
+/// (the replayer holds enough that the core's events never name one).
+fn nearest(held: &VecDeque<Held>, outputs: usize, time_s: f64) -> Option<&Held> {
+    let i = held.partition_point(|p| p.time_s < time_s);
     if i == 0 {
-        return 0;
+        return if held.len() == outputs {
+            held.front()
+        } else {
+            None
+        };
     }
-    if i >= series.len() {
-        return series.len() - 1;
+    if i >= held.len() {
+        return held.back();
     }
-    if (series[i].time_s - time_s).abs() < (time_s - series[i - 1].time_s).abs() {
-        i
+    if (held[i].time_s - time_s).abs() < (time_s - held[i - 1].time_s).abs() {
+        held.get(i)
     } else {
-        i - 1
+        held.get(i - 1)
     }
 }
 
-/// The reference's change between two output samples.
-fn reference_change(series: &[SeriesPoint], (start, end): (usize, usize)) -> Option<f64> {
-    Some(series.get(end)?.reference_deg? - series.get(start)?.reference_deg?)
+/// The reference's change between two outputs.
+fn reference_change(start: Option<f64>, end: Option<f64>) -> Option<f64> {
+    Some(end? - start?)
 }
 
 /// What the core and the replay know about a movement besides its times and angles.

@@ -1,6 +1,6 @@
 //! Rendering a [`RunReport`]: a human table, JSON, or CSV; and the 50 Hz series as CSV.
 
-use gyro_analysis::replay::{MovementResult, RunReport};
+use gyro_analysis::replay::{MovementResult, RunReport, SeriesPoint};
 use gyro_core::Verdict;
 use std::fmt::Write as _;
 use std::io::{self, Write};
@@ -253,30 +253,41 @@ pub fn movements_csv(out: &mut impl Write, movements: &[MovementResult]) -> io::
     Ok(())
 }
 
-/// CSV of the output series (the `--out` file).
+/// CSV of the output series (the `--out` file): [`series_csv_header`], then
+/// [`series_csv_row`] for each point.
 pub fn series_csv(out: &mut impl Write, report: &RunReport) -> io::Result<()> {
-    writeln!(out, "# output_rate_hz: {}", report.output_rate_hz)?;
+    series_csv_header(out, report.output_rate_hz)?;
+    for p in &report.series {
+        series_csv_row(out, p)?;
+    }
+    Ok(())
+}
+
+/// The lines of the series CSV before its rows: the output rate and the column names.
+pub fn series_csv_header(out: &mut impl Write, output_rate_hz: f32) -> io::Result<()> {
+    writeln!(out, "# output_rate_hz: {output_rate_hz}")?;
     writeln!(
         out,
         "time_s,rate_dps,motion,angle_deg,raw_angle_deg,angle_std_deg,bias_dps,reference_deg,error_deg"
-    )?;
-    for p in &report.series {
-        writeln!(
-            out,
-            "{:.6},{:.5},{},{:.6},{:.6},{},{:.6},{},{}",
-            p.time_s,
-            p.rate_dps,
-            match p.motion {
-                gyro_core::MotionState::Static => "static",
-                gyro_core::MotionState::Dynamic => "dynamic",
-            },
-            p.angle_deg,
-            p.raw_angle_deg,
-            p.angle_std_deg.map_or(String::new(), |v| format!("{v:.6}")),
-            p.bias_dps,
-            p.reference_deg.map_or(String::new(), |v| format!("{v:.6}")),
-            p.error_deg().map_or(String::new(), |v| format!("{v:.6}")),
-        )?;
-    }
-    Ok(())
+    )
+}
+
+/// One row of the series CSV.
+pub fn series_csv_row(out: &mut impl Write, p: &SeriesPoint) -> io::Result<()> {
+    writeln!(
+        out,
+        "{:.6},{:.5},{},{:.6},{:.6},{},{:.6},{},{}",
+        p.time_s,
+        p.rate_dps,
+        match p.motion {
+            gyro_core::MotionState::Static => "static",
+            gyro_core::MotionState::Dynamic => "dynamic",
+        },
+        p.angle_deg,
+        p.raw_angle_deg,
+        p.angle_std_deg.map_or(String::new(), |v| format!("{v:.6}")),
+        p.bias_dps,
+        p.reference_deg.map_or(String::new(), |v| format!("{v:.6}")),
+        p.error_deg().map_or(String::new(), |v| format!("{v:.6}")),
+    )
 }

@@ -515,8 +515,15 @@ fn regression_fit(
     let (real, replicas) = input.pooled(&|f| f.coef[index]);
     let (m0, s0) = mean_sd(&replicas);
     let raw = real - m0 - (known.with_effects[index] - known.quiet[index]);
-    let z = raw / s0;
-    let half = 1.96 * s0 * (1.0 + 1.0 / replicas.len().max(1) as f64).sqrt();
+    let mut half = 1.96 * s0 * (1.0 + 1.0 / replicas.len().max(1) as f64).sqrt();
+    let se = match run_scatter(input, index) {
+        Some(scatter) if scatter.se > s0 => {
+            half = half.max(t95(scatter.runs - 1) * scatter.se);
+            scatter.se
+        }
+        _ => s0,
+    };
+    let z = raw / se;
     let response = |x: f64| -> f64 {
         let mut set = known.effects.clone();
         set.push(make(to_param(x)));
@@ -554,6 +561,103 @@ fn regression_fit(
     let half = (half * half + (SYSTEMATIC_REL * raw).powi(2)).sqrt();
     let (lo, hi) = ((raw - half) / gain, (raw + half) / gain);
     (make(to_param(x)), z, (to_param(lo), to_param(hi)))
+}
+
+/// Share of the null's chi-square above which the real runs' scatter of a coefficient is
+/// taken as larger than the null's (one-sided, 1%).
+const SCATTER_P: f64 = 0.99;
+
+/// The real runs' own scatter of one regression coefficient, when it is larger than
+/// the null replicas' beyond chance.
+struct Scatter {
+    /// Standard error of the runs' mean coefficient from their scatter.
+    se: f64,
+    /// Runs.
+    runs: usize,
+}
+
+/// The null replicas give each coefficient's spread under the nominal model; something
+/// the nominal model lacks and that moves every run differently (a bias that wanders
+/// along the motion by chance) spreads the real runs' coefficients further, and a test
+/// against the null alone then finds a scale or a temperature term in a random walk.
+/// Each run's excess over its own replicas' mean is compared with a replica's spread
+/// about that mean: when their variance exceeds the null's beyond chance (χ² with
+/// runs − 1 degrees of freedom, one-sided [`SCATTER_P`]), the runs' own standard error
+/// is returned. `None`: fewer than 3 runs, or no excess scatter.
+fn run_scatter(input: &FitInput, index: usize) -> Option<Scatter> {
+    let runs: Vec<(f64, Vec<f64>)> = input
+        .train
+        .iter()
+        .zip(input.null)
+        .map(|(run, null)| {
+            let coefs = null.iter().map(|m| m.features.coef[index]).collect();
+            (run.features.coef[index], coefs)
+        })
+        .collect();
+    scatter_of(&runs)
+}
+
+/// [`run_scatter`] on each run's real value and its replicas' values.
+fn scatter_of(runs: &[(f64, Vec<f64>)]) -> Option<Scatter> {
+    let mut excess = Vec::new();
+    let mut null_var = Vec::new();
+    for (real, coefs) in runs {
+        let (m, sd) = mean_sd(coefs);
+        if real.is_finite() && m.is_finite() && sd.is_finite() {
+            excess.push(real - m);
+            null_var.push(sd * sd);
+        }
+    }
+    let n = excess.len();
+    if n < 3 {
+        return None;
+    }
+    let between = sample_var(&excess);
+    let null = null_var.iter().sum::<f64>() / n as f64;
+    let dof = (n - 1) as f64;
+    (between * dof > chi2_quantile(SCATTER_P, dof) * null).then(|| Scatter {
+        se: (between / n as f64).sqrt(),
+        runs: n,
+    })
+}
+
+#[cfg(test)]
+mod scatter_tests {
+    use super::*;
+
+    /// Replicas spread ±1 about 0 (sample sd 1), one per run.
+    fn replicas() -> Vec<f64> {
+        vec![-1.0, 1.0, -1.0, 1.0, 0.0, 0.0]
+    }
+
+    #[test]
+    fn runs_within_the_null_spread_keep_the_null_test() {
+        // A constant excess (a real effect the same in every run) plus scatter like the
+        // null's: the null's standard error stands.
+        let runs: Vec<_> = [5.3, 4.1, 5.9, 4.6, 5.0]
+            .iter()
+            .map(|&x| (x, replicas()))
+            .collect();
+        assert!(scatter_of(&runs).is_none());
+    }
+
+    #[test]
+    fn runs_scattered_beyond_the_null_give_their_own_error() {
+        // Excesses of ±6 where the replicas spread ±1 (a wander the null lacks): the
+        // runs' standard error, sd / √n.
+        let values = [6.0, -5.0, 7.0, -6.0, 4.0];
+        let runs: Vec<_> = values.iter().map(|&x| (x, replicas())).collect();
+        let s = scatter_of(&runs).expect("scatter beyond the null");
+        let (_, sd) = mean_sd(&values);
+        assert_eq!(s.runs, 5);
+        assert!((s.se - sd / 5f64.sqrt()).abs() < 1e-12, "{}", s.se);
+        // Fewer than 3 runs: no scatter to judge.
+        assert!(scatter_of(&runs[..2]).is_none());
+        // A run without a finite coefficient is left out.
+        let mut with_nan = runs.clone();
+        with_nan.push((f64::NAN, replicas()));
+        assert_eq!(scatter_of(&with_nan).map(|s| s.runs), Some(5));
+    }
 }
 
 /// Clock error from the time stamps ([`StampedClock`]): the training runs' mean ppm,

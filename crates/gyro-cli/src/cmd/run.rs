@@ -1,14 +1,17 @@
 //! `gyro-cli run`: replay a log through the pipeline and score it against the reference.
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::ValueEnum;
 use gyro_analysis::model;
 use gyro_analysis::replay;
 use gyro_core::{Compensation, Config, Direction, Tightening};
 use gyro_log as log;
 use gyro_log::value;
+use gyro_log::whole::Partial;
 use gyro_report::run as report;
-use std::path::PathBuf;
+use std::fs::File;
+use std::io::{self, BufWriter, Write as _};
+use std::path::{Path, PathBuf};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Format {
@@ -130,15 +133,30 @@ pub fn run(args: &Args) -> Result<()> {
             CompensationArg::Kalman => Compensation::Kalman,
         };
     }
-    // One pass: rows are read, placed on the grid and replayed as they come; only the
-    // output series is kept.
-    let result = replay::replay_file(
+    // One pass: rows are read, placed on the grid and replayed as they come. The output
+    // series is kept only for the plot, which needs it whole, or for an `--out` that is a
+    // stream (`/dev/stdout`: written after the report, as the report may share it);
+    // otherwise `--out` is written as the series comes and nothing grows with the log.
+    let keep_series =
+        args.plot.is_some() || args.out.as_deref().is_some_and(gyro_log::whole::is_stream);
+    let mut series_file = match &args.out {
+        Some(path) if !keep_series => Some(SeriesFile::beside(path)),
+        _ => None,
+    };
+    let mut kept = Vec::new();
+    let series: &mut dyn replay::SeriesSink = match (&mut series_file, keep_series) {
+        (Some(file), _) => file,
+        (None, true) => &mut kept,
+        (None, false) => &mut (),
+    };
+    let mut result = replay::replay_file_into(
         &args.log,
         &args.input,
         &args.grid,
         &config,
         &options,
         &mut super::warn,
+        series,
     )
     .map_err(|e| match e {
         replay::ReplayFileError::Log(e) => anyhow::Error::new(e),
@@ -149,6 +167,7 @@ pub fn run(args: &Args) -> Result<()> {
             ))
         }
     })?;
+    result.series = kept;
     let file = args.log.display().to_string();
     let json = match args.format {
         Format::Json => Some(report::json(&file, &result)?),
@@ -160,7 +179,12 @@ pub fn run(args: &Args) -> Result<()> {
         Format::Csv => report::movements_csv(&mut &mut *out, &result.movements),
     })?;
     if let Some(out) = &args.out {
-        super::output::write(out, |w| report::series_csv(w, &result))?;
+        match series_file {
+            Some(file) => file
+                .finish(result.output_rate_hz)
+                .with_context(|| format!("cannot write {}", out.display()))?,
+            None => super::output::write(out, |w| report::series_csv(w, &result))?,
+        }
     }
     if let Some(path) = &args.plot {
         let name = args
@@ -170,4 +194,88 @@ pub fn run(args: &Args) -> Result<()> {
         gyro_report::plot::run_plot(path, &name, &result)?;
     }
     Ok(())
+}
+
+/// The `--out` series written as the replay makes it, whole all the same: into a partial
+/// file beside the target ([`Partial`]), renamed over it by [`SeriesFile::finish`]; removed
+/// if the run fails. A write error is kept and reported by `finish`, after the report, as
+/// when the series was written at the end.
+struct SeriesFile {
+    partial: Option<Partial>,
+    out: Option<BufWriter<File>>,
+    started: bool,
+    error: Option<io::Error>,
+}
+
+impl SeriesFile {
+    fn beside(target: &Path) -> Self {
+        let mut file = Self {
+            partial: None,
+            out: None,
+            started: false,
+            error: None,
+        };
+        match Partial::beside(target) {
+            Ok(partial) => {
+                match File::create(partial.path()) {
+                    Ok(f) => file.out = Some(BufWriter::new(f)),
+                    Err(e) => file.error = Some(e),
+                }
+                file.partial = Some(partial);
+            }
+            Err(e) => file.error = Some(e),
+        }
+        file
+    }
+
+    /// Write with `write` unless an earlier write failed.
+    fn write(&mut self, write: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>) {
+        if self.error.is_some() {
+            return;
+        }
+        if let Some(out) = &mut self.out {
+            if let Err(e) = write(out) {
+                self.error = Some(e);
+            }
+        }
+    }
+
+    /// Complete the file (its header at `output_rate_hz` if no output came) and put it in
+    /// place of the target.
+    fn finish(mut self, output_rate_hz: f32) -> io::Result<()> {
+        if !self.started {
+            self.write(|w| report::series_csv_header(w, output_rate_hz));
+        }
+        self.write(|w| w.flush());
+        self.out = None;
+        let partial = self.partial.take();
+        match (self.error.take(), partial) {
+            (None, Some(partial)) => partial.finish(),
+            (error, partial) => {
+                partial.into_iter().for_each(Partial::discard);
+                Err(error.unwrap_or_else(|| io::Error::other("no partial file")))
+            }
+        }
+    }
+}
+
+impl replay::SeriesSink for SeriesFile {
+    fn start(&mut self, output_rate_hz: f32) {
+        self.started = true;
+        self.write(|w| report::series_csv_header(w, output_rate_hz));
+    }
+
+    fn point(&mut self, point: &replay::SeriesPoint) {
+        self.write(|w| report::series_csv_row(w, point));
+    }
+}
+
+impl Drop for SeriesFile {
+    /// A run that failed leaves no partial file.
+    fn drop(&mut self) {
+        self.out = None;
+        if let Some(partial) = self.partial.take() {
+            partial.discard();
+        }
+    }
 }

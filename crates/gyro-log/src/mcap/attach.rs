@@ -27,6 +27,9 @@ pub(super) struct Attacher {
     same_time: usize,
     /// Most rows held at once.
     most_held: usize,
+    /// Where the last row's search ended in `reference` (checked before use: rows in time
+    /// order find theirs there or one further).
+    hint: usize,
 }
 
 /// References this far (ns) before the earliest row still to come are kept when rows are
@@ -45,6 +48,7 @@ impl Attacher {
             previous: None,
             same_time: 0,
             most_held: 0,
+            hint: 0,
         }
     }
 
@@ -56,12 +60,12 @@ impl Attacher {
     /// A reference sample (log time ns, angle).
     pub fn reference(&mut self, time_ns: u64, angle: Option<f64>) {
         // After every sample with the same time (usually at the end).
-        let at = if self.reference.back().is_none_or(|&(t, _)| t <= time_ns) {
-            self.reference.len()
+        if self.reference.back().is_none_or(|&(t, _)| t <= time_ns) {
+            self.reference.push_back((time_ns, angle));
         } else {
-            self.reference.partition_point(|&(t, _)| t <= time_ns)
-        };
-        self.reference.insert(at, (time_ns, angle));
+            let at = self.reference.partition_point(|&(t, _)| t <= time_ns);
+            self.reference.insert(at, (time_ns, angle));
+        }
     }
 
     /// A row stamped `time_ns`.
@@ -89,6 +93,7 @@ impl Attacher {
             let keep_from = earliest.saturating_sub(self.max_span_ns);
             while self.reference.front().is_some_and(|&(t, _)| t < keep_from) {
                 self.reference.pop_front();
+                self.hint = self.hint.saturating_sub(1);
             }
         }
     }
@@ -107,13 +112,33 @@ impl Attacher {
         Some((t, row))
     }
 
+    /// The index of the first reference at or after `t`: the hint, or the one after it, if
+    /// it is that index; else a binary search.
+    fn first_at_or_after(&self, t: u64) -> usize {
+        let reference = &self.reference;
+        let n = reference.len();
+        let is_it = |i: usize| {
+            (i == 0 || reference.get(i - 1).is_some_and(|&(r, _)| r < t))
+                && (i == n || reference.get(i).is_some_and(|&(r, _)| r >= t))
+        };
+        let hint = self.hint.min(n);
+        if is_it(hint) {
+            hint
+        } else if hint < n && is_it(hint + 1) {
+            hint + 1
+        } else {
+            reference.partition_point(|&(r, _)| r < t)
+        }
+    }
+
     /// The reference of a row at `t`, or `None` if an unread reference could change it.
     fn decide(&mut self, t: u64) -> Option<Option<f64>> {
         if self.frontier <= t {
             return None; // a reference at exactly t may still come
         }
+        let lo = self.first_at_or_after(t);
+        self.hint = lo;
         let reference = &self.reference;
-        let lo = reference.partition_point(|&(r, _)| r < t);
         let hi = lo + reference.range(lo..).take_while(|&&(r, _)| r == t).count();
         let same_time = if self.previous == Some(t) {
             self.same_time + 1

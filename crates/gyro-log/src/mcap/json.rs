@@ -81,6 +81,21 @@ fn fast_gyro(data: &[u8]) -> Option<GyroFields> {
     })
 }
 
+/// The decimal digits of `text` from `i` on, appended to `mantissa` (wrapping: it is only
+/// used for at most 19 digits); `i` moves past them. How many.
+fn take_digits(text: &[u8], i: &mut usize, mantissa: &mut u64) -> usize {
+    let from = *i;
+    while let Some(d) = text
+        .get(*i)
+        .map(|b| b.wrapping_sub(b'0'))
+        .filter(|d| *d < 10)
+    {
+        *mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+        *i += 1;
+    }
+    *i - from
+}
+
 /// The unread rest of a message.
 struct Cursor<'a>(&'a [u8]);
 
@@ -103,36 +118,68 @@ impl Cursor<'_> {
         n
     }
 
-    /// `null` or a JSON number (strict grammar) that is finite as an `f64`.
+    /// `null` or a JSON number (strict grammar) that is finite as an `f64`. The digits
+    /// are gathered while the grammar is checked: up to 19 of them with no exponent, an
+    /// exact mantissa (at most 2^53) and at most 22 decimals give the value by one
+    /// correctly rounded division, as [`crate::csv_log::parse_plain_decimal`] does;
+    /// anything else goes to the standard library's parser.
     fn number_or_null(&mut self) -> Option<Option<f64>> {
+        const POW10: [f64; 23] = [
+            1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+            1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+        ];
         if self.tag(b"null").is_some() {
             return Some(None);
         }
-        let start = self.0;
-        let _ = self.tag(b"-");
-        match self.0.first() {
-            Some(b'0') => self.0 = &self.0[1..],
-            Some(b'1'..=b'9') => {
-                self.digits();
+        let text = self.0;
+        let negative = text.first() == Some(&b'-');
+        let mut i = usize::from(negative);
+        let mut mantissa = 0_u64;
+        let mut digits = 0_usize;
+        match text.get(i) {
+            Some(b'0') => {
+                i += 1;
+                digits += 1;
             }
+            Some(b'1'..=b'9') => digits += take_digits(text, &mut i, &mut mantissa),
             _ => return None,
         }
-        if self.tag(b".").is_some() && self.digits() == 0 {
-            return None;
-        }
-        if matches!(self.0.first(), Some(b'e' | b'E')) {
-            self.0 = &self.0[1..];
-            if matches!(self.0.first(), Some(b'+' | b'-')) {
-                self.0 = &self.0[1..];
+        let mut decimals = 0;
+        if text.get(i) == Some(&b'.') {
+            i += 1;
+            decimals = take_digits(text, &mut i, &mut mantissa);
+            if decimals == 0 {
+                return None;
             }
-            if self.digits() == 0 {
+            digits += decimals;
+        }
+        let mut plain = true;
+        if matches!(text.get(i), Some(b'e' | b'E')) {
+            plain = false;
+            i += 1;
+            if matches!(text.get(i), Some(b'+' | b'-')) {
+                i += 1;
+            }
+            let from = i;
+            while text.get(i).is_some_and(u8::is_ascii_digit) {
+                i += 1;
+            }
+            if i == from {
                 return None;
             }
         }
-        let number = &start[..start.len() - self.0.len()];
-        let value = match crate::csv_log::parse_plain_decimal(number) {
-            Some(value) => value,
-            None => std::str::from_utf8(number).ok()?.parse().ok()?,
+        let number = text.get(..i)?;
+        self.0 = text.get(i..)?;
+        let value = match POW10.get(decimals) {
+            Some(scale) if plain && digits <= 19 && mantissa <= 1 << 53 => {
+                let value = mantissa as f64 / scale;
+                if negative {
+                    -value
+                } else {
+                    value
+                }
+            }
+            _ => std::str::from_utf8(number).ok()?.parse().ok()?,
         };
         // Out of range: let serde_json decide (it refuses such numbers).
         value.is_finite().then_some(Some(value))
@@ -199,5 +246,58 @@ mod tests {
         assert_eq!(reference(br#"{"angle_deg":null}"#).unwrap(), Some(None));
         assert_eq!(reference(br#"{"other":1}"#).unwrap(), None);
         assert!(reference(br#"{"angle_deg":x}"#).is_err());
+    }
+
+    /// The fast number path gives serde_json's value, bit for bit, on numbers written
+    /// every way: shortest round trip (up to 17 significant digits), fixed decimals, long
+    /// mantissas, exponents, zeros.
+    #[test]
+    fn numbers_equal_serde_bit_for_bit() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut texts = vec![
+            "0".to_string(),
+            "-0".into(),
+            "-0.0".into(),
+            "9007199254740992".into(),
+            "9007199254740993".into(),
+            "0.9007199254740993".into(),
+            "1234567890123456789".into(),
+            "12345678901234567890".into(),
+            "0.0000000000000000000001".into(),
+            "0.00000000000000000000001".into(),
+        ];
+        for _ in 0..20_000 {
+            let bits = next();
+            let x = f64::from_bits(bits);
+            if !x.is_finite() {
+                continue;
+            }
+            let scaled = (bits >> 11) as f64 / (1_u64 << 53) as f64 * 1e3 - 500.0;
+            texts.push(format!("{x}"));
+            texts.push(format!("{x:e}"));
+            texts.push(format!("{scaled}"));
+            texts.push(format!("{scaled:.3}"));
+            texts.push(format!("{scaled:.12}"));
+            texts.push(format!("{scaled:.20}"));
+        }
+        for text in &texts {
+            let json = format!(r#"{{"rate_dps":{text}}}"#);
+            let serde = serde_json::from_str::<GyroIn>(&json).map(|m| m.rate_dps);
+            let fast = gyro(json.as_bytes()).map(|m| m.rate_dps);
+            match (serde, fast) {
+                (Ok(a), Ok(b)) => assert_eq!(
+                    a.map(|v| v.map(f64::to_bits)),
+                    b.map(|v| v.map(f64::to_bits)),
+                    "{text}"
+                ),
+                (a, b) => assert_eq!(a.is_err(), b.is_err(), "{text}"),
+            }
+        }
     }
 }
