@@ -11,6 +11,10 @@
 //! - `plain_loop_kahan`: the same with the decimator's sum compensated (Kahan) as the
 //!   pipeline's is, which is what its bit-exact outputs are built on.
 //!
+//! The pipeline runs each compensation mode sample by sample (`Pipeline::push`: `none`,
+//! `paper`, `kalman`) and through `Pipeline::push_block`, the whole input in one call
+//! (`block_*`) and in calls of 100 samples (`block100_*`).
+//!
 //! `scripts/bench_ratio.py` prints each bench's ns per input sample and its ratio to
 //! `plain_loop`, from criterion's `target/criterion/pipeline_90s_1khz/*/new/estimates.json`.
 
@@ -81,6 +85,7 @@ impl Plain {
 fn pipeline_per_sample(c: &mut Criterion) {
     const N: usize = 90_000; // 90 s at 1 kHz
     let signal = bench_signal_dps(N);
+    let times_s: Vec<f64> = (0..N).map(|i| i as f64 * 1e-3).collect();
     let mut group = c.benchmark_group("pipeline_90s_1khz");
     group.throughput(Throughput::Elements(N as u64));
     let plain = Plain::new(&Config::default());
@@ -111,6 +116,27 @@ fn pipeline_per_sample(c: &mut Criterion) {
                 black_box(last)
             })
         });
+        // The same samples through `push_block`: the whole 90 s in one call, and in calls
+        // of 100 samples (a firmware's DMA buffer of 0.1 s).
+        for chunk in [N, 100] {
+            let id = if chunk == N {
+                format!("block_{name}")
+            } else {
+                format!("block{chunk}_{name}")
+            };
+            group.bench_with_input(id, &signal, |b, signal| {
+                b.iter(|| {
+                    let mut pipeline = Pipeline::try_new(&config).expect("default config is valid");
+                    let mut last = 0.0_f32;
+                    for (times_s, rates_dps) in times_s.chunks(chunk).zip(signal.chunks(chunk)) {
+                        pipeline
+                            .push_block(times_s, black_box(rates_dps), |out| last = out.angle_deg)
+                            .expect("same lengths");
+                    }
+                    black_box(last)
+                })
+            });
+        }
     }
     group.finish();
 }

@@ -16,7 +16,7 @@ pub struct Decimator {
     count: u16,
     sum: KahanSum,
     /// The latest sample pushed (0 before the first); while the block's count is odd, it
-    /// is not yet in `sum`.
+    /// is not yet in `sum` (see [`Decimator::run`]).
     last: f32,
 }
 
@@ -53,29 +53,71 @@ impl Decimator {
 
     /// Push one input sample; returns the block mean after every `factor`-th sample.
     ///
-    /// The samples go into the compensated sum in pairs, in their order: the same sum, bit
-    /// for bit, as one at a time, with half the trips of the sum through memory from one
-    /// call to the next (a store and a reload on the sum's dependency chain each).
+    /// One sample is a run of one: [`Self::run`], [`BlockRun::add`], [`Self::close`].
     #[inline]
     pub fn push(&mut self, x: f32) -> Option<f32> {
-        self.count += 1;
-        let pair_ends = self.count % 2 == 0;
-        if self.count < self.factor {
-            if pair_ends {
-                self.sum.add(self.last);
-                self.sum.add(x);
+        let mut run = self.run();
+        run.add(x);
+        self.close(run)
+    }
+
+    /// How many more samples complete the current block.
+    #[inline]
+    pub const fn remaining(&self) -> u16 {
+        self.factor - self.count
+    }
+
+    /// Open the current block for a run of samples, to be added with [`BlockRun::add`]
+    /// (at most [`Self::remaining`] of them) and handed back with [`Self::close`].
+    ///
+    /// A run keeps the sum in registers from one sample to the next; between calls the
+    /// decimator keeps it in memory. The samples go into the compensated sum in pairs, in
+    /// their order: the same sum, bit for bit, as one at a time, however a block is split
+    /// into runs; a run of one sample (a [`Self::push`]) then trips the sum through memory
+    /// only every other sample (a store and a reload on the sum's chain of additions).
+    #[inline(always)]
+    pub const fn run(&self) -> BlockRun {
+        BlockRun {
+            sum: self.sum,
+            last: self.last,
+            count: self.count,
+        }
+    }
+
+    /// Take back a run: its samples stay in the block; returns the block's mean and starts
+    /// the next block if the run completed it.
+    #[inline(always)]
+    pub fn close(&mut self, run: BlockRun) -> Option<f32> {
+        if run.count < self.factor {
+            // Stored only if a pair went in: a run of one leaves it alone every other time,
+            // and the next sample's reload then waits on no store.
+            if run.count / 2 != self.count / 2 {
+                self.sum = run.sum;
             }
-            self.last = x;
+            self.last = run.last;
+            self.count = run.count;
             return None;
         }
-        if pair_ends {
-            self.sum.add(self.last);
+        let mut sum = run.sum;
+        if run.count % 2 == 1 {
+            sum.add(run.last);
         }
-        self.sum.add(x);
-        self.last = x;
-        let mean = self.sum.value() / f32::from(self.factor);
+        Some(self.complete(sum, run.last))
+    }
+
+    /// Complete a whole block summed elsewhere: `sum` of its `factor` samples, from
+    /// [`KahanSum::ZERO`] in their order, the latest `last`, in place of the current
+    /// block, which must be empty (no sample pending) unless it is the one summed. Returns
+    /// the block's mean, as [`Self::close`] would.
+    ///
+    /// For blocks summed side by side: independent sums keep the floating-point units busy
+    /// rather than wait on one sum's chain of additions.
+    #[inline(always)]
+    pub fn complete(&mut self, sum: KahanSum, last: f32) -> f32 {
+        self.last = last;
+        let mean = sum.value() / f32::from(self.factor);
         self.reset();
-        Some(mean)
+        mean
     }
 
     /// Drop the partial block (the latest sample stays known).
@@ -83,6 +125,35 @@ impl Decimator {
     pub fn reset(&mut self) {
         self.count = 0;
         self.sum = KahanSum::ZERO;
+    }
+}
+
+/// The current block of a [`Decimator`] while a run of samples is added to it
+/// ([`Decimator::run`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BlockRun {
+    /// The block's samples but the latest while their count is odd.
+    sum: KahanSum,
+    last: f32,
+    count: u16,
+}
+
+impl BlockRun {
+    /// Add one sample.
+    #[inline(always)]
+    pub fn add(&mut self, x: f32) {
+        self.count += 1;
+        if self.count % 2 == 0 {
+            self.sum.add(self.last);
+            self.sum.add(x);
+        }
+        self.last = x;
+    }
+
+    /// The latest sample added (the decimator's [`Decimator::last`] before any).
+    #[inline(always)]
+    pub const fn last(&self) -> f32 {
+        self.last
     }
 }
 
@@ -107,6 +178,35 @@ mod tests {
             .collect();
         assert_eq!(out, [3.0, 10.0]);
         assert_eq!(d.pending(), 1);
+    }
+
+    #[test]
+    fn runs_give_the_bits_of_pushes() {
+        let xs: Vec<f32> = (0..200)
+            .map(|i| (i as f32 * 0.37).sin() * 1e3 + 1e-3)
+            .collect();
+        let mut one = Decimator::try_new(7).unwrap();
+        let expected: Vec<u32> = xs
+            .iter()
+            .filter_map(|&x| one.push(x))
+            .map(f32::to_bits)
+            .collect();
+        for cut in [2, 3, 5, 7, 11] {
+            let mut d = Decimator::try_new(7).unwrap();
+            let mut got = Vec::new();
+            let mut rest = &xs[..];
+            while !rest.is_empty() {
+                let take = rest.len().min(cut).min(usize::from(d.remaining()));
+                let mut run = d.run();
+                for &x in &rest[..take] {
+                    run.add(x);
+                }
+                got.extend(d.close(run).map(f32::to_bits));
+                rest = &rest[take..];
+            }
+            assert_eq!(got, expected, "runs of {cut}");
+            assert_eq!(d, one, "runs of {cut}");
+        }
     }
 
     #[test]

@@ -2,13 +2,17 @@
 
 use core::fmt;
 
-/// Why a setting was refused. Carries the name of the setting (as in [`crate::Config`]).
+/// Why a setting or an argument was refused. Carries the name of the setting (as in
+/// [`crate::Config`]) or of the argument.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Error {
     /// The setting is NaN or infinite.
     NonFinite(&'static str),
     /// The setting is finite but outside its valid range.
     OutOfRange(&'static str),
+    /// The argument, a slice, is not as long as the block's times
+    /// ([`crate::Pipeline::push_block`]).
+    LengthMismatch(&'static str),
 }
 
 impl fmt::Display for Error {
@@ -16,6 +20,9 @@ impl fmt::Display for Error {
         match self {
             Error::NonFinite(name) => write!(f, "setting `{name}` is not a finite number"),
             Error::OutOfRange(name) => write!(f, "setting `{name}` is out of its valid range"),
+            Error::LengthMismatch(name) => {
+                write!(f, "`{name}` is not as long as the block's times")
+            }
         }
     }
 }

@@ -21,10 +21,7 @@ impl KahanSum {
     /// Add `x`.
     #[inline]
     pub fn add(&mut self, x: f32) {
-        let y = x - self.compensation;
-        let t = self.sum + y;
-        self.compensation = (t - self.sum) - y;
-        self.sum = t;
+        (self.sum, self.compensation) = step(self.sum, self.compensation, x);
     }
 
     /// The sum.
@@ -36,6 +33,51 @@ impl KahanSum {
     /// True if the sum and its compensation are finite.
     pub fn is_finite(&self) -> bool {
         self.sum.is_finite() && self.compensation.is_finite()
+    }
+}
+
+/// One compensated addition: `(sum, compensation)` with `x` added.
+#[inline(always)]
+fn step(sum: f32, compensation: f32, x: f32) -> (f32, f32) {
+    let y = x - compensation;
+    let t = sum + y;
+    (t, (t - sum) - y)
+}
+
+/// `N` independent compensated sums side by side, lane `k` equal bit for bit to a
+/// [`KahanSum`] given lane `k`'s values in the same order.
+///
+/// Each sum is a chain of dependent additions; side by side (in lanes the compiler may put
+/// in one vector register), the chains overlap instead of waiting on each other.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KahanLanes<const N: usize> {
+    sums: [f32; N],
+    compensations: [f32; N],
+}
+
+impl<const N: usize> KahanLanes<N> {
+    /// Zero in every lane.
+    pub const ZERO: Self = Self {
+        sums: [0.0; N],
+        compensations: [0.0; N],
+    };
+
+    /// Add `x[k]` to lane `k`.
+    #[inline(always)]
+    pub fn add(&mut self, x: [f32; N]) {
+        let lanes = self.sums.iter_mut().zip(&mut self.compensations);
+        for ((sum, compensation), x) in lanes.zip(x) {
+            (*sum, *compensation) = step(*sum, *compensation, x);
+        }
+    }
+
+    /// Lane `k` as a [`KahanSum`] (`k < N`).
+    #[inline]
+    pub fn lane(&self, k: usize) -> KahanSum {
+        KahanSum {
+            sum: self.sums[k],
+            compensation: self.compensations[k],
+        }
     }
 }
 
@@ -57,5 +99,26 @@ mod tests {
         assert!((k.value() - exact).abs() < 1e-3, "{}", k.value());
         // Plain f32 loses the addends entirely: the test would pass vacuously otherwise.
         assert!((plain - exact).abs() > 1.0);
+    }
+
+    #[test]
+    fn lanes_are_sums_bit_for_bit() {
+        let mut lanes = KahanLanes::<3>::ZERO;
+        let mut sums = [KahanSum::ZERO; 3];
+        for i in 0..1000 {
+            let x = [
+                1.0e4 / (i + 1) as f32,
+                -1.0e-4 * i as f32,
+                (i as f32 * 0.7).sin(),
+            ];
+            lanes.add(x);
+            for (sum, x) in sums.iter_mut().zip(x) {
+                sum.add(x);
+            }
+        }
+        for (k, sum) in sums.iter().enumerate() {
+            assert_eq!(lanes.lane(k).value().to_bits(), sum.value().to_bits());
+            assert_eq!(lanes.lane(k), *sum);
+        }
     }
 }

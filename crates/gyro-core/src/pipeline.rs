@@ -7,7 +7,7 @@ use crate::decision::Tightening;
 use crate::error::{check_range, Error};
 use crate::gauss_markov::GaussMarkov;
 use crate::integrator::Integrator;
-use crate::kahan::KahanSum;
+use crate::kahan::{KahanLanes, KahanSum};
 use crate::kalman::{KalmanBias, KalmanConfig};
 use crate::motion::{MotionConfig, MotionDetector, MotionState, Phase};
 use crate::sos::{Sos, SosState};
@@ -304,6 +304,26 @@ impl RestBlocks {
     }
 }
 
+/// How many whole blocks [`Pipeline::push_block`] sums side by side (half as many when
+/// fewer are at hand): 8 lanes, two 4-lane vector registers of sums and two of
+/// compensations, whose chains of additions overlap.
+const SIDE_BY_SIDE: usize = 8;
+
+/// One reading through the clip watch: `last` and `run` (the last reading and how many
+/// times in a row it came, up to the plateau) move on; true if it reaches the range
+/// (`level_dps`) or completes a clip plateau (see [`Movement::saturated`]). Judged on the
+/// reading, before correction.
+#[inline(always)]
+fn clip_seen(level_dps: f32, last: &mut f32, run: &mut u8, reading_dps: f32) -> bool {
+    // Without branches: whether a reading repeats is a coin toss on a quantised sensor.
+    let repeat = u8::from(reading_dps == *last);
+    *run = (run.saturating_add(1) & 0_u8.wrapping_sub(repeat)) | (1 - repeat);
+    *last = reading_dps;
+    let magnitude = libm::fabsf(reading_dps);
+    (magnitude >= level_dps)
+        | ((*run >= CLIP_PLATEAU_SAMPLES) & (magnitude >= CLIP_PLATEAU_MIN_DPS))
+}
+
 /// Group delay at DC of a cascade (output samples): for each section `B/A`,
 /// `Σ k b_k / Σ b_k − Σ k a_k / Σ a_k`. Zero if not finite (no DC gain).
 fn dc_group_delay_samples(design: &SosDesign) -> f64 {
@@ -322,6 +342,7 @@ fn dc_group_delay_samples(design: &SosDesign) -> f64 {
 }
 
 /// The pipeline. Push input samples; every `decimation_factor`-th push returns an output.
+/// [`Pipeline::push_block`] takes them in blocks, with the same outputs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pipeline {
     max_abs_rate_dps: f32,
@@ -462,11 +483,11 @@ impl Pipeline {
     ///
     /// The configured [`Correction`]'s scale and asymmetry are applied; its temperature
     /// terms are not (as if ΔT were 0): use [`Self::push_with_temperature`] where the
-    /// sensor's temperature is known.
+    /// sensor's temperature is known. [`Self::push_block`] takes many samples at once, with
+    /// the same outputs.
     #[inline]
     pub fn push(&mut self, time_s: f64, rate_dps: f32) -> Option<Output> {
-        let rate_dps = self.accept(rate_dps, false);
-        self.decimate(time_s, rate_dps)
+        self.segment::<false>(&[time_s], &[rate_dps], &[])
     }
 
     /// Push one input sample with the sensor's temperature `temperature_c` (°C): the whole
@@ -484,68 +505,360 @@ impl Pipeline {
         rate_dps: f32,
         temperature_c: f32,
     ) -> Option<Output> {
-        self.corrector.observe_temperature(temperature_c);
-        let rate_dps = self.accept(rate_dps, true);
-        self.decimate(time_s, rate_dps)
+        self.segment::<true>(&[time_s], &[rate_dps], &[temperature_c])
     }
 
-    // The per-sample path, `accept` then `decimate`, is inlined into the caller and does
-    // only what each input sample needs: plausibility, the clip watch, the correction and
-    // the decimator's sum. Everything else runs once per output sample, in `step`.
+    /// Push a block of input samples, `times_s[i]` (s) and `rates_dps[i]` (deg/s), handing
+    /// each output to `sink` as it comes (one per completed decimation block; a block may
+    /// span calls).
+    ///
+    /// The outputs and the state left are those of [`Self::push`] on the same samples one
+    /// by one, bit for bit, however the samples are split into calls. What differs is the
+    /// cost: the decimator's sum and the per-sample checks stay in registers through the
+    /// block, the block's times and counters are kept once per block, and runs of 4 or 8
+    /// whole decimation blocks of plausible samples have their sums added side by side
+    /// (each in its own order, so that the bits stay those of one sum at a time). Longer
+    /// calls gain more: a call of fewer than 4 blocks goes sample by sample.
+    ///
+    /// Refused, with nothing pushed, if the slices' lengths differ
+    /// ([`Error::LengthMismatch`]`("rates_dps")`).
+    ///
+    /// ```
+    /// use gyro_core::{Config, Pipeline};
+    ///
+    /// let config = Config::default(); // 1 kHz in, 50 Hz out
+    /// let times_s: Vec<f64> = (0..1000).map(|i| i as f64 * 1e-3).collect();
+    /// let rates_dps = vec![0.5_f32; 1000];
+    ///
+    /// let mut by_block = Pipeline::try_new(&config)?;
+    /// let mut outputs = Vec::new();
+    /// // Blocks of any length: here 300 samples, 15 outputs per full call.
+    /// for (times, rates) in times_s.chunks(300).zip(rates_dps.chunks(300)) {
+    ///     by_block.push_block(times, rates, |out| outputs.push(out))?;
+    /// }
+    ///
+    /// let mut one_by_one = Pipeline::try_new(&config)?;
+    /// let expected: Vec<_> = (0..1000)
+    ///     .filter_map(|i| one_by_one.push(times_s[i], rates_dps[i]))
+    ///     .collect();
+    /// assert_eq!(outputs.len(), 50);
+    /// assert_eq!(outputs, expected);
+    /// # Ok::<(), gyro_core::Error>(())
+    /// ```
+    pub fn push_block(
+        &mut self,
+        times_s: &[f64],
+        rates_dps: &[f32],
+        mut sink: impl FnMut(Output),
+    ) -> Result<(), Error> {
+        if rates_dps.len() != times_s.len() {
+            return Err(Error::LengthMismatch("rates_dps"));
+        }
+        self.run::<false>(times_s, rates_dps, &[], &mut sink);
+        Ok(())
+    }
 
-    /// Accept or reject a reading and correct it. Plausibility is judged on the reading; a
-    /// rejected one is replaced by the last valid one, corrected as it was then.
+    /// [`Self::push_block`] with the sensor's temperature per sample, `temperatures_c[i]`
+    /// (°C), as [`Self::push_with_temperature`] takes it.
+    ///
+    /// Refused, with nothing pushed, if the slices' lengths differ
+    /// ([`Error::LengthMismatch`] naming `rates_dps` or `temperatures_c`).
+    pub fn push_block_with_temperature(
+        &mut self,
+        times_s: &[f64],
+        rates_dps: &[f32],
+        temperatures_c: &[f32],
+        mut sink: impl FnMut(Output),
+    ) -> Result<(), Error> {
+        if rates_dps.len() != times_s.len() {
+            return Err(Error::LengthMismatch("rates_dps"));
+        }
+        if temperatures_c.len() != times_s.len() {
+            return Err(Error::LengthMismatch("temperatures_c"));
+        }
+        self.run::<true>(times_s, rates_dps, temperatures_c, &mut sink);
+        Ok(())
+    }
+
+    // The input path. Per sample it does only what each sample needs: plausibility, the clip
+    // watch, the correction and the decimator's sum, all in registers through a block
+    // (`segment`), or for whole blocks side by side (`sums`). The block's times and the
+    // output step run once per block (`end_block`, `step`).
+
+    /// Push samples (with their temperatures if `TEMPERATURE`; the slices' lengths agree).
     #[inline(always)]
-    fn accept(&mut self, rate_dps: f32, with_temperature: bool) -> f32 {
-        // `max_abs_rate_dps` is finite (validated): NaN and the infinities fail this test.
-        if libm::fabsf(rate_dps) <= self.max_abs_rate_dps {
-            self.observe_clip(rate_dps);
-            // The identity returns the reading, a zero's sign aside (−0 − 0·ΔT may give +0),
-            // which the decimator's sum does not see: both zeros leave it the same.
-            if !self.corrects {
-                rate_dps
-            } else if with_temperature {
-                self.corrector.correct_at_temperature(rate_dps)
-            } else {
-                self.corrector.correct(rate_dps)
+    fn run<const TEMPERATURE: bool>(
+        &mut self,
+        times_s: &[f64],
+        rates_dps: &[f32],
+        temperatures_c: &[f32],
+        sink: &mut impl FnMut(Output),
+    ) {
+        let factor = usize::from(self.decimator.factor());
+        let mut start = 0;
+        while start < rates_dps.len() {
+            let left = rates_dps.len() - start;
+            // Whole blocks side by side, when the temperature changes no rate: as many as
+            // the lanes hold, else fewer.
+            if self.decimator.pending() == 0 && !(TEMPERATURE && self.corrects) {
+                let lanes = if left >= SIDE_BY_SIDE * factor {
+                    SIDE_BY_SIDE
+                } else {
+                    SIDE_BY_SIDE / 2
+                };
+                let end = start + lanes * factor;
+                if left >= lanes * factor {
+                    let temperatures = if TEMPERATURE {
+                        &temperatures_c[start..end]
+                    } else {
+                        &[]
+                    };
+                    let (times, rates) = (&times_s[start..end], &rates_dps[start..end]);
+                    let pushed = if lanes == SIDE_BY_SIDE {
+                        self.sums::<SIDE_BY_SIDE>(times, rates, temperatures, sink)
+                    } else {
+                        self.sums::<{ SIDE_BY_SIDE / 2 }>(times, rates, temperatures, sink)
+                    };
+                    if pushed {
+                        start = end;
+                        continue;
+                    }
+                }
             }
-        } else {
-            self.reject()
+            let end = start + left.min(usize::from(self.decimator.remaining()));
+            let temperatures = if TEMPERATURE {
+                &temperatures_c[start..end]
+            } else {
+                &[]
+            };
+            if let Some(output) = self.segment::<TEMPERATURE>(
+                &times_s[start..end],
+                &rates_dps[start..end],
+                temperatures,
+            ) {
+                sink(output);
+            }
+            start = end;
         }
     }
 
-    /// Count a rejected reading; its replacement, the last rate the decimator took (the
-    /// last valid one, corrected, or 0 before the first).
-    #[cold]
-    #[inline(never)]
-    fn reject(&mut self) -> f32 {
-        self.rejected = self.rejected.saturating_add(1);
-        self.decimator.last()
+    /// Push the samples of one block's run (at most the block's remaining samples, at least
+    /// one), one after the other; the output if they complete the block.
+    #[inline(always)]
+    fn segment<const TEMPERATURE: bool>(
+        &mut self,
+        times_s: &[f64],
+        rates_dps: &[f32],
+        temperatures_c: &[f32],
+    ) -> Option<Output> {
+        let first_s = self.time_of(times_s, 0);
+        if self.decimator.pending() == 0 {
+            self.block_start_time_s = first_s;
+        }
+        let last_s = self.time_of_last(times_s, first_s);
+        self.last_time_s = last_s;
+
+        let mut block = self.decimator.run();
+        let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
+        let mut clipped = false;
+        for (i, &reading) in rates_dps.iter().enumerate() {
+            if TEMPERATURE {
+                self.corrector.observe_temperature(temperatures_c[i]);
+            }
+            let rate = if self.plausible(reading) {
+                clipped |= clip_seen(self.clip_level_dps, &mut clip_last, &mut clip_run, reading);
+                self.corrected::<TEMPERATURE>(reading)
+            } else {
+                // Replaced by the last rate the decimator took (0 before the first).
+                self.reject();
+                block.last()
+            };
+            block.add(rate);
+        }
+        (self.clip_last_dps, self.clip_run) = (clip_last, clip_run);
+        self.clip_pending |= clipped;
+        let mean_dps = self.decimator.close(block)?;
+        Some(self.end_block(last_s, mean_dps))
     }
 
-    /// Add an accepted rate to the decimator's block; at the block's end, one output step.
+    /// Push `LANES` whole blocks starting at a block boundary: first the
+    /// plausibility test, the clip watch (and the temperatures) over all samples in order,
+    /// then the blocks' sums side by side, each in its samples' order (the sums are
+    /// independent: interleaved, they keep the floating-point units busy rather than wait
+    /// on one sum's chain of additions), then the output steps in order. False, with
+    /// nothing pushed, if a sample is implausible: its replacement depends on the sample
+    /// before, so those blocks go one sample after the other (`segment`).
+    #[inline(never)]
+    fn sums<const LANES: usize>(
+        &mut self,
+        times_s: &[f64],
+        rates_dps: &[f32],
+        temperatures_c: &[f32],
+        sink: &mut impl FnMut(Output),
+    ) -> bool {
+        let factor = usize::from(self.decimator.factor());
+        debug_assert_eq!(self.decimator.pending(), 0);
+        if rates_dps.len() != LANES * factor {
+            return false;
+        }
+        let mut rows = [&rates_dps[..0]; LANES];
+        for (row, block) in rows.iter_mut().zip(rates_dps.chunks_exact(factor)) {
+            *row = block;
+        }
+        let Some(clipped) = self.clip_watch::<LANES>(rates_dps, factor) else {
+            return false;
+        };
+        for &temperature_c in temperatures_c {
+            self.corrector.observe_temperature(temperature_c);
+        }
+
+        let mut sums = KahanLanes::<LANES>::ZERO;
+        for i in 0..factor {
+            // Without temperature: a temperature that would change the rate keeps the
+            // blocks out of here.
+            let mut column = [0.0; LANES];
+            for (x, row) in column.iter_mut().zip(&rows) {
+                *x = self.corrected::<false>(row[i]);
+            }
+            sums.add(column);
+        }
+
+        for (k, row) in rows.into_iter().enumerate() {
+            let sum = sums.lane(k);
+            let times_s = &times_s[k * factor..(k + 1) * factor];
+            self.block_start_time_s = self.time_of(times_s, 0);
+            self.last_time_s = self.time_of_last(times_s, self.block_start_time_s);
+            self.clip_pending |= clipped[k];
+            let last = self.corrected::<false>(row[factor - 1]);
+            let mean_dps = self.decimator.complete(sum, last);
+            sink(self.end_block(self.last_time_s, mean_dps));
+        }
+        true
+    }
+
+    /// The plausibility test and the clip watch over whole blocks of `factor` samples in
+    /// order: each block's clip flag, or `None` (and nothing changed) if a sample is
+    /// implausible.
+    ///
+    /// Blocks that stay below both the clip plateau's level and the range, as rests do,
+    /// need no watch sample by sample: their test reads all samples at once, and the watch
+    /// moves on to their last reading and its run of repeats.
     #[inline(always)]
-    fn decimate(&mut self, time_s: f64, rate_dps: f32) -> Option<Output> {
-        let time_s = if time_s.is_finite() {
+    fn clip_watch<const LANES: usize>(
+        &mut self,
+        rates_dps: &[f32],
+        factor: usize,
+    ) -> Option<[bool; LANES]> {
+        let quiet_dps = self.clip_level_dps.min(CLIP_PLATEAU_MIN_DPS);
+        let max_dps = self.max_abs_rate_dps;
+        // Below the quiet level (and plausible): NaN fails both.
+        let (quiet, plausible) = rates_dps
+            .iter()
+            .fold((true, true), |(quiet, plausible), &x| {
+                let magnitude = libm::fabsf(x);
+                (
+                    quiet & (magnitude < quiet_dps),
+                    plausible & (magnitude <= max_dps),
+                )
+            });
+        if !plausible {
+            return None;
+        }
+        let mut clipped = [false; LANES];
+        if quiet {
+            let (&last, before) = rates_dps.split_last()?;
+            let repeats = before.iter().rev().take_while(|&&x| x == last).count();
+            self.clip_run = if repeats == before.len() && last == self.clip_last_dps {
+                self.clip_run
+                    .saturating_add(u8::try_from(rates_dps.len()).unwrap_or(u8::MAX))
+            } else {
+                u8::try_from(repeats + 1).unwrap_or(u8::MAX)
+            };
+            self.clip_last_dps = last;
+        } else {
+            let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
+            for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
+                for &reading in block {
+                    *clipped |=
+                        clip_seen(self.clip_level_dps, &mut clip_last, &mut clip_run, reading);
+                }
+            }
+            (self.clip_last_dps, self.clip_run) = (clip_last, clip_run);
+        }
+        Some(clipped)
+    }
+
+    /// Plausible: finite and within `max_abs_rate_dps`.
+    #[inline(always)]
+    fn plausible(&self, reading_dps: f32) -> bool {
+        // `max_abs_rate_dps` is finite (validated): NaN and the infinities fail this test.
+        libm::fabsf(reading_dps) <= self.max_abs_rate_dps
+    }
+
+    /// A plausible reading corrected (with the temperature change in use if `TEMPERATURE`).
+    #[inline(always)]
+    fn corrected<const TEMPERATURE: bool>(&self, reading_dps: f32) -> f32 {
+        // The identity returns the reading, a zero's sign aside (−0 − 0·ΔT may give +0),
+        // which the decimator's sum does not see: both zeros leave it the same.
+        if !self.corrects {
+            reading_dps
+        } else if TEMPERATURE {
+            self.corrector.correct_at_temperature(reading_dps)
+        } else {
+            self.corrector.correct(reading_dps)
+        }
+    }
+
+    /// Count a rejected reading (its replacement is the caller's).
+    #[cold]
+    #[inline(never)]
+    fn reject(&mut self) {
+        self.rejected = self.rejected.saturating_add(1);
+    }
+
+    /// The time of `times_s[i]` (s), the stamps before it taken one after the other from
+    /// the last time: the stamp if finite, else [`Self::substitute_time`] of the one before.
+    #[inline(always)]
+    fn time_of(&self, times_s: &[f64], i: usize) -> f64 {
+        let time_s = times_s[i];
+        if time_s.is_finite() {
             time_s
         } else {
-            self.substitute_time()
-        };
-        if self.decimator.pending() == 0 {
-            self.block_start_time_s = time_s;
+            self.time_walked(times_s, i)
         }
-        self.last_time_s = time_s;
-        let mean_dps = self.decimator.push(rate_dps)?;
-        Some(self.end_block(time_s, mean_dps))
     }
 
-    /// The time of a sample whose stamp is not finite: one input period on from the last
-    /// time (the output period over the factor), or 0 if there is none.
+    /// The time of the last of `times_s` (non-empty), the first's being `first_s`.
+    #[inline(always)]
+    fn time_of_last(&self, times_s: &[f64], first_s: f64) -> f64 {
+        let last = times_s.len() - 1;
+        if last == 0 {
+            first_s
+        } else {
+            self.time_of(times_s, last)
+        }
+    }
+
+    /// [`Self::time_of`] for a stamp that is not finite: walk from the last time.
     #[cold]
     #[inline(never)]
-    fn substitute_time(&self) -> f64 {
-        if self.last_time_s.is_finite() {
-            self.last_time_s + f64::from(self.output_period_s) / f64::from(self.decimator.factor())
+    fn time_walked(&self, times_s: &[f64], i: usize) -> f64 {
+        times_s[..=i]
+            .iter()
+            .fold(self.last_time_s, |before_s, &time_s| {
+                if time_s.is_finite() {
+                    time_s
+                } else {
+                    self.substitute_time(before_s)
+                }
+            })
+    }
+
+    /// The time of a sample whose stamp is not finite: one input period on from the time
+    /// before it (the output period over the factor), or 0 if there is none.
+    fn substitute_time(&self, before_s: f64) -> f64 {
+        if before_s.is_finite() {
+            before_s + f64::from(self.output_period_s) / f64::from(self.decimator.factor())
         } else {
             0.0
         }
@@ -557,24 +870,6 @@ impl Pipeline {
         // Halves first: the sum of two huge times would overflow.
         let centre_s = 0.5 * self.block_start_time_s + 0.5 * time_s;
         self.step(centre_s, mean_dps)
-    }
-
-    /// Flag a reading that reaches the range or completes a clip plateau (see
-    /// [`Movement::saturated`]). Judged on the reading, before correction.
-    #[inline(always)]
-    fn observe_clip(&mut self, reading_dps: f32) {
-        self.clip_run = if reading_dps == self.clip_last_dps {
-            self.clip_run.saturating_add(1)
-        } else {
-            1
-        };
-        self.clip_last_dps = reading_dps;
-        let magnitude = libm::fabsf(reading_dps);
-        if magnitude >= self.clip_level_dps
-            || (self.clip_run >= CLIP_PLATEAU_SAMPLES && magnitude >= CLIP_PLATEAU_MIN_DPS)
-        {
-            self.clip_pending = true;
-        }
     }
 
     /// Whether the movement in progress (its confirming run included) is saturated so far;

@@ -190,6 +190,8 @@ pub(crate) fn refusal(error: gyro_core::Error) -> Refusal {
             GyroStatus::ConfigOutOfRange,
             GyroField::from_core_name(name),
         ),
+        // Only from `Pipeline::push_block`, which the C API does not call.
+        gyro_core::Error::LengthMismatch(_) => (GyroStatus::ConfigOutOfRange, GyroField::Unknown),
     }
 }
 
