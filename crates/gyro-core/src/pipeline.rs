@@ -551,9 +551,7 @@ impl Pipeline {
         rates_dps: &[f32],
         mut sink: impl FnMut(Output),
     ) -> Result<(), Error> {
-        if rates_dps.len() != times_s.len() {
-            return Err(Error::LengthMismatch("rates_dps"));
-        }
+        same_lengths(times_s, rates_dps, None)?;
         self.run::<false>(times_s, rates_dps, &[], &mut sink);
         Ok(())
     }
@@ -570,12 +568,7 @@ impl Pipeline {
         temperatures_c: &[f32],
         mut sink: impl FnMut(Output),
     ) -> Result<(), Error> {
-        if rates_dps.len() != times_s.len() {
-            return Err(Error::LengthMismatch("rates_dps"));
-        }
-        if temperatures_c.len() != times_s.len() {
-            return Err(Error::LengthMismatch("temperatures_c"));
-        }
+        same_lengths(times_s, rates_dps, Some(temperatures_c))?;
         self.run::<true>(times_s, rates_dps, temperatures_c, &mut sink);
         Ok(())
     }
@@ -1069,6 +1062,21 @@ impl Pipeline {
             }
         }
     }
+}
+
+/// The block inputs' slices have one entry per sample: the first that does not is named.
+fn same_lengths(
+    times_s: &[f64],
+    rates_dps: &[f32],
+    temperatures_c: Option<&[f32]>,
+) -> Result<(), Error> {
+    if rates_dps.len() != times_s.len() {
+        return Err(Error::LengthMismatch("rates_dps"));
+    }
+    if temperatures_c.is_some_and(|t| t.len() != times_s.len()) {
+        return Err(Error::LengthMismatch("temperatures_c"));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
