@@ -119,6 +119,9 @@ fn names_an_injected_scale_factor_and_compensates_it() {
     let k = first["params"]["k"].as_f64().unwrap();
     assert!((k - 0.02).abs() < 2e-3, "k = {k}");
     assert_eq!(d["verdict"]["unmodelled"][0], "scale_factor");
+    // With the true effect the model fits: nothing is left unexplained.
+    assert_eq!(d["verdict"]["model_fits"], true, "{}", d["unexplained"]);
+    assert_eq!(d["unexplained"].as_array().map(Vec::len), Some(0));
     assert!(d["verdict"]["fraction_closed_holdout"].as_f64().unwrap() > 0.8);
     let g = &d["gap"];
     assert!(g["holdout_after"].as_f64().unwrap() < 0.2 * g["holdout_before"].as_f64().unwrap());
@@ -240,6 +243,10 @@ fn nothing_significant_without_an_effect() {
     args.extend(holdout.iter().map(String::as_str));
     let table = ok(&gyro(&args));
     assert!(table.contains("verdict: nothing significant"), "{table}");
+    assert!(
+        !table.contains("does not fit") && !table.contains("unexplained by the selected model"),
+        "the nominal model fits runs simulated with it: {table}"
+    );
     assert!(
         table.contains("temperature_bias"),
         "every effect is listed: {table}"

@@ -32,6 +32,29 @@ pub struct Where {
     pub z: f64,
 }
 
+/// A statistic the selected model leaves unexplained on the training runs (combined
+/// |z| at least `UNEXPLAINED_Z`): what no effect of the vocabulary, as selected, brings
+/// to its simulated ensemble. Means are over the runs.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Unexplained {
+    /// Segment or stratum.
+    pub segment: String,
+    /// Statistic.
+    pub statistic: String,
+    /// The real runs' value (mean over the training runs).
+    pub real: f64,
+    /// The nominal model's simulated value (mean of the ensembles' means).
+    pub nominal: f64,
+    /// The selected model's simulated value (mean of the ensembles' means).
+    pub simulated: f64,
+    /// Combined z over the training runs with the selected model (Σz/√n).
+    pub z_train: f64,
+    /// Combined z over the training runs with the nominal model.
+    pub z_train_nominal: f64,
+    /// Combined z over the held-out runs with the selected model.
+    pub z_holdout: f64,
+}
+
 /// One candidate effect's result.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct EffectResult {
@@ -73,6 +96,9 @@ pub struct Verdict {
     pub unmodelled: Vec<&'static str>,
     /// Fraction of the held-out gap closed by them, relative to the floor.
     pub fraction_closed_holdout: f64,
+    /// The selected model explains every statistic of the training runs (no entry in
+    /// `unexplained`): only then does it fit the sensor at hand.
+    pub model_fits: bool,
 }
 
 /// An untestable effect.
@@ -95,6 +121,9 @@ pub struct Diagnosis {
     pub effects: Vec<EffectResult>,
     /// Verdict.
     pub verdict: Verdict,
+    /// The statistics the selected model leaves unexplained on the training runs,
+    /// largest |z| first (empty when the model fits).
+    pub unexplained: Vec<Unexplained>,
     /// Effects that could not be tested, and why.
     pub untestable: Vec<UntestableEntry>,
     /// The nominal model used, and where its values came from.

@@ -36,7 +36,7 @@ pub mod envelopes;
 pub(crate) mod features;
 pub(crate) mod fit;
 pub mod line;
-mod locate;
+pub mod locate;
 pub mod posterior;
 pub(crate) mod score;
 mod select;
@@ -47,7 +47,7 @@ mod summarise;
 pub use compensate::BIAS_ID;
 pub use diagnosis::{
     CompensationRun, CompensationSummary, Diagnosis, EffectResult, GapSummary, InputEntry,
-    ModelSummary, NotCorrected, RunSummary, UntestableEntry, Verdict, Where,
+    ModelSummary, NotCorrected, RunSummary, Unexplained, UntestableEntry, Verdict, Where,
 };
 pub use ensemble::{split, RealRun};
 pub use features::MIN_TEMPERATURE_RANGE_C;

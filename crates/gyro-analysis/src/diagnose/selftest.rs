@@ -81,6 +81,8 @@ pub struct CaseResult {
     pub fraction_closed: f64,
     /// Held-out gap before and after.
     pub holdout_gap: (f64, f64),
+    /// The selected model leaves no statistic of the training runs unexplained.
+    pub model_fits: bool,
     /// The diagnosis's table of effects (why an effect was or was not named).
     pub effects: Vec<super::EffectResult>,
 }
@@ -108,6 +110,8 @@ pub struct SelfTest {
     pub coverage: f64,
     /// Mean held-out fraction of the gap closed over cases with effects.
     pub mean_fraction_closed: f64,
+    /// Cases whose selected model leaves nothing unexplained on the training runs.
+    pub model_fits: f64,
     /// Confusion matrix: (injected id, top-1 named or "none", count), single cases.
     pub confusion: Vec<(String, String, usize)>,
 }
@@ -188,6 +192,7 @@ fn score_case(kind: &'static str, injected: Vec<Effect>, d: &Diagnosis) -> CaseR
         covered,
         fraction_closed: d.verdict.fraction_closed_holdout,
         holdout_gap: (d.gap.holdout_before, d.gap.holdout_after),
+        model_fits: d.verdict.model_fits,
         effects: d.effects.clone(),
     }
 }
@@ -253,6 +258,7 @@ pub fn run(
     let pairs_both_named = frac(&|c| (c.kind == "pair").then_some(c.all_named));
     let pairs_both_named_group = frac(&|c| (c.kind == "pair").then_some(c.all_named_group));
     let null_clean = frac(&|c| (c.kind == "null").then_some(c.named.is_empty()));
+    let model_fits = frac(&|c| Some(c.model_fits));
     let all_cov: Vec<bool> = cases
         .iter()
         .flat_map(|c| c.covered.iter().map(|x| x.1))
@@ -288,6 +294,7 @@ pub fn run(
         null_clean,
         coverage,
         mean_fraction_closed,
+        model_fits,
         confusion,
     })
 }

@@ -173,6 +173,11 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         .map(|e| e.id)
         .collect();
     let holdout_after = gap(&f.selection.holdout_scores);
+    let unexplained = super::locate::unexplained(
+        &f.baseline.train.scores,
+        &f.train_after.0,
+        &f.selection.holdout_scores,
+    );
     let runs = run_summaries(
         f.runs,
         (&f.baseline.train.scores, &f.train_after.0),
@@ -191,7 +196,9 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         verdict: Verdict {
             unmodelled,
             fraction_closed_holdout: closed(floor, gap(&f.holdout_before), holdout_after),
+            model_fits: unexplained.is_empty(),
         },
+        unexplained,
         untestable: f
             .untestable
             .into_iter()

@@ -205,6 +205,9 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
             }
         }
     }
+    if !d.verdict.model_fits {
+        lines.push(unexplained_line(d));
+    }
     for m in &d.motion_lines {
         lines.push(format!(
             "seen in the data, not a sensor effect: the motion of the {} runs has a line at {:.1} Hz ({} deg/s in the reference rate, {:.0} times its local floor): the rig vibrates and both sensors see it",
@@ -215,6 +218,38 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
         ));
     }
     lines
+}
+
+/// `x` to three significant digits.
+pub fn sig3(x: f64) -> String {
+    rounded(x, 0.005 * x.abs())
+}
+
+/// How many statistics the selected model leaves unexplained on the training runs, and
+/// the largest three with their real and simulated values.
+fn unexplained_line(d: &Diagnosis) -> String {
+    let largest: Vec<String> = d
+        .unexplained
+        .iter()
+        .take(3)
+        .map(|u| {
+            format!(
+                "{} ({}): real {}, simulated {} (z {})",
+                u.statistic,
+                u.segment,
+                sig3(u.real),
+                sig3(u.simulated),
+                sig3(u.z_train)
+            )
+        })
+        .collect();
+    format!(
+        "the model does not fit the training runs: {} statistics remain unexplained (G {} against a floor of {}); no effect of the vocabulary, as selected, brings them to the simulation; largest: {}",
+        d.unexplained.len(),
+        sig3(d.gap.train_after),
+        sig3(d.gap.floor),
+        largest.join("; ")
+    )
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@
 //! dashed (the cross-correlation's: a 95% band, mean ± 1.96 sd of the members). The gap
 //! map and the tables use every run. The page renders; it computes nothing.
 
+use super::sig3;
 use crate::plot::diagnose_plot::{
     AngleErrorPlot, AngleErrorRow, Band, EnvelopePlot, GapMapPlot, Measured, Panel,
 };
@@ -887,6 +888,8 @@ z is the parameter test on the training runs (“exact” where the test is not 
 
     posterior_table(s, d);
 
+    unexplained_table(s, d);
+
     let _ = writeln!(s, "<h2>Where the gap lies</h2>");
     let _ = writeln!(
         s,
@@ -922,6 +925,50 @@ combined over all runs (Σz/√n). Positive: the real value is above the simulat
             sig(r.duration_s, 4),
             num(r.gap_before),
             num(r.gap_after)
+        );
+    }
+    let _ = writeln!(s, "</table>");
+}
+
+/// The statistics the selected model leaves unexplained on the training runs.
+fn unexplained_table(s: &mut String, d: &Diagnosis) {
+    let _ = writeln!(s, "<h2>What the model leaves unexplained</h2>");
+    if d.unexplained.is_empty() {
+        let _ = writeln!(
+            s,
+            "<p>Every statistic of the training runs is within |z| &lt; {} of its simulated ensemble with the selected model: it fits the sensor at hand.</p>",
+            gyro_analysis::diagnose::locate::UNEXPLAINED_Z
+        );
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "<p class=\"warn\">The model does not fit the training runs: {} statistics stay at |z| ≥ {} \
+against their ensembles with the selected effects (G {} against a floor of {}). No effect of the \
+vocabulary, as selected, brings them to the simulation; they are what the sensor (or the rig, or \
+the reference) does that the model cannot say. Real and simulated values are means over the \
+training runs; the held-out z is with the same model.</p>",
+        d.unexplained.len(),
+        gyro_analysis::diagnose::locate::UNEXPLAINED_Z,
+        sig3(d.gap.train_after),
+        sig3(d.gap.floor)
+    );
+    let _ = writeln!(
+        s,
+        "<table><tr><th>statistic</th><th>segment</th><th>real</th><th>nominal model</th><th>selected model</th><th>z nominal</th><th>z selected</th><th>z held out</th></tr>"
+    );
+    for u in &d.unexplained {
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td></tr>",
+            esc(&u.statistic),
+            esc(&u.segment),
+            sig3(u.real),
+            sig3(u.nominal),
+            sig3(u.simulated),
+            sig3(u.z_train_nominal),
+            sig3(u.z_train),
+            sig3(u.z_holdout)
         );
     }
     let _ = writeln!(s, "</table>");
@@ -1157,7 +1204,18 @@ mod tests {
             verdict: Verdict {
                 unmodelled: vec!["clock_error"],
                 fraction_closed_holdout: 0.9,
+                model_fits: false,
             },
+            unexplained: vec![gyro_analysis::diagnose::Unexplained {
+                segment: "dynamic".into(),
+                statistic: "residual_std".into(),
+                real: 3.2,
+                nominal: 0.05,
+                simulated: 0.9,
+                z_train: 512.0,
+                z_train_nominal: 5169.0,
+                z_holdout: 600.0,
+            }],
             untestable: Vec::new(),
             model: ModelSummary {
                 sensor: SensorModel::default(),
@@ -1201,6 +1259,13 @@ mod tests {
         assert!(!html.contains("http://"));
         let json = std::fs::read_to_string(dir.join("diagnosis.json")).unwrap();
         assert!(json.contains("\"clock_error\""));
+        assert!(
+            html.contains("The model does not fit the training runs: 1 statistics"),
+            "the unexplained statistics are said"
+        );
+        assert!(html.contains("<td>residual_std</td><td>dynamic</td><td class=\"n\">3.20</td>"));
+        assert!(json.contains("\"model_fits\": false") || json.contains("\"model_fits\":false"));
+        assert!(json.contains("\"unexplained\""));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -40,7 +40,7 @@ cases:"
             .collect();
         let _ = writeln!(
             s,
-            "  {:<6} {:<38} named {:<38} gap {:>8.2} -> {:>6.2}  closed {:>6}  {}",
+            "  {:<6} {:<38} named {:<38} gap {:>8.2} -> {:>6.2}  closed {:>6}  {}{}",
             c.kind,
             if injected.is_empty() {
                 "none".into()
@@ -55,7 +55,8 @@ cases:"
             c.holdout_gap.0,
             c.holdout_gap.1,
             pct(c.fraction_closed),
-            cov.join(" ")
+            cov.join(" "),
+            if c.model_fits { "" } else { "  (does not fit)" }
         );
     }
     let _ = writeln!(
@@ -98,6 +99,11 @@ top-1 accuracy (single effects): {} strict, {} counting confounded pairs ({}) as
         s,
         "mean fraction of the held-out gap closed (cases with effects): {}",
         pct(t.mean_fraction_closed)
+    );
+    let _ = writeln!(
+        s,
+        "cases whose selected model leaves nothing unexplained on the training runs: {}",
+        pct(t.model_fits)
     );
     s
 }
@@ -165,6 +171,32 @@ pub fn table(d: &Diagnosis) -> String {
     let _ = writeln!(s, "\nwhere (largest |z| of real vs the nominal ensembles):");
     for w in d.r#where.iter().take(10) {
         let _ = writeln!(s, "  {:>8.1}  {:<28} {}", w.z, w.segment, w.statistic);
+    }
+    if !d.unexplained.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nunexplained by the selected model (training runs, |z| >= {}; real vs simulated, means over the runs):",
+            gyro_analysis::diagnose::locate::UNEXPLAINED_Z
+        );
+        let _ = writeln!(
+            s,
+            "  {:>9} {:>9} {:>9}  {:<28} {:<28} {:>11} {:>11} {:>11}",
+            "z", "nominal z", "held-out z", "segment", "statistic", "real", "nominal", "selected"
+        );
+        for u in &d.unexplained {
+            let _ = writeln!(
+                s,
+                "  {:>9.1} {:>9.1} {:>9.1}  {:<28} {:<28} {:>11} {:>11} {:>11}",
+                u.z_train,
+                u.z_train_nominal,
+                u.z_holdout,
+                u.segment,
+                u.statistic,
+                super::sig3(u.real),
+                super::sig3(u.nominal),
+                super::sig3(u.simulated)
+            );
+        }
     }
     let _ = writeln!(
         s,
