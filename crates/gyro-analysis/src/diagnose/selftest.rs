@@ -83,6 +83,8 @@ pub struct CaseResult {
     pub holdout_gap: (f64, f64),
     /// The selected model leaves no statistic of the training runs unexplained.
     pub model_fits: bool,
+    /// The statistics it leaves unexplained (`segment/statistic`), largest |z| first.
+    pub unexplained: Vec<String>,
     /// The diagnosis's table of effects (why an effect was or was not named).
     pub effects: Vec<super::EffectResult>,
 }
@@ -193,6 +195,11 @@ fn score_case(kind: &'static str, injected: Vec<Effect>, d: &Diagnosis) -> CaseR
         fraction_closed: d.verdict.fraction_closed_holdout,
         holdout_gap: (d.gap.holdout_before, d.gap.holdout_after),
         model_fits: d.verdict.model_fits,
+        unexplained: d
+            .unexplained
+            .iter()
+            .map(|u| format!("{}/{}", u.segment, u.statistic))
+            .collect(),
         effects: d.effects.clone(),
     }
 }
