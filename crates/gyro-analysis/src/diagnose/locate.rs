@@ -36,20 +36,12 @@ struct Combined {
 impl Combined {
     /// Stouffer's combination Σz/√n.
     fn z(&self) -> f64 {
-        if self.z_count == 0 {
-            f64::NAN
-        } else {
-            self.z_sum / (self.z_count as f64).sqrt()
-        }
+        stouffer(self.z_sum, self.z_count)
     }
 
     /// Stouffer's combination of the tolerant z.
     fn z_tolerant(&self) -> f64 {
-        if self.z_count == 0 {
-            f64::NAN
-        } else {
-            self.z_tolerant_sum / (self.z_count as f64).sqrt()
-        }
+        stouffer(self.z_tolerant_sum, self.z_count)
     }
 
     fn real(&self) -> f64 {
@@ -58,6 +50,15 @@ impl Combined {
 
     fn simulated(&self) -> f64 {
         ratio(self.mean_sum, self.mean_count)
+    }
+}
+
+/// Σz/√n (NaN with no z).
+fn stouffer(sum: f64, n: usize) -> f64 {
+    if n == 0 {
+        f64::NAN
+    } else {
+        sum / (n as f64).sqrt()
     }
 }
 
