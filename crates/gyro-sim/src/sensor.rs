@@ -288,7 +288,13 @@ pub fn simulate_series(
 ) -> SimSeries {
     let fs = model.sample_rate_hz;
     let dt = 1.0 / fs;
-    let n = (motion.duration_s() * fs).floor() as usize + 1;
+    // A slow sample clock (either stamping) reaches the motion's end before the nominal
+    // count: the samples past it would read a held reference beside a held rate.
+    let slowest_clock = {
+        let terms = SimTerms::of(effects);
+        ((1.0 + terms.clock_ppm * 1e-6) * (1.0 + terms.count_clock_ppm * 1e-6)).min(1.0)
+    };
+    let n = (motion.duration_s() * fs * slowest_clock).floor() as usize + 1;
 
     let mut white_rng = stream(options.seed, Stream::White);
     let mut gm_rng = stream(options.seed, Stream::GaussMarkov);
@@ -442,4 +448,40 @@ pub fn simulate_series(
         });
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A recorded trajectory re-simulated with a slow sample clock (either stamping)
+    /// ends where the motion ends: no sample reads the held last rate beside the held
+    /// last reference angle.
+    #[test]
+    fn a_slow_clock_stops_at_the_motions_end() {
+        let fs = 100.0;
+        let angles: Vec<f64> = (0..1001).map(|k| 50.0 * k as f64 / fs).collect();
+        let motion = Motion::from_reference(0.0, 1.0 / fs, &angles, 1);
+        let model = SensorModel {
+            sample_rate_hz: fs,
+            arw_deg_per_rt_h: 0.0,
+            gm_sigma_dps: 0.0,
+            lsb_dps: 0.0,
+            bias_dps: 0.0,
+            ..SensorModel::default()
+        };
+        for effect in [
+            Effect::ClockError { ppm: -5000.0 },
+            Effect::ClockErrorCountStamped { ppm: -5000.0 },
+        ] {
+            let s = simulate_series(&model, &[effect], &motion, &SimOptions::default(), None);
+            assert!(s.rate_dps.len() < angles.len(), "{effect:?}");
+            let last = s.reference_deg.len() - 1;
+            let step = s.reference_deg[last] - s.reference_deg[last - 1];
+            assert!(
+                step > 0.4,
+                "{effect:?}: the reference stops moving ({step} deg)"
+            );
+        }
+    }
 }

@@ -37,6 +37,7 @@ pub(crate) mod features;
 pub(crate) mod fit;
 pub mod line;
 pub mod locate;
+pub(crate) mod low_band;
 pub mod posterior;
 pub(crate) mod score;
 mod select;

@@ -30,10 +30,10 @@ pub const REMAINING_SHARE: f64 = 0.5;
 /// The statistics (segment, statistic) that identify each effect.
 pub fn signature(id: &str) -> &'static [(&'static str, &'static str)] {
     match id {
-        "scale_factor" => &[("dynamic", "slope_vs_rate")],
+        "scale_factor" => &[("dynamic", "low_band_slope_vs_rate")],
         "scale_asymmetry" => &[
-            ("dynamic/positive", "slope_vs_rate"),
-            ("dynamic/negative", "slope_vs_rate"),
+            ("dynamic/positive", "low_band_slope_vs_rate"),
+            ("dynamic/negative", "low_band_slope_vs_rate"),
         ],
         "nonlinearity" => &[("dynamic", "cubic_vs_rate")],
         "nonlinearity_even" => &[("dynamic", "quadratic_vs_rate")],

@@ -23,6 +23,11 @@
 //! - `residual_mean`, `residual_std` (deg/s): every segment and stratum with ≥ 2 samples.
 //! - `slope_vs_rate` (1): least-squares slope of residual on reference rate, with
 //!   intercept: `dynamic`, `dynamic/positive`, `dynamic/negative`.
+//! - `low_band_slope_vs_rate` (1): the same slope with gyro and reference rate both in
+//!   the low band (zero-phase Butterworth at `low_band::LOW_BAND_HZ`), the sign strata by
+//!   the low-band reference rate: `dynamic`, `dynamic/positive`, `dynamic/negative`. A
+//!   gain read where a sensor's dynamics (a latency's phase, a roll-off above a few hertz)
+//!   leave it alone: the signature of `scale_factor` and `scale_asymmetry`.
 //! - `slope_vs_acceleration` (s): least-squares slope of residual on reference angular
 //!   acceleration (the same centred difference, applied to the reference rate), with
 //!   intercept: `dynamic`. A gyro lagging the reference by `d` gives ≈ −`d`.
@@ -131,6 +136,11 @@ pub struct Residuals {
     pub temperature_c: Vec<f64>,
     /// Whether the sample belongs to the static segment.
     pub is_static: Vec<bool>,
+    /// Gyro rate in the low band (deg/s; [`super::low_band`]), NaN where the reference
+    /// rate is undefined or the rate is too low for a low band.
+    pub low_rate_dps: Vec<f64>,
+    /// Reference rate in the low band (deg/s), filtered on the same stretches.
+    pub low_reference_rate_dps: Vec<f64>,
 }
 
 /// Fewest samples with a residual accepted by [`residuals`].
@@ -200,6 +210,16 @@ pub fn residuals_of(
             is_static[run].iter_mut().for_each(|s| *s = true);
         }
     }
+    let (low_rate_dps, low_reference_rate_dps) = match super::low_band::cutoff_hz(fs) {
+        Some(cutoff) => {
+            let both = |i: usize| rate_dps[i].is_finite() && reference_rate_dps[i].is_finite();
+            (
+                super::low_band::zero_phase(&rate_dps, fs, cutoff, both),
+                super::low_band::zero_phase(&reference_rate_dps, fs, cutoff, both),
+            )
+        }
+        None => (vec![f64::NAN; n], vec![f64::NAN; n]),
+    };
     Ok(Residuals {
         sample_rate_hz: fs,
         time_s,
@@ -209,6 +229,8 @@ pub fn residuals_of(
         residual_dps,
         temperature_c,
         is_static,
+        low_rate_dps,
+        low_reference_rate_dps,
     })
 }
 
@@ -613,6 +635,24 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
     }
     if let Some(s) = slope(&points(&|x| x < 0.0)) {
         out.push("dynamic/negative", "slope_vs_rate", s);
+    }
+    // The same in the low band, where a gain is read (`low_band`).
+    let low_points = |keep: &dyn Fn(f64) -> bool| -> Vec<(f64, f64)> {
+        (0..n)
+            .filter(|&i| dynamic[i])
+            .map(|i| (r.low_reference_rate_dps[i], r.low_rate_dps[i]))
+            .filter(|(w, g)| w.is_finite() && g.is_finite() && keep(*w))
+            .map(|(w, g)| (w, g - w))
+            .collect()
+    };
+    for (segment, keep) in [
+        ("dynamic", &(|_| true) as &dyn Fn(f64) -> bool),
+        ("dynamic/positive", &|w| w > 0.0),
+        ("dynamic/negative", &|w| w < 0.0),
+    ] {
+        if let Some(s) = slope(&low_points(keep)) {
+            out.push(segment, "low_band_slope_vs_rate", s);
+        }
     }
     let accel_points: Vec<(f64, f64)> = (0..n)
         .filter(|&i| dynamic[i] && r.reference_acceleration_dps2[i].is_finite())
