@@ -249,7 +249,7 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "only in motion, residual proportional to rate",
         typical: Effect::ScaleFactor { k: 0.01 },
         self_test: Effect::ScaleFactor { k: 0.01 },
-        fit: regression(Regressor::Rate, "regression slope on rate vs null replicas"),
+        fit: regression(Regressor::Rate, "straight-line slope on rate in the 2 Hz low band vs null replicas"),
         correction: CoreCorrection::ScaleK { per_unit: 1.0 },
         term: |p, t| t.scale_k += p[0],
         neutral: |p, _| p[0] == 0.0,
