@@ -360,7 +360,12 @@ pub fn simulate_member(
     match simulate_residuals(run, model, effects, seed) {
         Ok(r) => {
             let features = if effects.is_empty() {
-                features_with_spectra(&r, 1e-9)
+                // The null replicas' cross-spectra are never read (the motion lines'
+                // response is the real runs'): not kept for every member.
+                Features {
+                    cross_psd: Vec::new(),
+                    ..features_with_spectra(&r, 1e-9)
+                }
             } else {
                 features(&r, 1e-9)
             };
@@ -382,6 +387,7 @@ pub fn simulate_member(
                 bias_dps: f64::NAN,
                 incoherent_psd: Vec::new(),
                 reference_psd: Vec::new(),
+                cross_psd: Vec::new(),
             },
         },
     }

@@ -139,6 +139,10 @@ pub struct Features {
     pub incoherent_psd: Vec<f64>,
     /// The reference rate's PSD, on the same bins.
     pub reference_psd: Vec<f64>,
+    /// The cross-spectrum of gyro and reference rate, `S_gr = G · conj(W)` ((deg/s)²/Hz,
+    /// real and imaginary parts), on the same bins: the gyro's response to the motion at
+    /// its own lines. Kept for real runs only (the null replicas drop it).
+    pub cross_psd: Vec<(f64, f64)>,
 }
 
 /// Samples of a line-spectrum segment at `sample_rate_hz` (a power of two).
@@ -156,18 +160,20 @@ pub fn line_resolution_hz(sample_rate_hz: f64) -> f64 {
 /// which are all the `vibration` fit and the motion lines read (the spectra of every
 /// candidate ensemble would cost a transform per segment for nothing).
 pub fn features_with_spectra(r: &Residuals, plateau_tol_dps: f64) -> Features {
-    let (incoherent_psd, reference_psd) = line_spectra(r);
+    let (incoherent_psd, reference_psd, cross_psd) = line_spectra(r);
     Features {
         incoherent_psd,
         reference_psd,
+        cross_psd,
         ..features(r, plateau_tol_dps)
     }
 }
 
 /// Welch cross-spectra of `r`'s gyro rate `g` and reference rate `w` (Hann window, half
-/// overlap, on the stretches where both are defined): (incoherent PSD of g, PSD of w),
-/// both empty when no stretch holds a segment.
-fn line_spectra(r: &Residuals) -> (Vec<f64>, Vec<f64>) {
+/// overlap, on the stretches where both are defined): (incoherent PSD of g, PSD of w,
+/// cross-spectrum of g and w), all empty when no stretch holds a segment.
+type Spectra = (Vec<f64>, Vec<f64>, Vec<(f64, f64)>);
+fn line_spectra(r: &Residuals) -> Spectra {
     let len = line_segment_len(r.sample_rate_hz);
     let both = |i: usize| r.rate_dps[i].is_finite() && r.reference_rate_dps[i].is_finite();
     let window = crate::noise::psd::hann(len);
@@ -207,7 +213,7 @@ fn line_spectra(r: &Residuals) -> (Vec<f64>, Vec<f64>) {
         }
     }
     if count == 0 {
-        return (Vec::new(), Vec::new());
+        return (Vec::new(), Vec::new(), Vec::new());
     }
     let window_power: f64 = window.iter().map(|w| w * w).sum();
     let scale = 1.0 / (r.sample_rate_hz * window_power * count as f64);
@@ -220,7 +226,13 @@ fn line_spectra(r: &Residuals) -> (Vec<f64>, Vec<f64>) {
         })
         .collect();
     let reference = (0..bins).map(|k| srr[k] * scale * one_sided(k)).collect();
-    (incoherent, reference)
+    let cross = (0..bins)
+        .map(|k| {
+            let c = scale * one_sided(k);
+            (sgr_re[k] * c, sgr_im[k] * c)
+        })
+        .collect();
+    (incoherent, reference, cross)
 }
 
 /// The features of `r` without the line spectra (empty); `plateau_tol_dps` is the
@@ -425,6 +437,7 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> Features {
         bias_dps: run_bias(r, full_band_intercept),
         incoherent_psd: Vec::new(),
         reference_psd: Vec::new(),
+        cross_psd: Vec::new(),
     }
 }
 

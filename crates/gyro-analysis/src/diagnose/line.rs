@@ -204,10 +204,19 @@ pub struct MotionLine {
     pub runs: &'static str,
     /// Frequency (Hz).
     pub frequency_hz: f64,
-    /// Amplitude in the reference rate (deg/s, peak).
+    /// Amplitude of the motion's rate (deg/s, peak): the line in the reference rate over
+    /// the reference differentiator's gain at its frequency.
     pub amplitude_dps: f64,
     /// Times its local floor.
     pub ratio: f64,
+    /// The share of the line the gyro passes, `|ΣS_gr| / ΣS_rr` over the line's bin and
+    /// its neighbours, pooled over the runs, times the reference differentiator's gain
+    /// there (`stats::reference_rate_gain`): against the motion itself (1 for a pure
+    /// delay; a roll-off passes less).
+    pub gyro_gain: f64,
+    /// How far the gyro lags the reference at the line (s): its cross-spectrum's phase
+    /// over 2π·f (within half a period).
+    pub gyro_lag_s: f64,
 }
 
 /// The strongest line of the motion of `runs` above [`MIN_LINE_HZ`], if it stands
@@ -218,12 +227,46 @@ pub fn motion_line(runs: &[&RealRun], label: &'static str) -> Option<MotionLine>
     let psd = pooled_with(runs.iter().map(|r| &r.features), |f| &f.reference_psd);
     let (k, ratio) = strongest(&psd, resolution_hz)?;
     let (frequency_hz, amplitude_dps) = measure(&psd, k, resolution_hz);
-    (ratio >= MOTION_LINE_RATIO).then_some(MotionLine {
+    if ratio < MOTION_LINE_RATIO {
+        return None;
+    }
+    let amplitude_dps = amplitude_dps / super::stats::reference_rate_gain(fs, frequency_hz);
+    let (gyro_gain, gyro_lag_s) = response(runs, k, frequency_hz);
+    Some(MotionLine {
         runs: label,
         frequency_hz,
         amplitude_dps,
         ratio,
+        gyro_gain,
+        gyro_lag_s,
     })
+}
+
+/// The gyro's response to the motion at bin `k` (the line at `frequency_hz`): gain and
+/// lag (s) from the cross-spectrum and the reference's PSD summed over the bin and its
+/// neighbours (a Hann window spreads a line over three bins) and over `runs`; NaN when
+/// the runs hold no spectra.
+fn response(runs: &[&RealRun], k: usize, frequency_hz: f64) -> (f64, f64) {
+    let (mut re, mut im, mut srr) = (0.0, 0.0, 0.0);
+    for r in runs {
+        let f = &r.features;
+        for j in k.saturating_sub(1)..=k + 1 {
+            if let (Some(&(a, b)), Some(&w)) = (f.cross_psd.get(j), f.reference_psd.get(j)) {
+                re += a;
+                im += b;
+                srr += w;
+            }
+        }
+    }
+    if srr.is_nan() || srr <= 0.0 {
+        return (f64::NAN, f64::NAN);
+    }
+    let lag_s = -im.atan2(re) / (2.0 * std::f64::consts::PI * frequency_hz);
+    let fs = runs.first().map_or(f64::NAN, |r| r.sample_rate_hz);
+    // Against the motion, not against the reference rate's differentiator.
+    let gain =
+        (re * re + im * im).sqrt() / srr * super::stats::reference_rate_gain(fs, frequency_hz);
+    (gain, lag_s)
 }
 
 /// Amplitude of the line at `frequency_hz` in each run alone (for its interval).

@@ -143,6 +143,20 @@ pub struct Residuals {
     pub low_reference_rate_dps: Vec<f64>,
 }
 
+/// The gain of the reference rate's centred difference at `frequency_hz` (a boxcar of
+/// `2h` samples: `sin(π f 2h / fs) / (π f 2h / fs)`, no phase). At 100 Hz (h = 1) it
+/// passes 0.90 of a 12.8 Hz line and 0.22 of a 40 Hz one: a response read against the
+/// reference rate is divided by it.
+pub fn reference_rate_gain(sample_rate_hz: f64, frequency_hz: f64) -> f64 {
+    let h = ((sample_rate_hz * SMOOTH_WINDOW_S / 2.0).round()).max(1.0);
+    let x = std::f64::consts::PI * frequency_hz * 2.0 * h / sample_rate_hz;
+    if x.abs() < 1e-12 {
+        1.0
+    } else {
+        x.sin() / x
+    }
+}
+
 /// Fewest samples with a residual accepted by [`residuals`].
 const MIN_SAMPLES: usize = 10;
 
@@ -822,6 +836,16 @@ mod tests {
         assert!((get(&stats, "static", "residual_mean") - 0.3).abs() < 0.2);
         // White static residual.
         assert!(get(&stats, "static", "lag1_autocorrelation").abs() < 0.1);
+    }
+
+    #[test]
+    fn the_reference_differentiator_passes_a_sinc() {
+        // h = 1 at 100 Hz: sin(π f 0.02) / (π f 0.02).
+        assert!((reference_rate_gain(100.0, 12.8) - 0.8956).abs() < 1e-4);
+        assert!((reference_rate_gain(100.0, 40.5) - 0.2209).abs() < 1e-4);
+        assert_eq!(reference_rate_gain(1000.0, 0.0), 1.0);
+        // 1 kHz: h = 10, a 20 ms boxcar, zero at 50 Hz.
+        assert!(reference_rate_gain(1000.0, 50.0).abs() < 1e-12);
     }
 
     #[test]

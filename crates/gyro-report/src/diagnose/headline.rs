@@ -209,8 +209,17 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
         lines.push(unexplained_line(d));
     }
     for m in &d.motion_lines {
+        let response = if m.gyro_gain.is_finite() && m.gyro_lag_s.is_finite() {
+            format!(
+                "; the gyro passes {:.2} of it, {:.1} ms behind (a pure delay passes all of it)",
+                m.gyro_gain,
+                1e3 * m.gyro_lag_s
+            )
+        } else {
+            String::new()
+        };
         lines.push(format!(
-            "seen in the data, not a sensor effect: the motion of the {} runs has a line at {:.1} Hz ({} deg/s in the reference rate, {:.0} times its local floor): the rig vibrates and both sensors see it",
+            "seen in the data, not a sensor effect: the motion of the {} runs has a line at {:.1} Hz ({} deg/s in the motion's rate, {:.0} times its local floor): the rig vibrates and both sensors see it{response}",
             m.runs,
             m.frequency_hz,
             rounded(m.amplitude_dps, 0.05 * m.amplitude_dps),
