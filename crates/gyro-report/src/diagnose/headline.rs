@@ -71,8 +71,12 @@ pub fn sentence(e: &EffectResult) -> String {
             "the gyro's response is low-passed (two poles) at {} Hz",
             v("cutoff_hz", 1.0)
         ),
+        "scale_factor" if e.params.get("k").is_some_and(|k| *k < 0.0) => format!(
+            "scale {} % (the gyro reads that much less than the reference)",
+            v("k", 100.0)
+        ),
         "scale_factor" => format!(
-            "scale {} % (the gyro reads that much more than the reference)",
+            "scale +{} % (the gyro reads that much more than the reference)",
             v("k", 100.0)
         ),
         "scale_asymmetry" => format!(
@@ -288,6 +292,24 @@ mod tests {
     fn a_latency_reads_in_milliseconds_rounded_to_its_interval() {
         let s = sentence(&latency(0.012_618, 0.012_31, 0.012_93));
         assert_eq!(s, "the gyro lags the reference by 12.6 [12.3, 12.9] ms");
+    }
+
+    #[test]
+    fn a_scale_says_which_way_the_gyro_reads() {
+        let scale = |k: f64| EffectResult {
+            id: "scale_factor",
+            params: BTreeMap::from([("k", k)]),
+            ci95: BTreeMap::from([("k", [Some(k - 0.0003), Some(k + 0.0003)])]),
+            ..latency(0.0, 0.0, 0.0)
+        };
+        assert_eq!(
+            sentence(&scale(-0.015)),
+            "scale -1.50 [-1.53, -1.47] % (the gyro reads that much less than the reference)"
+        );
+        assert_eq!(
+            sentence(&scale(0.0059)),
+            "scale +0.59 [0.56, 0.62] % (the gyro reads that much more than the reference)"
+        );
     }
 
     #[test]
