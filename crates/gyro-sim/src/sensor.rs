@@ -50,6 +50,18 @@ impl Default for SensorModel {
 }
 
 impl SensorModel {
+    /// The same sensor without its random terms (white noise, Gauss-Markov bias) and
+    /// output rounding: what a deterministic effect alone does to a run (the bias, range
+    /// and rates stay).
+    pub fn noise_free(self) -> Self {
+        Self {
+            arw_deg_per_rt_h: 0.0,
+            gm_sigma_dps: 0.0,
+            lsb_dps: 0.0,
+            ..self
+        }
+    }
+
     /// White-noise standard deviation per sample (deg/s).
     pub fn white_sigma_dps(&self) -> f64 {
         self.arw_deg_per_rt_h / 60.0 * self.sample_rate_hz.sqrt()
@@ -464,12 +476,10 @@ mod tests {
         let motion = Motion::from_reference(0.0, 1.0 / fs, &angles, 1);
         let model = SensorModel {
             sample_rate_hz: fs,
-            arw_deg_per_rt_h: 0.0,
-            gm_sigma_dps: 0.0,
-            lsb_dps: 0.0,
             bias_dps: 0.0,
             ..SensorModel::default()
-        };
+        }
+        .noise_free();
         for effect in [
             Effect::ClockError { ppm: -5000.0 },
             Effect::ClockErrorCountStamped { ppm: -5000.0 },

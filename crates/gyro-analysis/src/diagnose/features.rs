@@ -37,7 +37,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::low_band;
-use super::stats::{stretches, Residuals, SMOOTH_WINDOW_S};
+use super::stats::{smooth_half_width, stretches, Residuals};
 use crate::noise::fft::fft_in_place;
 use crate::noise::AllanDeviation;
 
@@ -251,7 +251,7 @@ pub fn coefficients(r: &Residuals) -> [f64; N_REG] {
 fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> Features {
     let n = r.rate_dps.len();
     let fs = r.sample_rate_hz;
-    let h = ((fs * SMOOTH_WINDOW_S / 2.0).round() as usize).max(1);
+    let h = smooth_half_width(fs);
 
     // Plateau: samples at the largest |rate| while the reference is beyond it.
     let max_abs = r
@@ -346,14 +346,21 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> Features {
             let accel = low_band::derivative(&r.low_reference_rate_dps, fs);
             let low_jerk = low_band::derivative(&accel, fs);
             let reach = (fs / cutoff).ceil() as usize;
-            let mut plateau_before = Vec::with_capacity(n + 1);
-            plateau_before.push(0usize);
-            for i in 0..n {
-                let last = plateau_before.last().copied().unwrap_or(0);
-                plateau_before.push(last + usize::from(clipped && on_plateau(i)));
-            }
+            // Plateau samples before each index (only for a clipped run).
+            let plateau_before: Vec<usize> = if clipped {
+                std::iter::once(0)
+                    .chain((0..n).scan(0, |count, i| {
+                        *count += usize::from(on_plateau(i));
+                        Some(*count)
+                    }))
+                    .collect()
+            } else {
+                Vec::new()
+            };
             let near_plateau = |i: usize| {
-                plateau_before[(i + reach + 1).min(n)] > plateau_before[i.saturating_sub(reach)]
+                clipped
+                    && plateau_before[(i + reach + 1).min(n)]
+                        > plateau_before[i.saturating_sub(reach)]
             };
             let low_row = |i: usize| {
                 if near_plateau(i) {
@@ -590,12 +597,10 @@ mod tests {
         let motion = Motion::from_reference(0.0, 1.0 / fs, &angles, 1);
         let model = SensorModel {
             sample_rate_hz: fs,
-            arw_deg_per_rt_h: 0.0,
-            gm_sigma_dps: 0.0,
-            lsb_dps: 0.0,
             bias_dps: 0.0,
             ..SensorModel::default()
-        };
+        }
+        .noise_free();
         let s = simulate_series(
             &model,
             &[Effect::Bandwidth { cutoff_hz: 15.0 }],

@@ -334,12 +334,7 @@ impl FitInput<'_> {
 
     /// Pooled regression coefficients of noise-free simulations with `effects`.
     fn noise_free(&self, effects: &[Effect]) -> [f64; N_REG] {
-        let quiet = SensorModel {
-            arw_deg_per_rt_h: 0.0,
-            gm_sigma_dps: 0.0,
-            lsb_dps: 0.0,
-            ..*self.model
-        };
+        let quiet = self.model.noise_free();
         let coefs: Vec<[f64; N_REG]> = self
             .train
             .par_iter()

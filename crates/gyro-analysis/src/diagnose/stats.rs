@@ -143,12 +143,18 @@ pub struct Residuals {
     pub low_reference_rate_dps: Vec<f64>,
 }
 
+/// The half-width `h` (samples) of the reference rate's centred difference at
+/// `sample_rate_hz`: `max(1, round(fs · SMOOTH_WINDOW_S / 2))`.
+pub fn smooth_half_width(sample_rate_hz: f64) -> usize {
+    ((sample_rate_hz * SMOOTH_WINDOW_S / 2.0).round() as usize).max(1)
+}
+
 /// The gain of the reference rate's centred difference at `frequency_hz` (a boxcar of
 /// `2h` samples: `sin(π f 2h / fs) / (π f 2h / fs)`, no phase). At 100 Hz (h = 1) it
 /// passes 0.90 of a 12.8 Hz line and 0.22 of a 40 Hz one: a response read against the
 /// reference rate is divided by it.
 pub fn reference_rate_gain(sample_rate_hz: f64, frequency_hz: f64) -> f64 {
-    let h = ((sample_rate_hz * SMOOTH_WINDOW_S / 2.0).round()).max(1.0);
+    let h = smooth_half_width(sample_rate_hz) as f64;
     let x = std::f64::consts::PI * frequency_hz * 2.0 * h / sample_rate_hz;
     if x.abs() < 1e-12 {
         1.0
@@ -190,7 +196,7 @@ pub fn residuals_of(
     temperature_c: Vec<f64>,
 ) -> Result<Residuals, StatsError> {
     let n = rate_dps.len();
-    let h = ((fs * SMOOTH_WINDOW_S / 2.0).round() as usize).max(1);
+    let h = smooth_half_width(fs);
     let mut reference_rate_dps = vec![f64::NAN; n];
     for (i, r) in reference_rate_dps.iter_mut().enumerate() {
         if i < h || i + h >= n {
