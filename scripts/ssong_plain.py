@@ -8,7 +8,11 @@ differentiate the encoder angle, then
   residual of the least-squares fit gyro = (1 + k) * encoder_rate + b;
 - k: the gyro's scale against the encoder at that lag (the encoder itself reads
   351/360 of the shaft angle, see the data README);
-- b: the bias (deg/s).
+- b: the bias (deg/s);
+- N: the effective noise on moving data, on the 100 Hz samples as logged: per 100 s
+  window, the residual of gyro - encoder rate (centred difference) regressed on
+  [1, rate, acceleration, jerk]; the largest white noise its Allan deviation allows from
+  tau = 1 s to 10 s (deg/sqrt(h)).
 Usage: scripts/ssong_plain.py [DATA_DIR]   (needs numpy, pandas, scipy)
 """
 import sys
@@ -18,7 +22,31 @@ from scipy.signal import butter, sosfiltfilt
 
 root = sys.argv[1] if len(sys.argv) > 1 else "../shared/data/real"
 sos = butter(4, 5.0, fs=1000.0, output="sos")
-print("recording            lag_ms   k_vs_encoder   bias_dps")
+
+
+def effective_arw(g, ref, fs=100.0, window_s=100.0):
+    """N (deg/sqrt(h)): the largest white noise the Allan deviation of the regression
+    residual allows from tau = 1 s to 10 s, min over tau of adev(tau) * sqrt(tau) * 60. The
+    residual: per window, gyro (averaged over the same 3 samples as the centred difference)
+    minus the encoder rate, regressed on [1, rate, acceleration, jerk]."""
+    w = np.gradient(ref) * fs
+    gs = np.convolve(g, [0.25, 0.5, 0.25], "same")
+    n, residuals = int(window_s * fs), []
+    for k in range(0, len(g) - n + 1, n):
+        rate = w[k:k + n]
+        acc = np.gradient(rate) * fs
+        design = np.c_[np.ones(n), rate, acc, np.gradient(acc) * fs][2:-2]
+        y = (gs[k:k + n] - rate)[2:-2]
+        residuals.append(y - design @ np.linalg.lstsq(design, y, rcond=None)[0])
+    best = np.inf
+    for m in np.unique(np.round(10 ** np.arange(0, 1.01, 0.1) * fs).astype(int)):
+        d2 = [(lambda c: c[2 * m:] - 2 * c[m:-m] + c[:-2 * m])(np.cumsum(np.r_[0.0, r]) / fs) for r in residuals]
+        avar = np.mean(np.concatenate(d2) ** 2) / (2 * (m / fs) ** 2)
+        best = min(best, np.sqrt(avar * m / fs))
+    return 60.0 * best
+
+
+print("recording            lag_ms   k_vs_encoder   bias_dps   N_deg_per_rt_h")
 for axis in "xyz":
     for speed in ("slow", "medium"):
         d = pd.read_csv(f"{root}/ssong_{axis}_{speed}.csv", comment="#").drop_duplicates("time_s")
@@ -40,4 +68,5 @@ for axis in "xyz":
             y0, y1, y2 = res[i - 1], res[i], res[i + 1]
             best = lags[i] + 0.5 * (y0 - y2) / (y0 - 2 * y1 + y2)
         _, (scale, bias) = fit(lags[i])
-        print(f"ssong_{axis}_{speed:<8} {best:8.2f}   {100 * (scale - 1):+8.2f} %   {bias:+8.3f}")
+        arw = effective_arw(g, ref)
+        print(f"ssong_{axis}_{speed:<8} {best:8.2f}   {100 * (scale - 1):+8.2f} %   {bias:+8.3f}   {arw:8.1f}")

@@ -115,4 +115,19 @@ fn latency_is_named_on_real_yaw_and_its_correction_does_not_hurt() {
         .unwrap();
     assert!((0.9..0.99).contains(&line.gyro_gain), "{line:?}");
     assert!((0.010..0.014).contains(&line.gyro_lag_s), "{line:?}");
+    // The effective noise on moving data (the largest white noise that what the
+    // deterministic terms leave allows from 1 s to 10 s; `scripts/ssong_plain.py` on the
+    // whole recordings: 6.6 deg/sqrt(h) slow, 17.1 medium) is tens of times the model's
+    // white noise, and grows with the speed: a property of this motion, not of the sensor
+    // alone.
+    let e = &d.effective_noise;
+    let (t, h) = (e.training.as_ref().unwrap(), e.holdout.as_ref().unwrap());
+    assert!((4.0..9.0).contains(&t.arw_deg_per_rt_h), "{}", t.describe());
+    assert!(t.ratio_to_model > 10.0, "{}", t.describe());
+    assert!(
+        h.arw_deg_per_rt_h > 1.5 * t.arw_deg_per_rt_h,
+        "{} / {}",
+        t.describe(),
+        h.describe()
+    );
 }

@@ -251,6 +251,12 @@ fn nothing_significant_without_an_effect() {
         table.contains("temperature_bias"),
         "every effect is listed: {table}"
     );
+    // The effective noise on moving data is said beside the model's.
+    assert!(
+        table.contains("effective noise on moving data: angle random walk at most")
+            && table.contains("x the model's"),
+        "{table}"
+    );
 }
 
 #[test]

@@ -6,7 +6,6 @@
 mod common;
 use common::{gyro, json_of, ok, temp_dir, workspace_root};
 
-use gyro_analysis::noise::export;
 use gyro_log as log;
 use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
 use std::path::Path;
@@ -178,11 +177,12 @@ fn bench_csv(dir: &Path, name: &str, effects: &[Effect], seed: u64) -> String {
     path.to_string_lossy().into_owned()
 }
 
-/// `diagnose --noise-yaml` writes the selected model's effective values: its white noise
-/// with the output rounding, its Gauss-Markov bias and any named wander, as the JSON
-/// reports them.
+/// `diagnose --noise-yaml` writes the effective noise measured on the training runs, as
+/// the JSON reports it (`effective_noise.training`): N from the Allan deviation from 1 s to 10 s of
+/// what the deterministic terms leave, K from its fit. With a rate random walk of
+/// 0.02 deg/s/√s injected, the measured K is near it.
 #[test]
-fn diagnose_writes_the_selected_models_effective_noise() {
+fn diagnose_writes_the_measured_effective_noise() {
     let dir = temp_dir("noise_yaml_diagnose");
     let effect = [Effect::RateRandomWalk {
         k_dps_per_rt_s: 0.02,
@@ -215,55 +215,25 @@ fn diagnose_writes_the_selected_models_effective_noise() {
     let d = json_of(&gyro(&args));
     let (text, yaml) = parse(&out);
     assert!(
-        text.contains("# Source: effective values on moving data"),
+        text.contains("# Source: effective values measured on moving data"),
         "{text}"
     );
-
-    // What the JSON says the model is, through the documented rules.
-    let sensor = &d["model"]["sensor"];
+    let t = &d["effective_noise"]["training"];
     let f = |v: &serde_json::Value| v.as_f64().unwrap();
-    let fs = f(&sensor["sample_rate_hz"]);
-    let white = f(&sensor["arw_deg_per_rt_h"]) / 60.0 * fs.sqrt();
-    let lsb = f(&sensor["lsb_dps"]);
-    let n = ((white * white + lsb * lsb / 12.0) / fs).sqrt();
-    let mut k2 =
-        export::gauss_markov_random_walk(f(&sensor["gm_sigma_dps"]), f(&sensor["gm_tau_s"]))
-            .powi(2);
-    let effects = d["model"]["effects"].as_array().unwrap();
-    for e in effects {
-        match e["id"].as_str().unwrap() {
-            "rate_random_walk" => k2 += f(&e["params"]["k_dps_per_rt_s"]).powi(2),
-            "bias_instability" => {
-                k2 += export::bias_instability_random_walk(f(&e["params"]["sigma_dps"])).powi(2)
-            }
-            "quantization" => panic!("not injected: {e}"),
-            _ => {}
-        }
-    }
+    let n_dps = f(&t["arw_deg_per_rt_h"]) / 60.0;
+    let k_dps = f(&t["rate_random_walk_dps_per_rt_s"]);
     let gyr_n = num(&yaml, "gyr_n");
     let gyr_w = num(&yaml, "gyr_w");
     assert!(
-        (gyr_n / n.to_radians() - 1.0).abs() < 1e-5,
-        "{gyr_n} vs {n}\n{text}"
+        (gyr_n / n_dps.to_radians() - 1.0).abs() < 1e-5,
+        "{gyr_n} vs {n_dps}\n{text}"
     );
     assert!(
-        (gyr_w / k2.sqrt().to_radians() - 1.0).abs() < 1e-5,
-        "{gyr_w}\n{text}"
+        (gyr_w / k_dps.to_radians() - 1.0).abs() < 1e-5,
+        "{gyr_w} vs {k_dps}\n{text}"
     );
-    // The injected walk is added to the nominal Gauss-Markov bias by whichever wander
-    // effect the diagnosis names for it (rate_random_walk or its look-alike
-    // bias_instability on 45 s runs): K is then above the nominal model's.
-    let k_nominal =
-        export::gauss_markov_random_walk(f(&sensor["gm_sigma_dps"]), f(&sensor["gm_tau_s"]));
-    if effects
-        .iter()
-        .any(|e| e["id"] == "rate_random_walk" || e["id"] == "bias_instability")
-    {
-        assert!(gyr_w > k_nominal.to_radians(), "{gyr_w}\n{text}");
-    }
-    assert!(yaml.get("acc_n").is_none() && yaml.get("acc_w").is_none());
-
-    // Not with --self-test.
-    let out = gyro(&["diagnose", "--self-test", "--noise-yaml", &out_s]);
-    assert_eq!(out.status.code(), Some(1));
+    // Resolved as a +1/2 line or bounded by one, K is near the injected walk.
+    assert!((0.01..0.04).contains(&k_dps), "K {k_dps}\n{text}");
+    // The model's own white noise is static; in motion the residual holds more.
+    assert!(f(&t["ratio_to_model"]) >= 1.0, "{t}");
 }

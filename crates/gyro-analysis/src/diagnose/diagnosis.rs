@@ -132,6 +132,9 @@ pub struct Diagnosis {
     pub runs: Vec<RunSummary>,
     /// Angle error with the correctable effects compensated, if any were selected.
     pub compensation: Option<CompensationSummary>,
+    /// The effective noise on moving data, measured from the regression residual of the
+    /// training and of the held-out runs ([`super::effective`]).
+    pub effective_noise: super::effective::EffectiveNoise,
     /// Lines in the motion itself (the reference rate), training and held-out runs.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub motion_lines: Vec<super::line::MotionLine>,

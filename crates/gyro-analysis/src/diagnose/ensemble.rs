@@ -7,7 +7,8 @@
 //! real log's gaps.
 
 use super::features::{
-    coefficients, features, features_with_spectra, Features, N_REG, REGRESSORS, WANDER_TAUS_S,
+    coefficients, features, features_with_spectra, real_features, Features, N_REG, REGRESSORS,
+    WANDER_TAUS_S,
 };
 use super::stats::{residuals, residuals_of, stats_of, Residuals, Stat, StatsError};
 use crate::seed::derive_seed;
@@ -28,6 +29,9 @@ pub struct RealRun {
     pub stats: Vec<Stat>,
     /// Its features.
     pub features: Features,
+    /// Its regression residual per sample (deg/s; NaN outside the regression): what is
+    /// left after the deterministic terms ([`super::features::real_features`]).
+    pub residual_dps: Vec<f64>,
     /// The motion, from the reference.
     pub motion: Motion,
     /// Temperatures per sample, if the log has them.
@@ -136,7 +140,7 @@ impl RealRun {
     /// Prepare `log` (named `name`).
     pub fn prepare(name: String, log: RegularLog) -> Result<Self, StatsError> {
         let r = residuals(&log)?;
-        let features = features_with_spectra(&r, 1e-9);
+        let (features, residual_dps) = real_features(&r, 1e-9);
         let mut stats = stats_of(&r);
         stats.extend(feature_stats(&features));
         let fs = log.sample_rate_hz;
@@ -166,6 +170,7 @@ impl RealRun {
             duration_s: log.slots.len().saturating_sub(1) as f64 / fs,
             stats,
             features,
+            residual_dps,
             motion,
             temperature_c,
             reference_step_deg,

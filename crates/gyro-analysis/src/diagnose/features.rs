@@ -160,12 +160,25 @@ pub fn line_resolution_hz(sample_rate_hz: f64) -> f64 {
 /// which are all the `vibration` fit and the motion lines read (the spectra of every
 /// candidate ensemble would cost a transform per segment for nothing).
 pub fn features_with_spectra(r: &Residuals, plateau_tol_dps: f64) -> Features {
+    with_spectra(r, features(r, plateau_tol_dps))
+}
+
+/// The features of a real run ([`features_with_spectra`]) and its regression residual:
+/// per sample, what the full-band regression leaves of the smoothed gyro minus the
+/// reference rate (NaN where the sample is not in the regression). The residual is what
+/// the effective noise on moving data is measured from (`super::effective`).
+pub fn real_features(r: &Residuals, plateau_tol_dps: f64) -> (Features, Vec<f64>) {
+    let (f, residual) = features_of(r, plateau_tol_dps, true);
+    (with_spectra(r, f), residual)
+}
+
+fn with_spectra(r: &Residuals, f: Features) -> Features {
     let (incoherent_psd, reference_psd, cross_psd) = line_spectra(r);
     Features {
         incoherent_psd,
         reference_psd,
         cross_psd,
-        ..features(r, plateau_tol_dps)
+        ..f
     }
 }
 
@@ -238,17 +251,18 @@ fn line_spectra(r: &Residuals) -> Spectra {
 /// The features of `r` without the line spectra (empty); `plateau_tol_dps` is the
 /// tolerance of the clip plateau (e.g. an output step).
 pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
-    features_of(r, plateau_tol_dps, true)
+    features_of(r, plateau_tol_dps, true).0
 }
 
 /// The regression coefficients of `r` alone ([`Features::coef`]; the noise-free
 /// calibrations read nothing else).
 pub fn coefficients(r: &Residuals) -> [f64; N_REG] {
-    features_of(r, 1e-9, false).coef
+    features_of(r, 1e-9, false).0.coef
 }
 
-/// The features of `r`, the residual's wander only when `wander`.
-fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> Features {
+/// The features of `r` and the regression residual ([`real_features`]), the residual
+/// and its wander only when `wander` (else the residual is empty).
+fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, Vec<f64>) {
     let n = r.rate_dps.len();
     let fs = r.sample_rate_hz;
     let h = smooth_half_width(fs);
@@ -388,8 +402,9 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> Features {
 
     // Regression residual → wander.
     let mut wander_avar = [f64::NAN; 3];
+    let mut residual = Vec::new();
     if wander && coef[0].is_finite() {
-        let residual: Vec<f64> = (0..n)
+        residual = (0..n)
             .map(|i| match row(i) {
                 Some((x, y)) => y - (0..used).map(|k| coef[k] * x[k]).sum::<f64>(),
                 None => f64::NAN,
@@ -433,7 +448,7 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> Features {
         (f64::NAN, 0)
     };
 
-    Features {
+    let features = Features {
         coef,
         samples,
         wander_avar,
@@ -445,7 +460,8 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> Features {
         incoherent_psd: Vec::new(),
         reference_psd: Vec::new(),
         cross_psd: Vec::new(),
-    }
+    };
+    (features, residual)
 }
 
 /// Least-squares coefficients of the rows `row(i)`, `i < n`, on the regression columns

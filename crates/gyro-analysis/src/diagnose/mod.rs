@@ -31,6 +31,7 @@
 mod baseline;
 pub(crate) mod compensate;
 mod diagnosis;
+pub mod effective;
 pub(crate) mod ensemble;
 pub mod envelopes;
 pub(crate) mod features;

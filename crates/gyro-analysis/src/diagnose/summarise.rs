@@ -211,6 +211,11 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         },
         runs,
         compensation: f.compensation,
+        effective_noise: super::effective::EffectiveNoise::measure(
+            &f.runs.train,
+            &f.runs.holdout,
+            f.baseline.nominal.arw_deg_per_rt_h,
+        ),
         motion_lines: [
             super::line::motion_line(&f.runs.train, "training"),
             super::line::motion_line(&f.runs.holdout, "held-out"),

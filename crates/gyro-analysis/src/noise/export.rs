@@ -37,8 +37,12 @@
 //!   from [`super::fit`] (IEEE Std 952), nothing refitted. A term the fit dropped is
 //!   replaced by its upper bound: the −½ (+½) line that stays under the Allan deviation's
 //!   upper confidence bound at every τ.
-//! - [`NoiseParams::effective`] (`gyro-cli diagnose`): the sensor model the diagnosis
-//!   selected on moving data. N from its white noise plus the white noise the output
+//! - [`NoiseParams::from_residual`] (`gyro-cli diagnose`, measured on moving data): the
+//!   Allan deviation of what the deterministic terms leave of gyro minus reference
+//!   (`diagnose::effective`); N the largest white noise its Allan deviation allows from
+//!   τ = 1 s to 10 s ([`white_bound`]), K as for static data.
+//! - [`NoiseParams::effective`] (`gyro-cli diagnose` when the runs are too short to
+//!   measure it): the sensor model the diagnosis selected on moving data. N from its white noise plus the white noise the output
 //!   rounding adds in motion (lsb²/12 per sample for the nominal step and any named
 //!   `quantization`); K from its Gauss-Markov bias, a named `rate_random_walk` and a named
 //!   `bias_instability` (its six Gauss-Markov processes).
@@ -202,39 +206,7 @@ impl NoiseParams {
             ));
             bound
         };
-        let k_fit = fit.rate_random_walk_dps_per_rt_s.value;
-        let gm = &fit.gauss_markov;
-        let k_gm = match (gm.significant, gm.corr_time_s) {
-            (true, Some(t)) => gauss_markov_random_walk(gm.sigma_dps, t),
-            _ => 0.0,
-        };
-        let k_dps = if k_fit > 0.0 || k_gm > 0.0 {
-            let mut parts = Vec::new();
-            if k_fit > 0.0 {
-                parts.push(format!(
-                    "the fitted rate random walk K = {} deg/s/sqrt(s) (the +1/2 line at tau = 3 s)",
-                    sci(k_fit)
-                ));
-            }
-            if let (true, Some(t)) = (k_gm > 0.0, gm.corr_time_s) {
-                parts.push(format!(
-                    "the fitted Gauss-Markov bias (sigma {} deg/s, T {:.4} s) read at tau = 3 s, K = {} deg/s/sqrt(s)",
-                    sci(gm.sigma_dps),
-                    t,
-                    sci(k_gm)
-                ));
-            }
-            notes.push(format!("gyroscope_random_walk: {}", parts.join(" + ")));
-            k_fit.hypot(k_gm)
-        } else {
-            let bound = allan_bound(c, 0.5);
-            notes.push(format!(
-                "gyroscope_random_walk: UPPER BOUND: no +1/2 slope (rate random walk, Gauss-Markov bias) resolved up to tau = {:.4} s; the +1/2 line under the Allan deviation's upper bound at every tau, {} deg/s/sqrt(s)",
-                c.allan.points.last().map_or(0.0, |p| p.tau_s),
-                sci(bound)
-            ));
-            bound
-        };
+        let k_dps = random_walk(c, 0.0, &mut notes);
         if fit.bias_instability_dps.significant {
             notes.push(format!(
                 "not included: the bias instability B = {} deg/s (a flat Allan floor of {} deg/s, not a random walk)",
@@ -242,15 +214,133 @@ impl NoiseParams {
                 sci(fit.bias_instability_dps.value * FLICKER_ADEV_PER_B)
             ));
         }
+        Self::of_dps(n_dps, k_dps, c.sample_rate_hz, source, notes)
+    }
+
+    /// [`Self::new`] from N in deg/s/√Hz and K in deg/s/√s.
+    fn of_dps(
+        n_dps: f64,
+        k_dps: f64,
+        update_rate_hz: f64,
+        source: String,
+        notes: Vec<String>,
+    ) -> Result<Self, ExportError> {
         Self::new(
             noise_density_from_dps_per_rt_hz(n_dps),
             random_walk_from_dps_per_rt_s(k_dps),
-            c.sample_rate_hz,
+            update_rate_hz,
             source,
             notes,
         )
     }
 
+    /// The effective values on moving data (`gyro-cli diagnose`): `c` characterises
+    /// what the deterministic terms leave of gyro minus reference (the runs' regression
+    /// residual). Its Allan deviation is seldom a clean −½ line (periodic motion leaves
+    /// bumps), so N is the largest white noise it allows from 1 to 10 s
+    /// ([`white_bound`]), not the fitted line; K as in [`Self::from_allan`].
+    /// `notes` (e.g. the ratio to the model's values) go first in the comments.
+    pub fn from_residual(
+        c: &Characterization,
+        source: String,
+        mut notes: Vec<String>,
+    ) -> Result<Self, ExportError> {
+        let n_dps = white_bound(c).ok_or(ExportError::Invalid {
+            name: "gyroscope_noise_density",
+            value: f64::NAN,
+        })?;
+        notes.push(format!(
+            "gyroscope_noise_density: the largest white noise the residual's Allan deviation allows at every tau from 1 to 10 s (the fitted rate random walk taken off), N = {} deg/s/sqrt(Hz) ({:.4} deg/sqrt(h))",
+            sci(n_dps),
+            n_dps * 60.0
+        ));
+        let k_dps = random_walk(c, RANDOM_WALK_TAU_S, &mut notes);
+        Self::of_dps(n_dps, k_dps, c.sample_rate_hz, source, notes)
+    }
+}
+
+/// The averaging times over which the effective white noise is read (s): from 1 s, where
+/// the convention reads N, to 10 s, the length of a long movement.
+pub const WHITE_TAUS_S: (f64, f64) = (1.0, 10.0);
+
+/// N (deg/s/√Hz): the largest white noise the Allan deviation of `c` allows at every
+/// computed τ in [`WHITE_TAUS_S`]: the −½ line under its upper confidence bound (68%)
+/// there, after taking off the fitted rate random walk's K²·τ/3 (the point estimates'
+/// minimum over a dozen τ would sit below N by their scatter). For white noise it is N
+/// or a little above; a
+/// bounded error (periodic motion the model does not follow, whose Allan deviation falls
+/// as 1/τ) shows at 1 s but does not accumulate into angle, and is not counted as a walk.
+/// (A fitted Gauss-Markov term is not taken off: one with a correlation time near 1 s is
+/// the same curve as white noise there.) `None` when no computed τ lies in the range.
+pub fn white_bound(c: &Characterization) -> Option<f64> {
+    let walk = c.fit.rate_random_walk_dps_per_rt_s.value.powi(2) / 3.0;
+    let (lo, hi) = WHITE_TAUS_S;
+    c.allan
+        .points
+        .iter()
+        .filter(|p| p.tau_s >= lo * (1.0 - 1e-9) && p.tau_s <= hi * (1.0 + 1e-9))
+        .map(|p| {
+            let upper = if p.upper_dps.is_finite() {
+                p.upper_dps
+            } else {
+                p.adev_dps
+            };
+            ((upper.powi(2) - walk * p.tau_s).max(0.0) * p.tau_s).sqrt()
+        })
+        .min_by(f64::total_cmp)
+}
+
+/// K (deg/s/√s) of a residual's characterisation `c` ([`NoiseParams::from_residual`]) and
+/// whether the fit resolved it (else it is the +½ upper bound).
+pub fn residual_random_walk(c: &Characterization) -> (f64, bool) {
+    let mut notes = Vec::new();
+    let k = random_walk(c, RANDOM_WALK_TAU_S, &mut notes);
+    (k, !notes.iter().any(|n| n.contains("UPPER BOUND")))
+}
+
+/// K (deg/s/√s) of `c` with its note: the fitted rate random walk and Gauss-Markov bias
+/// read at τ = 3 s, else the +½ upper bound. A Gauss-Markov term whose correlation time
+/// is under `min_gm_tau_s` is left out: on a residual in motion the fit takes the
+/// motion's short bumps for one, and at the τ of a movement it is white, which the
+/// white bound already holds.
+fn random_walk(c: &Characterization, min_gm_tau_s: f64, notes: &mut Vec<String>) -> f64 {
+    let fit = &c.fit;
+    let k_fit = fit.rate_random_walk_dps_per_rt_s.value;
+    let gm = &fit.gauss_markov;
+    let k_gm = match (gm.significant, gm.corr_time_s) {
+        (true, Some(t)) if t >= min_gm_tau_s => gauss_markov_random_walk(gm.sigma_dps, t),
+        _ => 0.0,
+    };
+    if k_fit > 0.0 || k_gm > 0.0 {
+        let mut parts = Vec::new();
+        if k_fit > 0.0 {
+            parts.push(format!(
+                "the fitted rate random walk K = {} deg/s/sqrt(s) (the +1/2 line at tau = 3 s)",
+                sci(k_fit)
+            ));
+        }
+        if let (true, Some(t)) = (k_gm > 0.0, gm.corr_time_s) {
+            parts.push(format!(
+                "the fitted Gauss-Markov bias (sigma {} deg/s, T {:.4} s) read at tau = 3 s, K = {} deg/s/sqrt(s)",
+                sci(gm.sigma_dps),
+                t,
+                sci(k_gm)
+            ));
+        }
+        notes.push(format!("gyroscope_random_walk: {}", parts.join(" + ")));
+        k_fit.hypot(k_gm)
+    } else {
+        let bound = allan_bound(c, 0.5);
+        notes.push(format!(
+            "gyroscope_random_walk: UPPER BOUND: no +1/2 slope (rate random walk, Gauss-Markov bias) resolved up to tau = {:.4} s; the +1/2 line under the Allan deviation's upper bound at every tau, {} deg/s/sqrt(s)",
+            c.allan.points.last().map_or(0.0, |p| p.tau_s),
+            sci(bound)
+        ));
+        bound
+    }
+}
+
+impl NoiseParams {
     /// The effective values of a sensor model and the effects selected with it (module
     /// docs), e.g. a diagnosis's `selected_sensor` and `model.effects`; `provenance` (the
     /// diagnosis's notes on where the model's values came from) is kept in the comments.
@@ -347,13 +437,7 @@ impl NoiseParams {
             ));
         }
         notes.extend(provenance.iter().map(|p| format!("model: {p}")));
-        Self::new(
-            noise_density_from_dps_per_rt_hz(n_dps),
-            random_walk_from_dps_per_rt_s(k_dps),
-            fs,
-            source,
-            notes,
-        )
+        Self::of_dps(n_dps, k_dps, fs, source, notes)
     }
 
     /// The YAML of `format`.
@@ -476,7 +560,7 @@ impl NoiseParams {
 /// Allan deviation's upper bound at every τ: an upper bound for a term of that slope
 /// (the terms' variances add). `c` is N (deg/s/√Hz) for slope −½ and K/√3 for +½, so
 /// the value returned is N, or K = √3·c.
-fn allan_bound(c: &Characterization, slope: f64) -> f64 {
+pub(crate) fn allan_bound(c: &Characterization, slope: f64) -> f64 {
     let line = c
         .allan
         .points
@@ -525,6 +609,55 @@ fn one_line(text: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The white bound is the −½ line under the curve's upper bound from 1 s to 10 s
+    /// (here 1/0.9 of the point estimates, which it does not read): exact for white
+    /// noise; a bounded error (Allan deviation ∝ 1/τ) counts only as much as it still
+    /// shows at 10 s; a fitted random walk is taken off; τ outside the range is ignored.
+    #[test]
+    fn white_bound_is_the_half_line_under_the_curve() {
+        let mut c = crate::noise::characterize(
+            &[&(0..4000)
+                .map(|k| ((k * 7919) % 13) as f64)
+                .collect::<Vec<_>>()],
+            100.0,
+            &crate::noise::NoiseOptions::default(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        c.fit.rate_random_walk_dps_per_rt_s.value = 0.0;
+        let template = c.allan.points[0];
+        let curve = |avar: &dyn Fn(f64) -> f64| -> Vec<crate::noise::AllanPoint> {
+            [0.5, 1.0, 2.0, 5.0, 10.0, 20.0]
+                .iter()
+                .map(|&tau_s| crate::noise::AllanPoint {
+                    tau_s,
+                    adev_dps: 0.9 * avar(tau_s).sqrt(),
+                    upper_dps: avar(tau_s).sqrt(),
+                    ..template
+                })
+                .collect()
+        };
+        let close = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() < 1e-12);
+        // White noise alone, with a deeper dip at 0.5 s and 20 s (outside the range).
+        c.allan.points = curve(&|t| {
+            if (1.0..=10.0).contains(&t) {
+                0.09 / t
+            } else {
+                0.01 / t
+            }
+        });
+        assert!(close(white_bound(&c), 0.3), "{:?}", white_bound(&c));
+        // Plus a bounded error of 1 deg/s at 1 s, falling as 1/τ: what is left at 10 s.
+        c.allan.points = curve(&|t| 0.09 / t + 1.0 / (t * t));
+        assert!(close(white_bound(&c), (0.09f64 + 0.1).sqrt()));
+        // Plus a random walk the fit resolved: taken off.
+        c.allan.points = curve(&|t| 0.09 / t + 0.04 * t / 3.0);
+        c.fit.rate_random_walk_dps_per_rt_s.value = 0.2;
+        assert!(close(white_bound(&c), 0.3), "{:?}", white_bound(&c));
+        // Nothing computed in the range.
+        c.allan.points.retain(|p| p.tau_s < 1.0);
+        assert_eq!(white_bound(&c), None);
+    }
 
     #[test]
     fn unit_conversions_against_hand_computed_values() {

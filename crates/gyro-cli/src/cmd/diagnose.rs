@@ -280,7 +280,8 @@ fn self_test(args: &Args) -> Result<()> {
     Ok(())
 }
 
-/// `--noise-yaml`: the effective noise of the selected sensor model on these runs.
+/// `--noise-yaml`: the effective noise measured on the training runs (else that of the
+/// selected sensor model).
 fn write_noise_yaml(out: &Path, args: &Args, result: &Diagnosis) -> Result<()> {
     let names = |paths: &[PathBuf]| {
         paths
@@ -289,19 +290,43 @@ fn write_noise_yaml(out: &Path, args: &Args, result: &Diagnosis) -> Result<()> {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let source = format!(
-        "effective values on moving data: the sensor model gyro-cli diagnose selected (training: {}; held out: {}{})",
+    let runs = format!(
+        "training: {}; held out: {}{}",
         names(&args.train),
         names(&args.holdout),
         args.split_s
             .map_or(String::new(), |s| format!("; in windows of {s} s"))
     );
-    let params = gyro_analysis::noise::NoiseParams::effective(
-        &result.selected_sensor,
-        &result.model.effects,
-        &result.model.notes,
-        source,
-    )?;
+    let params = match &result.effective_noise.training {
+        Some(t) => {
+            let mut notes = vec![format!(
+                "{} (the diagnosis's sensor model has {:.4} deg/sqrt(h))",
+                t.describe(),
+                t.model_arw_deg_per_rt_h
+            )];
+            if let Some(h) = &result.effective_noise.holdout {
+                notes.push(format!(
+                    "{}: the effective noise depends on the motion",
+                    h.describe()
+                ));
+            }
+            gyro_analysis::noise::NoiseParams::from_residual(
+                &t.characterization,
+                format!(
+                    "effective values measured on moving data by gyro-cli diagnose: the Allan deviation of what the deterministic terms leave of gyro minus reference ({runs})"
+                ),
+                notes,
+            )?
+        }
+        None => gyro_analysis::noise::NoiseParams::effective(
+            &result.selected_sensor,
+            &result.model.effects,
+            &result.model.notes,
+            format!(
+                "effective values of the sensor model gyro-cli diagnose selected: the runs were too short to measure them ({runs})"
+            ),
+        )?,
+    };
     args.noise_yaml.write(out, &params)
 }
 

@@ -230,7 +230,28 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
             m.ratio
         ));
     }
+    if let Some(line) = effective_noise_line(&d.effective_noise) {
+        lines.push(line);
+    }
     lines
+}
+
+/// The effective noise on moving data, training runs beside held-out ones.
+fn effective_noise_line(e: &gyro_analysis::diagnose::effective::EffectiveNoise) -> Option<String> {
+    let t = e.training.as_ref()?;
+    let held_out = e.holdout.as_ref().map_or(String::new(), |h| {
+        format!(
+            "; on the held-out runs {} deg/sqrt(h) ({:.0}x)",
+            sig3(h.arw_deg_per_rt_h),
+            h.ratio_to_model
+        )
+    });
+    Some(format!(
+        "effective noise on moving data: angle random walk at most {} deg/sqrt(h) on the training runs ({:.0}x the model's {}; read from 1 to 10 s in what the deterministic terms leave of gyro minus reference){held_out}: what a filter must assume on this motion (--noise-yaml writes it)",
+        sig3(t.arw_deg_per_rt_h),
+        t.ratio_to_model,
+        sig3(t.model_arw_deg_per_rt_h)
+    ))
 }
 
 /// `x` to three significant digits.
