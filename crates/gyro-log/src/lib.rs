@@ -21,6 +21,7 @@
 mod ahead;
 pub mod bursts;
 mod csv_log;
+pub mod jumps;
 mod load;
 pub mod mcap;
 mod regular;

@@ -19,6 +19,7 @@
 
 use super::{Log, LogError, Row};
 use crate::bursts::{self, Bursts, Resampler};
+use crate::jumps::ReferenceJumps;
 use serde::Serialize;
 use std::path::Path;
 
@@ -98,6 +99,9 @@ pub struct Quality {
     pub trimmed_slots: u64,
     /// Slots without a reference after interpolation (only if the log has one).
     pub missing_reference_slots: u64,
+    /// Jumps of the reference while the gyro barely turns (a pose that wraps or flips):
+    /// the reference after each is re-based ([`crate::jumps`]).
+    pub reference_jumps: u64,
     /// The first few irregular lines: (what, line).
     pub examples: Vec<(String, u64)>,
     /// Set if the rows arrive in bursts: their arrival statistics. The rate's integral was
@@ -111,10 +115,10 @@ pub struct Quality {
     pub warnings: Vec<String>,
 }
 
-const MAX_EXAMPLES: usize = 12;
+pub(crate) const MAX_EXAMPLES: usize = 12;
 
 impl Quality {
-    fn note(&mut self, what: &str, line: u64) {
+    pub(crate) fn note(&mut self, what: &str, line: u64) {
         if self.examples.len() < MAX_EXAMPLES {
             self.examples.push((what.to_string(), line));
         }
@@ -477,6 +481,8 @@ struct Placer<'p, S: SlotSink + ?Sized> {
     /// Stage 3: time of the first and last slot delivered.
     first_time_s: Option<f64>,
     last_time_s: f64,
+    /// The reference re-based after its jumps, as the slots are delivered.
+    jumps: ReferenceJumps,
     sink: &'p mut S,
 }
 
@@ -553,6 +559,7 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
             },
             first_time_s: None,
             last_time_s: 0.0,
+            jumps: ReferenceJumps::default(),
             sink,
         }
     }
@@ -778,7 +785,13 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
                 self.first_time_s = Some(slot.time_s);
             }
             self.last_time_s = slot.time_s;
-            self.sink.slot(&slot);
+            if self.reference.enabled {
+                let sink = &mut self.sink;
+                self.jumps
+                    .push(slot, &mut self.quality, &mut |s| sink.slot(&s));
+            } else {
+                self.sink.slot(&slot);
+            }
         }
     }
 
@@ -801,6 +814,8 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
             + self.missing_count
             + self.resampler.as_ref().map_or(0, Resampler::trimmed_rows);
         self.deliver(true);
+        let sink = &mut self.sink;
+        self.jumps.finish(&mut self.quality, &mut |s| sink.slot(&s));
         let mut quality = self.quality;
         let first_time_s = self.first_time_s.unwrap_or(self.last_time_s);
         let span_s = self.last_time_s - first_time_s;
@@ -921,7 +936,10 @@ mod tests {
             super::super::check_bridged_slots(&log.path, options, rate_hz)?;
             if let Some(b) = arrival {
                 let mut whole = resample_whole(log, options, rate_hz, source, b)?;
+                // The rate's warning comes first, as in the streaming placement.
+                let later = std::mem::take(&mut whole.quality.warnings);
                 whole.quality.warnings.extend(warning);
+                whole.quality.warnings.extend(later);
                 return Ok(whole);
             }
             let period_s = 1.0 / rate_hz;
@@ -1069,6 +1087,13 @@ mod tests {
                 )?;
                 quality.missing_reference_slots =
                     slots.iter().filter(|s| s.reference_deg.is_none()).count() as u64;
+                let mut jumps = crate::jumps::ReferenceJumps::default();
+                let mut rebased = Vec::with_capacity(slots.len());
+                for slot in slots {
+                    jumps.push(slot, &mut quality, &mut |s| rebased.push(s));
+                }
+                jumps.finish(&mut quality, &mut |s| rebased.push(s));
+                slots = rebased;
             }
             if log.has_temperature {
                 fill_runs(
@@ -1369,7 +1394,8 @@ mod tests {
     }
 
     /// The two outcomes agree: the same error, or the same log; for rows in bursts the
-    /// rates may differ by rounding (the oracle differences a cumulative angle).
+    /// rates may differ by rounding (the oracle differences a cumulative angle), and so
+    /// may a reference re-based after a jump (the gyro's turn over it is in the jump).
     fn same_outcome(
         streamed: Result<RegularLog, LogError>,
         whole: Result<RegularLog, LogError>,
@@ -1394,15 +1420,22 @@ mod tests {
             let mut log = log.clone();
             for slot in &mut log.slots {
                 slot.rate_dps = 0.0;
+                slot.reference_deg = slot.reference_deg.map(|_| 0.0);
             }
             format!("{log:?}")
         };
         if rounded(a) != rounded(b) {
             return Err(format!("{}\n!=\n{}", rounded(a), rounded(b)));
         }
+        let close = |x: f64, y: f64| (x - y).abs() <= 1e-8 * (1.0 + y.abs());
         for (k, (x, y)) in a.slots.iter().zip(&b.slots).enumerate() {
-            if (x.rate_dps - y.rate_dps).abs() > 1e-8 * (1.0 + y.rate_dps.abs()) {
+            if !close(x.rate_dps, y.rate_dps) {
                 return Err(format!("slot {k}: rate {} != {}", x.rate_dps, y.rate_dps));
+            }
+            if let (Some(p), Some(q)) = (x.reference_deg, y.reference_deg) {
+                if !close(p, q) {
+                    return Err(format!("slot {k}: reference {p} != {q}"));
+                }
             }
         }
         Ok(())

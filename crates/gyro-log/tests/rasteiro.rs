@@ -23,17 +23,22 @@ fn recordings() -> Vec<PathBuf> {
     found
 }
 
+/// `path` on the grid, with the default options.
+fn placed(path: &std::path::Path) -> gyro_log::RegularLog {
+    load(
+        path,
+        &LogOptions::default(),
+        &GridOptions::default(),
+        &mut |_| {},
+    )
+    .unwrap()
+}
+
 #[test]
 fn bursts_are_recognised_and_the_integral_is_kept() {
     for path in recordings() {
         let raw = read_log(&path, &LogOptions::default()).unwrap();
-        let placed = load(
-            &path,
-            &LogOptions::default(),
-            &GridOptions::default(),
-            &mut |_| {},
-        )
-        .unwrap();
+        let placed = placed(&path);
         let bursts = placed
             .quality
             .bursts
@@ -80,5 +85,39 @@ fn bursts_are_recognised_and_the_integral_is_kept() {
             "{} slots, {expected}",
             placed.slots.len()
         );
+    }
+}
+
+/// The robot's pose wraps and flips while the board is still: every recording has such
+/// jumps, and after they are re-based the reference ends where the gyro says (within the
+/// sensors' own error, a few degrees over the whole path; as logged, the end is off by
+/// 320-720 degrees on 10 of the 18 files, and jumps that cancel leave the others' middles
+/// off), except the one file with a 0.17 s hole in its rows during a turn.
+#[test]
+fn reference_jumps_are_re_based() {
+    for path in recordings() {
+        let placed = placed(&path);
+        let q = &placed.quality;
+        assert!(
+            (1..=3).contains(&q.reference_jumps),
+            "{}: {q:?}",
+            path.display()
+        );
+        assert!(q.warnings.iter().any(|w| w.contains("reference jumps")));
+        let period_s = 1.0 / placed.sample_rate_hz;
+        let gyro_deg: f64 = placed.slots[1..]
+            .iter()
+            .map(|s| s.rate_dps * period_s)
+            .sum();
+        let first = placed.slots.iter().find_map(|s| s.reference_deg).unwrap();
+        let last = placed
+            .slots
+            .iter()
+            .rev()
+            .find_map(|s| s.reference_deg)
+            .unwrap();
+        let off = (gyro_deg - (last - first)).abs();
+        let holed = path.ends_with("rasteiro_MPU6500RM3100_V_300_z.csv");
+        assert!(holed || off < 10.0, "{}: {off} deg", path.display());
     }
 }

@@ -45,6 +45,7 @@ pub fn table(q: &Quality) -> String {
         (q.filled_slots, "samples interpolated"),
         (q.trimmed_slots, "samples trimmed at the ends"),
         (q.missing_reference_slots, "samples without reference"),
+        (q.reference_jumps, "reference jumps re-based"),
     ]
     .iter()
     .filter(|(n, _)| *n > 0)
