@@ -132,6 +132,10 @@ pub struct Diagnosis {
     pub runs: Vec<RunSummary>,
     /// Angle error with the correctable effects compensated, if any were selected.
     pub compensation: Option<CompensationSummary>,
+    /// What makes part of the diagnosis unreliable, one sentence each (e.g. a gyro–reference
+    /// lag beyond the cross-correlation's search); left out when empty.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// The effective noise on moving data, measured from the regression residual of the
     /// training and of the held-out runs ([`super::effective`]).
     pub effective_noise: super::effective::EffectiveNoise,

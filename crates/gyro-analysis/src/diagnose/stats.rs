@@ -407,6 +407,18 @@ fn xcorr_lag_trend(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
     Some((last - first) / (start as f64 / fs))
 }
 
+/// The lag of `stats`' cross-correlation peak (`all`/`xcorr_peak_lag_s`, at sample rate
+/// `fs`) when it sits on the edge of the search (±[`MAX_LAG_S`]): then the true lag is at
+/// least that, and the value is cut, not measured.
+pub fn lag_at_search_edge(stats: &[Stat], fs: f64) -> Option<f64> {
+    let edge_s = ((MAX_LAG_S * fs).round()).max(1.0) / fs;
+    stats
+        .iter()
+        .find(|s| s.segment == "all" && s.statistic == "xcorr_peak_lag_s")
+        .map(|s| s.value)
+        .filter(|v| v.abs() >= edge_s * (1.0 - 1e-9))
+}
+
 /// Cross-correlation peak lag (s) of `gyro` against `reference` within ±`max_lag` samples.
 ///
 /// Samples where either is undefined count as zero after mean removal. The correlation of
@@ -884,6 +896,16 @@ mod tests {
         assert!((lag - 0.01).abs() < 3e-3, "lag {lag}");
         let slope = get(&late, "dynamic", "slope_vs_acceleration");
         assert!((slope + 0.01).abs() < 1e-3, "acceleration slope {slope}");
+        // A lag beyond the search is cut at its edge, and said to be.
+        assert_eq!(lag_at_search_edge(&late, 1000.0), None);
+        let beyond = run(&[Effect::Latency { delay_s: 0.1 }], 1);
+        let cut = lag_at_search_edge(&beyond, 1000.0);
+        assert_eq!(
+            cut,
+            Some(MAX_LAG_S),
+            "{:?}",
+            get(&beyond, "all", "xcorr_peak_lag_s")
+        );
     }
 
     #[test]

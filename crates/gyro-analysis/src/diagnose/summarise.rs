@@ -7,7 +7,7 @@ use super::score::{gap, RunScore};
 use super::select::{Candidate, Selection};
 use super::{
     CompensationSummary, Diagnosis, EffectResult, GapSummary, ModelSummary, Options, Progress,
-    RunSummary, UntestableEntry, Verdict, Where,
+    RealRun, RunSummary, UntestableEntry, Verdict, Where,
 };
 use crate::model::ModelFile;
 use gyro_sim::{Effect, SensorModel};
@@ -211,6 +211,7 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         },
         runs,
         compensation: f.compensation,
+        warnings: lag_warnings(f.runs),
         effective_noise: super::effective::EffectiveNoise::measure(
             &f.runs.train,
             &f.runs.holdout,
@@ -226,5 +227,26 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         inputs: Vec::new(),
         corrected_model: f.corrected_model,
         selected_sensor: f.selected_sensor,
+    }
+}
+
+/// A warning when the gyro–reference lag of some runs lies beyond the cross-correlation's
+/// search: their `xcorr_peak_lag_s` is cut at its edge, and the latency's fit and
+/// posterior check read a cut value.
+fn lag_warnings(runs: &Runs) -> Vec<String> {
+    let all: Vec<&RealRun> = runs.train.iter().chain(&runs.holdout).copied().collect();
+    let cut: Vec<f64> = all
+        .iter()
+        .filter_map(|r| super::stats::lag_at_search_edge(&r.stats, r.sample_rate_hz))
+        .collect();
+    match cut.first() {
+        None => Vec::new(),
+        Some(edge) => vec![format!(
+            "on {} of {} runs the gyro {} the reference by at least {:.0} ms, the edge of the cross-correlation's search: their lag statistic is cut there, not measured, and a latency fitted or checked on it is not to be trusted (a logger that buffers, over a wireless link or USB, can put 100 ms between the two)",
+            cut.len(),
+            all.len(),
+            if *edge > 0.0 { "lags" } else { "leads" },
+            1e3 * edge.abs()
+        )],
     }
 }

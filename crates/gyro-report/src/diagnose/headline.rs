@@ -233,6 +233,7 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
     if let Some(line) = effective_noise_line(&d.effective_noise) {
         lines.push(line);
     }
+    lines.extend(d.warnings.iter().map(|w| format!("warning: {w}")));
     lines
 }
 

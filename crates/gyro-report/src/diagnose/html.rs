@@ -1232,6 +1232,7 @@ mod tests {
                     max_abs_error_after_deg: 0.2,
                 }],
             }),
+            warnings: Vec::new(),
             effective_noise: Default::default(),
             motion_lines: Vec::new(),
             inputs: Vec::new(),
