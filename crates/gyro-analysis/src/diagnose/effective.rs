@@ -17,11 +17,10 @@
 //! N) to 10 s (a long movement), the fitted rate random walk taken off
 //! ([`crate::noise::export::white_bound`]): what accumulates into angle over a movement.
 //! The rate random walk K and the bias instability B are the fit's, where it resolves
-//! them. The
-//! residual's own smoothing (the reference derivative's ±h samples) only touches τ of a
-//! few samples; the reference's differentiation noise falls off as 1/τ and is small by
-//! τ = 1 s. What remains there is what a filter sees as noise: the sensor's own, the
-//! unmodelled response, and whatever the reference does not resolve.
+//! them. The residual's own smoothing (the reference derivative's ±h samples) only
+//! touches τ of a few samples; the reference's differentiation noise falls off as 1/τ and
+//! is small by τ = 1 s. What remains there is what a filter sees as noise: the sensor's
+//! own, the unmodelled response, and whatever the reference does not resolve.
 //!
 //! Measured on the training and the held-out runs separately: on motion of another
 //! speed the effective noise differs, and that difference is itself a finding.

@@ -206,7 +206,7 @@ impl NoiseParams {
             ));
             bound
         };
-        let k_dps = random_walk(c, 0.0, &mut notes);
+        let (k_dps, _) = random_walk(c, 0.0, &mut notes);
         if fit.bias_instability_dps.significant {
             notes.push(format!(
                 "not included: the bias instability B = {} deg/s (a flat Allan floor of {} deg/s, not a random walk)",
@@ -254,7 +254,7 @@ impl NoiseParams {
             sci(n_dps),
             n_dps * 60.0
         ));
-        let k_dps = random_walk(c, RANDOM_WALK_TAU_S, &mut notes);
+        let (k_dps, _) = random_walk(c, RANDOM_WALK_TAU_S, &mut notes);
         Self::of_dps(n_dps, k_dps, c.sample_rate_hz, source, notes)
     }
 }
@@ -293,17 +293,15 @@ pub fn white_bound(c: &Characterization) -> Option<f64> {
 /// K (deg/s/√s) of a residual's characterisation `c` ([`NoiseParams::from_residual`]) and
 /// whether the fit resolved it (else it is the +½ upper bound).
 pub fn residual_random_walk(c: &Characterization) -> (f64, bool) {
-    let mut notes = Vec::new();
-    let k = random_walk(c, RANDOM_WALK_TAU_S, &mut notes);
-    (k, !notes.iter().any(|n| n.contains("UPPER BOUND")))
+    random_walk(c, RANDOM_WALK_TAU_S, &mut Vec::new())
 }
 
-/// K (deg/s/√s) of `c` with its note: the fitted rate random walk and Gauss-Markov bias
-/// read at τ = 3 s, else the +½ upper bound. A Gauss-Markov term whose correlation time
+/// K (deg/s/√s) of `c` with its note, and whether the fit resolved it: the fitted rate
+/// random walk and Gauss-Markov bias read at τ = 3 s, else the +½ upper bound. A Gauss-Markov term whose correlation time
 /// is under `min_gm_tau_s` is left out: on a residual in motion the fit takes the
 /// motion's short bumps for one, and at the τ of a movement it is white, which the
 /// white bound already holds.
-fn random_walk(c: &Characterization, min_gm_tau_s: f64, notes: &mut Vec<String>) -> f64 {
+fn random_walk(c: &Characterization, min_gm_tau_s: f64, notes: &mut Vec<String>) -> (f64, bool) {
     let fit = &c.fit;
     let k_fit = fit.rate_random_walk_dps_per_rt_s.value;
     let gm = &fit.gauss_markov;
@@ -328,7 +326,7 @@ fn random_walk(c: &Characterization, min_gm_tau_s: f64, notes: &mut Vec<String>)
             ));
         }
         notes.push(format!("gyroscope_random_walk: {}", parts.join(" + ")));
-        k_fit.hypot(k_gm)
+        (k_fit.hypot(k_gm), true)
     } else {
         let bound = allan_bound(c, 0.5);
         notes.push(format!(
@@ -336,7 +334,7 @@ fn random_walk(c: &Characterization, min_gm_tau_s: f64, notes: &mut Vec<String>)
             c.allan.points.last().map_or(0.0, |p| p.tau_s),
             sci(bound)
         ));
-        bound
+        (bound, false)
     }
 }
 
