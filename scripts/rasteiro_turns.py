@@ -21,7 +21,7 @@ Euler angles couple; the gyro of that axis then sees only leakage). Rests are st
 2 deg/s (a turn about another axis leaves this axis's pose still but not its gyro) and at
 least 60% of the pose samples agree to 0.05 degrees modulo 360 (at 180 degrees the pose
 flips to -180 and the recordings' resampling interpolates across the flip, so some rest
-samples hold neither value); the pose over a rest is the value most of its samples hold. The reference lags the gyro by 80-100 ms, so rest means use only
+samples hold neither value); the pose over a rest is the value most of its samples hold. The gyro lags the pose by 80-105 ms (cross-correlation), so rest means use only
 the central part of each rest (0.25 s trimmed at each end).
 
 Prints one line per file, then the median and 90th percentile of |error| per sensor and
