@@ -13,6 +13,16 @@ use gyro_analysis::diagnose::{diagnose, split, Options, RealRun, Silent};
 use gyro_log::{load, GridOptions, LogOptions};
 use std::path::PathBuf;
 
+/// Small ensembles and `bootstrap` resamples: quick enough for a test.
+fn quick(bootstrap: usize) -> Options {
+    Options {
+        members: 8,
+        candidate_members: 4,
+        bootstrap,
+        ..Options::default()
+    }
+}
+
 fn windows(file: &str, take: usize) -> Option<Vec<RealRun>> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/data/real")
@@ -46,13 +56,7 @@ fn latency_is_named_on_real_yaw_and_its_correction_does_not_hurt() {
     ) else {
         return;
     };
-    let options = Options {
-        members: 8,
-        candidate_members: 4,
-        bootstrap: 300,
-        ..Options::default()
-    };
-    let d = diagnose(&train, &holdout, &options, &Silent).unwrap();
+    let d = diagnose(&train, &holdout, &quick(300), &Silent).unwrap();
     let named: Vec<&str> = d.verdict.unmodelled.clone();
     assert!(named.contains(&"latency"), "named {named:?}");
     assert!(!named.contains(&"bandwidth"), "named {named:?}");
@@ -168,13 +172,7 @@ fn a_lag_beyond_the_search_is_said() {
     ) else {
         return;
     };
-    let options = Options {
-        members: 8,
-        candidate_members: 4,
-        bootstrap: 200,
-        ..Options::default()
-    };
-    let d = diagnose(&train, &holdout, &options, &Silent).unwrap();
+    let d = diagnose(&train, &holdout, &quick(200), &Silent).unwrap();
     assert!(
         d.warnings
             .iter()

@@ -127,20 +127,22 @@ impl ReferenceJumps {
         self.held.push(Held { slot, mismatch_deg });
         if self.held.len() > MAX_HELD_SLOTS {
             // Too long for a jump: the stretch goes on as it was.
-            self.held_gyro_deg = f64::INFINITY;
             self.drifting = true;
             self.release(quality, out);
         }
     }
 
-    /// Decide the held stretch and hand its slots on.
+    /// Decide the held stretch and hand its slots on (never a jump once it has outgrown
+    /// the hold).
     fn release(&mut self, quality: &mut Quality, out: &mut dyn FnMut(Slot)) {
         if self.held.is_empty() {
             return;
         }
         let total: f64 = self.held.iter().map(|h| h.mismatch_deg).sum();
         let gyro = std::mem::take(&mut self.held_gyro_deg);
-        let jump = total.abs() > REFERENCE_JUMP_DEG && gyro.abs() < GYRO_SHARE * total.abs();
+        let jump = !self.drifting
+            && total.abs() > REFERENCE_JUMP_DEG
+            && gyro.abs() < GYRO_SHARE * total.abs();
         if jump {
             quality.reference_jumps += 1;
             if total.abs() > self.largest_deg.abs() {
