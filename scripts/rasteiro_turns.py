@@ -111,19 +111,20 @@ def plain(t, w, rest_before, t0, t1):
     return np.sum(0.5 * (seg_w[1:] + seg_w[:-1]) * np.diff(seg_t)) - bias * (seg_t[-1] - seg_t[0])
 
 
-def run_series(gyro, path):
+def run_series(gyro, path, run_args=()):
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "series.csv")
-        subprocess.run([gyro, "run", path, "--out", out], check=True, capture_output=True)
+        subprocess.run([gyro, "run", path, "--out", out, *run_args], check=True, capture_output=True)
         s = pd.read_csv(out, comment="#")
     return s["time_s"].to_numpy(), s["angle_deg"].to_numpy()
 
 
-def turns(path, gyro):
+def turns(path, gyro, run_args=()):
+    """(truth, plain error, run error) per turn; `run_args` go to `gyro-cli run`."""
     d = pd.read_csv(path, comment="#")
     t, w, ref = (d[c].to_numpy() for c in ("time_s", "rate_dps", "reference_deg"))
     found = rests(t, w, ref)
-    st, sa = run_series(gyro, path)
+    st, sa = run_series(gyro, path, run_args)
     out = []
     for before, after in zip(found, found[1:]):
         lo, hi = central(t, *before)

@@ -2,6 +2,7 @@
 //! the paper's own error model recovers its parameters.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+use gyro_analysis::calibrate::delay::DelaySource;
 use gyro_analysis::calibrate::{
     calibrate, BenchRun, CalibrateOptions, Candidate, Objective, RunScore, Trace,
 };
@@ -136,6 +137,7 @@ fn fit_recovers_the_paper_model_and_halves_holdout_error() {
         leave_one_out: true,
         initial_tau_s: None,
         fit_motion: false,
+        reference_delay_s: None,
     };
     let result = calibrate(
         train,
@@ -206,6 +208,7 @@ fn paper_objective_also_halves_holdout_error() {
         leave_one_out: false,
         initial_tau_s: None,
         fit_motion: false,
+        reference_delay_s: None,
     };
     let result = calibrate(
         train,
@@ -230,6 +233,7 @@ fn runs_without_reference_are_refused() {
         leave_one_out: false,
         initial_tau_s: None,
         fit_motion: false,
+        reference_delay_s: None,
     };
     let err = calibrate(&[run], &[], &Config::default(), &options, &mut |_, _, _| {}).unwrap_err();
     assert!(err.to_string().contains("no reference_deg column"), "{err}");
@@ -250,6 +254,7 @@ fn motion_thresholds_fit_never_worsens_the_objective() {
         leave_one_out: false,
         initial_tau_s: Some(2.0),
         fit_motion,
+        reference_delay_s: None,
     };
     let fixed = calibrate(
         &runs,
@@ -323,6 +328,7 @@ fn written_model_is_not_worse_than_the_default_on_other_runs() {
         leave_one_out: true,
         initial_tau_s: None,
         fit_motion: false,
+        reference_delay_s: None,
     };
     let base = Config::default();
     let result = calibrate(&train, &[], &base, &options, &mut |_, _, _| {}).unwrap();
@@ -346,4 +352,111 @@ fn written_model_is_not_worse_than_the_default_on_other_runs() {
         training_choice > default,
         "the training-error choice {by_training:?} is not worse here: {training_choice} vs {default}"
     );
+}
+
+/// A simulated bench run (nominal CRM100 model, 1 kHz) with `effects`.
+fn sim_run(effects: &str, seed: u64) -> BenchRun {
+    let sensor = SensorModel::default();
+    let effects: Vec<sim::Effect> = effects
+        .split(' ')
+        .filter(|e| !e.is_empty())
+        .map(|e| sim::Effect::parse(e).unwrap())
+        .collect();
+    let motion = Motion::bench(&BenchProfile::default(), seed);
+    let options = SimOptions {
+        seed,
+        ..SimOptions::default()
+    };
+    let log = sim::simulate(&sensor, &effects, &motion, &options);
+    BenchRun {
+        name: format!("{effects:?}-{seed}"),
+        log: regularize(&log, &GridOptions::default()).unwrap(),
+    }
+}
+
+fn default_options() -> CalibrateOptions {
+    CalibrateOptions {
+        objective: Objective::MeanMaxAbs,
+        leave_one_out: true,
+        initial_tau_s: None,
+        fit_motion: false,
+        reference_delay_s: None,
+    }
+}
+
+#[test]
+fn a_scale_error_is_fitted_from_the_turns_and_written_when_it_helps_held_out() {
+    let train: Vec<BenchRun> = (301..=306)
+        .map(|s| sim_run("scale_factor:k=0.01", s))
+        .collect();
+    let holdout: Vec<BenchRun> = (307..=310)
+        .map(|s| sim_run("scale_factor:k=0.01", s))
+        .collect();
+    let base = Config::default();
+    let result = calibrate(
+        &train,
+        &holdout,
+        &base,
+        &default_options(),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    let sc = &result.scale;
+    println!("{sc:?}");
+    let k = sc.k.unwrap();
+    assert!((k - 0.01).abs() < 0.0005, "k {k}");
+    assert!(sc.standard_error.unwrap() < 0.0005, "{sc:?}");
+    assert!(sc.written, "{sc:?}");
+    let (before, after) = sc.holdout_deg.unwrap();
+    assert!(after < 0.5 * before, "{before} -> {after}");
+    assert!((f64::from(result.config.correction.scale_k) - k).abs() < 1e-6);
+    // A bench encoder sampled with the gyro: no delay applied.
+    assert_eq!(
+        result.reference_delay.delay_s, 0.0,
+        "{:?}",
+        result.reference_delay
+    );
+    assert_eq!(result.reference_delay.source, DelaySource::NotApplied);
+}
+
+#[test]
+fn without_a_scale_error_the_fitted_scale_is_within_its_noise() {
+    let train: Vec<BenchRun> = (311..=316).map(|s| sim_run("", s)).collect();
+    let base = Config::default();
+    let result = calibrate(&train, &[], &base, &default_options(), &mut |_, _, _| {}).unwrap();
+    let sc = &result.scale;
+    println!("{sc:?}");
+    let (k, se) = (sc.k.unwrap(), sc.standard_error.unwrap());
+    assert!(k.abs() < 3.0 * se + 1e-4, "k {k} se {se}");
+    assert!(k.abs() < 0.001, "k {k}");
+}
+
+#[test]
+fn a_given_delay_is_used_and_reported() {
+    let train: Vec<BenchRun> = (321..=323).map(|s| sim_run("", s)).collect();
+    let options = CalibrateOptions {
+        reference_delay_s: Some(0.004),
+        ..default_options()
+    };
+    let result = calibrate(&train, &[], &Config::default(), &options, &mut |_, _, _| {}).unwrap();
+    assert_eq!(result.reference_delay.delay_s, 0.004);
+    assert_eq!(result.reference_delay.source, DelaySource::Given);
+}
+
+#[test]
+fn a_gyro_latency_is_measured_as_the_reference_delay() {
+    let train: Vec<BenchRun> = (331..=333)
+        .map(|s| sim_run("latency:delay_s=0.02", s))
+        .collect();
+    let result = calibrate(
+        &train,
+        &[],
+        &Config::default(),
+        &default_options(),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    let d = &result.reference_delay;
+    assert_eq!(d.source, DelaySource::CrossCorrelation, "{d:?}");
+    assert!((d.delay_s - 0.02).abs() < 0.002, "{d:?}");
 }

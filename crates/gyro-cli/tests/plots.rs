@@ -127,6 +127,7 @@ fn small_calibration() -> Calibration {
             leave_one_out: false,
             initial_tau_s: None,
             fit_motion: false,
+            reference_delay_s: None,
         },
         &mut |_, _, _| {},
     )

@@ -1,5 +1,6 @@
 //! The text of `calibrate`: fitted models and the per-run scores.
 
+use gyro_analysis::calibrate::delay::DelaySource;
 use gyro_analysis::calibrate::{Calibration, Candidate, ChoiceReason, RunScore};
 use gyro_core::{Compensation, Config};
 use serde::Serialize;
@@ -100,6 +101,7 @@ pub fn table(c: &Calibration) -> String {
         "start: correlation time {:.1} s ({})\n",
         c.initial_tau.0, c.initial_tau.1
     );
+    s += &delay_text(c);
     let f = &c.fitted;
     if f.motion != Config::default().motion {
         s += &format!(
@@ -142,6 +144,75 @@ pub fn table(c: &Calibration) -> String {
     s += &score_table("training runs", &c.train);
     s += &score_table("hold-out runs", &c.holdout);
     s += &choice_table(c);
+    s += &scale_text(c);
+    s
+}
+
+/// The gyro's delay behind the reference the runs were scored with, and where it came from.
+fn delay_text(c: &Calibration) -> String {
+    let d = &c.reference_delay;
+    let per_run = || {
+        let lags: Vec<String> = d
+            .per_run_s
+            .iter()
+            .map(|l| l.map_or_else(|| "-".to_string(), |l| format!("{:.1}", 1e3 * l)))
+            .collect();
+        lags.join(", ")
+    };
+    match d.source {
+        DelaySource::Given => format!(
+            "reference delay: {:.1} ms as given: every run is scored against the reference that far back\n",
+            1e3 * d.delay_s
+        ),
+        DelaySource::CrossCorrelation => format!(
+            "reference delay: the gyro lags the reference by {:.1} ms (cross-correlation peak, median of the training runs: {} ms): every run is scored against the reference that far back, and the model file says so\n",
+            1e3 * d.delay_s,
+            per_run()
+        ),
+        DelaySource::NotApplied => format!(
+            "reference delay: none applied (cross-correlation peaks {} ms, under {} grid slots)\n",
+            per_run(),
+            gyro_analysis::calibrate::delay::MIN_SLOTS
+        ),
+    }
+}
+
+/// The scale factor from the movements' totals: its fit, its held-out effect and whether
+/// it was written.
+fn scale_text(c: &Calibration) -> String {
+    let sc = &c.scale;
+    let Some(k) = sc.k else {
+        return format!(
+            "scale: not fitted ({} completed movement(s) with a reference turn)\n",
+            sc.movements
+        );
+    };
+    let se = sc
+        .standard_error
+        .map_or_else(String::new, |se| format!(" ± {:.3}%", 100.0 * se));
+    let mut s = format!(
+        "scale: {:+.3}%{se} from the totals of {} movement(s) (the gyro reads (1 + k) times the reference turn)\n",
+        100.0 * k,
+        sc.movements
+    );
+    if let Some((without, with)) = sc.leave_one_out_deg {
+        s += &format!(
+            "  RMS error of the turns (rest to rest) leaving each run out, {} with its refit: {without:.4} -> {with:.4} deg, better on {}/{} runs\n",
+            candidate_name(c.choice.written),
+            sc.runs_better.0,
+            sc.runs_better.1
+        );
+    }
+    if let Some((without, with)) = sc.holdout_deg {
+        s += &format!("  the same on the hold-out runs: {without:.4} -> {with:.4} deg\n");
+    }
+    s += if sc.written {
+        "  written (config.correction.scale_k): held out it lowers the turns' error and is better on most runs\n"
+    } else if sc.leave_one_out_deg.is_none() {
+        "  not written: no leave-one-run-out refits (or no turns) to judge it on\n"
+    } else {
+        "  not written: held out it does not lower the turns' error (overall and on most runs)\n"
+    };
     s
 }
 
@@ -190,6 +261,13 @@ fn choice_table(c: &Calibration) -> String {
             score.training_deg
         );
     }
+    if c.choice.paper_at_bound {
+        let _ = writeln!(
+            s,
+            "  paper: not eligible: its fit sits on a bound (b0 {:.3} deg/s, o0 {:.3} deg), absorbing an error the model cannot express",
+            c.fitted.paper.b0_dps, c.fitted.paper.o0_deg
+        );
+    }
     let _ = writeln!(s, "model written: {}", choice_text(c));
     s
 }
@@ -217,8 +295,12 @@ pub fn choice_text(c: &Calibration) -> String {
             "no leave-one-run-out refits (switched off, or one training run), so nothing fitted is written"
         }
     };
+    let scale = match c.scale.k {
+        Some(k) if c.scale.written => format!("; scale {:+.3}% written", 100.0 * k),
+        _ => String::new(),
+    };
     format!(
-        "{} ({}): {why}",
+        "{} ({}): {why}{scale}",
         candidate_name(written),
         candidate_text(c, written)
     )

@@ -426,8 +426,32 @@ pub fn lag_at_search_edge(stats: &[Stat], fs: f64) -> Option<f64> {
 /// the best one (the same peak as an exhaustive search unless two peaks lie within a few
 /// samples of each other).
 fn xcorr_peak_lag(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
+    xcorr_peak_lag_within(gyro, reference, fs, MAX_LAG_S, Overlap::Divide)
+}
+
+/// How the cross-correlation at a lag is normalised.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Overlap {
+    /// By the overlap's length (`n − |lag|`): the diagnosis's statistic, compared with
+    /// simulations computed alike. It leans towards longer lags when the motion sits
+    /// inside the run (the sum stays, the divisor shrinks).
+    Divide,
+    /// By the run's length: no lean, the peak of motion inside the run is where the
+    /// signals align (a measured delay).
+    Whole,
+}
+
+/// [`xcorr_peak_lag`] within ±`max_lag_s` (s) instead of ±[`MAX_LAG_S`], normalised as
+/// `overlap` says.
+pub(crate) fn xcorr_peak_lag_within(
+    gyro: &[f64],
+    reference: &[f64],
+    fs: f64,
+    max_lag_s: f64,
+    overlap: Overlap,
+) -> Option<f64> {
     let n = gyro.len();
-    let max_lag = ((MAX_LAG_S * fs).round() as usize).max(1);
+    let max_lag = ((max_lag_s * fs).round() as usize).max(1);
     let both = |i: usize| gyro[i].is_finite() && reference[i].is_finite();
     let count = (0..n).filter(|&i| both(i)).count();
     if count < 3 {
@@ -467,7 +491,10 @@ fn xcorr_peak_lag(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
         for k in 4 * chunks..a.len() {
             sum += a[k] * b[k];
         }
-        sum / (n - l) as f64
+        match overlap {
+            Overlap::Divide => sum / (n - l) as f64,
+            Overlap::Whole => sum / n as f64,
+        }
     };
     let max_lag = max_lag as i64;
     let step = (max_lag / 10).clamp(1, 8);

@@ -32,6 +32,12 @@ pub struct Args {
     /// Also fit the motion detector's thresholds (slower: runs are replayed per trial).
     #[arg(long)]
     fit_motion: bool,
+    /// The gyro's delay behind the reference (s; negative: it leads) to score every run
+    /// with, written to the model file. Default: the `--model` file's `reference_delay_s`
+    /// if it has one, else measured on the training runs (cross-correlation of the rates
+    /// within ±0.5 s, applied from 2 grid slots); 0 scores against the reference as logged.
+    #[arg(long, value_parser = gyro_log::value::finite::<f64>, allow_negative_numbers = true)]
+    reference_delay_s: Option<f64>,
     /// Skip the leave-one-run-out refits. The model written is chosen on their held-out
     /// errors, so without them the starting configuration is written.
     #[arg(long)]
@@ -72,6 +78,14 @@ pub fn run(args: &Args) -> Result<()> {
         inputs.chain(args.model.as_deref()),
     )?;
     super::refuse_repeated_runs(&[("training", &args.logs), ("hold-out", &args.holdout)])?;
+    if let Some(d) = args.reference_delay_s {
+        if d.abs() > model::MAX_REFERENCE_DELAY_S {
+            anyhow::bail!(
+                "--reference-delay-s {d}: expected at most {} s either way",
+                model::MAX_REFERENCE_DELAY_S
+            );
+        }
+    }
     let base = match &args.model {
         Some(path) => model::load(path)?,
         None => model::ModelFile::new(Config::default()),
@@ -88,6 +102,9 @@ pub fn run(args: &Args) -> Result<()> {
         leave_one_out: !args.no_leave_one_out,
         initial_tau_s: args.tau_s,
         fit_motion: args.fit_motion,
+        reference_delay_s: args
+            .reference_delay_s
+            .or((base.reference_delay_s != 0.0).then_some(base.reference_delay_s)),
     };
     let result = calibrate(
         &train,
@@ -105,6 +122,7 @@ pub fn run(args: &Args) -> Result<()> {
     let result = result?;
     let mut out = base.clone();
     out.config = result.config;
+    out.reference_delay_s = result.reference_delay.delay_s;
     model::save(&args.out, &out).with_context(|| "writing the model file".to_string())?;
     let inputs: Vec<_> = train
         .iter()

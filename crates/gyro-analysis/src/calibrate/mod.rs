@@ -14,10 +14,15 @@
 //! β ∈ [1e-4, 10] 1/s, b0 ∈ [−10, 10] deg/s, o0 ∈ [−5, 5] deg, from β = 1/T of the rest
 //! data's correlation estimate (or 0.01 1/s), b0 = the median rest bias, o0 = 0.
 
-use crate::replay::{replay, RunReport, Summary};
+pub mod delay;
+pub mod scale;
+
+use crate::replay::{replay_with, ReplayOptions, RunReport, Summary};
+use delay::ReferenceDelay;
 use gyro_core::{Compensation, Config, GaussMarkov, KalmanConfig, MotionConfig, MotionState};
 use gyro_log::RegularLog;
 use nelder_mead::{Bounds, InitialSteps, NelderMead, Termination};
+use scale::{MovementTotal, ScaleFit};
 use serde::Serialize;
 
 /// A bench run: a log with a reference.
@@ -109,11 +114,20 @@ impl Trace {
     /// Replay `log` with `config` (compensation switched off) and keep what the paper
     /// mode needs.
     pub fn new(log: &RegularLog, config: &Config) -> Result<Self, gyro_core::Error> {
+        Self::new_with(log, config, &ReplayOptions::default())
+    }
+
+    /// [`Trace::new`], scored as `scoring` says (against the reference shifted by a delay).
+    pub fn new_with(
+        log: &RegularLog,
+        config: &Config,
+        scoring: &ReplayOptions,
+    ) -> Result<Self, gyro_core::Error> {
         let none = Config {
             compensation: Compensation::None,
             ..*config
         };
-        let report = replay(log, &none)?;
+        let report = replay_with(log, &none, scoring)?;
         Ok(Self::from_report(&report))
     }
 
@@ -393,6 +407,9 @@ pub struct Choice {
     pub reason: ChoiceReason,
     /// Every candidate's error, the default first.
     pub scores: Vec<CandidateScore>,
+    /// The paper model's fit sits on a bound of b0 or o0 ([`paper_at_bound`]): it is not
+    /// written whatever its error.
+    pub paper_at_bound: bool,
 }
 
 /// The candidate to write. A candidate beats the default when, held out (leave one run
@@ -400,6 +417,15 @@ pub struct Choice {
 /// of those, the lowest objective is written, else the default. Training errors are not
 /// looked at.
 pub fn choose(scores: &[CandidateScore]) -> (Candidate, ChoiceReason) {
+    choose_among(scores, &[])
+}
+
+/// [`choose`] with the candidates in `excluded` never written (the paper model when its fit
+/// sits on a bound, [`paper_at_bound`]).
+pub fn choose_among(
+    scores: &[CandidateScore],
+    excluded: &[Candidate],
+) -> (Candidate, ChoiceReason) {
     if scores.iter().all(|s| s.leave_one_out_deg.is_none()) {
         return (Candidate::Default, ChoiceReason::NoRefits);
     }
@@ -422,7 +448,8 @@ pub fn choose(scores: &[CandidateScore]) -> (Candidate, ChoiceReason) {
     };
     scores
         .iter()
-        .filter(|s| s.candidate != Candidate::Default && beats_default(s))
+        .filter(|s| s.candidate != Candidate::Default && !excluded.contains(&s.candidate))
+        .filter(|s| beats_default(s))
         .filter_map(|s| Some((s.candidate, finite(s)?)))
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map_or(
@@ -452,6 +479,12 @@ pub struct Calibration {
     pub start: Config,
     /// Which candidate is written, chosen on leave-one-run-out error.
     pub choice: Choice,
+    /// The scale factor from the movements' totals, written on top of the candidate when
+    /// it lowers the leave-one-run-out error.
+    pub scale: ScaleFit,
+    /// The gyro's delay behind the reference every replay was scored with; the model
+    /// file's `reference_delay_s`.
+    pub reference_delay: ReferenceDelay,
     /// The configuration written to the model file.
     pub config: Config,
     /// Per training run.
@@ -515,6 +548,20 @@ fn stats(values: &[f64]) -> [f64; 4] {
     [mean, var.sqrt(), min, max]
 }
 
+/// Bound of the paper model's |b0| (deg/s) in the fit.
+pub const B0_LIMIT_DPS: f64 = 10.0;
+/// Bound of the paper model's |o0| (deg) in the fit.
+pub const O0_LIMIT_DEG: f64 = 5.0;
+
+/// True if the paper model's b0 or o0 sits on its bound: the fit is absorbing an error
+/// the model cannot express (a turn's lag, a scale, another axis's turns), so its value
+/// is no measure of the sensor and is not written. β at its slow bound is a bias that
+/// does not decay within the runs, which the model does express.
+pub fn paper_at_bound(paper: &GaussMarkov) -> bool {
+    let near = |v: f32, limit: f64| (f64::from(v).abs() - limit).abs() < 1e-3 * limit;
+    near(paper.b0_dps, B0_LIMIT_DPS) || near(paper.o0_deg, O0_LIMIT_DEG)
+}
+
 /// Fit (β, b0, o0) on `traces`; `progress` is called after each evaluation with the best
 /// objective so far.
 fn fit_paper(
@@ -529,8 +576,8 @@ fn fit_paper(
         o0_deg: x[2] as f32,
     };
     let bounds = Bounds::new(
-        vec![1e-4_f64.ln(), -10.0, -5.0],
-        vec![10f64.ln(), 10.0, 5.0],
+        vec![1e-4_f64.ln(), -B0_LIMIT_DPS, -O0_LIMIT_DEG],
+        vec![10f64.ln(), B0_LIMIT_DPS, O0_LIMIT_DEG],
     )
     .map_err(|e| CalibrateError::Optimiser(e.to_string()))?;
     // Initial steps of a size that matters for each parameter (scipy's 5 % rule would give
@@ -582,6 +629,9 @@ struct RunErrors {
     rms_deg: f64,
     /// Error of each completed movement.
     movement_deg: Vec<f64>,
+    /// Each completed, unsaturated movement's reference angle and error, rest to rest:
+    /// what the scale is fitted on.
+    totals: Vec<MovementTotal>,
 }
 
 impl Objective {
@@ -623,11 +673,16 @@ impl Objective {
     }
 }
 
-fn replay_errors(run: &BenchRun, config: &Config) -> Result<RunErrors, CalibrateError> {
-    let report = replay(&run.log, config).map_err(|source| CalibrateError::Config {
-        name: run.name.clone(),
-        source,
-    })?;
+fn replay_errors(
+    run: &BenchRun,
+    config: &Config,
+    scoring: &ReplayOptions,
+) -> Result<RunErrors, CalibrateError> {
+    let report =
+        replay_with(&run.log, config, scoring).map_err(|source| CalibrateError::Config {
+            name: run.name.clone(),
+            source,
+        })?;
     let Summary {
         max_abs_error_deg,
         rms_error_deg,
@@ -642,6 +697,7 @@ fn replay_errors(run: &BenchRun, config: &Config) -> Result<RunErrors, Calibrate
             .filter(|m| m.complete)
             .filter_map(|m| m.error_deg)
             .collect(),
+        totals: scale::rest_to_rest(&report),
     })
 }
 
@@ -650,8 +706,9 @@ fn candidate_errors(
     run: &BenchRun,
     base: &Config,
     fitted: &Fitted,
+    scoring: &ReplayOptions,
 ) -> Result<[RunErrors; 4], CalibrateError> {
-    let [a, b, c, d] = Candidate::ALL.map(|c| replay_errors(run, &fitted.config(base, c)));
+    let [a, b, c, d] = Candidate::ALL.map(|c| replay_errors(run, &fitted.config(base, c), scoring));
     Ok([a?, b?, c?, d?])
 }
 
@@ -680,6 +737,9 @@ pub struct CalibrateOptions {
     pub initial_tau_s: Option<f64>,
     /// Also fit the motion detector's thresholds (`enter_dps`, `exit_dps`).
     pub fit_motion: bool,
+    /// The gyro's delay behind the reference (s) every replay is scored with; `None`:
+    /// measured on the training runs ([`delay::measure`]).
+    pub reference_delay_s: Option<f64>,
 }
 
 /// The correlation time of the bias from the rest segments of `runs` (Allan deviation
@@ -705,10 +765,14 @@ fn rest_correlation_time(runs: &[&BenchRun], base: &Config) -> Option<f64> {
     }
 }
 
-fn traces_for(runs: &[&BenchRun], base: &Config) -> Result<Vec<Trace>, CalibrateError> {
+fn traces_for(
+    runs: &[&BenchRun],
+    base: &Config,
+    scoring: &ReplayOptions,
+) -> Result<Vec<Trace>, CalibrateError> {
     runs.iter()
         .map(|run| {
-            Trace::new(&run.log, base).map_err(|source| CalibrateError::Config {
+            Trace::new_with(&run.log, base, scoring).map_err(|source| CalibrateError::Config {
                 name: run.name.clone(),
                 source,
             })
@@ -724,6 +788,7 @@ fn fit_motion(
     base: &Config,
     objective: Objective,
     start: GaussMarkov,
+    scoring: &ReplayOptions,
     progress: &mut dyn FnMut(&str, usize, f64),
 ) -> Result<Config, CalibrateError> {
     let with = |x: &[f64]| {
@@ -750,7 +815,7 @@ fn fit_motion(
     let outcome = optimiser
         .try_minimize(
             |x| -> Result<f64, CalibrateError> {
-                let traces = traces_for(train, &with(x))?;
+                let traces = traces_for(train, &with(x), scoring)?;
                 let (_, value, ..) = fit_paper(&traces, objective, start, &mut |_, _| {})?;
                 evaluations += 1;
                 progress("motion thresholds", evaluations, value);
@@ -821,6 +886,7 @@ fn fit(
     base: &Config,
     options: &CalibrateOptions,
     tau_s: f64,
+    scoring: &ReplayOptions,
     progress: &mut dyn FnMut(&str, usize, f64),
 ) -> Result<(Fit, Vec<Trace>), CalibrateError> {
     let rest_means: Vec<f64> = traces
@@ -833,8 +899,8 @@ fn fit(
         o0_deg: 0.0,
     };
     let (motion, traces) = if options.fit_motion {
-        let config = fit_motion(runs, base, options.objective, start, progress)?;
-        (config.motion, traces_for(runs, &config)?)
+        let config = fit_motion(runs, base, options.objective, start, scoring, progress)?;
+        (config.motion, traces_for(runs, &config, scoring)?)
     } else {
         (base.motion, traces)
     };
@@ -856,6 +922,98 @@ fn fit(
         },
         traces,
     ))
+}
+
+/// What [`decide_scale`] needs from a calibration.
+struct ScaleInput<'a> {
+    train: &'a [BenchRun],
+    holdout: &'a [BenchRun],
+    base: &'a Config,
+    scoring: &'a ReplayOptions,
+    written: Candidate,
+    /// The written candidate fitted on all training runs.
+    written_config: &'a Config,
+    /// What was fitted leaving each training run out, in training order (empty without
+    /// refits).
+    fold_fitted: &'a [Fitted],
+    /// Each training run's errors under every candidate fitted on all runs.
+    train_errors: &'a [[RunErrors; 4]],
+    /// Each left-out run's errors under every candidate fitted on the others.
+    held_out: &'a [[RunErrors; 4]],
+}
+
+/// The scale factor from the training runs' movement totals, rest to rest (under the
+/// starting configuration, [`Candidate::Default`]), and whether it is written: only if,
+/// fitted leaving each run out and added to the written candidate's refit, it lowers the
+/// turns' RMS error on the left-out runs and is better on most of them.
+fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
+    let totals_of = |errors: &[RunErrors; 4]| errors[0].totals.clone();
+    let all: Vec<MovementTotal> = input.train_errors.iter().flat_map(totals_of).collect();
+    let fitted = scale::fit(&all);
+    let slot = Candidate::ALL
+        .iter()
+        .position(|c| *c == input.written)
+        .unwrap_or(0);
+    let mut without = Vec::new();
+    let mut with = Vec::new();
+    if fitted.is_some() {
+        for (i, (run, fold)) in input.train.iter().zip(input.fold_fitted).enumerate() {
+            let others: Vec<MovementTotal> = input
+                .train_errors
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .flat_map(|(_, e)| totals_of(e))
+                .collect();
+            let Some(errors) = input.held_out.get(i) else {
+                break;
+            };
+            let fold_config = fold.config(input.base, input.written);
+            // A fold without a turn to fit on keeps its candidate as it is.
+            let scaled = scale::fit(&others)
+                .and_then(|(k, _)| scale::with_scale(&fold_config, k))
+                .unwrap_or(fold_config);
+            with.push(replay_errors(run, &scaled, input.scoring)?);
+            without.push(errors[slot].clone());
+        }
+    }
+    let pooled = |runs: &[RunErrors]| scale::turn_rms(runs.iter().flat_map(|r| &r.totals));
+    let leave_one_out_deg = pooled(&without).zip(pooled(&with));
+    let paired: Vec<(f64, f64)> = without
+        .iter()
+        .zip(&with)
+        .filter_map(|(o, w)| scale::turn_rms(&o.totals).zip(scale::turn_rms(&w.totals)))
+        .collect();
+    let runs_better = paired.iter().filter(|(o, w)| w < o).count();
+    let written = leave_one_out_deg.is_some_and(|(o, w)| w < o) && 2 * runs_better > paired.len();
+    let holdout_deg = match fitted {
+        Some((k, _)) if !input.holdout.is_empty() => {
+            let scaled = scale::with_scale(input.written_config, k);
+            let mut plain = Vec::new();
+            let mut corrected = Vec::new();
+            for run in input.holdout {
+                plain.push(replay_errors(run, input.written_config, input.scoring)?);
+                if let Some(config) = &scaled {
+                    corrected.push(replay_errors(run, config, input.scoring)?);
+                }
+            }
+            if corrected.len() == plain.len() {
+                pooled(&plain).zip(pooled(&corrected))
+            } else {
+                None
+            }
+        }
+        _ => None,
+    };
+    Ok(ScaleFit {
+        k: fitted.map(|(k, _)| k),
+        standard_error: fitted.and_then(|(_, se)| se),
+        movements: scale::turns(&all),
+        leave_one_out_deg,
+        runs_better: (runs_better, paired.len()),
+        holdout_deg,
+        written: written && fitted.is_some(),
+    })
 }
 
 /// Calibrate `base` on `train`; score on `train` and `holdout`. The configuration
@@ -885,7 +1043,14 @@ pub fn calibrate(
         },
     };
     let initial_tau = tau_for(&runs);
-    let base_traces = traces_for(&runs, base)?;
+    let reference_delay = match options.reference_delay_s {
+        Some(delay_s) => ReferenceDelay::given(delay_s),
+        None => delay::measure(&runs),
+    };
+    let scoring = ReplayOptions {
+        reference_delay_s: reference_delay.delay_s,
+    };
+    let base_traces = traces_for(&runs, base, &scoring)?;
     if base_traces.iter().all(|t| t.spans.is_empty()) {
         return Err(CalibrateError::NoMovement);
     }
@@ -895,12 +1060,14 @@ pub fn calibrate(
         base,
         options,
         initial_tau.0,
+        &scoring,
         progress,
     )?;
 
     // Leave-one-run-out: refit everything on the other runs, from their own start, and
     // score the left-out run with each candidate.
     let mut fold_fits = Vec::new();
+    let mut fold_fitted = Vec::new();
     let mut held_out: Vec<[RunErrors; 4]> = Vec::new();
     if options.leave_one_out && train.len() >= 2 {
         for (i, run) in train.iter().enumerate() {
@@ -922,10 +1089,12 @@ pub fn calibrate(
                 base,
                 options,
                 tau_for(&others).0,
+                &scoring,
                 &mut |_, n, best| progress(&stage, n, best),
             )?;
-            held_out.push(candidate_errors(run, base, &fold.fitted)?);
+            held_out.push(candidate_errors(run, base, &fold.fitted, &scoring)?);
             fold_fits.push(fold.fitted.paper);
+            fold_fitted.push(fold.fitted);
         }
     }
     let spread = (fold_fits.len() >= 3).then(|| {
@@ -947,14 +1116,14 @@ pub fn calibrate(
 
     let train_errors = train
         .iter()
-        .map(|run| candidate_errors(run, base, &full.fitted))
+        .map(|run| candidate_errors(run, base, &full.fitted, &scoring))
         .collect::<Result<Vec<_>, _>>()?;
     let holdout_scores = holdout
         .iter()
         .map(|run| {
             Ok(run_score(
                 &run.name,
-                &candidate_errors(run, base, &full.fitted)?,
+                &candidate_errors(run, base, &full.fitted, &scoring)?,
             ))
         })
         .collect::<Result<Vec<_>, CalibrateError>>()?;
@@ -974,7 +1143,29 @@ pub fn calibrate(
                 .aggregate(train_errors.iter().map(|e| &e[k])),
         })
         .collect();
-    let (written, reason) = choose(&scores);
+    let paper_at_bound = paper_at_bound(&full.fitted.paper);
+    let excluded: &[Candidate] = if paper_at_bound {
+        &[Candidate::Paper]
+    } else {
+        &[]
+    };
+    let (written, reason) = choose_among(&scores, excluded);
+    let written_config = full.fitted.config(base, written);
+    let scale = decide_scale(&ScaleInput {
+        train,
+        holdout,
+        base,
+        scoring: &scoring,
+        written,
+        written_config: &written_config,
+        fold_fitted: &fold_fitted,
+        train_errors: &train_errors,
+        held_out: &held_out,
+    })?;
+    let config = match scale.k {
+        Some(k) if scale.written => scale::with_scale(&written_config, k).unwrap_or(written_config),
+        _ => written_config,
+    };
     Ok(Calibration {
         fitted: full.fitted,
         objective: options.objective,
@@ -987,8 +1178,11 @@ pub fn calibrate(
             written,
             reason,
             scores,
+            paper_at_bound,
         },
-        config: full.fitted.config(base, written),
+        scale,
+        reference_delay,
+        config,
         train: train
             .iter()
             .zip(&train_errors)
