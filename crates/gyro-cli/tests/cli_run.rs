@@ -397,3 +397,96 @@ fn unusual_encodings_are_read_and_bad_gap_limits_refused() {
         assert!(stderr.contains("--max-gap-s"), "{bad}: {stderr}");
     }
 }
+
+/// `calibrate` fits a scale from the turns and a gyro latency as the reference delay, writes
+/// both into the model file, and `run --model` uses them; a delay of a second or more is
+/// refused.
+#[test]
+fn calibrate_writes_the_scale_and_the_reference_delay() {
+    let dir = temp_dir("calibrate-scale");
+    let mut runs = Vec::new();
+    for seed in 41..=44 {
+        let path = dir.join(format!("run{seed}.csv"));
+        let out = gyro(&[
+            "simulate",
+            "--force",
+            "-o",
+            path.to_str().unwrap(),
+            "--seed",
+            &seed.to_string(),
+            "--duration-s",
+            "60",
+            "--effect",
+            "scale_factor:k=-0.02",
+            "--effect",
+            "latency:delay_s=0.015",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        runs.push(path.to_str().unwrap().to_string());
+    }
+    let model = dir.join("model.json");
+    let mut args = vec![
+        "calibrate",
+        "--format",
+        "json",
+        "-o",
+        model.to_str().unwrap(),
+    ];
+    args.extend(runs[..3].iter().map(String::as_str));
+    args.extend(["--holdout", runs[3].as_str()]);
+    let report = json_of(&gyro(&args));
+    let scale = &report["scale"];
+    assert_eq!(scale["written"], true, "{scale}");
+    assert!(
+        (scale["k"].as_f64().unwrap() + 0.02).abs() < 0.001,
+        "{scale}"
+    );
+    let delay = &report["reference_delay"];
+    assert_eq!(delay["source"], "cross_correlation", "{delay}");
+    assert!(
+        (delay["delay_s"].as_f64().unwrap() - 0.015).abs() < 0.002,
+        "{delay}"
+    );
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let k = file["config"]["correction"]["scale_k"].as_f64().unwrap();
+    assert!((k + 0.02).abs() < 0.001, "{file}");
+    assert_eq!(file["reference_delay_s"], delay["delay_s"]);
+
+    // The held-out run: every turn's error, with the model and without.
+    let turns = |extra: &[&str]| {
+        let mut args = vec!["run", runs[3].as_str(), "--format", "json"];
+        args.extend(extra);
+        let run = json_of(&gyro(&args));
+        run["movements"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|m| m["reference_deg"].as_f64().unwrap().abs() > 10.0)
+            .map(|m| m["error_deg"].as_f64().unwrap().abs())
+            .fold(0.0_f64, f64::max)
+    };
+    let (without, with) = (turns(&[]), turns(&["--model", model.to_str().unwrap()]));
+    assert!(
+        with < 0.25 * without,
+        "worst turn error {without} -> {with} deg"
+    );
+
+    let refused = dir.join("refused.json");
+    let out = gyro(&[
+        "calibrate",
+        &runs[0],
+        "--reference-delay-s",
+        "1.5",
+        "-o",
+        refused.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("--reference-delay-s 1.5"), "{stderr}");
+    assert!(!refused.exists());
+}

@@ -206,8 +206,11 @@ fn scale_text(c: &Calibration) -> String {
     if let Some((without, with)) = sc.holdout_deg {
         s += &format!("  the same on the hold-out runs: {without:.4} -> {with:.4} deg\n");
     }
+    let significant = gyro_analysis::calibrate::scale::significant(k, sc.standard_error);
     s += if sc.written {
         "  written (config.correction.scale_k): held out it lowers the turns' error and is better on most runs\n"
+    } else if !significant {
+        "  not written: within its noise (under 1.96 standard errors from zero)\n"
     } else if sc.leave_one_out_deg.is_none() {
         "  not written: no leave-one-run-out refits (or no turns) to judge it on\n"
     } else {

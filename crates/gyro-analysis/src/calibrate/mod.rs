@@ -943,9 +943,10 @@ struct ScaleInput<'a> {
 }
 
 /// The scale factor from the training runs' movement totals, rest to rest (under the
-/// starting configuration, [`Candidate::Default`]), and whether it is written: only if,
-/// fitted leaving each run out and added to the written candidate's refit, it lowers the
-/// turns' RMS error on the left-out runs and is better on most of them.
+/// starting configuration, [`Candidate::Default`]), and whether it is written: only if it
+/// differs from zero beyond its noise ([`scale::significant`]) and, fitted leaving each
+/// run out and added to the written candidate's refit, it lowers the turns' RMS error on
+/// the left-out runs and is better on most of them.
 fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
     let totals_of = |errors: &[RunErrors; 4]| errors[0].totals.clone();
     let all: Vec<MovementTotal> = input.train_errors.iter().flat_map(totals_of).collect();
@@ -985,7 +986,10 @@ fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
         .filter_map(|(o, w)| scale::turn_rms(&o.totals).zip(scale::turn_rms(&w.totals)))
         .collect();
     let runs_better = paired.iter().filter(|(o, w)| w < o).count();
-    let written = leave_one_out_deg.is_some_and(|(o, w)| w < o) && 2 * runs_better > paired.len();
+    let significant = fitted.is_some_and(|(k, se)| scale::significant(k, se));
+    let written = significant
+        && leave_one_out_deg.is_some_and(|(o, w)| w < o)
+        && 2 * runs_better > paired.len();
     let holdout_deg = match fitted {
         Some((k, _)) if !input.holdout.is_empty() => {
             let scaled = scale::with_scale(input.written_config, k);

@@ -119,6 +119,16 @@ pub fn fit(movements: &[MovementTotal]) -> Option<(f64, Option<f64>)> {
     Some((k, se))
 }
 
+/// Standard errors a fitted `k` must lie from zero to be written: its 95% interval
+/// (±1.96 se) excludes no scale error.
+pub const MIN_Z: f64 = 1.96;
+
+/// True if `k` differs from zero beyond its noise: `|k| ≥` [`MIN_Z`] `· se`. Without a
+/// standard error (one turn) nothing shows that it is not noise.
+pub fn significant(k: f64, se: Option<f64>) -> bool {
+    se.is_some_and(|se| se.is_finite() && k.abs() >= MIN_Z * se)
+}
+
 /// `config` with a further scale error `k` corrected: the scale it already corrects and
 /// `k` compose, `(1 + k0)(1 + k) − 1`. `None` if the result is not a valid configuration.
 pub fn with_scale(config: &Config, k: f64) -> Option<Config> {
@@ -149,8 +159,9 @@ pub struct ScaleFit {
     /// The turn RMS on the hold-out runs with the written candidate, without and with
     /// the scale fitted on all training runs (deg; `None` without hold-out turns).
     pub holdout_deg: Option<(f64, f64)>,
-    /// Written into the model file (`config.correction.scale_k`): held out, it lowers the
-    /// turns' RMS error and is better on most left-out runs.
+    /// Written into the model file (`config.correction.scale_k`): it differs from zero
+    /// beyond its noise ([`significant`]), and held out it lowers the turns' RMS error and
+    /// is better on most left-out runs.
     pub written: bool,
 }
 
@@ -189,6 +200,14 @@ mod tests {
         assert_eq!(fit(&[m(10.0, 5.0)]), None, "50% is no scale error");
         assert_eq!(fit(&[m(10.0, f64::NAN)]), None);
         assert_eq!(fit(&[m(10.0, 0.1)]).unwrap().1, None);
+    }
+
+    #[test]
+    fn noise_is_not_a_scale() {
+        assert!(significant(-0.0127, Some(0.0003)));
+        assert!(!significant(-0.00003, Some(0.00002)));
+        assert!(!significant(0.01, None));
+        assert!(!significant(0.01, Some(f64::NAN)));
     }
 
     #[test]
