@@ -13,7 +13,11 @@
 //! spread over a few samples). When the stretch ends, it is a *jump* if its steps differ
 //! from the gyro by more than [`REFERENCE_JUMP_DEG`] in all, the gyro again turning by
 //! less than [`GYRO_SHARE`] of that: every reference value from the stretch on is
-//! re-based so that over the stretch the reference follows the gyro. Otherwise, or when
+//! re-based so that over the stretch the reference follows the gyro. A jump within
+//! [`WRAP_TOLERANCE_DEG`] of a whole number of turns is a wrap, and the reference after it
+//! is re-based by exactly those turns: what the reference and the gyro each did over the
+//! stretch (a pose that stops while a lagging gyro still turns, say) is then not traded
+//! for the gyro's version. Otherwise, or when
 //! the stretch outgrows [`MAX_HELD_SLOTS`], its slots go on as they were (motion the gyro
 //! did not see is a finding, not a thing to hide). A gyro that clips falls that far behind
 //! only under a turn many times its range; genuine motion moves both. Each jump is
@@ -28,6 +32,8 @@ pub const REFERENCE_JUMP_DEG: f64 = 90.0;
 pub const SUSPECT_DEG: f64 = 10.0;
 /// ... when the gyro turns by less than this share of the difference.
 pub const GYRO_SHARE: f64 = 0.1;
+/// A jump this close (deg) to a whole number of turns is a wrap of exactly those turns.
+pub const WRAP_TOLERANCE_DEG: f64 = 10.0;
 /// Longest stretch of suspect slots held back: a longer one is not a jump.
 pub const MAX_HELD_SLOTS: usize = 16;
 
@@ -157,9 +163,18 @@ impl ReferenceJumps {
                 ));
             }
         }
+        // A wrap re-bases by whole turns: the held slots are spread over them in
+        // proportion to their steps, so that the stretch ends on exactly that offset.
+        let turns = (total / 360.0).round();
+        let rebase = if jump && turns != 0.0 && (total - 360.0 * turns).abs() <= WRAP_TOLERANCE_DEG
+        {
+            360.0 * turns / total
+        } else {
+            1.0
+        };
         for mut h in self.held.drain(..) {
             if jump {
-                self.offset_deg += h.mismatch_deg;
+                self.offset_deg += h.mismatch_deg * rebase;
             }
             if let Some(raw) = h.slot.reference_deg {
                 h.slot.reference_deg = Some(raw - self.offset_deg);
@@ -208,8 +223,8 @@ mod tests {
             (0.0, Some(-0.01)),
             (0.0, Some(-0.01)),
             (0.0, Some(-180.0)),
-            (0.0, Some(-360.0)),
-            (0.0, Some(-360.0)),
+            (0.0, Some(-360.01)),
+            (0.0, Some(-360.01)),
         ]);
         for r in &out {
             assert!((r.unwrap_or(f64::NAN) + 0.01).abs() < 1e-9, "{out:?}");
@@ -257,6 +272,27 @@ mod tests {
         ]);
         assert_eq!(q.reference_jumps, 2);
         assert!(out.iter().all(|r| *r == Some(179.0)), "{out:?}");
+    }
+
+    /// A pose that wraps as it stops while a gyro that lags it still turns: the reference
+    /// after the wrap keeps the pose's own value less 360°, not the gyro's.
+    #[test]
+    fn a_wrap_is_whole_turns_whatever_the_gyro_does_over_it() {
+        let (out, q) = rebased(&[
+            (0.0, Some(178.0)),
+            (300.0, Some(180.0)),
+            (200.0, Some(-180.0)),
+            (100.0, Some(-180.0)),
+            (0.0, Some(-180.0)),
+        ]);
+        assert_eq!(q.reference_jumps, 1);
+        assert_eq!(out[1], Some(180.0));
+        // The gyro turned 2.5 deg over the jump step; the pose none.
+        assert!((out[4].unwrap() - 180.0).abs() < 1e-9, "{out:?}");
+        // Not a whole turn: re-based by what the gyro did not see.
+        let (out, q) = rebased(&[(0.0, Some(0.0)), (0.0, Some(250.0)), (0.0, Some(250.0))]);
+        assert_eq!(q.reference_jumps, 1);
+        assert_eq!(out[2], Some(0.0));
     }
 
     /// A wrap resampled onto a grid is spread over a few samples, one of them below the

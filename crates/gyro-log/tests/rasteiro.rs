@@ -121,3 +121,33 @@ fn reference_jumps_are_re_based() {
         assert!(holed || off < 10.0, "{}: {off} deg", path.display());
     }
 }
+
+/// On the z recordings the robot turns the board +180 deg and back; its pose wraps at the
+/// far end while the gyro, 80-120 ms behind, still turns. Re-based by whole turns, the
+/// reference reaches 180 deg and comes back to where it began.
+#[test]
+fn a_wrap_during_a_turn_keeps_the_pose_s_own_angle() {
+    for path in recordings()
+        .into_iter()
+        .filter(|p| p.to_string_lossy().ends_with("_z.csv"))
+    {
+        let placed = placed(&path);
+        let reference: Vec<f64> = placed
+            .slots
+            .iter()
+            .filter_map(|s| s.reference_deg)
+            .collect();
+        let (first, last) = (reference[0], reference[reference.len() - 1]);
+        let top = reference.iter().copied().fold(f64::MIN, f64::max);
+        assert!(
+            (last - first).abs() < 0.1,
+            "{}: {first} -> {last}",
+            path.display()
+        );
+        assert!(
+            (top - first - 180.0).abs() < 1.0,
+            "{}: top {top}",
+            path.display()
+        );
+    }
+}
