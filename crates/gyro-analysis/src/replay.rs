@@ -10,6 +10,7 @@
 //! reference ([`ReplayOptions::reference_delay_s`], the model file's `reference_delay_s`)
 //! is a matter of scoring only: the reference is shifted by it before the comparison.
 
+use crate::lag::LagMeter;
 use crate::model::ModelFile;
 use gyro_core::{
     decide, Compensation, Config, Decimator, Event, MotionState, Pipeline, Sos, SosState,
@@ -122,6 +123,10 @@ pub struct Summary {
     pub raw_rms_error_deg: Option<f64>,
     /// Raw angle − reference at the last sample (deg).
     pub raw_final_error_deg: Option<f64>,
+    /// The gyro's lag behind the reference it was scored against (s; negative: it leads),
+    /// from the output series' rates ([`crate::lag::LagMeter`]); `None` without a
+    /// reference, without motion both show, or beyond ±[`crate::lag::SEARCH_S`].
+    pub reference_lag_s: Option<f64>,
 }
 
 /// How a replay is scored, beyond the pipeline's configuration.
@@ -426,6 +431,7 @@ pub struct Replayer {
     first_time_s: Option<f64>,
     errors: ErrorStats,
     raw_errors: ErrorStats,
+    lag: LagMeter,
     movements: Vec<MovementResult>,
     open: Option<OpenMovement>,
     /// Filled input slots (gaps, missing rates) so far.
@@ -504,6 +510,7 @@ impl Replayer {
             first_time_s: None,
             errors: ErrorStats::default(),
             raw_errors: ErrorStats::default(),
+            lag: LagMeter::new(1.0 / f64::from(output_rate_hz)),
             movements: Vec::new(),
             open: None,
             filled_total: 0,
@@ -653,6 +660,8 @@ impl Replayer {
         if let Some(r) = point.reference_deg {
             self.raw_errors.add(f64::from(point.raw_angle_deg) - r);
         }
+        self.lag
+            .push(f64::from(point.rate_dps), point.reference_deg);
         self.first_time_s.get_or_insert(point.time_s);
         if self.held.len() >= self.max_held {
             self.held.pop_front();
@@ -735,6 +744,7 @@ impl Replayer {
             raw_max_abs_error_deg: raw_max_abs,
             raw_rms_error_deg: raw_rms,
             raw_final_error_deg: raw_final,
+            reference_lag_s: self.lag.lag_s(),
         };
         RunReport {
             sample_rate_hz: self.sample_rate_hz,

@@ -490,3 +490,61 @@ fn calibrate_writes_the_scale_and_the_reference_delay() {
     assert!(stderr.contains("--reference-delay-s 1.5"), "{stderr}");
     assert!(!refused.exists());
 }
+
+/// A gyro 60 ms behind its reference: `run` measures the lag and warns in every output;
+/// scored with that delay, or on the bench fixture, it does not.
+#[test]
+fn a_lagging_reference_is_measured_and_said() {
+    let dir = temp_dir("reference-lag");
+    let log = dir.join("late.csv");
+    let out = gyro(&[
+        "simulate",
+        "--force",
+        "-o",
+        log.to_str().unwrap(),
+        "--seed",
+        "7",
+        "--duration-s",
+        "40",
+        "--effect",
+        "latency:delay_s=0.06",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let log = log.to_str().unwrap();
+    let report = json_of(&gyro(&["run", log, "--format", "json"]));
+    let lag = report["summary"]["reference_lag_s"].as_f64().unwrap();
+    assert!((lag - 0.06).abs() < 0.004, "{lag}");
+    let warning = report["warnings"][0].as_str().unwrap();
+    assert!(
+        warning.contains("the gyro lags the reference as logged by 60 ms"),
+        "{warning}"
+    );
+    let table = gyro(&["run", log]);
+    assert!(String::from_utf8_lossy(&table.stdout).contains("warning: the gyro lags"));
+    let csv = gyro(&["run", log, "--format", "csv"]);
+    assert!(String::from_utf8_lossy(&csv.stderr).contains("warning: the gyro lags"));
+
+    let model = write(
+        &dir,
+        "delay.json",
+        r#"{"format": "gyro-model", "version": 1, "reference_delay_s": 0.06}"#,
+    );
+    let scored = json_of(&gyro(&["run", log, "--format", "json", "--model", &model]));
+    assert!(scored["summary"]["reference_lag_s"].as_f64().unwrap().abs() < 0.004);
+    assert!(scored.get("warnings").is_none(), "{}", scored["warnings"]);
+
+    let bench = bench_log();
+    let fixture = json_of(&gyro(&["run", bench.to_str().unwrap(), "--format", "json"]));
+    assert!(
+        fixture["summary"]["reference_lag_s"]
+            .as_f64()
+            .unwrap()
+            .abs()
+            < 0.002
+    );
+    assert!(fixture.get("warnings").is_none());
+}

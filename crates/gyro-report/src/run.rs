@@ -184,10 +184,37 @@ pub fn table(file: &str, report: &RunReport) -> String {
             opt(sm.raw_rms_error_deg, 4),
             opt(sm.raw_final_error_deg, 4)
         );
+        if let Some(warning) = lag_warning(report) {
+            let _ = writeln!(s, "warning: {warning}");
+        }
     } else {
         let _ = writeln!(s, "  no reference_deg column: no error figures");
     }
     s
+}
+
+/// The warning for a gyro that lags (or leads) the reference it is scored against by at
+/// least [`gyro_analysis::lag::NOTABLE_S`]: the errors during turns are then mostly the
+/// lag's, not the sensor's.
+pub fn lag_warning(report: &RunReport) -> Option<String> {
+    let lag_s = report.summary.reference_lag_s?;
+    if lag_s.abs() < gyro_analysis::lag::NOTABLE_S {
+        return None;
+    }
+    let how = if lag_s > 0.0 { "lags" } else { "leads" };
+    let scored = if report.reference_delay_s == 0.0 {
+        "the reference as logged".to_string()
+    } else {
+        format!(
+            "the reference (shifted by {:.1} ms)",
+            1e3 * report.reference_delay_s
+        )
+    };
+    Some(format!(
+        "the gyro {how} {scored} by {:.0} ms (cross-correlation of the rates): the errors against it during turns are the rate times that, not the sensor's; score with a model file's reference_delay_s of {:.3} s (`calibrate` measures and writes it)",
+        1e3 * lag_s.abs(),
+        report.reference_delay_s + lag_s,
+    ))
 }
 
 /// The JSON name of a verdict.
@@ -220,8 +247,16 @@ pub fn json(file: &str, report: &RunReport) -> serde_json::Result<String> {
         file: &'a str,
         #[serde(flatten)]
         report: &'a RunReport,
+        /// What makes the figures mean less than they seem ([`lag_warning`]).
+        #[serde(skip_serializing_if = "Vec::is_empty")]
+        warnings: Vec<String>,
     }
-    serde_json::to_string_pretty(&WithFile { file, report })
+    let warnings = lag_warning(report).into_iter().collect();
+    serde_json::to_string_pretty(&WithFile {
+        file,
+        report,
+        warnings,
+    })
 }
 
 /// CSV of the movements.

@@ -12,9 +12,8 @@ use super::BenchRun;
 use crate::diagnose::stats::{residuals, xcorr_peak_lag_within, Overlap};
 use serde::Serialize;
 
-/// Half-width of the search (s): a latency of a few milliseconds and a logger's arrival
-/// delay of a hundred both fall inside.
-pub const SEARCH_S: f64 = 0.5;
+/// Half-width of the search (s): the same as `run`'s ([`crate::lag::SEARCH_S`]).
+pub use crate::lag::SEARCH_S;
 
 /// Delays shorter than this many grid slots are not applied: the peak is not resolved
 /// finer than a slot or two, and a bench encoder and gyro sampled together show none.

@@ -518,14 +518,11 @@ pub(crate) fn xcorr_peak_lag_within(
         return None;
     }
     let k = best.0;
-    let mut offset = 0.0;
-    if k > -max_lag && k < max_lag {
-        let (a, b, d) = (corr(k - 1), best.1, corr(k + 1));
-        let denom = a - 2.0 * b + d;
-        if denom < 0.0 {
-            offset = (0.5 * (a - d) / denom).clamp(-0.5, 0.5);
-        }
-    }
+    let offset = if k > -max_lag && k < max_lag {
+        crate::lag::parabola_offset(corr(k - 1), best.1, corr(k + 1))
+    } else {
+        0.0
+    };
     Some((k as f64 + offset) / fs)
 }
 

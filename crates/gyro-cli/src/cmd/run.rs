@@ -178,6 +178,12 @@ pub fn run(args: &Args) -> Result<()> {
         Format::Json => writeln!(out, "{}", json.unwrap_or_default()),
         Format::Csv => report::movements_csv(&mut &mut *out, &result.movements),
     })?;
+    if args.format != Format::Table {
+        // The table carries it; the JSON too, the movements' CSV cannot.
+        if let Some(warning) = report::lag_warning(&result) {
+            super::warn(&warning);
+        }
+    }
     if let Some(out) = &args.out {
         match series_file {
             Some(file) => file
