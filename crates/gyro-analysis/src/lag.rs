@@ -7,6 +7,8 @@
 //! path, then looks like a bad sensor. `run` measures the lag on every log with a
 //! reference and says so when it is at least [`NOTABLE_S`].
 
+use crate::diagnose::stats::{residuals, xcorr_peak_lag_within, Overlap};
+use gyro_log::RegularLog;
 use std::collections::VecDeque;
 
 /// Half-width of the search (s): a gyro's latency of a few milliseconds and a logger's
@@ -20,6 +22,22 @@ pub const NOTABLE_S: f64 = 0.02;
 /// Smallest correlation coefficient of the rates at the peak for a lag to be reported: a
 /// still run, or one whose reference moves unlike the gyro, has no lag to speak of.
 pub const MIN_CORRELATION: f64 = 0.5;
+
+/// The lag of a whole log (s; positive: the gyro lags): the peak of the cross-correlation
+/// of its gyro rate with its reference rate on the grid within ±[`SEARCH_S`], normalised
+/// by the log's length (motion inside the log does not lean it towards longer lags).
+/// `None` without a reference or a peak.
+pub fn log_lag_s(log: &RegularLog) -> Option<f64> {
+    let r = residuals(log).ok()?;
+    xcorr_peak_lag_within(
+        &r.rate_dps,
+        &r.reference_rate_dps,
+        r.sample_rate_hz,
+        SEARCH_S,
+        Overlap::Whole,
+    )
+    .filter(|lag| lag.is_finite())
+}
 
 /// The offset (in lags, within ±½) of the vertex of the parabola through the correlation
 /// at the best lag (`at`) and its neighbours; 0 when they do not bend down.

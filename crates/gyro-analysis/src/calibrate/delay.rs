@@ -3,13 +3,11 @@
 //! apart. Scored against the reference as logged, every movement's reference change then
 //! misses the part of the turn the reference made before the gyro's movement began, and
 //! the per-sample error during turns is the rate times the delay; both look like sensor
-//! errors. The delay is the cross-correlation peak of the gyro rate against the
-//! reference rate within ±[`SEARCH_S`] (the diagnosis's statistic, with a wider search
-//! and normalised by the run's length, so that motion inside the run does not lean it
-//! towards longer lags), the median over the training runs.
+//! errors. The delay is each run's cross-correlation peak ([`crate::lag::log_lag_s`]),
+//! the median over the training runs.
 
 use super::BenchRun;
-use crate::diagnose::stats::{residuals, xcorr_peak_lag_within, Overlap};
+use crate::lag::log_lag_s;
 use serde::Serialize;
 
 /// Half-width of the search (s): the same as `run`'s ([`crate::lag::SEARCH_S`]).
@@ -55,23 +53,10 @@ impl ReferenceDelay {
     }
 }
 
-/// The peak lag of one run (s), within ±[`SEARCH_S`].
-fn run_lag_s(run: &BenchRun) -> Option<f64> {
-    let r = residuals(&run.log).ok()?;
-    xcorr_peak_lag_within(
-        &r.rate_dps,
-        &r.reference_rate_dps,
-        r.sample_rate_hz,
-        SEARCH_S,
-        Overlap::Whole,
-    )
-    .filter(|lag| lag.is_finite())
-}
-
 /// The delay measured on `runs`: the median of their peaks, applied when it is at least
 /// [`MIN_SLOTS`] grid slots of the first run.
 pub fn measure(runs: &[&BenchRun]) -> ReferenceDelay {
-    let per_run_s: Vec<Option<f64>> = runs.iter().map(|run| run_lag_s(run)).collect();
+    let per_run_s: Vec<Option<f64>> = runs.iter().map(|run| log_lag_s(&run.log)).collect();
     let lags: Vec<f64> = per_run_s.iter().flatten().copied().collect();
     let fs = runs.first().map_or(f64::NAN, |r| r.log.sample_rate_hz);
     match crate::median(&lags) {

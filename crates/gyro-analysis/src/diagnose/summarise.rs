@@ -239,14 +239,31 @@ fn lag_warnings(runs: &Runs) -> Vec<String> {
         .iter()
         .filter_map(|r| super::stats::lag_at_search_edge(&r.stats, r.sample_rate_hz))
         .collect();
-    match cut.first() {
-        None => Vec::new(),
-        Some(edge) => vec![format!(
-            "on {} of {} runs the gyro {} the reference by at least {:.0} ms, the edge of the cross-correlation's search: their lag statistic is cut there, not measured, and a latency fitted or checked on it is not to be trusted (a logger that buffers, over a wireless link or USB, can put 100 ms between the two)",
-            cut.len(),
-            all.len(),
-            if *edge > 0.0 { "lags" } else { "leads" },
-            1e3 * edge.abs()
-        )],
-    }
+    let Some(edge) = cut.first() else {
+        return Vec::new();
+    };
+    // What the lag is, searched wider on those runs.
+    let measured: Vec<f64> = all
+        .iter()
+        .filter(|r| super::stats::lag_at_search_edge(&r.stats, r.sample_rate_hz).is_some())
+        .filter_map(|r| crate::lag::log_lag_s(&r.log))
+        .collect();
+    let wider = match (
+        measured.iter().copied().reduce(f64::min),
+        measured.iter().copied().reduce(f64::max),
+    ) {
+        (Some(lo), Some(hi)) => format!(
+            "; searched within ±{:.0} ms, those runs give {:+.0} to {:+.0} ms (+: the gyro lags)",
+            1e3 * crate::lag::SEARCH_S,
+            1e3 * lo,
+            1e3 * hi
+        ),
+        _ => String::new(),
+    };
+    vec![format!(
+        "on {} of {} runs the gyro-reference lag lies at or beyond the edge of the cross-correlation's search, ±{:.0} ms{wider}: their lag statistic is cut there, not measured, and a latency fitted or checked on it is not to be trusted (a logger that buffers, over a wireless link or USB, can put 100 ms between the two)",
+        cut.len(),
+        all.len(),
+        1e3 * edge.abs()
+    )]
 }
