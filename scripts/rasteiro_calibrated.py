@@ -16,7 +16,15 @@ errors on the truth over the same training recordings, applied to the held-out t
 Turns and truth are those of `rasteiro_turns.py` (rest to rest against the robot's pose).
 
 Prints the median and 90th percentile of |error| per held-out group, and the ratio of the
-calibrated `run` to the scaled plain estimator.
+calibrated `run` to the scaled plain estimator. Then, held out by speed, what a wrench's
+controller would be told: how often the 95% interval of each turn's angle covers the
+truth (the movement's `angle_std_deg`; with the model, also the scale uncertainty that
+`calibrate` measured held out, `scale.residual_relative`, added as in the tightening
+decision: sqrt(sigma^2 + (u * angle)^2); the model's compensation is overridden to the
+Kalman form, the one whose movements carry a sigma), and the tightening decisions of `gyro-cli run`
+(k = 2) against windows of half-width 0.5, 1 and 2 degrees whose target lies from 1.2
+half-widths below the truth to 1.2 above: how many `ok` were wrong (truth outside the
+window), `nok` wrong (truth inside), and `recheck`.
 
 Usage: python3 scripts/rasteiro_calibrated.py [DATA_DIR] [--gyro target/release/gyro-cli]
 """
@@ -41,7 +49,8 @@ def path_of(data, sensor, speed, axis):
 
 
 def calibrate(gyro, train, model):
-    """Calibrate on `train`; the JSON's scale and delay."""
+    """Calibrate on `train`; the JSON's scale and delay (the scale with its held-out
+    residual)."""
     out = subprocess.run(
         [gyro, "calibrate", "--objective", "movement-rms", "--format", "json", "-o", model, *train],
         check=True,
@@ -88,6 +97,85 @@ def header(title):
     print(f"{'held out':<22} {'turns':>5}  {'plain':>13}  {'plain+scale':>13}  {'run':>13}  {'run --model':>13}  ratio")
 
 
+HALF_WIDTHS = (0.5, 1.0, 2.0)
+OFFSETS = (-1.2, -0.9, -0.6, -0.3, 0.0, 0.3, 0.6, 0.9, 1.2)
+
+
+def movements(gyro, path, extra=()):
+    out = subprocess.run(
+        [gyro, "run", path, "--format", "json", *extra], check=True, capture_output=True, text=True
+    )
+    return json.loads(out.stdout)["movements"]
+
+
+def matched(moves, truth):
+    """The movement that is this turn: the nearest angle, within 20 degrees."""
+    m = min(moves, key=lambda m: abs(m["angle_deg"] - truth), default=None)
+    return m if m is not None and abs(m["angle_deg"] - truth) < 20.0 else None
+
+
+def decisions(gyro, path, truth, extra):
+    """(wrong ok, wrong nok, recheck, decided) over the windows around `truth`."""
+    sign = 1.0 if truth > 0 else -1.0
+    wrong_ok = wrong_nok = recheck = decided = 0
+    for d in HALF_WIDTHS:
+        for o in OFFSETS:
+            target = abs(truth) + o * d
+            args = [
+                "--target-deg", f"{target:.6f}", "--tolerance-deg", f"{d}",
+                "--tightening-direction", "positive" if sign > 0 else "negative", *extra,
+            ]
+            m = matched(movements(gyro, path, args), truth)
+            if m is None or m.get("verdict") is None:
+                continue
+            inside = abs(abs(truth) - target) <= d
+            v = m["verdict"]
+            decided += 1
+            wrong_ok += v == "ok" and not inside
+            wrong_nok += v == "nok" and inside
+            recheck += v == "recheck"
+    return wrong_ok, wrong_nok, recheck, decided
+
+
+def trust(gyro, data, cache):
+    """Coverage and decisions on each speed held out, default and calibrated."""
+    rows = {"default": [0] * 6, "calibrated": [0] * 6}
+    for sensor in SENSORS:
+        for axis in "xyz":
+            for speed in SPEEDS:
+                test = path_of(data, sensor, speed, axis)
+                train = [path_of(data, sensor, s, axis) for s in SPEEDS if s != speed]
+                with tempfile.TemporaryDirectory() as tmp:
+                    model = os.path.join(tmp, "model.json")
+                    scale, _ = calibrate(gyro, train, model)
+                    u = scale.get("residual_relative") or 0.0
+                    configs = {
+                        "default": ((), 0.0),
+                        "calibrated": (
+                            ("--model", model, "--compensation", "kalman", "--scale-sigma", f"{u:.6f}"),
+                            u,
+                        ),
+                    }
+                    for name, (extra, u) in configs.items():
+                        moves = movements(gyro, test, extra[:4])
+                        for truth, _, _ in cache[test]:
+                            m = matched(moves, truth)
+                            if m is None or m["angle_std_deg"] is None:
+                                continue
+                            sigma = (m["angle_std_deg"] ** 2 + (u * m["angle_deg"]) ** 2) ** 0.5
+                            r = rows[name]
+                            r[0] += 1
+                            r[1] += abs(m["angle_deg"] - truth) <= 1.96 * sigma
+                            for i, v in enumerate(decisions(gyro, test, truth, extra)):
+                                r[2 + i] += v
+    print(f"{'held out by speed':<20} {'turns':>5} {'95% covers':>10} {'decisions':>9} {'wrong ok':>8} {'wrong nok':>9} {'recheck':>8}")
+    for name, r in rows.items():
+        print(
+            f"{name:<20} {r[0]:>5} {100 * r[1] / max(r[0], 1):>9.0f}% {r[5]:>9} {r[2]:>8} {r[3]:>9}"
+            f" {100 * r[4] / max(r[5], 1):>7.1f}%"
+        )
+
+
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     data = args[0] if args else os.path.join(os.path.dirname(__file__), "../../shared/data/real/rasteiro")
@@ -123,6 +211,8 @@ def main():
             test = [path_of(data, sensor, s, axis) for s in SPEEDS]
             rows.extend(held_out(gyro, train, test, cache)[0])
         line(f"{sensor} from {other}", rows)
+    print()
+    trust(gyro, data, cache)
 
 
 if __name__ == "__main__":

@@ -206,6 +206,13 @@ fn scale_text(c: &Calibration) -> String {
     if let Some((without, with)) = sc.holdout_deg {
         s += &format!("  the same on the hold-out runs: {without:.4} -> {with:.4} deg\n");
     }
+    if let Some(u) = sc.residual_relative {
+        s += &format!(
+            "  scale uncertainty left, held out: {:.3}% of the turn (RMS; the movement's σ does not hold it: `run --scale-sigma {:.4}` adds it to the tightening decision)\n",
+            100.0 * u,
+            u
+        );
+    }
     let significant = gyro_analysis::calibrate::scale::significant(k, sc.standard_error);
     s += if sc.written {
         "  written (config.correction.scale_k): held out it lowers the turns' error and is better on most runs\n"

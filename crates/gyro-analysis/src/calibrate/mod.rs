@@ -990,6 +990,11 @@ fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
     let written = significant
         && leave_one_out_deg.is_some_and(|(o, w)| w < o)
         && 2 * runs_better > paired.len();
+    let residual_relative = scale::relative_rms(
+        if written { &with } else { &without }
+            .iter()
+            .flat_map(|r| &r.totals),
+    );
     let holdout_deg = match fitted {
         Some((k, _)) if !input.holdout.is_empty() => {
             let scaled = scale::with_scale(input.written_config, k);
@@ -1016,6 +1021,7 @@ fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
         leave_one_out_deg,
         runs_better: (runs_better, paired.len()),
         holdout_deg,
+        residual_relative,
         written: written && fitted.is_some(),
     })
 }

@@ -77,6 +77,20 @@ pub fn turn_rms<'a>(movements: impl IntoIterator<Item = &'a MovementTotal>) -> O
     (n > 0).then(|| (sum_sq / n as f64).sqrt())
 }
 
+/// RMS of the turns' relative errors (error / reference turn) among `movements`; `None`
+/// without a turn. Left out with the scale applied, it is the scale uncertainty that
+/// remains: what the tightening decision's `scale_sigma` is for.
+pub fn relative_rms<'a>(movements: impl IntoIterator<Item = &'a MovementTotal>) -> Option<f64> {
+    let (mut sum_sq, mut n) = (0.0, 0_usize);
+    for m in movements {
+        if m.reference_deg.abs() >= MIN_TURN_DEG {
+            sum_sq += (m.error_deg / m.reference_deg).powi(2);
+            n += 1;
+        }
+    }
+    (n > 0).then(|| (sum_sq / n as f64).sqrt())
+}
+
 /// Movements of `movements` that count in the fit.
 pub fn turns(movements: &[MovementTotal]) -> usize {
     movements
@@ -159,6 +173,11 @@ pub struct ScaleFit {
     /// The turn RMS on the hold-out runs with the written candidate, without and with
     /// the scale fitted on all training runs (deg; `None` without hold-out turns).
     pub holdout_deg: Option<(f64, f64)>,
+    /// The scale uncertainty that remains, held out: the RMS of the left-out runs' turn
+    /// errors relative to the turn, with the scale if it is written, else without
+    /// ([`relative_rms`]). The movement's σ knows the bias and the noise, not this; the
+    /// tightening decision adds it as `scale_sigma`.
+    pub residual_relative: Option<f64>,
     /// Written into the model file (`config.correction.scale_k`): it differs from zero
     /// beyond its noise ([`significant`]), and held out it lowers the turns' RMS error and
     /// is better on most left-out runs.
@@ -200,6 +219,13 @@ mod tests {
         assert_eq!(fit(&[m(10.0, 5.0)]), None, "50% is no scale error");
         assert_eq!(fit(&[m(10.0, f64::NAN)]), None);
         assert_eq!(fit(&[m(10.0, 0.1)]).unwrap().1, None);
+    }
+
+    #[test]
+    fn relative_errors_of_the_turns() {
+        let u = relative_rms(&[m(100.0, 0.3), m(-200.0, 0.8), m(2.0, 1.0)]).unwrap();
+        assert!((u - ((0.003_f64.powi(2) + 0.004_f64.powi(2)) / 2.0).sqrt()).abs() < 1e-12);
+        assert_eq!(relative_rms(&[m(2.0, 1.0)]), None);
     }
 
     #[test]
