@@ -99,6 +99,7 @@ echo '{"format": "gyro-model", "version": 1, "config": {"sample_rate_hz": -5}}' 
 echo '{"format": "gyro-model", "version": 1, "colour": "red"}' >in/model_unknown_key.json
 echo '{"format": "gyro-model", "version": 1, "config": {' >in/model_truncated.json
 echo '{"format": "gyro-model", "version": 1, "reference_delay_s": 5}' >in/model_delay.json
+echo '{"format": "gyro-model", "version": 1, "scale_sigma": -0.1}' >in/model_scale_sigma.json
 : >in/model_empty.json
 iconv -f UTF-8 -t UTF-16 in/model.json >in/model_utf16.json 2>/dev/null || cp in/binary.csv in/model_utf16.json
 mkdir -p in/a_directory
@@ -180,7 +181,7 @@ c "noise missing.mcap" refuse "missing.mcap" "\$G noise in/missing.mcap"
 c "run --model missing.json" refuse "missing.json" "\$G run in/good.csv --model in/missing.json"
 
 # Model files
-for f in model_v2 model_bad_setting model_unknown_key model_truncated model_delay model_empty model_utf16; do
+for f in model_v2 model_bad_setting model_unknown_key model_truncated model_delay model_scale_sigma model_empty model_utf16; do
     c "run --model $f.json" refuse "$f.json" "\$G run in/good.csv --model in/$f.json"
 done
 c "simulate --model model_truncated.json" refuse "model_truncated.json" "\$G simulate --model in/model_truncated.json -o out/s.csv"

@@ -19,9 +19,10 @@ Prints the median and 90th percentile of |error| per held-out group, and the rat
 calibrated `run` to the scaled plain estimator. Then, held out by speed, what a wrench's
 controller would be told: how often the 95% interval of each turn's angle covers the
 truth (the movement's `angle_std_deg`; with the model, also the scale uncertainty that
-`calibrate` measured held out, `scale.residual_relative`, added as in the tightening
-decision: sqrt(sigma^2 + (u * angle)^2); the model's compensation is overridden to the
-Kalman form, the one whose movements carry a sigma), and the tightening decisions of `gyro-cli run`
+`calibrate` measured held out and wrote as the model's `scale_sigma`, added as the
+tightening decision adds it: sqrt(sigma^2 + (u * angle)^2); the model's compensation is
+overridden to the Kalman form, the one whose movements carry a sigma), and the tightening
+decisions of `gyro-cli run`
 (k = 2) against windows of half-width 0.5, 1 and 2 degrees whose target lies from 1.2
 half-widths below the truth to 1.2 above: how many `ok` were wrong (truth outside the
 window), `nok` wrong (truth inside), and `recheck`.
@@ -151,13 +152,10 @@ def trust(gyro, data, cache):
                     u = scale.get("residual_relative") or 0.0
                     configs = {
                         "default": ((), 0.0),
-                        "calibrated": (
-                            ("--model", model, "--compensation", "kalman", "--scale-sigma", f"{u:.6f}"),
-                            u,
-                        ),
+                        "calibrated": (("--model", model, "--compensation", "kalman"), u),
                     }
                     for name, (extra, u) in configs.items():
-                        moves = movements(gyro, test, extra[:4])
+                        moves = movements(gyro, test, extra)
                         for truth, _, _ in cache[test]:
                             m = matched(moves, truth)
                             if m is None or m["angle_std_deg"] is None:

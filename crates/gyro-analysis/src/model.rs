@@ -53,6 +53,13 @@ pub struct ModelFile {
     /// slots), so that the error measures the sensor, not the logger's timing. Default 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub reference_delay_s: f64,
+    /// The gyro's scale uncertainty left after calibration (relative, 0.01 = 1%), as
+    /// `calibrate` measured it on runs it was not fitted on. The movement's σ knows the bias
+    /// and the noise, not the scale: `run`'s tightening decision adds it to each movement's
+    /// σ as this share of the angle (its `--scale-sigma`, unless given). Within 0..1;
+    /// default 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub scale_sigma: f64,
 }
 
 fn is_zero(x: &f64) -> bool {
@@ -68,6 +75,7 @@ impl ModelFile {
             config,
             sensor: SensorModel::default(),
             reference_delay_s: 0.0,
+            scale_sigma: 0.0,
         }
     }
 
@@ -132,6 +140,14 @@ pub enum ModelError {
         /// The value found.
         value: f64,
     },
+    /// `scale_sigma` is not within 0..1.
+    #[error("{path}: scale_sigma must be within 0 and 1 (a share of the angle), found {value}")]
+    ScaleSigma {
+        /// File.
+        path: PathBuf,
+        /// The value found.
+        value: f64,
+    },
     /// A setting is invalid.
     #[error("{path}: {setting}")]
     Invalid {
@@ -182,6 +198,12 @@ pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
         return Err(ModelError::ReferenceDelay {
             path: path.to_path_buf(),
             value: model.reference_delay_s,
+        });
+    }
+    if !(0.0..=1.0).contains(&model.scale_sigma) {
+        return Err(ModelError::ScaleSigma {
+            path: path.to_path_buf(),
+            value: model.scale_sigma,
         });
     }
     Ok(model)
@@ -259,12 +281,14 @@ mod tests {
         config.correction.temperature_ref_c = Some(24.5);
         let model = ModelFile {
             reference_delay_s: 0.0125,
+            scale_sigma: 0.0016,
             ..ModelFile::new(config)
         };
         let path = temp("corrected.json");
         save(&path, &model).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.contains("\"reference_delay_s\": 0.0125"), "{text}");
+        assert!(text.contains("\"scale_sigma\": 0.0016"), "{text}");
         assert!(text.contains("\"temperature_ref_c\": 24.5"), "{text}");
         assert_eq!(load(&path).unwrap(), model);
     }

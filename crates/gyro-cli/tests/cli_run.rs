@@ -456,6 +456,26 @@ fn calibrate_writes_the_scale_and_the_reference_delay() {
     let k = file["config"]["correction"]["scale_k"].as_f64().unwrap();
     assert!((k + 0.02).abs() < 0.001, "{file}");
     assert_eq!(file["reference_delay_s"], delay["delay_s"]);
+    // The scale uncertainty left held out, for the tightening decision.
+    let u = file["scale_sigma"].as_f64().unwrap();
+    assert!(u > 0.0 && u < 0.001, "{file}");
+    assert_eq!(file["scale_sigma"], scale["residual_relative"]);
+    let decided = json_of(&gyro(&[
+        "run",
+        runs[3].as_str(),
+        "--format",
+        "json",
+        "--model",
+        model.to_str().unwrap(),
+        "--target-deg",
+        "90",
+        "--tolerance-deg",
+        "2",
+    ]));
+    let used = decided["config"]["tightening"]["scale_sigma"]
+        .as_f64()
+        .unwrap();
+    assert!((used - u).abs() < 1e-6 * u.max(1e-3), "{used} vs {u}");
 
     // The held-out run: every turn's error, with the model and without.
     let turns = |extra: &[&str]| {

@@ -208,9 +208,8 @@ fn scale_text(c: &Calibration) -> String {
     }
     if let Some(u) = sc.residual_relative {
         s += &format!(
-            "  scale uncertainty left, held out: {:.3}% of the turn (RMS; the movement's σ does not hold it: `run --scale-sigma {:.4}` adds it to the tightening decision)\n",
-            100.0 * u,
-            u
+            "  scale uncertainty left, held out: {:.3}% of the turn (RMS; the movement's σ does not hold it: written as the model's scale_sigma, which run's tightening decision adds)\n",
+            100.0 * u
         );
     }
     let significant = gyro_analysis::calibrate::scale::significant(k, sc.standard_error);

@@ -123,6 +123,15 @@ pub fn run(args: &Args) -> Result<()> {
     let mut out = base.clone();
     out.config = result.config;
     out.reference_delay_s = result.reference_delay.delay_s;
+    // The scale uncertainty left held out, for run's tightening decision (kept from
+    // `--model` when nothing was measured).
+    if let Some(u) = result
+        .scale
+        .residual_relative
+        .filter(|u| (0.0..=1.0).contains(u))
+    {
+        out.scale_sigma = u;
+    }
     model::save(&args.out, &out).with_context(|| "writing the model file".to_string())?;
     let inputs: Vec<_> = train
         .iter()

@@ -71,9 +71,10 @@ pub struct Args {
     tightening_direction: DirectionArg,
     /// Relative uncertainty of the gyro's scale factor (0.01 = 1%), added to each
     /// movement's σ as a share of its angle: the filter's σ does not know the scale. Use it
-    /// for a gyro whose scale is not calibrated.
-    #[arg(long, value_name = "FRACTION", default_value_t = 0.0, value_parser = value::non_negative::<f32>)]
-    scale_sigma: f32,
+    /// for a gyro whose scale is not calibrated. Default: the model file's `scale_sigma`
+    /// (what `calibrate` measured), else 0.
+    #[arg(long, value_name = "FRACTION", value_parser = value::non_negative::<f32>)]
+    scale_sigma: Option<f32>,
     /// Output format on stdout (csv: the movements).
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -100,16 +101,20 @@ pub fn run(args: &Args) -> Result<()> {
             .into_iter()
             .chain(args.model.as_deref()),
     )?;
-    let (mut config, options) = match &args.model {
+    let (mut config, options, model_scale_sigma) = match &args.model {
         Some(path) => {
             let model = model::load(path)?;
             let config = Config {
                 range_dps: Some(model.range_dps()),
                 ..model.config
             };
-            (config, replay::ReplayOptions::from_model(&model))
+            (
+                config,
+                replay::ReplayOptions::from_model(&model),
+                model.scale_sigma as f32,
+            )
         }
-        None => (Config::default(), replay::ReplayOptions::default()),
+        None => (Config::default(), replay::ReplayOptions::default(), 0.0),
     };
     if let Some(range_dps) = args.range_dps {
         config.range_dps = Some(range_dps);
@@ -123,8 +128,16 @@ pub fn run(args: &Args) -> Result<()> {
                 DirectionArg::Positive => Direction::Positive,
                 DirectionArg::Negative => Direction::Negative,
             },
-            scale_sigma: args.scale_sigma,
+            scale_sigma: 0.0,
         });
+    }
+    // The scale uncertainty: as given, else at least what the model's calibration
+    // measured (the model's own window keeps a larger one).
+    if let Some(t) = &mut config.tightening {
+        t.scale_sigma = match args.scale_sigma {
+            Some(given) => given,
+            None => t.scale_sigma.max(model_scale_sigma),
+        };
     }
     if let Some(c) = args.compensation {
         config.compensation = match c {
