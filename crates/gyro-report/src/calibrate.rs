@@ -170,7 +170,7 @@ fn delay_text(c: &Calibration) -> String {
             per_run()
         ),
         DelaySource::NotApplied => format!(
-            "reference delay: none applied (cross-correlation peaks {} ms, under {} grid slots)\n",
+            "reference delay: none applied (cross-correlation peaks {} ms, under {} of a grid slot)\n",
             per_run(),
             gyro_analysis::calibrate::delay::MIN_SLOTS
         ),

@@ -13,9 +13,10 @@ use serde::Serialize;
 /// Half-width of the search (s): the same as `run`'s ([`crate::lag::SEARCH_S`]).
 pub use crate::lag::SEARCH_S;
 
-/// Delays shorter than this many grid slots are not applied: the peak is not resolved
-/// finer than a slot or two, and a bench encoder and gyro sampled together show none.
-pub const MIN_SLOTS: f64 = 2.0;
+/// Delays shorter than this many grid slots are not applied: the parabola through the peak
+/// resolves a fraction of a slot, but below half of one a delay cannot be told from where
+/// the grid's slots fall (a bench encoder and gyro sampled together show a few µs).
+pub const MIN_SLOTS: f64 = 0.5;
 
 /// Where the delay used for scoring came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -35,7 +35,7 @@ pub struct Args {
     /// The gyro's delay behind the reference (s; negative: it leads) to score every run
     /// with, written to the model file. Default: the `--model` file's `reference_delay_s`
     /// if it has one, else measured on the training runs (cross-correlation of the rates
-    /// within ±0.5 s, applied from 2 grid slots); 0 scores against the reference as logged.
+    /// within ±0.5 s, applied from half a grid slot); 0 scores against the reference as logged.
     #[arg(long, value_parser = gyro_log::value::finite::<f64>, allow_negative_numbers = true)]
     reference_delay_s: Option<f64>,
     /// Skip the leave-one-run-out refits. The model written is chosen on their held-out
