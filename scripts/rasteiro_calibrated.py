@@ -149,7 +149,7 @@ def trust(gyro, data, cache):
                 with tempfile.TemporaryDirectory() as tmp:
                     model = os.path.join(tmp, "model.json")
                     scale, _ = calibrate(gyro, train, model)
-                    u = scale.get("residual_relative") or 0.0
+                    u = scale.get("residual_relative_upper") or 0.0
                     configs = {
                         "default": ((), 0.0),
                         "calibrated": (("--model", model, "--compensation", "kalman"), u),

@@ -206,10 +206,11 @@ fn scale_text(c: &Calibration) -> String {
     if let Some((without, with)) = sc.holdout_deg {
         s += &format!("  the same on the hold-out runs: {without:.4} -> {with:.4} deg\n");
     }
-    if let Some(u) = sc.residual_relative {
+    if let (Some(u), Some(upper)) = (sc.residual_relative, sc.residual_relative_upper) {
         s += &format!(
-            "  scale uncertainty left, held out: {:.3}% of the turn (RMS; the movement's σ does not hold it: written as the model's scale_sigma, which run's tightening decision adds)\n",
-            100.0 * u
+            "  scale uncertainty left, held out: {:.3}% of the turn (RMS), at most {:.3}% (95% bound): the movement's σ does not hold it; the bound is written as the model's scale_sigma, which run's tightening decision adds\n",
+            100.0 * u,
+            100.0 * upper
         );
     }
     let significant = gyro_analysis::calibrate::scale::significant(k, sc.standard_error);

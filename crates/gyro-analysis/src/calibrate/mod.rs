@@ -990,7 +990,7 @@ fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
     let written = significant
         && leave_one_out_deg.is_some_and(|(o, w)| w < o)
         && 2 * runs_better > paired.len();
-    let residual_relative = scale::relative_rms(
+    let residual = scale::relative_rms(
         if written { &with } else { &without }
             .iter()
             .flat_map(|r| &r.totals),
@@ -1021,7 +1021,8 @@ fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
         leave_one_out_deg,
         runs_better: (runs_better, paired.len()),
         holdout_deg,
-        residual_relative,
+        residual_relative: residual.map(|(rms, _)| rms),
+        residual_relative_upper: residual.map(|(rms, n)| scale::upper_95(rms, n)),
         written: written && fitted.is_some(),
     })
 }

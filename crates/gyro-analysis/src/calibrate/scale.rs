@@ -77,10 +77,12 @@ pub fn turn_rms<'a>(movements: impl IntoIterator<Item = &'a MovementTotal>) -> O
     (n > 0).then(|| (sum_sq / n as f64).sqrt())
 }
 
-/// RMS of the turns' relative errors (error / reference turn) among `movements`; `None`
-/// without a turn. Left out with the scale applied, it is the scale uncertainty that
-/// remains: what the tightening decision's `scale_sigma` is for.
-pub fn relative_rms<'a>(movements: impl IntoIterator<Item = &'a MovementTotal>) -> Option<f64> {
+/// RMS of the turns' relative errors (error / reference turn) among `movements`, and the
+/// number of turns; `None` without a turn. Left out with the scale applied, it is the
+/// scale uncertainty that remains: what the tightening decision's `scale_sigma` is for.
+pub fn relative_rms<'a>(
+    movements: impl IntoIterator<Item = &'a MovementTotal>,
+) -> Option<(f64, usize)> {
     let (mut sum_sq, mut n) = (0.0, 0_usize);
     for m in movements {
         if m.reference_deg.abs() >= MIN_TURN_DEG {
@@ -88,7 +90,21 @@ pub fn relative_rms<'a>(movements: impl IntoIterator<Item = &'a MovementTotal>) 
             n += 1;
         }
     }
-    (n > 0).then(|| (sum_sq / n as f64).sqrt())
+    (n > 0).then(|| ((sum_sq / n as f64).sqrt(), n))
+}
+
+/// The one-sided 95% upper bound of an RMS `rms` measured on `n` values: the spread is
+/// known only as well as `n` turns show it, and the decision's guard band needs the
+/// uncertainty it may be, not the one it was (JCGM 106's expanded uncertainty, in spirit).
+/// `rms · sqrt(n / χ²₀.₀₅(n))`, with the χ² quantile by Wilson and Hilferty's cube: the
+/// factor is within 4% of the exact one from n = 3 on, 14% above it at n = 2 (on the
+/// safe side).
+pub fn upper_95(rms: f64, n: usize) -> f64 {
+    const Z_05: f64 = -1.644_853_626_951_472_2;
+    let k = n.max(1) as f64;
+    let c = 2.0 / (9.0 * k);
+    let cube = (1.0 - c + Z_05 * c.sqrt()).max(0.05);
+    rms * (k / (k * cube.powi(3))).sqrt()
 }
 
 /// Movements of `movements` that count in the fit.
@@ -175,9 +191,11 @@ pub struct ScaleFit {
     pub holdout_deg: Option<(f64, f64)>,
     /// The scale uncertainty that remains, held out: the RMS of the left-out runs' turn
     /// errors relative to the turn, with the scale if it is written, else without
-    /// ([`relative_rms`]). The movement's σ knows the bias and the noise, not this; the
-    /// tightening decision adds it as `scale_sigma`.
+    /// ([`relative_rms`]). The movement's σ knows the bias and the noise, not this.
     pub residual_relative: Option<f64>,
+    /// Its 95% upper bound from the number of left-out turns ([`upper_95`]): what the
+    /// tightening decision adds as `scale_sigma` (the model file's).
+    pub residual_relative_upper: Option<f64>,
     /// Written into the model file (`config.correction.scale_k`): it differs from zero
     /// beyond its noise ([`significant`]), and held out it lowers the turns' RMS error and
     /// is better on most left-out runs.
@@ -223,9 +241,29 @@ mod tests {
 
     #[test]
     fn relative_errors_of_the_turns() {
-        let u = relative_rms(&[m(100.0, 0.3), m(-200.0, 0.8), m(2.0, 1.0)]).unwrap();
+        let (u, n) = relative_rms(&[m(100.0, 0.3), m(-200.0, 0.8), m(2.0, 1.0)]).unwrap();
         assert!((u - ((0.003_f64.powi(2) + 0.004_f64.powi(2)) / 2.0).sqrt()).abs() < 1e-12);
+        assert_eq!(n, 2);
         assert_eq!(relative_rms(&[m(2.0, 1.0)]), None);
+    }
+
+    #[test]
+    fn an_rms_from_few_turns_is_bounded_above() {
+        // Exact factors sqrt(n / chi2_0.05(n)) from scipy.stats.chi2.ppf(0.05, n).
+        for (n, exact, within) in [
+            (2, 4.4154, 0.15),
+            (3, 2.9200, 0.04),
+            (5, 2.0893, 0.01),
+            (20, 1.3576, 0.01),
+            (100, 1.1328, 0.01),
+        ] {
+            let got = upper_95(1.0, n);
+            assert!(got >= exact * 0.999, "{n}: {got} under {exact}");
+            assert!(
+                (got - exact).abs() < within * exact,
+                "{n}: {got} vs {exact}"
+            );
+        }
     }
 
     #[test]

@@ -123,12 +123,13 @@ pub fn run(args: &Args) -> Result<()> {
     let mut out = base.clone();
     out.config = result.config;
     out.reference_delay_s = result.reference_delay.delay_s;
-    // The scale uncertainty left held out, for run's tightening decision (kept from
-    // `--model` when nothing was measured).
+    // The scale uncertainty left held out (its 95% upper bound), for run's tightening
+    // decision (kept from `--model` when nothing was measured).
     if let Some(u) = result
         .scale
-        .residual_relative
-        .filter(|u| (0.0..=1.0).contains(u))
+        .residual_relative_upper
+        .map(|u| u.min(1.0))
+        .filter(|u| *u >= 0.0)
     {
         out.scale_sigma = u;
     }
