@@ -569,3 +569,37 @@ fn a_lagging_reference_is_measured_and_said() {
     );
     assert!(fixture.get("warnings").is_none());
 }
+
+/// Verdicts without a σ (any compensation but the Kalman form) are said to be unguarded
+/// in every output; with the Kalman form they are not.
+#[test]
+fn verdicts_without_a_sigma_are_said_to_be_unguarded() {
+    let bench = bench_log();
+    let log = bench.to_str().unwrap();
+    let window = ["--target-deg", "90", "--tolerance-deg", "0.5"];
+    let mut args = vec!["run", log, "--format", "json", "--compensation", "none"];
+    args.extend(window);
+    let report = json_of(&gyro(&args));
+    let warning = report["warnings"][0].as_str().unwrap();
+    assert!(
+        warning.contains("the verdicts have no σ") && warning.contains("guard band is zero"),
+        "{warning}"
+    );
+    let mut args = vec![
+        "run",
+        log,
+        "--compensation",
+        "paper",
+        "--scale-sigma",
+        "0.01",
+    ];
+    args.extend(window);
+    let table = String::from_utf8_lossy(&gyro(&args).stdout).to_string();
+    assert!(
+        table.contains("guard band is only the scale term (1% of the angle)"),
+        "{table}"
+    );
+    let mut args = vec!["run", log, "--format", "json"];
+    args.extend(window);
+    assert!(json_of(&gyro(&args)).get("warnings").is_none());
+}

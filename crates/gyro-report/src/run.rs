@@ -161,6 +161,9 @@ pub fn table(file: &str, report: &RunReport) -> String {
                 count(Verdict::Invalid),
                 other_way
             );
+            if let Some(warning) = unguarded_warning(report) {
+                let _ = writeln!(s, "warning: {warning}");
+            }
         }
     }
     let sm = &report.summary;
@@ -191,6 +194,37 @@ pub fn table(file: &str, report: &RunReport) -> String {
         let _ = writeln!(s, "  no reference_deg column: no error figures");
     }
     s
+}
+
+/// Every warning about what the figures and verdicts mean, in the order the table gives
+/// them: the JSON's `warnings`, and stderr for the CSV.
+pub fn warnings(report: &RunReport) -> Vec<String> {
+    unguarded_warning(report)
+        .into_iter()
+        .chain(lag_warning(report))
+        .collect()
+}
+
+/// The warning for tightening verdicts without a σ: only the Kalman form gives a movement
+/// one, so in the other compensations the guard band holds only the scale term and an
+/// `ok` may sit on a bias error of any size.
+pub fn unguarded_warning(report: &RunReport) -> Option<String> {
+    let t = report.config.tightening.as_ref()?;
+    if report.config.compensation == gyro_core::Compensation::Kalman {
+        return None;
+    }
+    let mode = match report.config.compensation {
+        gyro_core::Compensation::None => "none",
+        _ => "paper",
+    };
+    Some(format!(
+        "the verdicts have no σ: only the Kalman form gives a movement one, and with compensation {mode} the guard band is {}, so an `ok` does not allow for the bias; run with --compensation kalman for a guarded decision",
+        if t.scale_sigma > 0.0 {
+            format!("only the scale term ({}% of the angle)", 100.0 * t.scale_sigma)
+        } else {
+            "zero".to_string()
+        }
+    ))
 }
 
 /// The warning for a gyro that lags (or leads) the reference it is scored against by at
@@ -247,11 +281,11 @@ pub fn json(file: &str, report: &RunReport) -> serde_json::Result<String> {
         file: &'a str,
         #[serde(flatten)]
         report: &'a RunReport,
-        /// What makes the figures mean less than they seem ([`lag_warning`]).
+        /// What makes the figures and verdicts mean less than they seem ([`warnings`]).
         #[serde(skip_serializing_if = "Vec::is_empty")]
         warnings: Vec<String>,
     }
-    let warnings = lag_warning(report).into_iter().collect();
+    let warnings = warnings(report);
     serde_json::to_string_pretty(&WithFile {
         file,
         report,

@@ -193,7 +193,7 @@ pub fn run(args: &Args) -> Result<()> {
     })?;
     if args.format != Format::Table {
         // The table carries it; the JSON too, the movements' CSV cannot.
-        if let Some(warning) = report::lag_warning(&result) {
+        for warning in report::warnings(&result) {
             super::warn(&warning);
         }
     }
