@@ -5,27 +5,16 @@
 //! third.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+mod common;
+
+use common::real_log;
 use gyro_analysis::calibrate::delay::DelaySource;
 use gyro_analysis::calibrate::{calibrate, BenchRun, CalibrateOptions, Candidate, Objective};
 use gyro_core::Config;
-use gyro_log::{load, GridOptions, LogOptions};
-use std::path::PathBuf;
+use gyro_log::GridOptions;
 
 fn run(name: &str) -> Option<BenchRun> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/real/rasteiro")
-        .join(name);
-    if !path.exists() {
-        eprintln!("skipped: {} not present", path.display());
-        return None;
-    }
-    let log = load(
-        &path,
-        &LogOptions::default(),
-        &GridOptions::default(),
-        &mut |_| {},
-    )
-    .unwrap();
+    let log = real_log(&format!("rasteiro/{name}"), &GridOptions::default())?;
     Some(BenchRun {
         name: name.to_string(),
         log,

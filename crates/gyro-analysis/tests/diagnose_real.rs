@@ -9,9 +9,11 @@
 //! README's figures come from the full recordings.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+mod common;
+
+use common::real_log;
 use gyro_analysis::diagnose::{diagnose, split, Options, RealRun, Silent};
-use gyro_log::{load, GridOptions, LogOptions};
-use std::path::PathBuf;
+use gyro_log::GridOptions;
 
 /// Small ensembles and `bootstrap` resamples: quick enough for a test.
 fn quick(bootstrap: usize) -> Options {
@@ -24,20 +26,7 @@ fn quick(bootstrap: usize) -> Options {
 }
 
 fn windows(file: &str, take: usize) -> Option<Vec<RealRun>> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/real")
-        .join(file);
-    if !path.exists() {
-        eprintln!("skipped: {} not present", path.display());
-        return None;
-    }
-    let log = load(
-        &path,
-        &LogOptions::default(),
-        &GridOptions::default(),
-        &mut |_| {},
-    )
-    .unwrap();
+    let log = real_log(file, &GridOptions::default())?;
     Some(
         split(&log, 50.0)
             .into_iter()
@@ -146,18 +135,11 @@ fn a_lag_beyond_the_search_is_said() {
     let file =
         |speed: &str, axis: &str| format!("rasteiro/rasteiro_MPU6050RM3100_{speed}_{axis}.csv");
     let load_at_100 = |name: String| -> Option<RealRun> {
-        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("../../../shared/data/real")
-            .join(&name);
-        if !path.exists() {
-            eprintln!("skipped: {} not present", path.display());
-            return None;
-        }
         let grid = GridOptions {
             sample_rate_hz: Some(100.0),
             ..GridOptions::default()
         };
-        let log = load(&path, &LogOptions::default(), &grid, &mut |_| {}).unwrap();
+        let log = real_log(&name, &grid)?;
         Some(RealRun::prepare(name, log).unwrap())
     };
     let (Some(train), Some(holdout)) = (

@@ -4,26 +4,15 @@
 //! on arrival at a PC, 80-120 ms behind the robot's pose.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+mod common;
+
+use common::real_log;
 use gyro_analysis::replay::replay;
 use gyro_core::Config;
-use gyro_log::{load, GridOptions, LogOptions};
-use std::path::PathBuf;
+use gyro_log::GridOptions;
 
 fn lag_s(relative: &str) -> Option<Option<f64>> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/real")
-        .join(relative);
-    if !path.exists() {
-        eprintln!("skipped: {} not present", path.display());
-        return None;
-    }
-    let log = load(
-        &path,
-        &LogOptions::default(),
-        &GridOptions::default(),
-        &mut |_| {},
-    )
-    .unwrap();
+    let log = real_log(relative, &GridOptions::default())?;
     Some(
         replay(&log, &Config::default())
             .unwrap()

@@ -285,11 +285,10 @@ pub fn json(file: &str, report: &RunReport) -> serde_json::Result<String> {
         #[serde(skip_serializing_if = "Vec::is_empty")]
         warnings: Vec<String>,
     }
-    let warnings = warnings(report);
     serde_json::to_string_pretty(&WithFile {
         file,
         report,
-        warnings,
+        warnings: warnings(report),
     })
 }
 

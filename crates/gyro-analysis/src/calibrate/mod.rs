@@ -940,6 +940,8 @@ struct ScaleInput<'a> {
     train_errors: &'a [[RunErrors; 4]],
     /// Each left-out run's errors under every candidate fitted on the others.
     held_out: &'a [[RunErrors; 4]],
+    /// Each hold-out run's errors under every candidate fitted on all training runs.
+    holdout_errors: &'a [[RunErrors; 4]],
 }
 
 /// The scale factor from the training runs' movement totals, rest to rest (under the
@@ -951,6 +953,7 @@ fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
     let totals_of = |errors: &[RunErrors; 4]| errors[0].totals.clone();
     let all: Vec<MovementTotal> = input.train_errors.iter().flat_map(totals_of).collect();
     let fitted = scale::fit(&all);
+    // Where the written candidate's errors sit in each `[RunErrors; 4]`.
     let slot = Candidate::ALL
         .iter()
         .position(|c| *c == input.written)
@@ -995,22 +998,20 @@ fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
             .iter()
             .flat_map(|r| &r.totals),
     );
-    let holdout_deg = match fitted {
-        Some((k, _)) if !input.holdout.is_empty() => {
-            let scaled = scale::with_scale(input.written_config, k);
-            let mut plain = Vec::new();
-            let mut corrected = Vec::new();
-            for run in input.holdout {
-                plain.push(replay_errors(run, input.written_config, input.scoring)?);
-                if let Some(config) = &scaled {
-                    corrected.push(replay_errors(run, config, input.scoring)?);
-                }
-            }
-            if corrected.len() == plain.len() {
-                pooled(&plain).zip(pooled(&corrected))
-            } else {
-                None
-            }
+    let scaled = fitted.and_then(|(k, _)| scale::with_scale(input.written_config, k));
+    let holdout_deg = match scaled {
+        Some(config) if !input.holdout.is_empty() => {
+            let plain: Vec<RunErrors> = input
+                .holdout_errors
+                .iter()
+                .map(|e| e[slot].clone())
+                .collect();
+            let corrected = input
+                .holdout
+                .iter()
+                .map(|run| replay_errors(run, &config, input.scoring))
+                .collect::<Result<Vec<_>, _>>()?;
+            pooled(&plain).zip(pooled(&corrected))
         }
         _ => None,
     };
@@ -1023,7 +1024,7 @@ fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
         holdout_deg,
         residual_relative: residual.map(|(rms, _)| rms),
         residual_relative_upper: residual.map(|(rms, n)| scale::upper_95(rms, n)),
-        written: written && fitted.is_some(),
+        written,
     })
 }
 
@@ -1129,15 +1130,15 @@ pub fn calibrate(
         .iter()
         .map(|run| candidate_errors(run, base, &full.fitted, &scoring))
         .collect::<Result<Vec<_>, _>>()?;
+    let holdout_errors = holdout
+        .iter()
+        .map(|run| candidate_errors(run, base, &full.fitted, &scoring))
+        .collect::<Result<Vec<_>, _>>()?;
     let holdout_scores = holdout
         .iter()
-        .map(|run| {
-            Ok(run_score(
-                &run.name,
-                &candidate_errors(run, base, &full.fitted, &scoring)?,
-            ))
-        })
-        .collect::<Result<Vec<_>, CalibrateError>>()?;
+        .zip(&holdout_errors)
+        .map(|(run, e)| run_score(&run.name, e))
+        .collect();
     let scores: Vec<CandidateScore> = Candidate::ALL
         .iter()
         .enumerate()
@@ -1172,6 +1173,7 @@ pub fn calibrate(
         fold_fitted: &fold_fitted,
         train_errors: &train_errors,
         held_out: &held_out,
+        holdout_errors: &holdout_errors,
     })?;
     let config = match scale.k {
         Some(k) if scale.written => scale::with_scale(&written_config, k).unwrap_or(written_config),

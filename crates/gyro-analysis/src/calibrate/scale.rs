@@ -61,6 +61,11 @@ pub fn rest_to_rest(report: &RunReport) -> Vec<MovementTotal> {
 /// Smallest reference turn (deg) a movement needs to count in the fit.
 pub const MIN_TURN_DEG: f64 = 10.0;
 
+/// True if `m` counts as a turn: the reference turns by at least [`MIN_TURN_DEG`].
+fn is_turn(m: &MovementTotal) -> bool {
+    m.reference_deg.abs() >= MIN_TURN_DEG
+}
+
 /// Largest |k| fitted: the core's correction accepts up to ±0.25.
 const MAX_ABS_K: f64 = 0.2;
 
@@ -69,7 +74,7 @@ const MAX_ABS_K: f64 = 0.2;
 pub fn turn_rms<'a>(movements: impl IntoIterator<Item = &'a MovementTotal>) -> Option<f64> {
     let (mut sum_sq, mut n) = (0.0, 0_usize);
     for m in movements {
-        if m.reference_deg.abs() >= MIN_TURN_DEG {
+        if is_turn(m) {
             sum_sq += m.error_deg * m.error_deg;
             n += 1;
         }
@@ -85,7 +90,7 @@ pub fn relative_rms<'a>(
 ) -> Option<(f64, usize)> {
     let (mut sum_sq, mut n) = (0.0, 0_usize);
     for m in movements {
-        if m.reference_deg.abs() >= MIN_TURN_DEG {
+        if is_turn(m) {
             sum_sq += (m.error_deg / m.reference_deg).powi(2);
             n += 1;
         }
@@ -109,21 +114,14 @@ pub fn upper_95(rms: f64, n: usize) -> f64 {
 
 /// Movements of `movements` that count in the fit.
 pub fn turns(movements: &[MovementTotal]) -> usize {
-    movements
-        .iter()
-        .filter(|m| m.reference_deg.abs() >= MIN_TURN_DEG)
-        .count()
+    movements.iter().filter(|m| is_turn(m)).count()
 }
 
 /// Least-squares scale error of `movements` (the turns among them) on top of the configuration that measured
 /// them: `(k, standard error)`. `None` without a turn, or beyond ±20%; the standard
 /// error needs 2 movements.
 pub fn fit(movements: &[MovementTotal]) -> Option<(f64, Option<f64>)> {
-    let turns: Vec<MovementTotal> = movements
-        .iter()
-        .filter(|m| m.reference_deg.abs() >= MIN_TURN_DEG)
-        .copied()
-        .collect();
+    let turns: Vec<MovementTotal> = movements.iter().copied().filter(is_turn).collect();
     let movements = turns.as_slice();
     let sxx: f64 = movements.iter().map(|m| m.reference_deg.powi(2)).sum();
     let sxy: f64 = movements

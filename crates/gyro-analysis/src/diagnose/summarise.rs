@@ -235,18 +235,23 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
 /// posterior check read a cut value.
 fn lag_warnings(runs: &Runs) -> Vec<String> {
     let all: Vec<&RealRun> = runs.train.iter().chain(&runs.holdout).copied().collect();
-    let cut: Vec<f64> = all
+    // The runs cut at the edge, with the edge.
+    let cut: Vec<(&RealRun, f64)> = all
         .iter()
-        .filter_map(|r| super::stats::lag_at_search_edge(&r.stats, r.sample_rate_hz))
+        .filter_map(|r| {
+            Some((
+                *r,
+                super::stats::lag_at_search_edge(&r.stats, r.sample_rate_hz)?,
+            ))
+        })
         .collect();
-    let Some(edge) = cut.first() else {
+    let Some(&(_, edge)) = cut.first() else {
         return Vec::new();
     };
     // What the lag is, searched wider on those runs.
-    let measured: Vec<f64> = all
+    let measured: Vec<f64> = cut
         .iter()
-        .filter(|r| super::stats::lag_at_search_edge(&r.stats, r.sample_rate_hz).is_some())
-        .filter_map(|r| crate::lag::log_lag_s(&r.log))
+        .filter_map(|(r, _)| crate::lag::log_lag_s(&r.log))
         .collect();
     let wider = match (
         measured.iter().copied().reduce(f64::min),
