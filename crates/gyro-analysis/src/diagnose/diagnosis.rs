@@ -142,6 +142,11 @@ pub struct Diagnosis {
     /// Lines in the motion itself (the reference rate), training and held-out runs.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub motion_lines: Vec<super::line::MotionLine>,
+    /// What the movements show rest to rest (lag searched wide, scale of the turns,
+    /// movements the reference does not follow), when the training runs have turns
+    /// ([`super::turns`]); left out otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub turns: Option<super::turns::TurnEvidence>,
     /// What was read of each log and what was irregular in it (filled in by the caller,
     /// which read the logs; empty for the self-check's simulated runs).
     #[serde(skip_serializing_if = "Vec::is_empty")]

@@ -45,6 +45,7 @@ mod select;
 pub mod selftest;
 pub(crate) mod stats;
 mod summarise;
+pub mod turns;
 
 pub use compensate::BIAS_ID;
 pub use diagnosis::{
@@ -233,6 +234,13 @@ pub fn diagnose(
         progress,
     );
 
+    // 5b. What the turns show, rest to rest, on top of what was written.
+    let turn_base = corrected_model
+        .clone()
+        .unwrap_or_else(|| options.base_model.clone());
+    let (turns, turn_model) = turns::turn_evidence(train, holdout, &turn_base, options);
+    let corrected_model = turn_model.or(corrected_model);
+
     // 6. Summarise.
     let train_after = summarise::train_after(
         &runs,
@@ -255,5 +263,6 @@ pub fn diagnose(
         train_after,
         compensation,
         corrected_model,
+        turns,
     }))
 }

@@ -64,6 +64,14 @@ impl Candidate {
 }
 
 impl<'a> Scorer<'a> {
+    /// The held-out runs' sample rate (Hz; one for all runs, `super::check_runs`).
+    pub(crate) fn sample_rate_hz(&self) -> f64 {
+        self.runs
+            .holdout
+            .first()
+            .map_or(f64::NAN, |r| r.sample_rate_hz)
+    }
+
     pub(crate) fn new(
         runs: &'a Runs<'a>,
         baseline: &'a Baseline,
@@ -486,6 +494,7 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
                 candidates[i].fit.effect.id(),
                 &scorer.before,
                 &selection.holdout_scores,
+                scorer.sample_rate_hz(),
             );
             if !check.passes && first_failed.is_none() {
                 first_failed = Some(i);
@@ -502,6 +511,7 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
                     c.fit.effect.id(),
                     &scorer.before,
                     &c.alone_scores,
+                    scorer.sample_rate_hz(),
                 ));
             }
         }

@@ -411,12 +411,18 @@ fn xcorr_lag_trend(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
 /// `fs`) when it sits on the edge of the search (±[`MAX_LAG_S`]): then the true lag is at
 /// least that, and the value is cut, not measured.
 pub fn lag_at_search_edge(stats: &[Stat], fs: f64) -> Option<f64> {
-    let edge_s = ((MAX_LAG_S * fs).round()).max(1.0) / fs;
     stats
         .iter()
         .find(|s| s.segment == "all" && s.statistic == "xcorr_peak_lag_s")
         .map(|s| s.value)
-        .filter(|v| v.abs() >= edge_s * (1.0 - 1e-9))
+        .filter(|v| is_at_search_edge(*v, fs))
+}
+
+/// True if a cross-correlation peak lag `lag_s` (at sample rate `fs`) sits on the edge of
+/// the search, ±[`MAX_LAG_S`] rounded to whole samples: the true lag is at least that.
+pub fn is_at_search_edge(lag_s: f64, fs: f64) -> bool {
+    let edge_s = ((MAX_LAG_S * fs).round()).max(1.0) / fs;
+    lag_s.abs() >= edge_s * (1.0 - 1e-9)
 }
 
 /// Cross-correlation peak lag (s) of `gyro` against `reference` within ±`max_lag` samples.

@@ -161,6 +161,7 @@ pub(crate) struct Findings<'a> {
     pub(crate) train_after: (Vec<RunScore>, f64),
     pub(crate) compensation: Option<CompensationSummary>,
     pub(crate) corrected_model: Option<ModelFile>,
+    pub(crate) turns: Option<super::turns::TurnEvidence>,
 }
 
 /// Stage 6: the diagnosis.
@@ -225,6 +226,7 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         .flatten()
         .collect(),
         inputs: Vec::new(),
+        turns: f.turns,
         corrected_model: f.corrected_model,
         selected_sensor: f.selected_sensor,
     }

@@ -158,6 +158,7 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
     if lines.is_empty() {
         lines.push("no effect of the vocabulary is named: the nominal model holds on these runs, or what differs is not in the vocabulary (see the where-statistics)".into());
     }
+    lines.extend(turn_lines(d));
     if let Some(c) = &d.compensation {
         let median = |f: &dyn Fn(&gyro_analysis::diagnose::CompensationRun) -> f64| {
             let v: Vec<f64> = c.runs.iter().map(f).filter(|x| x.is_finite()).collect();
@@ -166,8 +167,13 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
         let before = median(&|r| r.max_abs_error_before_deg);
         let after = median(&|r| r.max_abs_error_after_deg);
         if c.corrected.is_empty() {
+            let what = if turns_wrote(d) {
+                "no correction of the per-sample effects is written (the written model holds only the turns' corrections above)"
+            } else {
+                "no correction is written"
+            };
             lines.push(format!(
-                "no correction is written: none lowered the held-out angle error (median max |error| {before:.2} deg)"
+                "{what}: none lowered the held-out angle error (median max |error| {before:.2} deg)"
             ));
         } else {
             let better = c
@@ -234,6 +240,91 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
         lines.push(line);
     }
     lines.extend(d.warnings.iter().map(|w| format!("warning: {w}")));
+    lines
+}
+
+/// True if the turns' evidence wrote a correction into the model file.
+fn turns_wrote(d: &Diagnosis) -> bool {
+    d.turns.as_ref().is_some_and(|t| {
+        t.lag.as_ref().is_some_and(|l| l.written) || t.scale.as_ref().is_some_and(|s| s.written)
+    })
+}
+
+/// What the movements show rest to rest ([`gyro_analysis::diagnose::turns`]), one line
+/// each: a lag too long for the per-sample statistics, the turns' scale, and the
+/// movements the reference does not follow.
+pub fn turn_lines(d: &Diagnosis) -> Vec<String> {
+    let Some(t) = &d.turns else {
+        return Vec::new();
+    };
+    let mut lines = Vec::new();
+    if let Some(lag) = t.lag.as_ref().filter(|l| l.beyond_statistic) {
+        let (lo, hi) = lag.train_range_s;
+        let held = lag.holdout_median_s.map_or(String::new(), |h| {
+            format!("; {:.0} ms on the held-out runs", 1e3 * h)
+        });
+        let what = if lag.median_s >= 0.0 { "lags" } else { "leads" };
+        let written = match (lag.written, lag.holdout_max_abs_error_deg) {
+            (true, Some((b, a))) => format!(
+                "written as the model's reference_delay_s (held-out median max |angle error| {b:.2} -> {a:.2} deg)"
+            ),
+            (false, Some((b, a))) => format!(
+                "not written: as the model's reference_delay_s it did not lower the held-out angle error ({b:.2} -> {a:.2} deg)"
+            ),
+            _ => "not written: the starting model has a reference delay".into(),
+        };
+        lines.push(format!(
+            "the gyro {what} the reference by {:.0} ms ({:.0} to {:.0} over the training runs{held}), beyond the per-sample statistics' ±{:.0} ms, so latency and bandwidth cannot be fitted there; the turns are judged rest to rest, where it does not matter; {written}",
+            1e3 * lag.median_s.abs(),
+            1e3 * lo,
+            1e3 * hi,
+            1e3 * gyro_analysis::diagnose::turns::STATISTIC_LAG_S
+        ));
+    }
+    if let Some(s) = &t.scale {
+        let pct = |x: f64| format!("{:+.2}%", 100.0 * x);
+        let (kb, ka) = s.holdout_k;
+        let (rb, ra) = s.holdout_turn_rms_deg;
+        let (better, runs) = s.holdout_runs_better;
+        let held = format!(
+            "held out, the {} turns' own scale {} -> {} and their RMS error {rb:.2} -> {ra:.2} deg with it, better on {better} of {runs} runs",
+            t.holdout_turns,
+            pct(kb),
+            pct(ka)
+        );
+        let verdict = if s.written {
+            "written (config.correction.scale_k)".to_string()
+        } else if s.named {
+            format!("named, not corrected: it did not lower the held-out turns' error significantly (bootstrap P {:.2})", s.bootstrap_p)
+        } else {
+            "not named: within its noise, or the held-out turns do not show it".to_string()
+        };
+        lines.push(format!(
+            "the turns, rest to rest: the gyro reads {} [{}, {}] of the reference's turn ({} training turns, z {:.1}); {held}: {verdict}",
+            pct(s.k),
+            pct(s.ci95.0),
+            pct(s.ci95.1),
+            t.train_turns,
+            s.z
+        ));
+    }
+    if !t.untracked.is_empty() {
+        let gyro: Vec<f64> = t.untracked.iter().map(|u| u.gyro_deg.abs()).collect();
+        let lo = gyro.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = gyro.iter().copied().fold(0.0, f64::max);
+        let reference = t
+            .untracked
+            .iter()
+            .map(|u| u.reference_deg.abs())
+            .fold(0.0, f64::max);
+        let mut runs: Vec<&str> = t.untracked.iter().map(|u| u.run.as_str()).collect();
+        runs.dedup();
+        lines.push(format!(
+            "seen in the data, not in the vocabulary: {} movements the reference does not follow, in {} runs: the gyro turns {lo:.1} to {hi:.1} deg while the reference turns at most {reference:.2} deg: a turn about another axis seen through a mount off the reference's axes (cross-axis sensitivity), or motion the reference misses",
+            t.untracked.len(),
+            runs.len()
+        ));
+    }
     lines
 }
 

@@ -763,6 +763,8 @@ Effects are fitted on the training runs only and scored on the held-out runs.</p
         }
     );
 
+    turns_section(s, d);
+
     let _ = writeln!(s, "<h2>Nominal model</h2>");
     let m = &d.model.sensor;
     let _ = writeln!(
@@ -852,6 +854,88 @@ effect that fails is not named and the selection is made again without it.</p>"
         }
     }
     let _ = writeln!(s, "</table>");
+}
+
+/// What the movements show rest to rest: the lag searched wide, the turns' scale, and
+/// the movements the reference does not follow, one row per run.
+fn turns_section(s: &mut String, d: &Diagnosis) {
+    let Some(t) = &d.turns else {
+        return;
+    };
+    if t.train_turns == 0 && t.untracked.is_empty() {
+        return;
+    }
+    let _ = writeln!(s, "<h2>Turns, rest to rest</h2>");
+    let _ = writeln!(
+        s,
+        "<p>Each movement's total, the angle and the reference read at the middle of the rests \
+around it: what neither a reference reported late or coarsely nor the per-sample statistics \
+change. A scale is named when it is at least 4 standard errors and 0.1% from zero and the \
+held-out turns keep at most half of their own scale with it; it is written when it lowers \
+the held-out turns' RMS error (paired over held-out runs, bootstrap P &lt; 5%).</p>"
+    );
+    let pct = |x: f64| format!("{:+.2}%", 100.0 * x);
+    let _ = writeln!(
+        s,
+        "<table><tr><th></th><th>training</th><th>held out</th></tr>\
+<tr><td>turns (reference ≥ 10°)</td><td class=\"n\">{}</td><td class=\"n\">{}</td></tr>",
+        t.train_turns, t.holdout_turns
+    );
+    if let Some(l) = &t.lag {
+        let _ = writeln!(
+            s,
+            "<tr><td>gyro–reference lag, searched within ±500 ms (median; + the gyro lags)</td><td class=\"n\">{:.1} ms [{:.1}, {:.1}]</td><td class=\"n\">{}</td></tr>",
+            1e3 * l.median_s,
+            1e3 * l.train_range_s.0,
+            1e3 * l.train_range_s.1,
+            l.holdout_median_s
+                .map_or("–".to_string(), |h| format!("{:.1} ms", 1e3 * h))
+        );
+    }
+    if let Some(k) = &t.scale {
+        let _ = writeln!(
+            s,
+            "<tr><td>scale of the turns (95% interval)</td><td class=\"n\">{} [{}, {}]</td><td class=\"n\">{} → {} with it</td></tr>\
+<tr><td>turn RMS error</td><td></td><td class=\"n\">{:.2}° → {:.2}°, better on {} of {} runs</td></tr>\
+<tr><td>scale verdict</td><td colspan=\"2\">{}</td></tr>",
+            pct(k.k),
+            pct(k.ci95.0),
+            pct(k.ci95.1),
+            pct(k.holdout_k.0),
+            pct(k.holdout_k.1),
+            k.holdout_turn_rms_deg.0,
+            k.holdout_turn_rms_deg.1,
+            k.holdout_runs_better.0,
+            k.holdout_runs_better.1,
+            if k.written {
+                "named and written (<code>config.correction.scale_k</code>)"
+            } else if k.named {
+                "named, not corrected"
+            } else {
+                "not named"
+            }
+        );
+    }
+    let _ = writeln!(s, "</table>");
+    if !t.untracked.is_empty() {
+        let _ = writeln!(
+            s,
+            "<p>Movements the reference does not follow (the gyro turns, the reference less than \
+half as much): a turn about another axis seen through a mount off the reference's axes, or \
+motion the reference misses. No effect of the vocabulary expresses them.</p>\
+<table><tr><th>run</th><th>gyro</th><th>reference</th></tr>"
+        );
+        for u in &t.untracked {
+            let _ = writeln!(
+                s,
+                "<tr><td>{}</td><td class=\"n\">{:+.2}°</td><td class=\"n\">{:+.2}°</td></tr>",
+                esc(&u.run),
+                u.gyro_deg,
+                u.reference_deg
+            );
+        }
+        let _ = writeln!(s, "</table>");
+    }
 }
 
 fn tables(s: &mut String, d: &Diagnosis) {
@@ -1236,6 +1320,7 @@ mod tests {
             effective_noise: Default::default(),
             motion_lines: Vec::new(),
             inputs: Vec::new(),
+            turns: None,
             corrected_model: None,
             selected_sensor: SensorModel::default(),
         }
@@ -1314,5 +1399,61 @@ mod tests {
         assert_eq!(b.lo, vec![1.0, 4.0]);
         assert_eq!(b.mid, vec![2.0, 5.0]);
         assert_eq!(b.hi, vec![3.0, 5.0]);
+    }
+
+    #[test]
+    fn the_headline_says_what_the_turns_show() {
+        use gyro_analysis::diagnose::turns::{TurnEvidence, TurnScale, Untracked, WideLag};
+        let mut d = diagnosis();
+        d.turns = Some(TurnEvidence {
+            train_turns: 12,
+            holdout_turns: 6,
+            lag: Some(WideLag {
+                median_s: 0.107,
+                train_range_s: (0.094, 0.111),
+                holdout_median_s: Some(0.09),
+                beyond_statistic: true,
+                holdout_max_abs_error_deg: Some((37.4, 11.9)),
+                bootstrap_p: Some(0.0),
+                written: true,
+            }),
+            scale: Some(TurnScale {
+                k: -0.0112,
+                standard_error: 0.0007,
+                ci95: (-0.0127, -0.0097),
+                z: -16.0,
+                holdout_k: (-0.0107, 0.0005),
+                holdout_turn_rms_deg: (2.11, 0.55),
+                holdout_runs_better: (2, 2),
+                bootstrap_p: 0.0,
+                named: true,
+                written: true,
+            }),
+            untracked: vec![Untracked {
+                run: "a.csv".into(),
+                gyro_deg: -9.5,
+                reference_deg: 0.002,
+            }],
+        });
+        let lines = super::super::headline(&d).join("\n");
+        assert!(lines.contains("the gyro lags the reference by 107 ms (94 to 111 over the training runs; 90 ms on the held-out runs)"), "{lines}");
+        assert!(lines.contains("written as the model's reference_delay_s (held-out median max |angle error| 37.40 -> 11.90 deg)"), "{lines}");
+        assert!(
+            lines.contains(
+                "the gyro reads -1.12% [-1.27%, -0.97%] of the reference's turn (12 training turns"
+            ),
+            "{lines}"
+        );
+        assert!(lines.contains("RMS error 2.11 -> 0.55 deg with it, better on 2 of 2 runs: written (config.correction.scale_k)"), "{lines}");
+        assert!(lines.contains("1 movements the reference does not follow, in 1 runs: the gyro turns 9.5 to 9.5 deg"), "{lines}");
+        let dir = temp("turns");
+        write_report(&dir, &d, None, &Options::default()).unwrap();
+        let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+        assert!(html.contains("<h2>Turns, rest to rest</h2>"), "{html}");
+        assert!(
+            html.contains("−1.12%") || html.contains("-1.12% [-1.27%, -0.97%]"),
+            "{html}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
