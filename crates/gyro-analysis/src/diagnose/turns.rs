@@ -143,8 +143,7 @@ fn replay(run: &RealRun, model: &ModelFile) -> Option<RunReport> {
     replay_with(&run.log, &model.config, &ReplayOptions::from_model(model)).ok()
 }
 
-/// Median over `runs` of their max abs angle error replayed with `model` (NaN where
-/// none), and the per-run values.
+/// Each run's max abs angle error replayed with `model` (NaN where it has none).
 fn max_abs_errors(runs: &[RealRun], model: &ModelFile) -> Vec<f64> {
     runs.par_iter()
         .map(|run| {
@@ -170,14 +169,17 @@ pub(crate) fn turn_evidence(
     model: &ModelFile,
     options: &super::Options,
 ) -> (Option<TurnEvidence>, Option<ModelFile>) {
-    let train_totals = totals(train, model);
-    let holdout_totals = totals(holdout, model);
-    let train_turns: usize = train_totals.iter().map(|t| scale::turns(t)).sum();
-    let holdout_turns: usize = holdout_totals.iter().map(|t| scale::turns(t)).sum();
     let mut written = model.clone();
     let mut changed = false;
 
     let lag = wide_lag(train, holdout, &mut written, &mut changed, options);
+
+    // The totals with the model as it stands after the lag (read at mid-rest, they barely
+    // depend on it, but every figure below is then of one model).
+    let train_totals = totals(train, &written);
+    let holdout_totals = totals(holdout, &written);
+    let train_turns: usize = train_totals.iter().map(|t| scale::turns(t)).sum();
+    let holdout_turns: usize = holdout_totals.iter().map(|t| scale::turns(t)).sum();
 
     let scale = (train_turns >= 2 && holdout_turns >= 1)
         .then(|| {
