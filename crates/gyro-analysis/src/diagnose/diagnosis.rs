@@ -160,6 +160,23 @@ pub struct Diagnosis {
     pub selected_sensor: SensorModel,
 }
 
+impl Diagnosis {
+    /// Why the residual-based figures (the effective noise, the where-statistics) say
+    /// little about the sensor here, when they do: a reference that lags or leads the
+    /// gyro beyond the per-sample statistics' reach makes the residual during turns the
+    /// rate times the lag ([`super::turns`]). `None` otherwise.
+    pub fn residual_caveat(&self) -> Option<String> {
+        let lag = self.turns.as_ref()?.lag.as_ref()?;
+        lag.beyond_statistic.then(|| {
+            format!(
+                "the reference is {:.0} ms {} the gyro, beyond the per-sample statistics' reach: this residual is mostly the rate times that lag, far above the sensor's own noise",
+                1e3 * lag.median_s.abs(),
+                if lag.median_s >= 0.0 { "ahead of" } else { "behind" }
+            )
+        })
+    }
+}
+
 /// One log's input-quality report.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct InputEntry {

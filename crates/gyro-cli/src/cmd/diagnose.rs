@@ -310,6 +310,9 @@ fn write_noise_yaml(out: &Path, args: &Args, result: &Diagnosis) -> Result<()> {
                     h.describe()
                 ));
             }
+            if let Some(caveat) = result.residual_caveat() {
+                notes.push(caveat);
+            }
             gyro_analysis::noise::NoiseParams::from_residual(
                 &t.characterization,
                 format!(

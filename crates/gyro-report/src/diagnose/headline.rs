@@ -237,7 +237,10 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
         ));
     }
     if let Some(line) = effective_noise_line(&d.effective_noise) {
-        lines.push(line);
+        lines.push(match d.residual_caveat() {
+            Some(caveat) => format!("{line}; but {caveat}"),
+            None => line,
+        });
     }
     lines.extend(d.warnings.iter().map(|w| format!("warning: {w}")));
     lines

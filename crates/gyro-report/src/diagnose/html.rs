@@ -1446,6 +1446,9 @@ mod tests {
         );
         assert!(lines.contains("RMS error 2.11 -> 0.55 deg with it, better on 2 of 2 runs: written (config.correction.scale_k)"), "{lines}");
         assert!(lines.contains("1 movements the reference does not follow, in 1 runs: the gyro turns 9.5 to 9.5 deg"), "{lines}");
+        assert!(d
+            .residual_caveat()
+            .is_some_and(|c| c.starts_with("the reference is 107 ms ahead of the gyro")));
         let dir = temp("turns");
         write_report(&dir, &d, None, &Options::default()).unwrap();
         let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
