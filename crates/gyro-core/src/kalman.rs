@@ -106,6 +106,9 @@ pub struct KalmanBias {
     /// α: the scale of the bias's wander rate (β·α, so `q` scales by about α while the
     /// bias keeps its stationary spread).
     wander_scale: f32,
+    /// φ = e^(−β·α·dt), the bias's transition per step: set with α, which changes only at
+    /// rest updates, so that a step computes no exponential.
+    phi: f32,
 }
 
 impl KalmanBias {
@@ -126,7 +129,13 @@ impl KalmanBias {
             block_variance: f32::NAN,
             movement_bias_variance: f32::NAN,
             wander_scale: 1.0,
+            phi: transition_of(config.beta_per_s * dt_s, 1.0),
         })
+    }
+
+    /// The step `dt_s` the filter was built for (s).
+    pub const fn dt_s(&self) -> f32 {
+        self.dt_s
     }
 
     /// Current bias estimate (deg/s).
@@ -172,17 +181,18 @@ impl KalmanBias {
     /// Discrete GM: var(b) stays σ_b² with that q. At β = 0 the bias is a constant and
     /// only its initial uncertainty remains.
     fn transition(&self) -> (f32, f32) {
-        let phi = libm::expf(-self.beta_dt * self.wander_scale);
+        let phi = self.phi;
         (phi, self.sigma_b2 * (1.0 - phi * phi))
     }
 
     /// Propagate one step; `moving` if the angle integrates this step.
     pub fn predict(&mut self, moving: bool) {
-        let coupling = if moving { -self.dt_s } else { 0.0 };
         let (phi, q_bias) = self.transition();
-        let f = Matrix2::new(1.0, coupling, 0.0, phi);
-        let q_angle = if moving { self.q_angle() } else { 0.0 };
-        self.p = f * self.p * f.transpose() + Matrix2::new(q_angle, 0.0, 0.0, q_bias);
+        self.p = if moving {
+            propagate(&self.p, -self.dt_s, phi, self.q_angle(), q_bias)
+        } else {
+            propagate_static(&self.p, phi, q_bias)
+        };
         self.bias_dps = self.bias_mean_dps + phi * (self.bias_dps - self.bias_mean_dps);
     }
 
@@ -248,11 +258,11 @@ impl KalmanBias {
         } else {
             self.r_rate / samples.max(1) as f32
         };
-        let h = RowVector2::new(0.0, 1.0);
         let s = self.p[(1, 1)] + r;
         if s.is_nan() || s <= 0.0 {
             return 0.0;
         }
+        let h = RowVector2::new(0.0, 1.0);
         let gain: Vector2<f32> = self.p * h.transpose() / s;
         let innovation = rate_dps - self.bias_dps;
         let nis = innovation * innovation / s;
@@ -260,6 +270,7 @@ impl KalmanBias {
             let scaled =
                 self.wander_scale * libm::expf(WANDER_SCALE_STEP * (nis.min(NIS_CAP) - 1.0));
             self.wander_scale = scaled.clamp(WANDER_SCALE_RANGE.0, WANDER_SCALE_RANGE.1);
+            self.phi = transition_of(self.beta_dt, self.wander_scale);
         }
         self.bias_dps += gain[1] * innovation;
         // Joseph form keeps P symmetric and positive in f32.
@@ -281,6 +292,56 @@ impl KalmanBias {
     }
 }
 
+/// `F·P·Fᵀ + Q` for `F = [1 coupling; 0 φ]` and `Q = diag(q_angle, q_bias)`, element by
+/// element in the operations nalgebra's `f * p * f.transpose() + q` performs, so the same
+/// bits (each element of a product is `a(i,1)·b(1,j) + a(i,0)·b(0,j)`, products by the
+/// constants 0 and 1 included, which keep a zero's sign and a non-finite element as they
+/// do there), without the shuffles of its 2×2 products.
+#[inline(always)]
+fn propagate(p: &Matrix2<f32>, coupling: f32, phi: f32, q_angle: f32, q_bias: f32) -> Matrix2<f32> {
+    let (p00, p01, p10, p11) = (p[(0, 0)], p[(0, 1)], p[(1, 0)], p[(1, 1)]);
+    // A = F·P; F's 1 leaves its factor as it is (1·x = x exactly).
+    let a00 = coupling * p10 + p00;
+    let a01 = coupling * p11 + p01;
+    let a10 = phi * p10 + 0.0 * p00;
+    let a11 = phi * p11 + 0.0 * p01;
+    // A·Fᵀ, Fᵀ = [1 0; coupling φ].
+    let b00 = a01 * coupling + a00;
+    let b01 = a01 * phi + a00 * 0.0;
+    let b10 = a11 * coupling + a10;
+    let b11 = a11 * phi + a10 * 0.0;
+    Matrix2::new(b00 + q_angle, b01 + 0.0, b10 + 0.0, b11 + q_bias)
+}
+
+/// [`propagate`] at rest (no coupling, no angle noise), with a shorter chain of
+/// operations from one step's P to the next's where that gives the same bits: for finite
+/// elements the products by 0 are zeros, and adding a zero leaves a number that is not
+/// zero as it is, so that `P00` stays, `P01` and `P10` are scaled by φ, and `P11` becomes
+/// `φ·P11·φ + q_bias`. Where a zero or a non-finite value could make the difference, the
+/// whole computation.
+#[inline(always)]
+fn propagate_static(p: &Matrix2<f32>, phi: f32, q_bias: f32) -> Matrix2<f32> {
+    let (p00, p01, p10, p11) = (p[(0, 0)], p[(0, 1)], p[(1, 0)], p[(1, 1)]);
+    let (f01, f10, f11) = (p01 * phi, phi * p10, phi * p11);
+    let g11 = f11 * phi;
+    let values = [p00, p01, p10, p11, f01, f10, f11, g11];
+    // Without early exit: the test is off the chain from one P to the next.
+    let finite = values.iter().fold(true, |all, v| all & v.is_finite());
+    let nonzero = [p00, p01, f01, f10, f11, g11]
+        .iter()
+        .fold(true, |all, &v| all & (v != 0.0));
+    if finite & nonzero {
+        Matrix2::new(p00, f01, f10, g11 + q_bias)
+    } else {
+        propagate(p, 0.0, phi, 0.0, q_bias)
+    }
+}
+
+/// φ = e^(−β·dt·α) for `beta_dt` = β·dt and `wander_scale` = α.
+fn transition_of(beta_dt: f32, wander_scale: f32) -> f32 {
+    libm::expf(-beta_dt * wander_scale)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -289,6 +350,60 @@ mod tests {
     fn noise(k: u32, sigma: f32) -> f32 {
         let x = k.wrapping_mul(2_654_435_761) >> 8;
         sigma * 1.732 * ((x % 2001) as f32 / 1000.0 - 1.0)
+    }
+
+    /// `propagate` gives nalgebra's `F·P·Fᵀ + Q` bit for bit, signed zeros and
+    /// non-finite elements included.
+    #[test]
+    fn propagate_is_nalgebras_product() {
+        let special = [
+            0.0_f32,
+            -0.0,
+            1.0,
+            -1.0,
+            1e-30,
+            -3.5e-8,
+            f32::MIN_POSITIVE,
+            7.25e3,
+            f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        let mut state = 0x2545_f491_u32;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            if state % 4 == 0 {
+                special[(state / 4) as usize % special.len()]
+            } else {
+                f32::from_bits(state % 0x7f00_0000) * if state % 3 == 0 { -1.0 } else { 1.0 }
+            }
+        };
+        for _ in 0..200_000 {
+            let p = Matrix2::new(next(), next(), next(), next());
+            let (coupling, phi, q_angle, q_bias) = (next(), next(), next(), next());
+            // φ as the filter has it, in [0, 1], and any.
+            let phi_in_range = libm::fabsf(phi) / (1.0 + libm::fabsf(phi));
+            for phi in [phi, phi_in_range] {
+                for (coupling, q_angle) in [(coupling, q_angle), (0.0, 0.0)] {
+                    let f = Matrix2::new(1.0, coupling, 0.0, phi);
+                    let want = f * p * f.transpose() + Matrix2::new(q_angle, 0.0, 0.0, q_bias);
+                    let mut got = [propagate(&p, coupling, phi, q_angle, q_bias)].to_vec();
+                    if coupling.to_bits() == 0 && q_angle.to_bits() == 0 {
+                        got.push(propagate_static(&p, phi, q_bias));
+                    }
+                    for got in got {
+                        for (w, g) in want.iter().zip(got.iter()) {
+                            assert!(
+                                w.to_bits() == g.to_bits() || w.is_nan() && g.is_nan(),
+                                "{p:?} {coupling} {phi} {q_angle} {q_bias}: {want:?} vs {got:?}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -344,9 +344,17 @@ impl MotionDetector {
 
     /// How far from the bias a steady level is still a rest (deg/s).
     fn near_dps(&self) -> f32 {
-        (0.25 * self.enter_dps)
-            .max(2.0 * self.exit_dps)
-            .min(self.enter_dps)
+        // Comparisons rather than `max` and `min`, which also test for NaN: the settings
+        // are finite (validated). Where the two forms could differ, in a zero's sign,
+        // every use of this level is a comparison or the cap of a non-negative step (which
+        // the noise average gives the same value either way).
+        let (quarter, double) = (0.25 * self.enter_dps, 2.0 * self.exit_dps);
+        let wider = if quarter > double { quarter } else { double };
+        if wider < self.enter_dps {
+            wider
+        } else {
+            self.enter_dps
+        }
     }
 
     /// Samples a level must last to count as steady: `min_rest`, and at least a few.
@@ -364,7 +372,9 @@ impl MotionDetector {
         let step = libm::fabsf(rate_dps - self.previous_dps);
         if step.is_finite() {
             // One outlier (a knock) moves the average by a bounded amount.
-            let step = step.min(4.0 * self.near_dps());
+            // `step.min(cap)` without its NaN test: the step is finite.
+            let cap = 4.0 * self.near_dps();
+            let step = if step < cap { step } else { cap };
             self.noise_dps += NOISE_WEIGHT * (step - self.noise_dps);
         }
     }

@@ -324,6 +324,38 @@ fn clip_seen(level_dps: f32, last: &mut f32, run: &mut u8, reading_dps: f32) -> 
         | ((*run >= CLIP_PLATEAU_SAMPLES) & (magnitude >= CLIP_PLATEAU_MIN_DPS))
 }
 
+/// Where the clip watch ends over readings none of which repeats the one before it (the
+/// first may repeat the watch's `last_dps`): the first reading's plateau flag (its run
+/// of repeats is the only one that may reach [`CLIP_PLATEAU_SAMPLES`]), the last reading
+/// and its run. `None` if some reading after the first repeats the one before, or if
+/// there are none.
+#[inline(always)]
+fn distinct_run(rates_dps: &[f32], last_dps: f32, run: u8) -> Option<DistinctRun> {
+    let (&first, rest) = rates_dps.split_first()?;
+    // Without early exit, so that the comparisons go in vector lanes.
+    let distinct = rates_dps
+        .iter()
+        .zip(rest)
+        .fold(true, |distinct, (&before, &x)| distinct & (x != before));
+    if !distinct {
+        return None;
+    }
+    let (mut last, mut run) = (last_dps, run);
+    let first_clipped = clip_seen(f32::INFINITY, &mut last, &mut run, first);
+    Some(DistinctRun {
+        first_clipped,
+        last_dps: rates_dps[rates_dps.len() - 1],
+        run: if rest.is_empty() { run } else { 1 },
+    })
+}
+
+/// See [`distinct_run`].
+struct DistinctRun {
+    first_clipped: bool,
+    last_dps: f32,
+    run: u8,
+}
+
 /// Group delay at DC of a cascade (output samples): for each section `B/A`,
 /// `Σ k b_k / Σ b_k − Σ k a_k / Σ a_k`. Zero if not finite (no DC gain).
 fn dc_group_delay_samples(design: &SosDesign) -> f64 {
@@ -361,7 +393,6 @@ pub struct Pipeline {
     corrects: bool,
     compensation: Compensation,
     paper: GaussMarkov,
-    output_period_s: f32,
     filter_delay_s: f64,
     decimator: Decimator,
     sos: Sos,
@@ -419,7 +450,6 @@ impl Pipeline {
             corrects: !config.correction.is_identity(),
             compensation: config.compensation,
             paper: config.paper,
-            output_period_s,
             filter_delay_s: dc_group_delay_samples(&design) * f64::from(output_period_s),
             decimator: Decimator::try_new(factor)?,
             sos,
@@ -447,7 +477,8 @@ impl Pipeline {
 
     /// Output sample period (s).
     pub const fn output_period_s(&self) -> f32 {
-        self.output_period_s
+        // The Kalman filter's step: one copy of the period in the state.
+        self.kalman.dt_s()
     }
 
     /// Group delay of the low-pass filter at DC (s): how far the filtered rate, and the
@@ -705,16 +736,7 @@ impl Pipeline {
             self.corrector.observe_temperature(temperature_c);
         }
 
-        let mut sums = KahanLanes::<LANES>::ZERO;
-        for i in 0..factor {
-            // Without temperature: a temperature that would change the rate keeps the
-            // blocks out of here.
-            let mut column = [0.0; LANES];
-            for (x, row) in column.iter_mut().zip(&rows) {
-                *x = self.corrected::<false>(row[i]);
-            }
-            sums.add(column);
-        }
+        let sums = self.block_sums(&rows);
 
         for (k, row) in rows.into_iter().enumerate() {
             let sum = sums.lane(k);
@@ -727,6 +749,42 @@ impl Pipeline {
             sink(self.end_block(self.last_time_s, mean_dps));
         }
         true
+    }
+
+    /// The compensated sums of whole blocks (`rows`, of one length), side by side, each in
+    /// its samples' order. The samples are read 4 of a block at a time: one load and one
+    /// bounds check for 4 values, which shuffles then turn into 4 columns of the lanes,
+    /// rather than a load and a check for each value.
+    #[inline(always)]
+    fn block_sums<const LANES: usize>(&self, rows: &[&[f32]; LANES]) -> KahanLanes<LANES> {
+        let factor = rows.first().map_or(0, |row| row.len());
+        // Without temperature: a temperature that would change the rate keeps the blocks
+        // out of here.
+        let mut sums = KahanLanes::<LANES>::ZERO;
+        let mut i = 0;
+        while i + 4 <= factor {
+            let quads: [[f32; 4]; LANES] = core::array::from_fn(|k| {
+                rows[k]
+                    .get(i..i + 4)
+                    .and_then(|quad| <[f32; 4]>::try_from(quad).ok())
+                    .unwrap_or_default()
+            });
+            // Column by column straight from the quads (an array of the columns first
+            // measured slower).
+            #[allow(clippy::needless_range_loop)]
+            for j in 0..4 {
+                sums.add(core::array::from_fn(|k| {
+                    self.corrected::<false>(quads[k][j])
+                }));
+            }
+            i += 4;
+        }
+        for i in i..factor {
+            sums.add(core::array::from_fn(|k| {
+                self.corrected::<false>(rows[k].get(i).copied().unwrap_or_default())
+            }));
+        }
+        sums
     }
 
     /// The plausibility test and the clip watch over whole blocks of `factor` samples in
@@ -768,6 +826,17 @@ impl Pipeline {
                 u8::try_from(repeats + 1).unwrap_or(u8::MAX)
             };
             self.clip_last_dps = last;
+        } else if let Some(distinct) = distinct_run(rates_dps, self.clip_last_dps, self.clip_run) {
+            // No reading repeats the one before it, but perhaps the first: a plateau can
+            // only complete there, and the watch ends on a run of one (or the first's).
+            let level_dps = self.clip_level_dps;
+            for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
+                *clipped = block
+                    .iter()
+                    .fold(false, |seen, &x| seen | (libm::fabsf(x) >= level_dps));
+            }
+            clipped[0] |= distinct.first_clipped;
+            (self.clip_last_dps, self.clip_run) = (distinct.last_dps, distinct.run);
         } else {
             let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
             for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
@@ -851,7 +920,7 @@ impl Pipeline {
     /// before it (the output period over the factor), or 0 if there is none.
     fn substitute_time(&self, before_s: f64) -> f64 {
         if before_s.is_finite() {
-            before_s + f64::from(self.output_period_s) / f64::from(self.decimator.factor())
+            before_s + f64::from(self.output_period_s()) / f64::from(self.decimator.factor())
         } else {
             0.0
         }
@@ -898,7 +967,7 @@ impl Pipeline {
         // in motion would otherwise gain a whole step of T × rate).
         if integrates && self.index > 0 {
             let (previous_rate, previous_corrected) = self.previous;
-            let half_dt_s = 0.5 * self.output_period_s;
+            let half_dt_s = 0.5 * self.output_period_s();
             self.raw.step(half_dt_s, previous_rate, rate_dps);
             self.corrected
                 .step(half_dt_s, previous_corrected, corrected_dps);
@@ -937,8 +1006,9 @@ impl Pipeline {
                 self.kalman.add_motion(u32::from(run).saturating_sub(1));
                 // The movement starts at the quiet sample before the run.
                 let start_index = self.index.saturating_sub(u32::from(run));
-                let start_time_s =
-                    time_s - f64::from(run) * f64::from(self.output_period_s) - self.filter_delay_s;
+                let start_time_s = time_s
+                    - f64::from(run) * f64::from(self.output_period_s())
+                    - self.filter_delay_s;
                 // The rest samples still held back lead into the movement: drop them.
                 self.rest_blocks.clear();
                 // The run so far is still pending: it belongs to the movement.
@@ -1017,7 +1087,7 @@ impl Pipeline {
         let track = self.track.take()?;
         let (end_index, end_time_s) = track.settle().unwrap_or((self.index, time_s));
         let raw_angle_deg = self.raw.committed_deg() - track.raw_at_start_deg;
-        let duration_s = (end_index - track.start_index) as f32 * self.output_period_s;
+        let duration_s = (end_index - track.start_index) as f32 * self.output_period_s();
         self.paper_total
             .add(raw_angle_deg - self.paper.misalignment_deg(duration_s));
         Some(Movement {
@@ -1055,7 +1125,7 @@ impl Pipeline {
                     Some(track) => {
                         let elapsed = self.index.saturating_sub(track.start_index);
                         let moved = self.raw.angle_deg() - track.raw_at_start_deg;
-                        let duration_s = elapsed as f32 * self.output_period_s;
+                        let duration_s = elapsed as f32 * self.output_period_s();
                         total + moved - self.paper.misalignment_deg(duration_s)
                     }
                 }
@@ -1086,8 +1156,10 @@ mod size_tests {
     /// The firmware budget: the whole pipeline state in 512 bytes at most. It is exactly
     /// 512, every byte a field: `Track` gave up 8 bytes of `Option` padding for the
     /// corrector, the saturation state (10 bytes) is paid for by `previous` without an
-    /// `Option` tag and the sample rate kept as f32 instead of the period as f64, and the
-    /// last free byte says whether the correction is the identity.
+    /// `Option` tag and the sample rate kept as f32 instead of the period as f64, the
+    /// last free byte says whether the correction is the identity, and the Kalman
+    /// filter's cached transition φ is paid for by the output period kept once (the
+    /// filter's step).
     #[test]
     fn pipeline_state_fits_in_512_bytes() {
         use core::mem::size_of;
