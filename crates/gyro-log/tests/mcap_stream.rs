@@ -122,9 +122,21 @@ fn a_truncated_file_warns_with_the_byte_offset_and_keeps_the_rows_before() {
 /// Messages of one channel pair (`/gyro`, `/reference`) at the given times, written in the
 /// given groups, each group closed as a chunk of its own.
 fn write_groups(path: &Path, groups: &[Vec<u64>], finish: bool) {
+    write_groups_as(path, groups, finish, Some(mcap::Compression::Zstd), true);
+}
+
+/// [`write_groups`] with chunks compressed by `compression`, or without chunks.
+fn write_groups_as(
+    path: &Path,
+    groups: &[Vec<u64>],
+    finish: bool,
+    compression: Option<mcap::Compression>,
+    chunked: bool,
+) {
     let file = std::fs::File::create(path).unwrap();
     let mut w = mcap::WriteOptions::new()
-        .compression(Some(mcap::Compression::Zstd))
+        .compression(compression)
+        .use_chunks(chunked)
         .create(BufWriter::new(file))
         .unwrap();
     let gyro_schema = r#"{"type":"object","properties":{"rate_dps":{}}}"#;
@@ -163,6 +175,51 @@ fn write_groups(path: &Path, groups: &[Vec<u64>], finish: bool) {
     }
     if finish {
         w.finish().unwrap();
+    }
+}
+
+/// zstd chunks (decompressed whole), uncompressed chunks, lz4 chunks and messages outside
+/// chunks (mcap's linear reader) give the same rows, finished or cut after a few chunks.
+#[test]
+fn every_compression_and_loose_messages_read_alike() {
+    let dir = temp_dir("stream-compression");
+    let groups: Vec<Vec<u64>> = (0..6).map(|g| (g * 500..(g + 1) * 500).collect()).collect();
+    let zstd = dir.join("zstd.mcap");
+    write_groups(&zstd, &groups, true);
+    let expected = gyro_log::read_mcap(&zstd, &McapOptions::default()).unwrap();
+    assert_eq!(expected.log.rows.len(), 3000);
+    assert!(expected.warnings.is_empty());
+    for (name, compression, chunked) in [
+        ("none", None, true),
+        ("lz4", Some(mcap::Compression::Lz4), true),
+        ("loose", None, false),
+    ] {
+        let path = dir.join(format!("{name}.mcap"));
+        write_groups_as(&path, &groups, true, compression, chunked);
+        let got = gyro_log::read_mcap(&path, &McapOptions::default()).unwrap();
+        assert!(got.warnings.is_empty(), "{name}: {:?}", got.warnings);
+        assert_eq!(got.log.rows.len(), expected.log.rows.len(), "{name}");
+        for (a, b) in got.log.rows.iter().zip(&expected.log.rows) {
+            assert_eq!(values(a), values(b), "{name}");
+        }
+        // Cut in the middle of the data: the rows before the cut, with a warning.
+        let bytes = std::fs::read(&path).unwrap();
+        let cut = dir.join(format!("{name}-cut.mcap"));
+        std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+        let got = gyro_log::read_mcap(&cut, &McapOptions::default()).unwrap();
+        assert_eq!(got.warnings.len(), 1, "{name}");
+        assert!(got.warnings[0].contains("read up to byte"), "{name}");
+        let kept = got.log.rows.len();
+        assert!(kept > 0 && kept < 3000, "{name}");
+        // The last row's reference may be cut off (loose messages: it comes after it).
+        for (i, (a, b)) in got.log.rows.iter().zip(&expected.log.rows).enumerate() {
+            let (a, b) = (values(a), values(b));
+            if i + 1 < kept {
+                assert_eq!(a, b, "{name}");
+            } else {
+                assert_eq!((a.0, a.1, a.2), (b.0, b.1, b.2), "{name}");
+            }
+        }
     }
 }
 

@@ -96,6 +96,46 @@ fn take_digits(text: &[u8], i: &mut usize, mantissa: &mut u64) -> usize {
     *i - from
 }
 
+/// `mantissa / 10^decimals` correctly rounded, for a mantissa above 2^53 (not exact as an
+/// `f64`), when it can be decided in 128-bit integers; `None` otherwise (a tie, or numbers
+/// too large for the check). The `f64` quotient of the rounded mantissa is within an ulp
+/// or so of the true value; the candidate (or its neighbour) is the answer if the true
+/// value lies strictly between its two half-ulp midpoints, which is checked exactly:
+/// `m · 2^(1-e)` against `(2M ± 1) · 10^decimals`, for the candidate `M · 2^e`.
+fn checked_quotient(mantissa: u64, decimals: usize) -> Option<f64> {
+    let pow10 = 10_u128.checked_pow(u32::try_from(decimals).ok()?)?;
+    let mut candidate = mantissa as f64 / pow10 as f64;
+    if !candidate.is_normal() {
+        return None;
+    }
+    // The true value scaled by 2^(1-e): numerator `scaled`, denominator `pow10`; the
+    // candidate's neighbours share its exponent (checked below), so `e` is fixed.
+    let bits = candidate.to_bits();
+    let e = ((bits >> 52) & 0x7ff) as i32 - 1075;
+    let shift = u32::try_from(1 - e).ok()?;
+    if 64 - mantissa.leading_zeros() + shift > 127 {
+        return None;
+    }
+    let scaled = u128::from(mantissa) << shift;
+    for _ in 0..2 {
+        let bits = candidate.to_bits();
+        if ((bits >> 52) & 0x7ff) as i32 - 1075 != e {
+            return None; // crossed a power of two
+        }
+        let m = u128::from((bits & ((1 << 52) - 1)) | (1 << 52));
+        let below = (2 * m - 1).checked_mul(pow10)?;
+        let above = (2 * m + 1).checked_mul(pow10)?;
+        if below < scaled && scaled < above {
+            return Some(candidate);
+        }
+        if scaled == below || scaled == above {
+            return None; // a tie: left to the standard parser
+        }
+        candidate = f64::from_bits(if scaled > above { bits + 1 } else { bits - 1 });
+    }
+    None
+}
+
 /// The unread rest of a message.
 struct Cursor<'a>(&'a [u8]);
 
@@ -170,16 +210,17 @@ impl Cursor<'_> {
         }
         let number = text.get(..i)?;
         self.0 = text.get(i..)?;
-        let value = match POW10.get(decimals) {
+        let exact = match POW10.get(decimals) {
             Some(scale) if plain && digits <= 19 && mantissa <= 1 << 53 => {
-                let value = mantissa as f64 / scale;
-                if negative {
-                    -value
-                } else {
-                    value
-                }
+                Some(mantissa as f64 / scale)
             }
-            _ => std::str::from_utf8(number).ok()?.parse().ok()?,
+            Some(_) if plain && digits <= 19 => checked_quotient(mantissa, decimals),
+            _ => None,
+        };
+        let value = match exact {
+            Some(value) if negative => -value,
+            Some(value) => value,
+            None => std::str::from_utf8(number).ok()?.parse().ok()?,
         };
         // Out of range: let serde_json decide (it refuses such numbers).
         value.is_finite().then_some(Some(value))
@@ -299,5 +340,51 @@ mod tests {
                 (a, b) => assert_eq!(a.is_err(), b.is_err(), "{text}"),
             }
         }
+    }
+
+    /// Mantissas above 2^53 (up to 19 digits) with 0 to 22 decimals, and the tie-prone
+    /// ones near half-ulp boundaries: [`checked_quotient`] gives the standard parser's value
+    /// or none.
+    #[test]
+    fn checked_quotient_equals_the_standard_parser() {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut decided = 0;
+        for i in 0..400_000 {
+            let mantissa = match i % 4 {
+                0 => (1 << 53) + next() % (1 << 60),
+                1 => next() % 10_000_000_000_000_000_000,
+                // Shortest forms of doubles near 1 and 25 (17 digits).
+                2 => 10_000_000_000_000_000 + next() % 90_000_000_000_000_000,
+                _ => (next() % (1 << 11)) << 53 | 1 << 52, // multiples of large powers of two
+            };
+            if mantissa <= 1 << 53 {
+                continue;
+            }
+            let decimals = (next() % 23) as usize;
+            let digits = mantissa.to_string();
+            let text = if decimals == 0 {
+                digits
+            } else if digits.len() > decimals {
+                let (a, b) = digits.split_at(digits.len() - decimals);
+                format!("{a}.{b}")
+            } else {
+                format!("0.{}{digits}", "0".repeat(decimals - digits.len()))
+            };
+            let want: f64 = text.parse().unwrap();
+            if let Some(got) = checked_quotient(mantissa, decimals) {
+                decided += 1;
+                assert_eq!(got.to_bits(), want.to_bits(), "{text}");
+            }
+            let json = format!(r#"{{"rate_dps":{text}}}"#);
+            let fast = gyro(json.as_bytes()).unwrap().rate_dps;
+            assert_eq!(fast, Some(Some(want)), "{text}");
+        }
+        assert!(decided > 200_000, "{decided}");
     }
 }

@@ -143,14 +143,47 @@ struct SchemaInfo {
     data: Vec<u8>,
 }
 
+/// The channels by id: a lookup per message is one index into a table as long as the
+/// largest id seen.
+#[derive(Default)]
+struct Channels {
+    list: Vec<ChannelInfo>,
+    /// By id: 1 + the channel's index in `list`, 0 for none.
+    by_id: Vec<u32>,
+}
+
+impl Channels {
+    fn contains_key(&self, id: &u16) -> bool {
+        self.by_id.get(usize::from(*id)).is_some_and(|&i| i != 0)
+    }
+
+    /// Add channel `id` (not yet present).
+    fn insert(&mut self, id: u16, channel: ChannelInfo) {
+        let id = usize::from(id);
+        if self.by_id.len() <= id {
+            self.by_id.resize(id + 1, 0);
+        }
+        self.list.push(channel);
+        self.by_id[id] = self.list.len() as u32;
+    }
+
+    fn get_mut(&mut self, id: &u16) -> Option<&mut ChannelInfo> {
+        let i = *self.by_id.get(usize::from(*id))?;
+        self.list.get_mut((i as usize).checked_sub(1)?)
+    }
+
+    fn values(&self) -> std::slice::Iter<'_, ChannelInfo> {
+        self.list.iter()
+    }
+}
+
 /// Everything gathered while streaming, besides the rows.
 struct State {
     path: PathBuf,
     options: McapOptions,
     saw_header: bool,
     schemas: HashMap<u16, SchemaInfo>,
-    /// By id (a B-tree: a lookup per message, among a few channels, costs less than a hash).
-    channels: BTreeMap<u16, ChannelInfo>,
+    channels: Channels,
     metadata: BTreeMap<String, String>,
     /// The rate channel: its id, topic and kind.
     rate_channel: Option<(u16, String, Kind)>,
@@ -236,7 +269,7 @@ impl McapRows {
             options: options.clone(),
             saw_header,
             schemas: HashMap::new(),
-            channels: BTreeMap::new(),
+            channels: Channels::default(),
             metadata: BTreeMap::new(),
             rate_channel: None,
             attacher: Attacher::new(REFERENCE_MAX_SPAN_S),
@@ -430,7 +463,7 @@ impl McapRows {
             cause,
         })?;
         let options = &self.state.options;
-        let mut units = Units::new(file, self.units.units());
+        let mut units = UnitsAhead::here(Units::new(file, self.units.units()));
         let mut earliest = u64::MAX;
         while let Some(event) = units.next_event() {
             let Ok(Event::Record { opcode, data }) = event else {

@@ -1,9 +1,11 @@
 //! Reading the data section unit by unit ([`Unit`]: a chunk or a loose message), in the
-//! order the layout gives. One `mcap` linear reader is fed the units' bytes one after the
-//! other: it checks each chunk's CRC before handing on any of its records and decompresses
-//! it (zstd, lz4 or none), reusing its buffers and decompressor from chunk to chunk.
+//! order the layout gives. A chunk compressed with zstd (or not compressed) is read whole,
+//! decompressed in one call straight into the batch handed to the decoding thread, its
+//! CRC checked (over the decompressed records, before any of them is given), and its
+//! records given in place, without a copy. Any other unit (a loose message, a chunk in
+//! lz4) goes through one `mcap` linear reader, fed the units' bytes one after the other.
 
-use super::layout::{Unit, RECORD_LENGTH_LIMIT};
+use super::layout::{Unit, RECORD_HEADER_LEN, RECORD_LENGTH_LIMIT};
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::McapError;
 use std::fs::File;
@@ -31,25 +33,23 @@ pub(super) enum UnitError {
     Damaged { offset: u64, what: String },
 }
 
+/// Bytes of a chunk record's body before its compression name: start and end time,
+/// uncompressed size, uncompressed CRC, the name's length.
+const CHUNK_FIXED_LEN: usize = 8 + 8 + 8 + 4 + 4;
+
 /// The data section's units as one stream of records.
 pub(super) struct Units {
     file: File,
     units: Arc<[Unit]>,
-    /// Index of the next unit to feed to the reader.
+    /// Index of the next unit to read.
     next: usize,
-    /// Bytes of the current unit not yet fed.
-    remaining: u64,
-    /// The current unit's `UnitDone` has been given.
-    announced: bool,
-    reader: LinearReader,
-    /// The last record given, copied out of the reader.
-    record: Vec<u8>,
-}
-
-/// An [`Event`] whose record was copied out.
-enum Next {
-    Record { opcode: u8 },
-    UnitDone { next_start_ns: u64 },
+    /// The current unit's bytes, as in the file: the first `raw_len`.
+    raw: Vec<u8>,
+    raw_len: usize,
+    /// zstd's decompression context, reused from chunk to chunk (made at the first).
+    zstd: Option<zstd::bulk::Decompressor<'static>>,
+    /// For units read otherwise (made at the first).
+    reader: Option<LinearReader>,
 }
 
 impl Units {
@@ -58,16 +58,10 @@ impl Units {
             file,
             units: units.into(),
             next: 0,
-            remaining: 0,
-            announced: true,
-            reader: LinearReader::new_with_options(
-                LinearReaderOptions::default()
-                    .with_skip_start_magic(true)
-                    .with_skip_end_magic(true)
-                    .with_prevalidate_chunk_crcs(true)
-                    .with_record_length_limit(RECORD_LENGTH_LIMIT as usize),
-            ),
-            record: Vec::new(),
+            raw: Vec::new(),
+            raw_len: 0,
+            zstd: None,
+            reader: None,
         }
     }
 
@@ -89,82 +83,190 @@ impl Units {
         Arc::clone(&self.units)
     }
 
-    /// The next event; `None` once every unit has been read.
-    pub fn next_event(&mut self) -> Option<Result<Event<'_>, UnitError>> {
-        let mut record = std::mem::take(&mut self.record);
-        record.clear();
-        let next = self.next_into(&mut record);
-        self.record = record;
-        Some(next?.map(|next| match next {
-            Next::Record { opcode } => Event::Record {
-                opcode,
-                data: &self.record,
-            },
-            Next::UnitDone { next_start_ns } => Event::UnitDone { next_start_ns },
-        }))
-    }
-
-    /// The next event, a record's bytes appended to `data`; `None` once every unit has
-    /// been read.
-    fn next_into(&mut self, data: &mut Vec<u8>) -> Option<Result<Next, UnitError>> {
-        loop {
-            let need = match self.reader.next_event()? {
-                Ok(LinearReadEvent::ReadRequest(need)) => need,
-                Ok(LinearReadEvent::Record {
-                    opcode,
-                    data: record,
-                }) => {
-                    data.extend_from_slice(record);
-                    return Some(Ok(Next::Record { opcode }));
-                }
-                Err(e) => return Some(Err(self.damaged(&e))),
-            };
-            if self.remaining == 0 {
-                // The reader asks for exactly the bytes it lacks: wanting more after a
-                // unit's last byte, it has given all of that unit's records.
-                if !self.announced {
-                    self.announced = true;
-                    let next_start_ns = self.units.get(self.next).map_or(u64::MAX, |u| u.start_ns);
-                    return Some(Ok(Next::UnitDone { next_start_ns }));
-                }
-                let Some(unit) = self.units.get(self.next) else {
-                    self.reader.notify_read(0); // the end
-                    continue;
-                };
-                if let Err(e) = self.file.seek(SeekFrom::Start(unit.offset)) {
-                    return Some(Err(UnitError::Io(e)));
-                }
-                self.remaining = unit.len;
-                self.next += 1;
-                self.announced = false;
-            }
-            let want = need.min(self.remaining as usize);
-            let read = loop {
-                match self.file.read(&mut self.reader.insert(want)[..want]) {
-                    Ok(n) => break n,
-                    Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
-                    Err(e) => return Some(Err(UnitError::Io(e))),
-                }
-            };
-            if read == 0 {
-                // The file shrank since it was scanned.
-                return Some(Err(UnitError::Io(io::ErrorKind::UnexpectedEof.into())));
-            }
-            self.remaining -= read as u64;
-            self.reader.notify_read(read);
-        }
-    }
-
-    fn damaged(&self, e: &McapError) -> UnitError {
-        let offset = self.current_offset();
-        let what = match e {
-            McapError::UnexpectedEof => "the chunk ends early".into(),
-            McapError::RecordTooLarge { .. } | McapError::ChunkTooLarge(_) => {
-                format!("{e} (a corrupt length)")
-            }
-            e => e.to_string(),
+    /// Read the next unit into `batch`: its records, then its `UnitDone`. `Ok(false)` once
+    /// every unit has been read. On an error, the unit's records before the damage are
+    /// in `batch` (none for a chunk whose CRC or compression fails).
+    fn read_unit(&mut self, batch: &mut Batch) -> Result<bool, UnitError> {
+        let Some(&unit) = self.units.get(self.next) else {
+            return Ok(false);
         };
-        UnitError::Damaged { offset, what }
+        self.next += 1;
+        let offset = unit.offset;
+        let len = unit.len as usize;
+        if self.raw.len() < len {
+            self.raw.resize(len, 0); // zeroed once, when it grows: kept for later units
+        }
+        self.raw_len = len;
+        let read = self
+            .file
+            .seek(SeekFrom::Start(offset))
+            .and_then(|_| self.file.read_exact(&mut self.raw[..len]));
+        if let Err(e) = read {
+            // `UnexpectedEof`: the file shrank since it was scanned.
+            return Err(UnitError::Io(e));
+        }
+        let fast = unit.chunk && self.chunk(offset, batch)?;
+        if !fast {
+            self.linear(offset, batch)?;
+        }
+        let next_start_ns = self.units.get(self.next).map_or(u64::MAX, |u| u.start_ns);
+        batch.items.push((Item::UnitDone { next_start_ns }, offset));
+        Ok(true)
+    }
+
+    /// The chunk in `raw`, if compressed with zstd or not at all: decompressed into
+    /// `batch.data`, CRC-checked, its records listed. `Ok(false)` for another compression.
+    fn chunk(&mut self, offset: u64, batch: &mut Batch) -> Result<bool, UnitError> {
+        let damaged = |what: String| UnitError::Damaged { offset, what };
+        let body = self
+            .raw
+            .get(RECORD_HEADER_LEN as usize..self.raw_len)
+            .unwrap_or_default();
+        let u64_at = |i: usize| -> Option<u64> {
+            Some(u64::from_le_bytes(body.get(i..i + 8)?.try_into().ok()?))
+        };
+        let u32_at = |i: usize| -> Option<u32> {
+            Some(u32::from_le_bytes(body.get(i..i + 4)?.try_into().ok()?))
+        };
+        let too_short = || damaged("a chunk too short for its header".into());
+        let uncompressed_size = u64_at(16).ok_or_else(too_short)?;
+        let crc = u32_at(24).ok_or_else(too_short)?;
+        let name_len = u32_at(28).ok_or_else(too_short)? as usize;
+        let name_end = CHUNK_FIXED_LEN
+            .checked_add(name_len)
+            .filter(|&end| end <= body.len())
+            .ok_or_else(too_short)?;
+        let compression = &body[CHUNK_FIXED_LEN..name_end];
+        let zstd = match compression {
+            b"zstd" => true,
+            b"" => false,
+            _ => return Ok(false),
+        };
+        let compressed_size = u64_at(name_end).ok_or_else(too_short)?;
+        let data_start = name_end + 8;
+        let compressed = usize::try_from(compressed_size)
+            .ok()
+            .and_then(|size| body.get(data_start..data_start.checked_add(size)?))
+            .ok_or_else(|| {
+                damaged(format!(
+                    "a chunk whose compressed size ({compressed_size} bytes) exceeds the record"
+                ))
+            })?;
+        if uncompressed_size > RECORD_LENGTH_LIMIT {
+            return Err(damaged(format!(
+                "a chunk claims {uncompressed_size} uncompressed bytes: corrupt"
+            )));
+        }
+        let start = batch.data.len();
+        if zstd {
+            let size = uncompressed_size as usize;
+            batch.data.reserve(size);
+            let decompressor = match &mut self.zstd {
+                Some(d) => d,
+                empty => empty.insert(zstd::bulk::Decompressor::new().map_err(UnitError::Io)?),
+            };
+            let mut out = io::Cursor::new(&mut batch.data);
+            out.set_position(start as u64);
+            let wrote = decompressor
+                .decompress_to_buffer(compressed, &mut out)
+                .map_err(|e| damaged(format!("the chunk does not decompress (zstd: {e})")))?;
+            if wrote != size {
+                batch.data.truncate(start);
+                return Err(damaged(format!(
+                    "the chunk decompresses to {wrote} bytes, its header says {size}"
+                )));
+            }
+        } else {
+            if compressed_size != uncompressed_size {
+                return Err(damaged(format!(
+                    "an uncompressed chunk of {compressed_size} bytes whose header says {uncompressed_size}"
+                )));
+            }
+            batch.data.extend_from_slice(compressed);
+        }
+        let records = &batch.data[start..];
+        if crc != 0 {
+            let calculated = crc32fast::hash(records);
+            if calculated != crc {
+                batch.data.truncate(start);
+                return Err(damaged(format!(
+                    "chunk CRC mismatch (stored {crc:08x}, computed {calculated:08x})"
+                )));
+            }
+        }
+        let header_len = RECORD_HEADER_LEN as usize;
+        let end = batch.data.len();
+        let mut at = start;
+        while at < end {
+            let rest = &batch.data[at..end];
+            let Some(len) = rest
+                .get(1..header_len)
+                .and_then(|b| Some(u64::from_le_bytes(b.try_into().ok()?)))
+            else {
+                return Err(damaged("the chunk ends inside a record header".into()));
+            };
+            let opcode = rest[0];
+            let Some(record_end) = usize::try_from(len)
+                .ok()
+                .and_then(|len| len.checked_add(at + header_len))
+                .filter(|&e| e <= end)
+            else {
+                return Err(damaged(format!(
+                    "a record (opcode {opcode:#04x}) of {len} bytes overruns its chunk"
+                )));
+            };
+            let range = at + header_len..record_end;
+            batch.items.push((Item::Record { opcode, range }, offset));
+            at = record_end;
+        }
+        Ok(true)
+    }
+
+    /// The unit in `raw` through the linear reader: its records copied into `batch`.
+    fn linear(&mut self, offset: u64, batch: &mut Batch) -> Result<(), UnitError> {
+        let reader = self.reader.get_or_insert_with(|| {
+            LinearReader::new_with_options(
+                LinearReaderOptions::default()
+                    .with_skip_start_magic(true)
+                    .with_skip_end_magic(true)
+                    .with_prevalidate_chunk_crcs(true)
+                    .with_record_length_limit(RECORD_LENGTH_LIMIT as usize),
+            )
+        });
+        let mut fed = false;
+        loop {
+            match reader.next_event() {
+                // Not reached: the reader is never told the file ended.
+                None => return Ok(()),
+                Some(Ok(LinearReadEvent::ReadRequest(_))) => {
+                    if fed {
+                        // The reader asks for more after the unit's last byte: it has
+                        // given all of that unit's records.
+                        return Ok(());
+                    }
+                    let len = self.raw_len;
+                    reader.insert(len)[..len].copy_from_slice(&self.raw[..len]);
+                    reader.notify_read(len);
+                    fed = true;
+                }
+                Some(Ok(LinearReadEvent::Record { opcode, data })) => {
+                    let start = batch.data.len();
+                    batch.data.extend_from_slice(data);
+                    let range = start..batch.data.len();
+                    batch.items.push((Item::Record { opcode, range }, offset));
+                }
+                Some(Err(e)) => {
+                    let what = match e {
+                        McapError::UnexpectedEof => "the chunk ends early".into(),
+                        McapError::RecordTooLarge { .. } | McapError::ChunkTooLarge(_) => {
+                            format!("{e} (a corrupt length)")
+                        }
+                        e => e.to_string(),
+                    };
+                    return Err(UnitError::Damaged { offset, what });
+                }
+            }
+        }
     }
 }
 
@@ -267,6 +369,19 @@ impl UnitsAhead {
         }
     }
 
+    /// The same events, read on the caller's thread.
+    pub fn here(units: Units) -> Self {
+        Self {
+            units: units.units(),
+            file_len: units.file_len(),
+            source: Source::Here(Box::new(units)),
+            current: Batch::default(),
+            position: 0,
+            done: false,
+            offset: 0,
+        }
+    }
+
     /// Length of the file (bytes).
     pub fn file_len(&self) -> u64 {
         self.file_len
@@ -274,10 +389,7 @@ impl UnitsAhead {
 
     /// [`Units::current_offset`] when the last event was given.
     pub fn current_offset(&self) -> u64 {
-        match &self.source {
-            Source::Here(units) => units.current_offset(),
-            Source::Thread { .. } => self.offset,
-        }
+        self.offset
     }
 
     /// The units, in reading order.
@@ -287,10 +399,6 @@ impl UnitsAhead {
 
     /// [`Units::next_event`].
     pub fn next_event(&mut self) -> Option<Result<Event<'_>, UnitError>> {
-        let (batches, spare) = match &mut self.source {
-            Source::Here(units) => return units.next_event(),
-            Source::Thread { batches, spare, .. } => (batches, spare),
-        };
         loop {
             if let Some((item, offset)) = self.current.items.get(self.position) {
                 self.position += 1;
@@ -313,14 +421,19 @@ impl UnitsAhead {
                 self.offset = self.current.last_offset;
                 return last.map(Err);
             }
-            let Some(next) = batches.as_ref().and_then(|b| b.recv().ok()) else {
-                self.done = true;
-                return Some(Err(UnitError::Io(io::Error::other(
-                    "the thread reading the file stopped",
-                ))));
-            };
-            let used = std::mem::replace(&mut self.current, next);
-            let _ = spare.try_send(used);
+            match &mut self.source {
+                Source::Here(units) => fill(units, &mut self.current),
+                Source::Thread { batches, spare, .. } => {
+                    let Some(next) = batches.as_ref().and_then(|b| b.recv().ok()) else {
+                        self.done = true;
+                        return Some(Err(UnitError::Io(io::Error::other(
+                            "the thread reading the file stopped",
+                        ))));
+                    };
+                    let used = std::mem::replace(&mut self.current, next);
+                    let _ = spare.try_send(used);
+                }
+            }
             self.position = 0;
         }
     }
@@ -346,36 +459,26 @@ impl Drop for UnitsAhead {
 fn produce(mut units: Units, sender: &SyncSender<Batch>, spares: &Receiver<Batch>) {
     loop {
         let mut batch = spares.try_recv().unwrap_or_default();
-        batch.data.clear();
-        batch.items.clear();
-        batch.last = None;
-        loop {
-            let start = batch.data.len();
-            let item = match units.next_into(&mut batch.data) {
-                Some(Ok(Next::Record { opcode })) => Item::Record {
-                    opcode,
-                    range: start..batch.data.len(),
-                },
-                Some(Ok(Next::UnitDone { next_start_ns })) => Item::UnitDone { next_start_ns },
-                Some(Err(e)) => {
-                    batch.last = Some(Some(e));
-                    break;
-                }
-                None => {
-                    batch.last = Some(None);
-                    break;
-                }
-            };
-            let unit_done = matches!(item, Item::UnitDone { .. });
-            batch.items.push((item, units.current_offset()));
-            if unit_done && batch.data.len() >= BATCH_BYTES {
-                break;
-            }
-        }
-        batch.last_offset = units.current_offset();
+        fill(&mut units, &mut batch);
         let last = batch.last.is_some();
         if sender.send(batch).is_err() || last {
             return;
         }
     }
+}
+
+/// Empty `batch` and fill it with the next units' events: whole units until it holds
+/// [`BATCH_BYTES`], the end or an error.
+fn fill(units: &mut Units, batch: &mut Batch) {
+    batch.data.clear();
+    batch.items.clear();
+    batch.last = None;
+    while batch.last.is_none() && batch.data.len() < BATCH_BYTES {
+        match units.read_unit(batch) {
+            Ok(true) => {}
+            Ok(false) => batch.last = Some(None),
+            Err(e) => batch.last = Some(Some(e)),
+        }
+    }
+    batch.last_offset = units.current_offset();
 }
