@@ -247,7 +247,7 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
 }
 
 /// True if the turns' evidence wrote a correction into the model file.
-fn turns_wrote(d: &Diagnosis) -> bool {
+pub(super) fn turns_wrote(d: &Diagnosis) -> bool {
     d.turns.as_ref().is_some_and(|t| {
         t.lag.as_ref().is_some_and(|l| l.written) || t.scale.as_ref().is_some_and(|s| s.written)
     })

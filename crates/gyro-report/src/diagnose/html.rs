@@ -520,9 +520,9 @@ fn gap_map(d: &Diagnosis) -> GapMapPlot {
         .iter()
         .map(|r| {
             if r.role == "train" {
-                r.name.clone()
+                super::run_label(d, &r.name)
             } else {
-                format!("{} (held out)", r.name)
+                format!("{} (held out)", super::run_label(d, &r.name))
             }
         })
         .collect();
@@ -567,7 +567,7 @@ fn angle_error_plot(d: &Diagnosis) -> Option<AngleErrorPlot> {
             .runs
             .iter()
             .map(|r| AngleErrorRow {
-                name: r.name.clone(),
+                name: super::run_label(d, &r.name),
                 before_deg: r.max_abs_error_before_deg,
                 after_deg: r.max_abs_error_after_deg,
             })
@@ -929,7 +929,7 @@ motion the reference misses. No effect of the vocabulary expresses them.</p>\
             let _ = writeln!(
                 s,
                 "<tr><td>{}</td><td class=\"n\">{:+.2}°</td><td class=\"n\">{:+.2}°</td></tr>",
-                esc(&u.run),
+                esc(&super::run_label(d, &u.run)),
                 u.gyro_deg,
                 u.reference_deg
             );
@@ -1004,7 +1004,7 @@ combined over all runs (Σz/√n). Positive: the real value is above the simulat
         let _ = writeln!(
             s,
             "<tr><td>{}</td><td>{}</td><td class=\"n\">{} s</td><td class=\"n\">{}</td><td class=\"n\">{}</td></tr>",
-            esc(&r.name),
+            esc(&super::run_label(d, &r.name)),
             esc(r.role),
             sig(r.duration_s, 4),
             num(r.gap_before),
@@ -1458,5 +1458,30 @@ mod tests {
             "{html}"
         );
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn runs_are_named_relative_to_the_directory_they_share() {
+        let mut d = diagnosis();
+        d.runs[0].name = "/data/real/rasteiro/a_x.csv".into();
+        d.runs[1].name = "/data/real/rasteiro/b_x.csv".into();
+        assert_eq!(
+            super::super::run_label(&d, "/data/real/rasteiro/a_x.csv"),
+            "a_x.csv"
+        );
+        d.runs[1].name = "/data/real/ssong/é.csv".into();
+        assert_eq!(
+            super::super::run_label(&d, "/data/real/ssong/é.csv"),
+            "ssong/é.csv"
+        );
+        assert_eq!(
+            super::super::run_label(&d, "/data/real/rasteiro/a_x.csv#2"),
+            "rasteiro/a_x.csv#2"
+        );
+        d.runs[1].name = "b.csv".into();
+        assert_eq!(
+            super::super::run_label(&d, "/data/real/rasteiro/a_x.csv"),
+            "/data/real/rasteiro/a_x.csv"
+        );
     }
 }

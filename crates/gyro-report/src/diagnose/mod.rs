@@ -12,3 +12,23 @@ pub use html::{
     WHERE_ROWS,
 };
 pub use text::{self_test_table, table};
+
+use gyro_analysis::diagnose::Diagnosis;
+
+/// `name` (a run's log path, as given) without the directory all of `d`'s runs share:
+/// the report names runs relative to their input, and long absolute paths that differ
+/// only in the file name are unreadable in a table.
+pub fn run_label(d: &Diagnosis, name: &str) -> String {
+    let dir = |n: &str| n.rfind(['/', '\\']).map_or(0, |i| i + 1);
+    let Some(first) = d.runs.first() else {
+        return name.to_string();
+    };
+    // The longest directory prefix (ending at a separator) common to every run.
+    let mut common = &first.name[..dir(&first.name)];
+    for r in &d.runs {
+        while !r.name.starts_with(common) {
+            common = &common[..dir(&common[..common.len().saturating_sub(1)])];
+        }
+    }
+    name.strip_prefix(common).unwrap_or(name).to_string()
+}

@@ -279,18 +279,25 @@ pub fn table(d: &Diagnosis) -> String {
         }
         let _ = writeln!(
             s,
-            "\nrun --model with corrections for {}: max abs angle error per held-out run (deg)",
+            "\nrun --model with corrections for {}: max abs angle error per held-out run (deg){}",
             if c.corrected.is_empty() {
                 "nothing (no correction lowered the held-out error)".to_string()
             } else {
                 c.corrected.join(", ")
+            },
+            if super::headline::turns_wrote(d) {
+                "; the turns' corrections (headline) come on top of these"
+            } else {
+                ""
             }
         );
         for r in &c.runs {
             let _ = writeln!(
                 s,
                 "  {:<40} {:>9.4} -> {:>9.4}",
-                r.name, r.max_abs_error_before_deg, r.max_abs_error_after_deg
+                super::run_label(d, &r.name),
+                r.max_abs_error_before_deg,
+                r.max_abs_error_after_deg
             );
         }
     }
