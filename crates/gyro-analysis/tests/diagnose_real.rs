@@ -25,6 +25,17 @@ fn quick(bootstrap: usize) -> Options {
     }
 }
 
+/// A real recording placed on a 100 Hz grid (the rasteiro sensors' nominal rate), or
+/// `None` when the recordings are not beside the workspace.
+fn load_at_100(name: String) -> Option<RealRun> {
+    let grid = GridOptions {
+        sample_rate_hz: Some(100.0),
+        ..GridOptions::default()
+    };
+    let log = real_log(&name, &grid)?;
+    Some(RealRun::prepare(name, log).unwrap())
+}
+
 fn windows(file: &str, take: usize) -> Option<Vec<RealRun>> {
     let log = real_log(file, &GridOptions::default())?;
     Some(
@@ -134,14 +145,6 @@ fn latency_is_named_on_real_yaw_and_its_correction_does_not_hurt() {
 fn a_lag_beyond_the_search_is_said() {
     let file =
         |speed: &str, axis: &str| format!("rasteiro/rasteiro_MPU6050RM3100_{speed}_{axis}.csv");
-    let load_at_100 = |name: String| -> Option<RealRun> {
-        let grid = GridOptions {
-            sample_rate_hz: Some(100.0),
-            ..GridOptions::default()
-        };
-        let log = real_log(&name, &grid)?;
-        Some(RealRun::prepare(name, log).unwrap())
-    };
     let (Some(train), Some(holdout)) = (
         ["x", "y"]
             .iter()
@@ -180,14 +183,6 @@ fn a_lag_beyond_the_search_is_said() {
 fn the_turns_show_the_lag_the_scale_and_the_tilt() {
     let file =
         |sensor: &str, speed: &str| format!("rasteiro/rasteiro_{sensor}RM3100_{speed}_x.csv");
-    let load_at_100 = |name: String| -> Option<RealRun> {
-        let grid = GridOptions {
-            sample_rate_hz: Some(100.0),
-            ..GridOptions::default()
-        };
-        let log = real_log(&name, &grid)?;
-        Some(RealRun::prepare(name, log).unwrap())
-    };
     let boards = ["MPU6050", "MPU6500"];
     let (Some(train), Some(holdout)) = (
         boards

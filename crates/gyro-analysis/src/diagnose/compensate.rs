@@ -137,12 +137,7 @@ pub(crate) fn compensate(
         trial.push(*t);
         let (model, _) = with_tries(base, &trial);
         let after = max_abs_errors(holdout, &model);
-        let paired: Vec<f64> = current
-            .iter()
-            .zip(&after)
-            .filter(|(a, b)| a.is_finite() && b.is_finite())
-            .map(|(a, b)| a - b)
-            .collect();
+        let paired = paired_gains(&current, &after);
         let seed = crate::seed::derive_seed(options.seed, "correction", k as u64);
         let p = super::score::bootstrap_p(&paired, options.bootstrap.max(1), seed);
         if !paired.is_empty() && p < CORRECTION_P {
@@ -180,15 +175,26 @@ pub(crate) fn compensate(
     (Some(summary), (!ids.is_empty()).then_some(corrected))
 }
 
+/// Per run, the error without less the error with (positive: better with), where both
+/// are finite: what the bootstrap over held-out runs is taken on.
+pub(super) fn paired_gains(without: &[f64], with: &[f64]) -> Vec<f64> {
+    without
+        .iter()
+        .zip(with)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(a, b)| a - b)
+        .collect()
+}
+
 /// Median of the finite values (NaN when none).
-fn median(values: &[f64]) -> f64 {
+pub(super) fn median(values: &[f64]) -> f64 {
     let finite: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
     crate::median(&finite).unwrap_or(f64::NAN)
 }
 
 /// Max abs angle error of every held-out run replayed with `model` (NaN when a run
 /// cannot be replayed or has no reference).
-fn max_abs_errors(holdout: &[RealRun], model: &ModelFile) -> Vec<f64> {
+pub(super) fn max_abs_errors(holdout: &[RealRun], model: &ModelFile) -> Vec<f64> {
     holdout
         .par_iter()
         .map(|run| {

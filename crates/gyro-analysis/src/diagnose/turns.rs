@@ -23,7 +23,7 @@
 //! per-sample statistic's reach only if, as the model's `reference_delay_s`, it lowers the
 //! held-out runs' max abs angle error alike.
 
-use super::compensate::CORRECTION_P;
+use super::compensate::{max_abs_errors, paired_gains, CORRECTION_P};
 use super::ensemble::RealRun;
 use super::fit::{t95, Z_CRITICAL};
 use super::score::bootstrap_p;
@@ -143,20 +143,9 @@ fn replay(run: &RealRun, model: &ModelFile) -> Option<RunReport> {
     replay_with(&run.log, &model.config, &ReplayOptions::from_model(model)).ok()
 }
 
-/// Each run's max abs angle error replayed with `model` (NaN where it has none).
-fn max_abs_errors(runs: &[RealRun], model: &ModelFile) -> Vec<f64> {
-    runs.par_iter()
-        .map(|run| {
-            replay(run, model)
-                .and_then(|r| r.summary.max_abs_error_deg)
-                .unwrap_or(f64::NAN)
-        })
-        .collect()
-}
-
+/// The finite median of `values`, if any.
 fn median(values: &[f64]) -> Option<f64> {
-    let finite: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-    crate::median(&finite)
+    Some(super::compensate::median(values)).filter(|m| m.is_finite())
 }
 
 /// The turn evidence of `train` against `holdout`, on top of `model` (the model the
@@ -244,12 +233,7 @@ fn wide_lag(
         trial.reference_delay_s = median_s;
         let before = max_abs_errors(holdout, model);
         let after = max_abs_errors(holdout, &trial);
-        let paired: Vec<f64> = before
-            .iter()
-            .zip(&after)
-            .filter(|(a, b)| a.is_finite() && b.is_finite())
-            .map(|(a, b)| a - b)
-            .collect();
+        let paired = paired_gains(&before, &after);
         let seed = crate::seed::derive_seed(options.seed, "turns-lag", 0);
         let p = bootstrap_p(&paired, options.bootstrap.max(1), seed);
         out.holdout_max_abs_error_deg = median(&before).zip(median(&after));
