@@ -141,6 +141,7 @@ def decisions(gyro, path, truth, extra):
 def trust(gyro, data, cache):
     """Coverage and decisions on each speed held out, default and calibrated."""
     rows = {"default": [0] * 6, "calibrated": [0] * 6}
+    residuals = []
     for sensor in SENSORS:
         for axis in "xyz":
             for speed in SPEEDS:
@@ -150,6 +151,8 @@ def trust(gyro, data, cache):
                     model = os.path.join(tmp, "model.json")
                     scale, _ = calibrate(gyro, train, model)
                     u = scale.get("residual_relative_upper") or 0.0
+                    if scale.get("residual_relative") is not None:
+                        residuals.append((scale["residual_relative"], u))
                     configs = {
                         "default": ((), 0.0),
                         "calibrated": (("--model", model, "--compensation", "kalman"), u),
@@ -166,6 +169,13 @@ def trust(gyro, data, cache):
                             r[1] += abs(m["angle_deg"] - truth) <= 1.96 * sigma
                             for i, v in enumerate(decisions(gyro, test, truth, extra)):
                                 r[2 + i] += v
+    if residuals:
+        low, high = min(r for r, _ in residuals), max(r for r, _ in residuals)
+        low_u, high_u = min(u for _, u in residuals), max(u for _, u in residuals)
+        print(
+            f"scale_sigma: left-out relative RMS {100 * low:.2f}-{100 * high:.2f}%, "
+            f"95% upper bound {100 * low_u:.2f}-{100 * high_u:.2f}% ({len(residuals)} folds)"
+        )
     print(f"{'held out by speed':<20} {'turns':>5} {'95% covers':>10} {'decisions':>9} {'wrong ok':>8} {'wrong nok':>9} {'recheck':>8}")
     for name, r in rows.items():
         print(

@@ -87,8 +87,15 @@ pub struct Quality {
     pub backward_steps: u64,
     /// Steps differing from the period by more than 5% (but less than 1.5 periods).
     pub jittered_steps: u64,
-    /// Gaps (steps of 1.5 periods or more).
+    /// Gaps (steps of 1.5 periods or more; for rows in bursts, steps over
+    /// [`Bursts::gap_step_s`]), backlogs included.
     pub gaps: u64,
+    /// Gaps of a log in bursts after which the rows arrived faster than the sensor samples
+    /// until the count caught up: a stalled link's backlog, spread evenly over the gap and
+    /// the backlog instead of bridging the gap ([`crate::bursts`]).
+    pub backlogs: u64,
+    /// Rows whose stamps were spread over a backlog's gap.
+    pub retimed_rows: u64,
     /// Longest step between rows (s).
     pub longest_step_s: f64,
     /// Rows whose rate was empty, NaN or infinite.
@@ -606,8 +613,10 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
                         return;
                     }
                     self.quality.gaps += 1;
-                    self.quality
-                        .note("gap bridged by the resampled angle", row.line);
+                    self.quality.note(
+                        "gap: bridged by the resampled angle, or re-timed with a backlog after it",
+                        row.line,
+                    );
                 } else if dt > 0.0 && (dt - self.period_s).abs() > 0.05 * self.period_s {
                     self.quality.jittered_steps += 1;
                 }
@@ -800,6 +809,20 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
     fn finish(mut self) -> Result<Quality, LogError> {
         if let Some(e) = self.row_error.take() {
             return Err(e);
+        }
+        if let Some(resampler) = self.resampler.as_mut() {
+            let mut slots = std::mem::take(&mut self.resampled);
+            let result = resampler.finish(self.path, &mut slots);
+            self.quality.backlogs = resampler.retimer.backlogs;
+            self.quality.retimed_rows = resampler.retimer.retimed_rows;
+            if let Err(e) = result {
+                if self.fill_error.is_none() {
+                    self.fill_error = Some(e);
+                }
+            }
+            for slot in slots.drain(..) {
+                self.rate(slot);
+            }
         }
         if self.last_rate.is_none() {
             return Err(LogError::NoData {
@@ -1180,7 +1203,7 @@ mod tests {
                             });
                         }
                         quality.gaps += 1;
-                        quality.note("gap bridged by the resampled angle", row.line);
+                        quality.note("gap: bridged by the resampled angle, or re-timed with a backlog after it", row.line);
                     } else if dt > 0.0 && (dt - period_s).abs() > 0.05 * period_s {
                         quality.jittered_steps += 1;
                     }
@@ -1195,6 +1218,44 @@ mod tests {
                 }
                 kept.push(kept_row);
                 previous = Some(row);
+            }
+            // Pass 2: a gap after which the count of rows catches up with the local period
+            // within the horizon is a backlog: its rows share the gap's time evenly.
+            let mut i = 1;
+            while i < kept.len() {
+                let last_s = kept[i - 1].time_s;
+                if kept[i].time_s - last_s <= gap_step_s {
+                    i += 1;
+                    continue;
+                }
+                let window: Vec<f64> = (1..i)
+                    .filter(|&k| kept[k].time_s >= last_s - crate::bursts::LOCAL_PERIOD_WINDOW_S)
+                    .map(|k| kept[k].time_s - kept[k - 1].time_s)
+                    .filter(|&step_s| step_s <= gap_step_s)
+                    .collect();
+                if window.len() < crate::bursts::MIN_LOCAL_STEPS {
+                    i += 1;
+                    continue;
+                }
+                let local_period_s = window.iter().sum::<f64>() / window.len() as f64;
+                let mut j = i;
+                while j < kept.len() {
+                    let span_s = kept[j].time_s - last_s;
+                    let count = j - i + 1;
+                    if span_s <= count as f64 * local_period_s {
+                        for (n, row) in kept[i..=j].iter_mut().enumerate() {
+                            row.time_s = last_s + span_s * (n + 1) as f64 / count as f64;
+                        }
+                        quality.backlogs += 1;
+                        quality.retimed_rows += count as u64;
+                        break;
+                    }
+                    if span_s >= crate::bursts::BACKLOG_HORIZON_S {
+                        break;
+                    }
+                    j += 1;
+                }
+                i = j + 1;
             }
             let valid: Vec<usize> = (0..kept.len())
                 .filter(|&i| kept[i].rate_dps.is_some())
@@ -1301,6 +1362,9 @@ mod tests {
         LongGap,
         LongBack,
         Duplicate,
+        /// A link that stalls for this many periods, then delivers its backlog a quarter
+        /// period apart (in a bursty log; elsewhere a gap).
+        Stall(u32),
     }
 
     fn step() -> impl Strategy<Value = Step> {
@@ -1311,6 +1375,7 @@ mod tests {
             2 => (0.01..1.5_f64).prop_map(Step::Back),
             4 => (2_u32..12).prop_map(Step::Gap),
             3 => Just(Step::Duplicate),
+            2 => (4_u32..30).prop_map(Step::Stall),
         ]
     }
 
@@ -1340,6 +1405,8 @@ mod tests {
         let period = 0.01;
         let mut rows: Vec<Row> = Vec::new();
         let mut time_s = 12.5;
+        // Rows of a stall's backlog still to deliver.
+        let mut backlog = 0_u32;
         for (i, (step, (rate, reference, temperature))) in steps.iter().enumerate() {
             let line = i as u64 + 3;
             let mut row = Row {
@@ -1352,9 +1419,17 @@ mod tests {
             if let Some(previous) = rows.last() {
                 time_s = previous.time_s
                     + match step {
+                        Step::Regular if bursty && backlog > 0 => {
+                            backlog -= 1;
+                            0.25 * period
+                        }
                         // Arrival in bursts: regular steps from 0.25 to 1.75 periods.
                         Step::Regular if bursty => {
                             period * (0.25 + 1.5 * (i as f64 * 0.618_034).fract())
+                        }
+                        Step::Stall(n) => {
+                            backlog = if bursty { n + n / 3 } else { 0 };
+                            period * f64::from(*n)
                         }
                         Step::Regular | Step::Duplicate => period,
                         Step::Jitter(j) => period * (1.0 + j),
@@ -1670,5 +1745,86 @@ mod tests {
             ..GridOptions::default()
         };
         assert!(regularize(&log, &options).is_ok());
+    }
+
+    /// A 100 Hz sensor turning 90° in one second (a raised cosine) over a link that
+    /// delivers rows 0–15 ms late, at least 2.5 ms apart; `stall` is a span of sample
+    /// times whose rows wait for its end (a stalled link, then its backlog) or are lost.
+    fn linked_turn(stall: Option<(f64, f64)>, lost: bool) -> Log {
+        let mut state: u64 = 7;
+        let mut previous = f64::NEG_INFINITY;
+        let mut rows = Vec::new();
+        for k in 0..400_u32 {
+            let t = f64::from(k) * 0.01;
+            let rate = if (1.5..2.5).contains(&t) {
+                90.0 * (1.0 - (2.0 * std::f64::consts::PI * (t - 1.5)).cos())
+            } else {
+                0.0
+            };
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            let mut arrival_s = t + (state >> 40) as f64 / f64::from(1_u32 << 24) * 0.015;
+            if let Some((from, to)) = stall {
+                if (from..to).contains(&t) {
+                    if lost {
+                        continue;
+                    }
+                    arrival_s = to;
+                }
+            }
+            previous = arrival_s.max(previous + 0.0025);
+            rows.push(Row {
+                line: u64::from(k) + 2,
+                time_s: previous,
+                rate_dps: Some(rate),
+                reference_deg: None,
+                temperature_c: None,
+            });
+        }
+        Log {
+            path: "link.csv".into(),
+            rows,
+            ..Log::default()
+        }
+    }
+
+    fn turn_deg(log: &RegularLog) -> f64 {
+        log.slots[1..].iter().map(|s| s.rate_dps).sum::<f64>() / log.sample_rate_hz
+    }
+
+    /// A stalled link's backlog is spread over the stall, not counted twice; lost samples
+    /// are bridged (filled), not re-timed; both as the whole-log passes do.
+    #[test]
+    fn a_backlog_after_a_stall_is_re_timed() {
+        let options = GridOptions::default();
+        let clean = regularize(&linked_turn(None, false), &options).unwrap();
+        assert!(clean.quality.bursts.is_some());
+        assert_eq!(clean.quality.backlogs, 0);
+        assert!(
+            (turn_deg(&clean) - 90.0).abs() < 1.0,
+            "{}",
+            turn_deg(&clean)
+        );
+        // 0.2 s around the peak rate (about 35° of the turn) arrive at its end.
+        let stalled = linked_turn(Some((1.8, 2.0)), false);
+        let placed = regularize(&stalled, &options).unwrap();
+        let q = &placed.quality;
+        assert_eq!(q.backlogs, 1, "{q:?}");
+        assert!(q.retimed_rows >= 20, "{q:?}");
+        assert_eq!(q.filled_slots, 0, "{q:?}");
+        assert!(
+            (turn_deg(&placed) - 90.0).abs() < 1.0,
+            "{}",
+            turn_deg(&placed)
+        );
+        let oracle = whole::regularize_whole(&stalled, &options);
+        same_outcome(Ok(placed), oracle).unwrap();
+        // The same samples lost: no backlog; the gap is bridged and said.
+        let holed = linked_turn(Some((1.8, 2.0)), true);
+        let placed = regularize(&holed, &options).unwrap();
+        assert_eq!(placed.quality.backlogs, 0);
+        assert!(placed.quality.filled_slots >= 15, "{:?}", placed.quality);
+        same_outcome(Ok(placed), whole::regularize_whole(&holed, &options)).unwrap();
     }
 }

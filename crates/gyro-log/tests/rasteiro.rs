@@ -55,7 +55,11 @@ fn bursts_are_recognised_and_the_integral_is_kept() {
             "{}",
             placed.sample_rate_hz
         );
-        // The integral on the grid is the trapezoid on the stamps up to the last grid time.
+        // The integral on the grid is the trapezoid on the stamps up to the last grid time,
+        // where no backlog was re-timed (one file has them: below).
+        if placed.quality.backlogs > 0 {
+            continue;
+        }
         let end_s = placed.slots.last().unwrap().time_s;
         let mut on_stamps = 0.0;
         for w in raw.rows.windows(2) {
@@ -88,11 +92,52 @@ fn bursts_are_recognised_and_the_integral_is_kept() {
     }
 }
 
+/// The MPU6500 recordings at V_300 stall for 0.17 s during a −180° z turn at 450 °/s, and
+/// the 24 rows after the stall arrive 4 ms apart until the count catches up: the stall's
+/// samples, buffered. Bridged as a gap, the stall's 76° would count twice (the gap's
+/// trapezoid, then the backlog's rows); re-timed, the turn comes out right.
+#[test]
+fn a_stalled_link_s_backlog_is_re_timed_not_counted_twice() {
+    for path in recordings() {
+        let placed = placed(&path);
+        let q = &placed.quality;
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if !name.starts_with("rasteiro_MPU6500RM3100_V_300_") {
+            // The other files' gaps are lost samples (or too early in a log to tell).
+            assert_eq!(q.backlogs, 0, "{name}: {q:?}");
+            continue;
+        }
+        // The 41 ms gap at 3.6 s (5 rows) and the 0.17 s stall at 11.1 s (24 rows).
+        assert_eq!((q.backlogs, q.retimed_rows), (2, 29), "{name}: {q:?}");
+        if name.ends_with("_z.csv") {
+            // The −180° turn, from rest (10.5 s) to rest (12.5 s), bias removed.
+            let period_s = 1.0 / placed.sample_rate_hz;
+            let mean = |a: f64, b: f64| {
+                let r: Vec<f64> = placed
+                    .slots
+                    .iter()
+                    .filter(|s| (a..b).contains(&s.time_s))
+                    .map(|s| s.rate_dps)
+                    .collect();
+                r.iter().sum::<f64>() / r.len() as f64
+            };
+            let bias_dps = mean(8.0, 8.8);
+            let turn_deg: f64 = placed
+                .slots
+                .iter()
+                .filter(|s| (10.0..12.8).contains(&s.time_s))
+                .map(|s| (s.rate_dps - bias_dps) * period_s)
+                .sum();
+            assert!((turn_deg + 180.0).abs() < 4.0, "{name}: {turn_deg}");
+        }
+    }
+}
+
 /// The robot's pose wraps and flips while the board is still: every recording has such
 /// jumps, and after they are re-based the reference ends where the gyro says (within the
 /// sensors' own error, a few degrees over the whole path; as logged, the end is off by
 /// 320-720 degrees on 10 of the 18 files, and jumps that cancel leave the others' middles
-/// off), except the one file with a 0.17 s hole in its rows during a turn.
+/// off).
 #[test]
 fn reference_jumps_are_re_based() {
     for path in recordings() {
@@ -117,8 +162,7 @@ fn reference_jumps_are_re_based() {
             .find_map(|s| s.reference_deg)
             .unwrap();
         let off = (gyro_deg - (last - first)).abs();
-        let holed = path.ends_with("rasteiro_MPU6500RM3100_V_300_z.csv");
-        assert!(holed || off < 10.0, "{}: {off} deg", path.display());
+        assert!(off < 10.0, "{}: {off} deg", path.display());
     }
 }
 

@@ -41,6 +41,11 @@ pub fn table(q: &Quality) -> String {
         (q.backward_steps, "steps back in time"),
         (q.jittered_steps, "jittered steps"),
         (q.gaps, "gaps"),
+        (
+            q.backlogs,
+            "of them a stalled link's backlog (rows re-timed)",
+        ),
+        (q.retimed_rows, "rows re-timed"),
         (q.missing_rate_rows, "missing rates"),
         (q.filled_slots, "samples interpolated"),
         (q.trimmed_slots, "samples trimmed at the ends"),
