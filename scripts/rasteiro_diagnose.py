@@ -71,7 +71,8 @@ def describe(label, d, written):
         g = [abs(x["gyro_deg"]) for x in u]
         parts.append(f"{len(u)} untracked ({min(g):.1f}-{max(g):.1f} deg)")
     named = [e["id"] for e in d["effects"] if e["significant"]]
-    parts.append(f"vocabulary: {', '.join(named) or 'none'}; model file {'written' if written else 'not written'}")
+    parts.append(f"vocabulary: {', '.join(named) or 'none'}; {len(d.get('unexplained') or [])} unexplained")
+    parts.append(f"model file {'written' if written else 'not written'}")
     print("  " + "; ".join(parts))
 
 

@@ -603,3 +603,53 @@ fn verdicts_without_a_sigma_are_said_to_be_unguarded() {
     args.extend(window);
     assert!(json_of(&gyro(&args)).get("warnings").is_none());
 }
+
+/// A 100 Hz log whose PC stalls for 0.2 s at the peak of a 90° turn and then reads the
+/// buffered rows 0.2 ms apart: the stall's rows are re-timed over it (a backlog), not
+/// bridged as a gap and placed again after it (which read the turn as 122°).
+#[test]
+fn a_stalled_link_s_backlog_is_not_counted_twice() {
+    let mut text = String::from("time_s,rate_dps,reference_deg\n");
+    let (mut reference_deg, mut previous_rate, mut previous_stamp) = (0.0, 0.0, f64::MIN);
+    for k in 0..600_u32 {
+        let t = f64::from(k) * 0.01;
+        let rate = if (2.0..3.0).contains(&t) {
+            90.0 * (1.0 - (2.0 * std::f64::consts::PI * (t - 2.0)).cos())
+        } else {
+            0.0
+        };
+        if k > 0 {
+            reference_deg += 0.5 * (rate + previous_rate) * 0.01;
+        }
+        previous_rate = rate;
+        // Rows on time; those sampled from 2.4 s to 2.6 s wait for 2.6 s.
+        let mut stamp = t;
+        if (2.4..2.6).contains(&t) {
+            stamp = 2.6;
+        }
+        stamp = stamp.max(previous_stamp + 0.0002);
+        previous_stamp = stamp;
+        text.push_str(&format!("{stamp:.6},{rate:.4},{reference_deg:.4}\n"));
+    }
+    let dir = temp_dir("stall");
+    let log = write(&dir, "stall.csv", &text);
+    let out = json_of(&gyro(&[
+        "run",
+        &log,
+        "--format",
+        "json",
+        "--target-deg",
+        "90",
+        "--tolerance-deg",
+        "3",
+    ]));
+    let input = &out["input"];
+    assert_eq!(input["backlogs"].as_u64(), Some(1), "{input}");
+    assert_eq!(input["gaps"].as_u64(), Some(0), "{input}");
+    assert_eq!(input["filled_slots"].as_u64(), Some(0), "{input}");
+    let movements = out["movements"].as_array().unwrap();
+    assert_eq!(movements.len(), 1, "{movements:?}");
+    let m = &movements[0];
+    assert!((m["angle_deg"].as_f64().unwrap() - 90.0).abs() < 0.5, "{m}");
+    assert_eq!(m["verdict"].as_str(), Some("ok"), "{m}");
+}

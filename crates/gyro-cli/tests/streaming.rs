@@ -362,9 +362,9 @@ fn streaming_equals_materialising_on_fixtures_and_generated_logs() {
         ("warts.csv", "sample_rate_source: \"metadata\""),
         (
             "warts_detected_rate.csv",
-            "sample_rate_source: \"median_step\"",
+            "sample_rate_source: \"single_steps\"",
         ),
-        ("long_jittery.csv", "sample_rate_source: \"median_step\""),
+        ("long_jittery.csv", "sample_rate_source: \"single_steps\""),
         ("long_runs.csv", "trimmed_slots: 9"),
         ("missing_run.csv", "missing_run.csv:124: gap of 0.720 s"),
         (

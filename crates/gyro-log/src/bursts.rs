@@ -9,15 +9,8 @@
 //! each slot's rate is the angle gained since the previous slot divided by the period. The
 //! integral of the rate over the log is then the one the stamps say, whatever the bursts.
 //!
-//! A gap in such a log is not always lost samples. When the link stalls, the sensor keeps
-//! sampling and the rows it buffered arrive together after the stall, a few milliseconds
-//! apart: stamped on arrival, the stall's samples sit after it, the trapezoid across the
-//! gap counts the stall's rotation once and the backlog's rows count it again. A
-//! [`Retimer`] holds the rows after a gap until the arrival count catches up with the
-//! sensor's local period (the mean step of the second before the gap): those rows are a
-//! *backlog*, and they and the gap share its time evenly. When the count does not catch up
-//! within [`BACKLOG_HORIZON_S`], samples were lost: the stamps stay and the gap is bridged
-//! (its slots are `filled`).
+//! A stall of the link (a gap, then the buffered rows a few milliseconds apart) is re-timed
+//! before the rows get here ([`crate::backlog`]).
 //!
 //! A log is *bursty* when, among its first [`crate::RATE_WINDOW_STEPS`] steps, more than a
 //! third are *off the grid*: further than a quarter of the median step from a whole number
@@ -27,7 +20,6 @@
 
 use crate::{LogError, Row, Slot};
 use serde::Serialize;
-use std::collections::VecDeque;
 use std::path::Path;
 
 /// A step further than this share of the median step from a whole number of median steps
@@ -37,16 +29,6 @@ const OFF_GRID: f64 = 0.25;
 const BURSTY_SHARE: f64 = 1.0 / 3.0;
 /// Fewer positive steps than this say nothing about arrival: treated as regular.
 const MIN_STEPS: usize = 20;
-
-/// After a gap, how long the arrival count has to catch up with the sensor's period before
-/// the gap counts as lost samples (s): a link's buffer drains in a few tenths of a second.
-pub const BACKLOG_HORIZON_S: f64 = 0.5;
-/// The sensor's local period is the mean step over this long before a gap (s): the row
-/// rate of these logs differs between rest and motion (9 against 12 ms on the rasteiro
-/// recordings), so the file's mean step is not the period at the gap.
-pub const LOCAL_PERIOD_WINDOW_S: f64 = 1.0;
-/// Fewer steps than this before a gap give no local period: the gap is left as it is.
-pub(crate) const MIN_LOCAL_STEPS: usize = 5;
 
 /// The arrival statistics of a bursty log (from its first steps).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -127,99 +109,6 @@ pub(crate) fn value_at(
     Some(va + w * (vb - va))
 }
 
-/// Rows in, rows out, with the stamps of a backlog after a gap spread evenly over the gap
-/// and the backlog (see the module docs). Stamps must be non-decreasing.
-pub(crate) struct Retimer {
-    gap_step_s: f64,
-    /// Steps of at most `gap_step_s` released within [`LOCAL_PERIOD_WINDOW_S`] of the last
-    /// row: (the later row's stamp, the step).
-    recent: VecDeque<(f64, f64)>,
-    /// The stamp of the last row released.
-    last_s: Option<f64>,
-    /// After a gap: the stamp of the row before it and the local period.
-    anchor: Option<(f64, f64)>,
-    /// The rows since the gap, held until the count catches up or the horizon passes.
-    held: Vec<Row>,
-    /// Gaps followed by a backlog, re-timed.
-    pub(crate) backlogs: u64,
-    /// Rows re-timed over those gaps.
-    pub(crate) retimed_rows: u64,
-}
-
-impl Retimer {
-    /// A retimer for a log whose steps over `gap_step_s` are gaps.
-    pub(crate) fn new(gap_step_s: f64) -> Self {
-        Self {
-            gap_step_s,
-            recent: VecDeque::new(),
-            last_s: None,
-            anchor: None,
-            held: Vec::new(),
-            backlogs: 0,
-            retimed_rows: 0,
-        }
-    }
-
-    /// Take the next row; push the rows released, in order, onto `out`.
-    pub(crate) fn push(&mut self, row: Row, out: &mut Vec<Row>) {
-        if let Some((anchor_s, period_s)) = self.anchor {
-            self.held.push(row);
-            let count = self.held.len();
-            let span_s = row.time_s - anchor_s;
-            if span_s <= count as f64 * period_s {
-                for (k, held) in self.held.iter_mut().enumerate() {
-                    held.time_s = anchor_s + span_s * (k + 1) as f64 / count as f64;
-                }
-                self.backlogs += 1;
-                self.retimed_rows += count as u64;
-            } else if span_s < BACKLOG_HORIZON_S {
-                return;
-            }
-            self.anchor = None;
-            let held = std::mem::take(&mut self.held);
-            for row in &held {
-                self.release(*row, out);
-            }
-            self.held = held;
-            self.held.clear();
-            return;
-        }
-        if let Some(last_s) = self.last_s {
-            if row.time_s - last_s > self.gap_step_s && self.recent.len() >= MIN_LOCAL_STEPS {
-                let sum_s: f64 = self.recent.iter().map(|&(_, step_s)| step_s).sum();
-                self.anchor = Some((last_s, sum_s / self.recent.len() as f64));
-                self.held.push(row);
-                return;
-            }
-        }
-        self.release(row, out);
-    }
-
-    /// The end of the rows: release those held (a gap the count did not catch up with).
-    pub(crate) fn finish(&mut self, out: &mut Vec<Row>) {
-        self.anchor = None;
-        out.append(&mut self.held);
-    }
-
-    fn release(&mut self, row: Row, out: &mut Vec<Row>) {
-        if let Some(last_s) = self.last_s {
-            let step_s = row.time_s - last_s;
-            if step_s <= self.gap_step_s {
-                self.recent.push_back((row.time_s, step_s));
-            }
-        }
-        while self
-            .recent
-            .front()
-            .is_some_and(|&(time_s, _)| time_s < row.time_s - LOCAL_PERIOD_WINDOW_S)
-        {
-            self.recent.pop_front();
-        }
-        self.last_s = Some(row.time_s);
-        out.push(row);
-    }
-}
-
 /// Rows in, grid slots out, preserving the integral of the rate (streaming).
 ///
 /// Grid point 0 is the first row with a rate (its values as they are); grid point `j` is at
@@ -249,10 +138,6 @@ pub(crate) struct Resampler {
     leading: u64,
     /// The latest stamp (non-decreasing).
     clock_s: f64,
-    /// Backlogs after gaps re-timed before the rows are integrated.
-    pub(crate) retimer: Retimer,
-    /// The rows the retimer released, to integrate.
-    released: Vec<Row>,
 }
 
 impl Resampler {
@@ -272,8 +157,6 @@ impl Resampler {
             between_count: 0,
             leading: 0,
             clock_s: f64::NEG_INFINITY,
-            retimer: Retimer::new(gap_step_s),
-            released: Vec::new(),
         }
     }
 
@@ -283,8 +166,7 @@ impl Resampler {
     }
 
     /// Take one row (in file order, duplicates already dropped); push the grid slots it
-    /// completes onto `out` (the rows after a gap wait for the [`Retimer`]). An error is a
-    /// run without a rate too long to bridge.
+    /// completes onto `out`. An error is a run without a rate too long to bridge.
     pub(crate) fn row(
         &mut self,
         path: &Path,
@@ -294,28 +176,6 @@ impl Resampler {
         let mut row = *row;
         row.time_s = row.time_s.max(self.clock_s);
         self.clock_s = row.time_s;
-        let mut released = std::mem::take(&mut self.released);
-        self.retimer.push(row, &mut released);
-        let result = released
-            .drain(..)
-            .try_for_each(|row| self.integrate(path, row, out));
-        self.released = released;
-        result
-    }
-
-    /// The end of the rows: integrate those the retimer still holds.
-    pub(crate) fn finish(&mut self, path: &Path, out: &mut Vec<Slot>) -> Result<(), LogError> {
-        let mut released = std::mem::take(&mut self.released);
-        self.retimer.finish(&mut released);
-        let result = released
-            .drain(..)
-            .try_for_each(|row| self.integrate(path, row, out));
-        self.released = released;
-        result
-    }
-
-    /// Integrate one row released by the retimer.
-    fn integrate(&mut self, path: &Path, row: Row, out: &mut Vec<Slot>) -> Result<(), LogError> {
         let Some(rate_dps) = row.rate_dps else {
             if self.valid.is_none() {
                 self.leading += 1;

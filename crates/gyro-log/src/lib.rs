@@ -19,6 +19,7 @@
 //! ```
 
 mod ahead;
+pub mod backlog;
 pub mod bursts;
 mod csv_log;
 pub mod jumps;

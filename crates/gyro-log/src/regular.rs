@@ -18,6 +18,7 @@
 //! Nothing is invented silently: [`Quality`] reports each count with example lines.
 
 use super::{Log, LogError, Row};
+use crate::backlog::Retimer;
 use crate::bursts::{self, Bursts, Resampler};
 use crate::jumps::ReferenceJumps;
 use serde::Serialize;
@@ -74,7 +75,8 @@ pub struct Quality {
     pub slots: u64,
     /// Sample rate of the grid (Hz).
     pub sample_rate_hz: f64,
-    /// Where the rate came from: `option`, `metadata` or `median_step`.
+    /// Where the rate came from: `option`, `metadata`, `mean_step` (rows in bursts) or
+    /// `single_steps` (the mean of the steps that are one period).
     pub sample_rate_source: &'static str,
     /// Slots over the time the log spans (Hz): differs from the grid rate if the
     /// logger's clock or the nominal rate is off.
@@ -88,11 +90,11 @@ pub struct Quality {
     /// Steps differing from the period by more than 5% (but less than 1.5 periods).
     pub jittered_steps: u64,
     /// Gaps (steps of 1.5 periods or more; for rows in bursts, steps over
-    /// [`Bursts::gap_step_s`]), backlogs included.
+    /// [`Bursts::gap_step_s`]), backlogs not included.
     pub gaps: u64,
-    /// Gaps of a log in bursts after which the rows arrived faster than the sensor samples
-    /// until the count caught up: a stalled link's backlog, spread evenly over the gap and
-    /// the backlog instead of bridging the gap ([`crate::bursts`]).
+    /// Gaps after which the rows arrived faster than the sensor samples until the count
+    /// caught up: a stalled link's backlog, its rows spread evenly over the gap instead of
+    /// bridging the gap ([`crate::backlog`]).
     pub backlogs: u64,
     /// Rows whose stamps were spread over a backlog's gap.
     pub retimed_rows: u64,
@@ -330,7 +332,11 @@ pub(crate) fn check_bridged_slots(
     Ok(())
 }
 
-/// The rate from the median positive step of the first [`RATE_WINDOW_STEPS`] steps.
+/// The rate from the positive steps of the first [`RATE_WINDOW_STEPS`] steps that are one
+/// period: the mean of those within half the median step of it (gaps, and the zero steps
+/// of repeated stamps, left out). The median alone is not the period when the steps are
+/// not symmetric about it: a 104 Hz sensor stamped to the millisecond steps 9 and 10 ms,
+/// median 10 ms, and a row per slot on a 100 Hz grid would stretch time by 4%.
 fn median_step_rate(path: &Path, rows: &[Row]) -> Result<(f64, &'static str), LogError> {
     let mut steps: Vec<f64> = rows
         .windows(2)
@@ -344,7 +350,17 @@ fn median_step_rate(path: &Path, rows: &[Row]) -> Result<(f64, &'static str), Lo
         });
     }
     steps.sort_by(f64::total_cmp);
-    Ok((1.0 / steps[steps.len() / 2], "median_step"))
+    Ok((1.0 / single_step_mean(&steps), "single_steps"))
+}
+
+/// The mean of the sorted positive `steps` within half the median of it (a period each).
+fn single_step_mean(sorted_steps: &[f64]) -> f64 {
+    let median = sorted_steps[sorted_steps.len() / 2];
+    let (sum, count) = sorted_steps
+        .iter()
+        .filter(|&&dt| (dt - median).abs() < 0.5 * median)
+        .fold((0.0, 0_usize), |(sum, count), &dt| (sum + dt, count + 1));
+    sum / count as f64
 }
 
 /// Place the rows of `log` on a regular grid (all of it in memory; see [`place`] for the
@@ -464,6 +480,9 @@ struct Placer<'p, S: SlotSink + ?Sized> {
     resampler: Option<Resampler>,
     gap_step_s: f64,
     resampled: Vec<Slot>,
+    /// Stage 0: backlogs after a stall re-timed, and the rows it released.
+    retimer: Retimer,
+    released: Vec<Row>,
     /// A step back or gap between rows too long: stage 1 stops (the rows are still read).
     row_error: Option<LogError>,
     /// A run of missing rates too long: stages 2 and 3 stop.
@@ -547,6 +566,8 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
                 .map(|_| Resampler::new(period_s, gap_step_s, options.max_gap_s, max_run)),
             gap_step_s,
             resampled: Vec::new(),
+            retimer: Retimer::new(gap_step_s),
+            released: Vec::new(),
             row_error: None,
             fill_error: None,
             leading_missing: 0,
@@ -571,9 +592,20 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
         }
     }
 
+    /// Stage 0: a row through the retimer (a stalled link's backlog is re-timed over the
+    /// stall, [`crate::backlog`]); the rows it releases go on to stage 1.
+    fn row(&mut self, row: &Row) {
+        let mut released = std::mem::take(&mut self.released);
+        self.retimer.push(*row, &mut released);
+        for row in released.drain(..) {
+            self.place_row(&row);
+        }
+        self.released = released;
+    }
+
     /// Stage 1: a row to its slot, after the slots of a gap before it. A missing rate is
     /// NaN (and `filled`) for now.
-    fn row(&mut self, row: &Row) {
+    fn place_row(&mut self, row: &Row) {
         self.quality.rows += 1;
         if self.row_error.is_some() {
             return;
@@ -613,10 +645,8 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
                         return;
                     }
                     self.quality.gaps += 1;
-                    self.quality.note(
-                        "gap: bridged by the resampled angle, or re-timed with a backlog after it",
-                        row.line,
-                    );
+                    self.quality
+                        .note("gap bridged by the resampled angle", row.line);
                 } else if dt > 0.0 && (dt - self.period_s).abs() > 0.05 * self.period_s {
                     self.quality.jittered_steps += 1;
                 }
@@ -807,22 +837,15 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
     /// The end of the rows: trim the trailing slots without a rate, deliver the rest, and
     /// return the report or the first error (in the order of the passes over a whole log).
     fn finish(mut self) -> Result<Quality, LogError> {
+        let mut released = std::mem::take(&mut self.released);
+        self.retimer.finish(&mut released);
+        for row in released.drain(..) {
+            self.place_row(&row);
+        }
+        self.quality.backlogs = self.retimer.backlogs;
+        self.quality.retimed_rows = self.retimer.retimed_rows;
         if let Some(e) = self.row_error.take() {
             return Err(e);
-        }
-        if let Some(resampler) = self.resampler.as_mut() {
-            let mut slots = std::mem::take(&mut self.resampled);
-            let result = resampler.finish(self.path, &mut slots);
-            self.quality.backlogs = resampler.retimer.backlogs;
-            self.quality.retimed_rows = resampler.retimer.retimed_rows;
-            if let Err(e) = result {
-                if self.fill_error.is_none() {
-                    self.fill_error = Some(e);
-                }
-            }
-            for slot in slots.drain(..) {
-                self.rate(slot);
-            }
         }
         if self.last_rate.is_none() {
             return Err(LogError::NoData {
@@ -940,7 +963,61 @@ mod tests {
                 });
             }
             steps.sort_by(f64::total_cmp);
-            Ok((1.0 / steps[steps.len() / 2], "median_step"))
+            let median = steps[steps.len() / 2];
+            let single: Vec<f64> = steps
+                .iter()
+                .copied()
+                .filter(|dt| (dt - median).abs() < 0.5 * median)
+                .collect();
+            let mean_s = single.iter().sum::<f64>() / single.len() as f64;
+            Ok((1.0 / mean_s, "single_steps"))
+        }
+
+        /// The rows with each stalled link's backlog re-timed over its gap (the whole-log
+        /// form of [`crate::backlog`]), and the counts of backlogs and rows re-timed.
+        fn retime_whole(rows: &[Row], gap_step_s: f64) -> (Vec<Row>, u64, u64) {
+            use crate::backlog::{BACKLOG_HORIZON_S, LOCAL_PERIOD_WINDOW_S, MIN_LOCAL_STEPS};
+            let mut rows = rows.to_vec();
+            let (mut backlogs, mut retimed) = (0, 0);
+            // The stamps made non-decreasing, as re-timed so far.
+            let mut clock: Vec<f64> = rows.first().map(|r| r.time_s).into_iter().collect();
+            let mut i = 1;
+            while i < rows.len() {
+                let last_s = clock[i - 1];
+                let steps: Vec<f64> = (1..i)
+                    .filter(|&k| clock[k] >= last_s - LOCAL_PERIOD_WINDOW_S)
+                    .map(|k| clock[k] - clock[k - 1])
+                    .filter(|&step_s| step_s <= gap_step_s)
+                    .collect();
+                let mut end = i;
+                if rows[i].time_s - last_s > gap_step_s && steps.len() >= MIN_LOCAL_STEPS {
+                    let period_s = steps.iter().sum::<f64>() / steps.len() as f64;
+                    let mut j = i;
+                    while j < rows.len() {
+                        let span_s = rows[j].time_s.max(last_s) - last_s;
+                        let count = j - i + 1;
+                        if span_s <= count as f64 * period_s {
+                            for (n, row) in rows[i..=j].iter_mut().enumerate() {
+                                row.time_s = last_s + span_s * (n + 1) as f64 / count as f64;
+                            }
+                            backlogs += 1;
+                            retimed += count as u64;
+                            break;
+                        }
+                        if span_s >= BACKLOG_HORIZON_S {
+                            break;
+                        }
+                        j += 1;
+                    }
+                    end = j.min(rows.len() - 1);
+                }
+                for k in i..=end {
+                    let previous = clock[k - 1];
+                    clock.push(rows[k].time_s.max(previous));
+                }
+                i = end + 1;
+            }
+            (rows, backlogs, retimed)
         }
 
         /// The whole-log implementation `place` replaced, kept verbatim as the oracle.
@@ -957,8 +1034,19 @@ mod tests {
             let warning =
                 super::super::check_given_rate(&log.path, &log.rows, arrival, rate_hz, source)?;
             super::super::check_bridged_slots(&log.path, options, rate_hz)?;
+            let grid_period_s = 1.0 / rate_hz;
+            let gap_step_s = arrival.map_or(1.5 * grid_period_s, |b| {
+                b.gap_step_s.max(1.5 * grid_period_s)
+            });
+            let (rows, backlogs, retimed_rows) = retime_whole(&log.rows, gap_step_s);
+            let log = &Log {
+                rows,
+                ..log.clone()
+            };
             if let Some(b) = arrival {
                 let mut whole = resample_whole(log, options, rate_hz, source, b)?;
+                whole.quality.backlogs = backlogs;
+                whole.quality.retimed_rows = retimed_rows;
                 // The rate's warning comes first, as in the streaming placement.
                 let later = std::mem::take(&mut whole.quality.warnings);
                 whole.quality.warnings.extend(warning);
@@ -971,6 +1059,8 @@ mod tests {
                 sample_rate_hz: rate_hz,
                 sample_rate_source: source,
                 warnings: warning.into_iter().collect(),
+                backlogs,
+                retimed_rows,
                 ..Quality::default()
             };
 
@@ -1203,7 +1293,7 @@ mod tests {
                             });
                         }
                         quality.gaps += 1;
-                        quality.note("gap: bridged by the resampled angle, or re-timed with a backlog after it", row.line);
+                        quality.note("gap bridged by the resampled angle", row.line);
                     } else if dt > 0.0 && (dt - period_s).abs() > 0.05 * period_s {
                         quality.jittered_steps += 1;
                     }
@@ -1218,44 +1308,6 @@ mod tests {
                 }
                 kept.push(kept_row);
                 previous = Some(row);
-            }
-            // Pass 2: a gap after which the count of rows catches up with the local period
-            // within the horizon is a backlog: its rows share the gap's time evenly.
-            let mut i = 1;
-            while i < kept.len() {
-                let last_s = kept[i - 1].time_s;
-                if kept[i].time_s - last_s <= gap_step_s {
-                    i += 1;
-                    continue;
-                }
-                let window: Vec<f64> = (1..i)
-                    .filter(|&k| kept[k].time_s >= last_s - crate::bursts::LOCAL_PERIOD_WINDOW_S)
-                    .map(|k| kept[k].time_s - kept[k - 1].time_s)
-                    .filter(|&step_s| step_s <= gap_step_s)
-                    .collect();
-                if window.len() < crate::bursts::MIN_LOCAL_STEPS {
-                    i += 1;
-                    continue;
-                }
-                let local_period_s = window.iter().sum::<f64>() / window.len() as f64;
-                let mut j = i;
-                while j < kept.len() {
-                    let span_s = kept[j].time_s - last_s;
-                    let count = j - i + 1;
-                    if span_s <= count as f64 * local_period_s {
-                        for (n, row) in kept[i..=j].iter_mut().enumerate() {
-                            row.time_s = last_s + span_s * (n + 1) as f64 / count as f64;
-                        }
-                        quality.backlogs += 1;
-                        quality.retimed_rows += count as u64;
-                        break;
-                    }
-                    if span_s >= crate::bursts::BACKLOG_HORIZON_S {
-                        break;
-                    }
-                    j += 1;
-                }
-                i = j + 1;
             }
             let valid: Vec<usize> = (0..kept.len())
                 .filter(|&i| kept[i].rate_dps.is_some())
@@ -1641,7 +1693,7 @@ mod tests {
         };
         let options = GridOptions::default();
         let streamed = regularize(&log, &options).unwrap();
-        assert_eq!(streamed.quality.sample_rate_source, "median_step");
+        assert_eq!(streamed.quality.sample_rate_source, "single_steps");
         assert!((streamed.sample_rate_hz - 100.0).abs() < 1e-6);
         assert_eq!(streamed.quality.gaps, 50_000 - 1);
         assert_eq!(
@@ -1748,9 +1800,10 @@ mod tests {
     }
 
     /// A 100 Hz sensor turning 90° in one second (a raised cosine) over a link that
-    /// delivers rows 0–15 ms late, at least 2.5 ms apart; `stall` is a span of sample
-    /// times whose rows wait for its end (a stalled link, then its backlog) or are lost.
-    fn linked_turn(stall: Option<(f64, f64)>, lost: bool) -> Log {
+    /// delivers rows up to `wait_s` late, at least `spacing_s` apart; `stall` is a span of
+    /// sample times whose rows wait for its end (a stalled link, then its backlog) or are
+    /// lost.
+    fn linked_turn(stall: Option<(f64, f64)>, lost: bool, wait_s: f64, spacing_s: f64) -> Log {
         let mut state: u64 = 7;
         let mut previous = f64::NEG_INFINITY;
         let mut rows = Vec::new();
@@ -1764,7 +1817,7 @@ mod tests {
             state = state
                 .wrapping_mul(6_364_136_223_846_793_005)
                 .wrapping_add(1_442_695_040_888_963_407);
-            let mut arrival_s = t + (state >> 40) as f64 / f64::from(1_u32 << 24) * 0.015;
+            let mut arrival_s = t + (state >> 40) as f64 / f64::from(1_u32 << 24) * wait_s;
             if let Some((from, to)) = stall {
                 if (from..to).contains(&t) {
                     if lost {
@@ -1773,7 +1826,7 @@ mod tests {
                     arrival_s = to;
                 }
             }
-            previous = arrival_s.max(previous + 0.0025);
+            previous = arrival_s.max(previous + spacing_s);
             rows.push(Row {
                 line: u64::from(k) + 2,
                 time_s: previous,
@@ -1798,7 +1851,8 @@ mod tests {
     #[test]
     fn a_backlog_after_a_stall_is_re_timed() {
         let options = GridOptions::default();
-        let clean = regularize(&linked_turn(None, false), &options).unwrap();
+        let link = |stall, lost| linked_turn(stall, lost, 0.015, 0.0025);
+        let clean = regularize(&link(None, false), &options).unwrap();
         assert!(clean.quality.bursts.is_some());
         assert_eq!(clean.quality.backlogs, 0);
         assert!(
@@ -1807,7 +1861,7 @@ mod tests {
             turn_deg(&clean)
         );
         // 0.2 s around the peak rate (about 35° of the turn) arrive at its end.
-        let stalled = linked_turn(Some((1.8, 2.0)), false);
+        let stalled = link(Some((1.8, 2.0)), false);
         let placed = regularize(&stalled, &options).unwrap();
         let q = &placed.quality;
         assert_eq!(q.backlogs, 1, "{q:?}");
@@ -1821,10 +1875,86 @@ mod tests {
         let oracle = whole::regularize_whole(&stalled, &options);
         same_outcome(Ok(placed), oracle).unwrap();
         // The same samples lost: no backlog; the gap is bridged and said.
-        let holed = linked_turn(Some((1.8, 2.0)), true);
+        let holed = link(Some((1.8, 2.0)), true);
         let placed = regularize(&holed, &options).unwrap();
         assert_eq!(placed.quality.backlogs, 0);
         assert!(placed.quality.filled_slots >= 15, "{:?}", placed.quality);
         same_outcome(Ok(placed), whole::regularize_whole(&holed, &options)).unwrap();
+    }
+
+    /// A regular logger (rows 0-0.5 ms late: one per period) whose PC stalls for 0.2 s
+    /// and then reads the buffered rows 0.2 ms apart: without re-timing, the stall is
+    /// bridged as a gap and its rows placed after it (a 90° turn read as 122°).
+    #[test]
+    fn a_regular_logger_s_stall_is_re_timed_too() {
+        let options = GridOptions::default();
+        let stalled = linked_turn(Some((1.8, 2.0)), false, 0.0005, 0.0002);
+        let placed = regularize(&stalled, &options).unwrap();
+        let q = &placed.quality;
+        assert!(q.bursts.is_none(), "{q:?}");
+        assert_eq!((q.backlogs, q.gaps, q.filled_slots), (1, 0, 0), "{q:?}");
+        assert_eq!(placed.slots.len(), 400, "one slot per sample");
+        assert!(
+            (turn_deg(&placed) - 90.0).abs() < 0.5,
+            "{}",
+            turn_deg(&placed)
+        );
+        same_outcome(Ok(placed), whole::regularize_whole(&stalled, &options)).unwrap();
+        // Lost instead: a gap, filled, and no backlog.
+        let holed = linked_turn(Some((1.8, 2.0)), true, 0.0005, 0.0002);
+        let placed = regularize(&holed, &options).unwrap();
+        assert_eq!((placed.quality.backlogs, placed.quality.gaps), (0, 1));
+        same_outcome(Ok(placed), whole::regularize_whole(&holed, &options)).unwrap();
+    }
+
+    /// A 104 Hz sensor (9.6 ms) stamped to the millisecond steps 9 and 10 ms, the median
+    /// 10 ms: the grid takes the mean of the single-period steps, so a row per slot keeps
+    /// time (a 100 Hz grid would stretch every angle by 4%).
+    #[test]
+    fn the_grid_rate_is_the_mean_of_single_steps_not_the_median() {
+        let period_s = 1.0 / 104.0;
+        let rows: Vec<Row> = (0..2000_u32)
+            .map(|k| Row {
+                line: u64::from(k) + 2,
+                time_s: (f64::from(k) * period_s * 1000.0).floor() / 1000.0,
+                rate_dps: Some(10.0),
+                reference_deg: None,
+                temperature_c: None,
+            })
+            .collect();
+        let log = Log {
+            path: "ms.csv".into(),
+            rows,
+            ..Log::default()
+        };
+        let placed = regularize(&log, &GridOptions::default()).unwrap();
+        assert_eq!(placed.quality.sample_rate_source, "single_steps");
+        assert!(
+            (placed.sample_rate_hz - 104.0).abs() < 0.1,
+            "{}",
+            placed.sample_rate_hz
+        );
+        assert_eq!(placed.slots.len(), 2000);
+        // 10 °/s for the rows' span: the angle the stamps say.
+        let span_s = log.rows[1999].time_s - log.rows[0].time_s;
+        let angle_deg = turn_deg(&placed);
+        assert!(
+            (angle_deg - 10.0 * span_s).abs() < 0.01 * angle_deg,
+            "{angle_deg}"
+        );
+        same_outcome(
+            Ok(placed),
+            whole::regularize_whole(&log, &GridOptions::default()),
+        )
+        .unwrap();
+        // With a lost sample now and then (a step of two periods), the same.
+        let mut holed = log.clone();
+        holed.rows.retain(|r| r.line % 50 != 0);
+        let placed = regularize(&holed, &GridOptions::default()).unwrap();
+        assert!(
+            (placed.sample_rate_hz - 104.0).abs() < 0.1,
+            "{}",
+            placed.sample_rate_hz
+        );
     }
 }

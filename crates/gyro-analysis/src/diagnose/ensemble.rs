@@ -68,7 +68,7 @@ impl StampedClock {
     /// the rows' stamps (not a log resampled for arriving in bursts, whose slot times are
     /// the grid's) and it has at least three stamped samples.
     pub fn of(log: &RegularLog) -> Option<Self> {
-        if log.quality.sample_rate_source == "median_step" || log.quality.bursts.is_some() {
+        if log.quality.sample_rate_source == "single_steps" || log.quality.bursts.is_some() {
             return None;
         }
         let points: Vec<(f64, f64)> = log
@@ -560,7 +560,7 @@ mod tests {
         assert!(c.ppm.abs() < 1e-6, "{c:?}");
         // A grid whose rate came from the stamps themselves cannot show the clock.
         assert_eq!(
-            StampedClock::of(&stamped(1000.0, 1.005, "median_step", 0.0)),
+            StampedClock::of(&stamped(1000.0, 1.005, "single_steps", 0.0)),
             None
         );
     }

@@ -23,7 +23,10 @@
 //!
 //! Effects seen directly in the data (clip plateaus, the output grid, gaps, the
 //! between-run bias) and those without a statistic of their own here (temperature terms,
-//! the stamped clock) have no signature statistic: their check does not apply.
+//! the stamped clock) have no signature statistic: their check does not apply. An effect
+//! with a signature that none of the held-out runs can measure (the lag trend of runs
+//! whose lag lies beyond the search) fails (`unmeasured`): the check cannot be made, so
+//! the effect is not named on the strength of other statistics.
 
 use super::score::RunScore;
 use serde::Serialize;
@@ -77,15 +80,26 @@ pub struct SignatureCheck {
 /// The posterior check of one effect.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PosteriorCheck {
-    /// Every signature statistic passes (true when there is none).
+    /// Every signature statistic passes (true when the effect has none; false when it
+    /// has one and no held-out run measures it).
     pub passes: bool,
-    /// The signature statistics checked (empty: the check does not apply).
+    /// The signature statistics checked (empty: the check does not apply, or could not
+    /// be made).
     pub statistics: Vec<SignatureCheck>,
+    /// The effect has signature statistics and no held-out run measures any of them;
+    /// left out of the JSON when false.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub unmeasured: bool,
 }
 
 impl PosteriorCheck {
     /// One line: each statistic's real, nominal and with-effect values.
     pub fn describe(&self) -> String {
+        if self.unmeasured {
+            return "its signature statistic is not measured on the held-out runs (a lag \
+                    beyond the search): the check fails"
+                .into();
+        }
         if self.statistics.is_empty() {
             return "no signature statistic (seen directly or not measurable here)".into();
         }
@@ -146,15 +160,18 @@ pub fn check(
     after: &[RunScore],
     sample_rate_hz: f64,
 ) -> PosteriorCheck {
-    let statistics: Vec<SignatureCheck> = signature(id)
+    let expected = signature(id);
+    let statistics: Vec<SignatureCheck> = expected
         .iter()
         .filter_map(|&(segment, statistic)| {
             pooled(segment, statistic, before, after, sample_rate_hz)
         })
         .collect();
+    let unmeasured = !expected.is_empty() && statistics.is_empty();
     PosteriorCheck {
-        passes: statistics.iter().all(|s| s.passes),
+        passes: !unmeasured && statistics.iter().all(|s| s.passes),
         statistics,
+        unmeasured,
     }
 }
 
@@ -285,10 +302,22 @@ mod tests {
     fn no_signature_statistic_means_the_check_does_not_apply() {
         let before = vec![score(0.0108, 0.0002, 0.0001); 2];
         let c = check("dropouts", &before, &before, 1000.0);
-        assert!(c.passes && c.statistics.is_empty());
-        // A signature statistic missing from the scores is left out, not failed.
-        let c = check("scale_factor", &before, &before, 1000.0);
-        assert!(c.passes && c.statistics.is_empty());
+        assert!(c.passes && c.statistics.is_empty() && !c.unmeasured);
+    }
+
+    #[test]
+    fn a_signature_no_held_out_run_measures_fails() {
+        // The scores hold only the lag peak: a scale factor's slope, or the count-stamped
+        // clock's lag trend (not measured when the lag lies beyond the search), is missing.
+        let before = vec![score(0.0108, 0.0002, 0.0001); 2];
+        for id in ["scale_factor", "clock_error_count_stamped"] {
+            let c = check(id, &before, &before, 1000.0);
+            assert!(
+                !c.passes && c.unmeasured && c.statistics.is_empty(),
+                "{c:?}"
+            );
+            assert!(c.describe().contains("not measured"), "{}", c.describe());
+        }
     }
 
     #[test]

@@ -45,7 +45,8 @@
 //!   the peak and its neighbours; positive when the gyro lags the reference: `all`.
 //! - `xcorr_lag_trend` (s/s): the same lag in the last third of the run less that in the
 //!   first third, over the time between their starts (a sample clock stamped by its own
-//!   count lags more and more): `all`.
+//!   count lags more and more): `all`; left out when either lag sits on the edge of the
+//!   search.
 //! - `angle_error_rms_<H>s` (deg): RMS over non-overlapping windows of `H` s
 //!   ([`HORIZONS_S`]) of the residual integrated over the window, after removing the
 //!   static residual mean (the bias; the mean over all samples when there is no static
@@ -395,7 +396,9 @@ fn lag1(x: &[f64], runs: &[std::ops::Range<usize>]) -> Option<f64> {
 }
 
 /// Change of the cross-correlation peak lag over the run (s per s): the lag of the last
-/// third less that of the first, over the time between their centres.
+/// third less that of the first, over the time between their centres. `None` when either
+/// lag sits on the edge of the search: a bound is not a measurement, and the difference of
+/// two bounds says nothing of a trend.
 fn xcorr_lag_trend(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
     let third = gyro.len() / 3;
     if third < 3 {
@@ -404,6 +407,9 @@ fn xcorr_lag_trend(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
     let first = xcorr_peak_lag(&gyro[..third], &reference[..third], fs)?;
     let start = gyro.len() - third;
     let last = xcorr_peak_lag(&gyro[start..], &reference[start..], fs)?;
+    if is_at_search_edge(first, fs) || is_at_search_edge(last, fs) {
+        return None;
+    }
     Some((last - first) / (start as f64 / fs))
 }
 
@@ -936,6 +942,9 @@ mod tests {
             "{:?}",
             get(&beyond, "all", "xcorr_peak_lag_s")
         );
+        // A lag trend is measured within the search, not between two cut lags.
+        assert!(late.iter().any(|s| s.statistic == "xcorr_lag_trend"));
+        assert!(!beyond.iter().any(|s| s.statistic == "xcorr_lag_trend"));
     }
 
     #[test]
