@@ -7,7 +7,7 @@
 //! rate interpolated across it) and then places the backlog's rows too, so the stall's
 //! rotation counts twice (32° of a 90° turn for a 0.2 s stall at its peak rate).
 //!
-//! A [`Retimer`] holds the rows after a gap until the count of rows catches up with the
+//! The retimer holds the rows after a gap until the count of rows catches up with the
 //! sensor's *local period*, the mean step of the rows of the [`LOCAL_PERIOD_WINDOW_S`]
 //! before the gap (steps of at most the gap threshold): the first row `n` rows after the
 //! gap stamped at most `n` local periods after the row before it ends a *backlog*, and the

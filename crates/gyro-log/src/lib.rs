@@ -449,8 +449,8 @@ pub enum LogError {
         rate_hz: f64,
         /// Where it came from: "option" or "metadata" (printed as a phrase).
         source_name: &'static str,
-        /// The rate of the stamps (Hz): the median step's, or the mean row rate for rows
-        /// arriving in bursts.
+        /// The rate of the stamps (Hz): the mean of the single-period steps, or the mean row
+        /// rate for rows arriving in bursts.
         measured_hz: f64,
         /// `measured_hz / rate_hz`.
         ratio: f64,

@@ -232,12 +232,12 @@ pub const RATE_DISAGREEMENT: f64 = 2.0;
 /// [`RATE_DISAGREEMENT`]) is accepted with a warning.
 pub const RATE_WARNING_SHARE: f64 = 0.01;
 
-/// Positive steps needed before a given rate is checked against the stamps' median step.
+/// Positive steps needed before a given rate is checked against the stamps' rate.
 pub const RATE_CHECK_MIN_STEPS: usize = 20;
 
 /// Check a given rate (option or metadata) against the first rows' stamps: the stamps'
-/// rate is the mean row rate for rows arriving in bursts, else the median step's. More
-/// than [`RATE_DISAGREEMENT`] off either way is an error; more than [`RATE_WARNING_SHARE`]
+/// rate is the mean row rate for rows arriving in bursts, else the single steps' mean
+/// ([`single_step_rate`]). More than [`RATE_DISAGREEMENT`] off either way is an error; more than [`RATE_WARNING_SHARE`]
 /// off, a warning (returned). With fewer than [`RATE_CHECK_MIN_STEPS`] positive steps (a
 /// median of a few steps says little) only a rate more than [`RATE_DISAGREEMENT`] above the
 /// fastest step's is refused: every step would be a gap.
@@ -279,7 +279,7 @@ pub(crate) fn check_given_rate(
     }
     let measured_hz = match arrival {
         Some(b) => 1.0 / b.mean_step_s,
-        None => match median_step_rate(path, rows) {
+        None => match single_step_rate(path, rows) {
             Ok((hz, _)) => hz,
             Err(_) => return Ok(None),
         },
@@ -333,11 +333,11 @@ pub(crate) fn check_bridged_slots(
 }
 
 /// The rate from the positive steps of the first [`RATE_WINDOW_STEPS`] steps that are one
-/// period: the mean of those within half the median step of it (gaps, and the zero steps
-/// of repeated stamps, left out). The median alone is not the period when the steps are
+/// period: the mean of those within half the median step of it, ends included (gaps, and
+/// the zero steps of repeated stamps, left out). The median alone is not the period when the steps are
 /// not symmetric about it: a 104 Hz sensor stamped to the millisecond steps 9 and 10 ms,
 /// median 10 ms, and a row per slot on a 100 Hz grid would stretch time by 4%.
-fn median_step_rate(path: &Path, rows: &[Row]) -> Result<(f64, &'static str), LogError> {
+fn single_step_rate(path: &Path, rows: &[Row]) -> Result<(f64, &'static str), LogError> {
     let mut steps: Vec<f64> = rows
         .windows(2)
         .take(RATE_WINDOW_STEPS)
@@ -353,12 +353,18 @@ fn median_step_rate(path: &Path, rows: &[Row]) -> Result<(f64, &'static str), Lo
     Ok((1.0 / single_step_mean(&steps), "single_steps"))
 }
 
-/// The mean of the sorted positive `steps` within half the median of it (a period each).
+/// Steps within this share of the median step of it are one period (half, and a little
+/// more so that a 416 Hz sensor stamped to the millisecond, steps 2 and 3 ms, keeps its
+/// 3 ms steps to rounding); a lost sample's step is twice the period.
+const SINGLE_STEP_SPREAD: f64 = 0.500_001;
+
+/// The mean of the sorted positive `steps` within [`SINGLE_STEP_SPREAD`] of the median (a
+/// period each).
 fn single_step_mean(sorted_steps: &[f64]) -> f64 {
     let median = sorted_steps[sorted_steps.len() / 2];
     let (sum, count) = sorted_steps
         .iter()
-        .filter(|&&dt| (dt - median).abs() < 0.5 * median)
+        .filter(|&&dt| (dt - median).abs() <= SINGLE_STEP_SPREAD * median)
         .fold((0.0, 0_usize), |(sum, count), &dt| (sum + dt, count + 1));
     sum / count as f64
 }
@@ -430,7 +436,7 @@ pub fn place<S: SlotSink + ?Sized>(
     let rate = match (given_rate(info, options), arrival) {
         (Some(rate), _) => rate,
         (None, Some(b)) => Ok((1.0 / b.mean_step_s, "mean_step")),
-        (None, None) => median_step_rate(info.path, &ahead),
+        (None, None) => single_step_rate(info.path, &ahead),
     };
     let rate = check_max_gap(info.path, options).and(rate);
     let rate = rate.and_then(|(rate_hz, source)| {
@@ -967,7 +973,7 @@ mod tests {
             let single: Vec<f64> = steps
                 .iter()
                 .copied()
-                .filter(|dt| (dt - median).abs() < 0.5 * median)
+                .filter(|dt| (dt - median).abs() <= 0.500_001 * median)
                 .collect();
             let mean_s = single.iter().sum::<f64>() / single.len() as f64;
             Ok((1.0 / mean_s, "single_steps"))
@@ -1956,5 +1962,22 @@ mod tests {
             "{}",
             placed.sample_rate_hz
         );
+        // 416 Hz to the millisecond: steps of 2 and 3 ms, median 2 ms; no slot filled.
+        let mut fast = log.clone();
+        for (k, row) in fast.rows.iter_mut().enumerate() {
+            row.time_s = (k as f64 / 416.0 * 1000.0).floor() / 1000.0;
+        }
+        let placed = regularize(&fast, &GridOptions::default()).unwrap();
+        assert!(
+            (placed.sample_rate_hz - 416.0).abs() < 0.5,
+            "{}",
+            placed.sample_rate_hz
+        );
+        assert_eq!(placed.quality.filled_slots, 0, "{:?}", placed.quality);
+        same_outcome(
+            Ok(placed),
+            whole::regularize_whole(&fast, &GridOptions::default()),
+        )
+        .unwrap();
     }
 }
