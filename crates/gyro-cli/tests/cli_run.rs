@@ -557,6 +557,40 @@ fn a_lagging_reference_is_measured_and_said() {
     let scored = json_of(&gyro(&["run", log, "--format", "json", "--model", &model]));
     assert!(scored["summary"]["reference_lag_s"].as_f64().unwrap().abs() < 0.004);
     assert!(scored.get("warnings").is_none(), "{}", scored["warnings"]);
+    // The warning names the flag that scores it; the flag does, over the model's delay.
+    assert!(warning.contains("--reference-delay-s 0.06"), "{warning}");
+    let flagged = json_of(&gyro(&[
+        "run",
+        log,
+        "--format",
+        "json",
+        "--reference-delay-s",
+        "0.06",
+    ]));
+    assert!(
+        flagged["summary"]["reference_lag_s"]
+            .as_f64()
+            .unwrap()
+            .abs()
+            < 0.004
+    );
+    assert!(flagged.get("warnings").is_none(), "{}", flagged["warnings"]);
+    assert_eq!(flagged["summary"], scored["summary"]);
+    let over = json_of(&gyro(&[
+        "run",
+        log,
+        "--format",
+        "json",
+        "--model",
+        &model,
+        "--reference-delay-s",
+        "0",
+    ]));
+    assert!((over["summary"]["reference_lag_s"].as_f64().unwrap() - 0.06).abs() < 0.004);
+    let refused = gyro(&["run", log, "--reference-delay-s", "-1.5"]);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("--reference-delay-s -1.5"), "{stderr}");
 
     let bench = bench_log();
     let fixture = json_of(&gyro(&["run", bench.to_str().unwrap(), "--format", "json"]));

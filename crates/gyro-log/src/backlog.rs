@@ -12,7 +12,8 @@
 //! before the gap (steps of at most the gap threshold): the first row `n` rows after the
 //! gap stamped at most `n` local periods after the row before it ends a *backlog*, and the
 //! gap and its `n` rows share that span evenly. When the count does not catch up within
-//! [`BACKLOG_HORIZON_S`], samples were lost: the stamps stay and the gap is bridged.
+//! [`BACKLOG_HORIZON_S`] of the first row after the gap, samples were lost: the stamps stay
+//! and the gap is bridged.
 //!
 //! Lost samples cannot pass for a backlog unless a row's delay exceeds anything the steps
 //! show: `n` rows after a gap of `m` lost samples, the count catches up only if the row
@@ -25,8 +26,9 @@
 use crate::Row;
 use std::collections::VecDeque;
 
-/// After a gap, how long the arrival count has to catch up with the sensor's period before
-/// the gap counts as lost samples (s): a link's buffer drains in a few tenths of a second.
+/// How long after the first row that follows a gap the arrival count has to catch up with
+/// the sensor's period before the gap counts as lost samples (s): a link's buffer drains
+/// in a few tenths of a second (the rasteiro stall's 24 rows in 0.11 s).
 pub const BACKLOG_HORIZON_S: f64 = 0.5;
 /// The sensor's local period is the mean step over this long before a gap (s): the row
 /// rate of a bursty log differs between rest and motion (9 against 12 ms on the rasteiro
@@ -45,8 +47,9 @@ pub(crate) struct Retimer {
     recent: VecDeque<(f64, f64)>,
     /// The latest stamp released (non-decreasing).
     clock_s: Option<f64>,
-    /// After a gap: the stamp of the row before it and the local period.
-    anchor: Option<(f64, f64)>,
+    /// After a gap: the stamp of the row before it, the local period, and the span from
+    /// that stamp to the first row after the gap.
+    anchor: Option<(f64, f64, f64)>,
     /// The rows since the gap, held until the count catches up or the horizon passes.
     held: Vec<Row>,
     /// Gaps followed by a backlog, re-timed.
@@ -71,7 +74,7 @@ impl Retimer {
 
     /// Take the next row; push the rows released, in order, onto `out`.
     pub(crate) fn push(&mut self, row: Row, out: &mut Vec<Row>) {
-        if let Some((anchor_s, period_s)) = self.anchor {
+        if let Some((anchor_s, period_s, gap_s)) = self.anchor {
             self.held.push(row);
             let count = self.held.len();
             let span_s = row.time_s.max(anchor_s) - anchor_s;
@@ -81,7 +84,7 @@ impl Retimer {
                 }
                 self.backlogs += 1;
                 self.retimed_rows += count as u64;
-            } else if span_s < BACKLOG_HORIZON_S {
+            } else if span_s - gap_s < BACKLOG_HORIZON_S {
                 return;
             }
             self.anchor = None;
@@ -96,7 +99,8 @@ impl Retimer {
         if let Some(clock_s) = self.clock_s {
             if row.time_s - clock_s > self.gap_step_s && self.recent.len() >= MIN_LOCAL_STEPS {
                 let sum_s: f64 = self.recent.iter().map(|&(_, step_s)| step_s).sum();
-                self.anchor = Some((clock_s, sum_s / self.recent.len() as f64));
+                let gap_s = row.time_s - clock_s;
+                self.anchor = Some((clock_s, sum_s / self.recent.len() as f64, gap_s));
                 self.held.push(row);
                 return;
             }
@@ -178,6 +182,23 @@ mod tests {
         // The rows before and after keep their stamps.
         assert_eq!(&out[..20], &stamps[..20]);
         assert_eq!(&out[26..], &stamps[26..]);
+    }
+
+    #[test]
+    fn a_long_stall_s_backlog_is_re_timed_too() {
+        // A 0.7 s stall: its 70 samples and the 17 taken while they drain 2 ms apart
+        // arrive after it; the count catches up 0.17 s after the first row, 0.87 s after
+        // the row before the gap; then the rows arrive every 10 ms again.
+        let mut stamps: Vec<f64> = (0..20).map(|k| f64::from(k) * 0.01).collect();
+        let first_s = 0.19 + 0.7;
+        stamps.extend((0..88).map(|k| first_s + f64::from(k) * 0.002));
+        stamps.extend((1..20).map(|k| first_s + 0.174 + f64::from(k) * 0.01));
+        let (out, r) = retimed(&stamps, 0.015);
+        assert_eq!((r.backlogs, r.retimed_rows), (1, 88), "{out:?}");
+        assert!(
+            out.windows(2).all(|w| (w[1] - w[0] - 0.01).abs() < 2e-4),
+            "{out:?}"
+        );
     }
 
     #[test]

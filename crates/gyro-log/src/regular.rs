@@ -998,6 +998,7 @@ mod tests {
                 let mut end = i;
                 if rows[i].time_s - last_s > gap_step_s && steps.len() >= MIN_LOCAL_STEPS {
                     let period_s = steps.iter().sum::<f64>() / steps.len() as f64;
+                    let gap_s = rows[i].time_s - last_s;
                     let mut j = i;
                     while j < rows.len() {
                         let span_s = rows[j].time_s.max(last_s) - last_s;
@@ -1010,7 +1011,7 @@ mod tests {
                             retimed += count as u64;
                             break;
                         }
-                        if span_s >= BACKLOG_HORIZON_S {
+                        if span_s - gap_s >= BACKLOG_HORIZON_S {
                             break;
                         }
                         j += 1;

@@ -245,7 +245,7 @@ pub fn lag_warning(report: &RunReport) -> Option<String> {
         )
     };
     Some(format!(
-        "the gyro {how} {scored} by {:.0} ms (cross-correlation of the rates): the errors against it during turns are the rate times that, not the sensor's; score with a model file's reference_delay_s of {:.3} s (`calibrate` measures and writes it)",
+        "the gyro {how} {scored} by {:.0} ms (cross-correlation of the rates): the errors against it during turns are the rate times that, not the sensor's; score with --reference-delay-s {:.3} (or a model file's reference_delay_s: `calibrate` measures and writes it)",
         1e3 * lag_s.abs(),
         report.reference_delay_s + lag_s,
     ))

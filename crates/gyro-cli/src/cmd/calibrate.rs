@@ -78,14 +78,7 @@ pub fn run(args: &Args) -> Result<()> {
         inputs.chain(args.model.as_deref()),
     )?;
     super::refuse_repeated_runs(&[("training", &args.logs), ("hold-out", &args.holdout)])?;
-    if let Some(d) = args.reference_delay_s {
-        if d.abs() > model::MAX_REFERENCE_DELAY_S {
-            anyhow::bail!(
-                "--reference-delay-s {d}: expected at most {} s either way",
-                model::MAX_REFERENCE_DELAY_S
-            );
-        }
-    }
+    super::check_reference_delay(args.reference_delay_s)?;
     let base = match &args.model {
         Some(path) => model::load(path)?,
         None => model::ModelFile::new(Config::default()),

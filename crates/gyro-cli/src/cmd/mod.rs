@@ -96,6 +96,18 @@ impl NoiseYamlArgs {
 }
 
 /// Print a warning about the input on stderr.
+/// Refuse a `--reference-delay-s` beyond what a model file may hold
+/// ([`gyro_analysis::model::MAX_REFERENCE_DELAY_S`]).
+pub fn check_reference_delay(delay_s: Option<f64>) -> Result<()> {
+    match delay_s {
+        Some(d) if d.abs() > gyro_analysis::model::MAX_REFERENCE_DELAY_S => anyhow::bail!(
+            "--reference-delay-s {d}: expected at most {} s either way",
+            gyro_analysis::model::MAX_REFERENCE_DELAY_S
+        ),
+        _ => Ok(()),
+    }
+}
+
 pub fn warn(warning: &str) {
     say!("warning: {warning}");
 }

@@ -75,6 +75,12 @@ pub struct Args {
     /// (what `calibrate` measured), else 0.
     #[arg(long, value_name = "FRACTION", value_parser = value::non_negative::<f32>)]
     scale_sigma: Option<f32>,
+    /// The gyro's delay behind the reference (s; negative: it leads) to score against:
+    /// the angle at t is compared with the reference at t − delay. Default: the model
+    /// file's `reference_delay_s`, else 0 (the reference as logged). `run` warns when it
+    /// measures a lag of 20 ms or more, and names the delay that would score it.
+    #[arg(long, value_name = "S", value_parser = value::finite::<f64>, allow_negative_numbers = true)]
+    reference_delay_s: Option<f64>,
     /// Output format on stdout (csv: the movements).
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -101,7 +107,8 @@ pub fn run(args: &Args) -> Result<()> {
             .into_iter()
             .chain(args.model.as_deref()),
     )?;
-    let (mut config, options, model_scale_sigma) = match &args.model {
+    super::check_reference_delay(args.reference_delay_s)?;
+    let (mut config, mut options, model_scale_sigma) = match &args.model {
         Some(path) => {
             let model = model::load(path)?;
             let config = Config {
@@ -116,6 +123,9 @@ pub fn run(args: &Args) -> Result<()> {
         }
         None => (Config::default(), replay::ReplayOptions::default(), 0.0),
     };
+    if let Some(delay_s) = args.reference_delay_s {
+        options.reference_delay_s = delay_s;
+    }
     if let Some(range_dps) = args.range_dps {
         config.range_dps = Some(range_dps);
     }
