@@ -820,7 +820,7 @@ fn posterior_table(s: &mut String, d: &Diagnosis) {
         .effects
         .iter()
         .filter_map(|e| e.posterior_check.as_ref().map(|c| (e, c)))
-        .filter(|(e, c)| !c.statistics.is_empty() && (e.significant || !c.passes))
+        .filter(|(e, c)| (!c.statistics.is_empty() || c.unmeasured) && (e.significant || !c.passes))
         .collect();
     if rows.is_empty() {
         return;
@@ -838,6 +838,14 @@ effect that fails is not named and the selection is made again without it.</p>"
         "<table><tr><th>effect</th><th>statistic</th><th>real</th><th>nominal</th><th>with the effect</th><th>±95%</th><th>check</th></tr>"
     );
     for (e, c) in rows {
+        if c.unmeasured {
+            let _ = writeln!(
+                s,
+                "<tr><td><code>{}</code></td><td colspan=\"5\">{}</td><td><span class=\"warn\">fails</span></td></tr>",
+                esc(e.id),
+                esc(&c.describe())
+            );
+        }
         for st in &c.statistics {
             let _ = writeln!(
                 s,
@@ -1374,6 +1382,43 @@ mod tests {
         let err = write_report(&file, &diagnosis(), None, &Options::default()).unwrap_err();
         assert!(err.to_string().contains("not-a-dir"), "{err}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// An effect whose signature no held-out run measures fails its check, and both the
+    /// page and the table say why.
+    #[test]
+    fn an_unmeasured_signature_is_shown_failing() {
+        let mut d = diagnosis();
+        d.effects.push(gyro_analysis::diagnose::EffectResult {
+            id: "clock_error_count_stamped",
+            params: std::collections::BTreeMap::from([("ppm", 5737.0)]),
+            delta_bic: 360.0,
+            holdout_gap_before: 296.0,
+            holdout_gap_after: 199.0,
+            fraction_closed: 0.33,
+            significant: false,
+            ci95: std::collections::BTreeMap::new(),
+            z: Some(4.4),
+            test: String::new(),
+            bootstrap_p: 0.0,
+            confounded_with: Vec::new(),
+            posterior_check: Some(gyro_analysis::diagnose::posterior::PosteriorCheck {
+                passes: false,
+                statistics: Vec::new(),
+                unmeasured: true,
+            }),
+        });
+        let mut html = String::new();
+        posterior_table(&mut html, &d);
+        assert!(html.contains("clock_error_count_stamped"), "{html}");
+        assert!(html.contains("not measured on the held-out runs"), "{html}");
+        let text = super::super::text::table(&d);
+        assert!(
+            text.contains(
+                "clock_error_count_stamped fails  its signature statistic is not measured"
+            ),
+            "{text}"
+        );
     }
 
     #[test]

@@ -247,7 +247,7 @@ pub fn table(d: &Diagnosis) -> String {
         .effects
         .iter()
         .filter_map(|e| e.posterior_check.as_ref().map(|c| (e, c)))
-        .filter(|(e, c)| !c.statistics.is_empty() && (e.significant || !c.passes))
+        .filter(|(e, c)| (!c.statistics.is_empty() || c.unmeasured) && (e.significant || !c.passes))
         .collect();
     if !checks.is_empty() {
         let _ = writeln!(
