@@ -237,8 +237,8 @@ pub const RATE_CHECK_MIN_STEPS: usize = 20;
 
 /// Check a given rate (option or metadata) against the first rows' stamps: the stamps'
 /// rate is the mean row rate for rows arriving in bursts, else the single steps' mean
-/// ([`single_step_rate`]). More than [`RATE_DISAGREEMENT`] off either way is an error; more than [`RATE_WARNING_SHARE`]
-/// off, a warning (returned). With fewer than [`RATE_CHECK_MIN_STEPS`] positive steps (a
+/// ([`single_step_rate`]). More than [`RATE_DISAGREEMENT`] off either way is an error;
+/// more than [`RATE_WARNING_SHARE`] off, a warning (returned). With fewer than [`RATE_CHECK_MIN_STEPS`] positive steps (a
 /// median of a few steps says little) only a rate more than [`RATE_DISAGREEMENT`] above the
 /// fastest step's is refused: every step would be a gap.
 pub(crate) fn check_given_rate(
@@ -334,9 +334,9 @@ pub(crate) fn check_bridged_slots(
 
 /// The rate from the positive steps of the first [`RATE_WINDOW_STEPS`] steps that are one
 /// period: the mean of those within half the median step of it, ends included (gaps, and
-/// the zero steps of repeated stamps, left out). The median alone is not the period when the steps are
-/// not symmetric about it: a 104 Hz sensor stamped to the millisecond steps 9 and 10 ms,
-/// median 10 ms, and a row per slot on a 100 Hz grid would stretch time by 4%.
+/// the zero steps of repeated stamps, left out). The median alone is not the period when
+/// the steps are not symmetric about it: a 104 Hz sensor stamped to the millisecond steps
+/// 9 and 10 ms, median 10 ms, and a row per slot on a 100 Hz grid would stretch time by 4%.
 fn single_step_rate(path: &Path, rows: &[Row]) -> Result<(f64, &'static str), LogError> {
     let mut steps: Vec<f64> = rows
         .windows(2)
@@ -973,7 +973,7 @@ mod tests {
             let single: Vec<f64> = steps
                 .iter()
                 .copied()
-                .filter(|dt| (dt - median).abs() <= 0.500_001 * median)
+                .filter(|dt| (dt - median).abs() <= super::super::SINGLE_STEP_SPREAD * median)
                 .collect();
             let mean_s = single.iter().sum::<f64>() / single.len() as f64;
             Ok((1.0 / mean_s, "single_steps"))
@@ -990,13 +990,18 @@ mod tests {
             let mut i = 1;
             while i < rows.len() {
                 let last_s = clock[i - 1];
-                let steps: Vec<f64> = (1..i)
-                    .filter(|&k| clock[k] >= last_s - LOCAL_PERIOD_WINDOW_S)
-                    .map(|k| clock[k] - clock[k - 1])
-                    .filter(|&step_s| step_s <= gap_step_s)
-                    .collect();
+                // The steps of the local period, looked at only after a gap.
+                let steps: Vec<f64> = if rows[i].time_s - last_s > gap_step_s {
+                    (1..i)
+                        .filter(|&k| clock[k] >= last_s - LOCAL_PERIOD_WINDOW_S)
+                        .map(|k| clock[k] - clock[k - 1])
+                        .filter(|&step_s| step_s <= gap_step_s)
+                        .collect()
+                } else {
+                    Vec::new()
+                };
                 let mut end = i;
-                if rows[i].time_s - last_s > gap_step_s && steps.len() >= MIN_LOCAL_STEPS {
+                if steps.len() >= MIN_LOCAL_STEPS {
                     let period_s = steps.iter().sum::<f64>() / steps.len() as f64;
                     let gap_s = rows[i].time_s - last_s;
                     let mut j = i;

@@ -95,7 +95,6 @@ impl NoiseYamlArgs {
     }
 }
 
-/// Print a warning about the input on stderr.
 /// Refuse a `--reference-delay-s` beyond what a model file may hold
 /// ([`gyro_analysis::model::MAX_REFERENCE_DELAY_S`]).
 pub fn check_reference_delay(delay_s: Option<f64>) -> Result<()> {
@@ -108,6 +107,7 @@ pub fn check_reference_delay(delay_s: Option<f64>) -> Result<()> {
     }
 }
 
+/// Print a warning about the input on stderr.
 pub fn warn(warning: &str) {
     say!("warning: {warning}");
 }

@@ -820,7 +820,7 @@ fn posterior_table(s: &mut String, d: &Diagnosis) {
         .effects
         .iter()
         .filter_map(|e| e.posterior_check.as_ref().map(|c| (e, c)))
-        .filter(|(e, c)| (!c.statistics.is_empty() || c.unmeasured) && (e.significant || !c.passes))
+        .filter(|(e, c)| super::text::shows_posterior(e, c))
         .collect();
     if rows.is_empty() {
         return;

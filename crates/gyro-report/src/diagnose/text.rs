@@ -116,6 +116,15 @@ fn num(x: f64) -> String {
     }
 }
 
+/// A posterior check worth listing: it checked something (or could not), for an effect
+/// named or left out by it.
+pub(super) fn shows_posterior(
+    e: &gyro_analysis::diagnose::EffectResult,
+    c: &gyro_analysis::diagnose::posterior::PosteriorCheck,
+) -> bool {
+    (!c.statistics.is_empty() || c.unmeasured) && (e.significant || !c.passes)
+}
+
 /// Not named because its simulation does not reproduce its signature statistics.
 pub(super) fn fails_posterior(e: &gyro_analysis::diagnose::EffectResult) -> bool {
     e.posterior_check.as_ref().is_some_and(|c| !c.passes)
@@ -247,7 +256,7 @@ pub fn table(d: &Diagnosis) -> String {
         .effects
         .iter()
         .filter_map(|e| e.posterior_check.as_ref().map(|c| (e, c)))
-        .filter(|(e, c)| (!c.statistics.is_empty() || c.unmeasured) && (e.significant || !c.passes))
+        .filter(|(e, c)| shows_posterior(e, c))
         .collect();
     if !checks.is_empty() {
         let _ = writeln!(
