@@ -12,11 +12,18 @@
 //! A stall of the link (a gap, then the buffered rows a few milliseconds apart) is re-timed
 //! before the rows get here ([`crate::backlog`]).
 //!
-//! A log is *bursty* when, among its first [`crate::RATE_WINDOW_STEPS`] steps, more than a
-//! third are *off the grid*: further than a quarter of the median step from a whole number
-//! (one or more) of median steps. Those are the steps a row-per-slot placement gets wrong;
-//! jitter and lost samples (steps of two or three periods) are not off the grid. Regular
-//! loggers: well under 1%; the rasteiro recordings: 63–70%.
+//! A log is *bursty* when, among its first [`crate::RATE_WINDOW_STEPS`] steps, either
+//! - more than a third are *off the grid*: further than a quarter of the median step from a
+//!   whole number (one or more) of median steps. Those are the steps a row-per-slot
+//!   placement gets wrong; jitter and lost samples (steps of two or three periods) are not
+//!   off the grid. Regular loggers: well under 1%; the rasteiro recordings: 63–70%; or
+//! - more than [`REPEATED_LIMIT`] of the steps do not advance the stamp (a repeated stamp
+//!   with other values, or a step back). A row per slot gives each such row a period its
+//!   stamp does not: samples delivered in packets stamped on arrival (four rows, one
+//!   stamp, then a step of four periods: time stretched fourfold), a sensor faster than
+//!   the stamps' resolution (2 kHz stamped to the millisecond: twofold), or stamps coarser
+//!   than the rows (110 rows/s stamped to 10 ms: steps of 0, 10 and 20 ms, every positive
+//!   one on the grid, and 18% more slots than time).
 
 use crate::{LogError, Row, Slot};
 use serde::Serialize;
@@ -29,6 +36,10 @@ const OFF_GRID: f64 = 0.25;
 const BURSTY_SHARE: f64 = 1.0 / 3.0;
 /// Fewer positive steps than this say nothing about arrival: treated as regular.
 const MIN_STEPS: usize = 20;
+/// A log in which more than this share of the steps do not advance the stamp is bursty
+/// (each such row placed one per slot adds a period of time: 1% of them, a 90° turn 0.9°
+/// off).
+pub const REPEATED_LIMIT: f64 = 0.01;
 
 /// The arrival statistics of a bursty log (from its first steps).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -43,6 +54,9 @@ pub struct Bursts {
     /// Steps longer than this (s) are counted as gaps: twice the 99th percentile step, at
     /// least 1.5 mean steps (the bursts themselves are not gaps).
     pub gap_step_s: f64,
+    /// Share of the steps that do not advance the stamp (a repeated stamp with other
+    /// values, or a step back; exact duplicates are dropped, not counted).
+    pub repeated_stamp_share: f64,
 }
 
 /// The arrival statistics of `rows` if they arrive in bursts (see the module docs); `None`
@@ -64,6 +78,8 @@ pub fn classify(rows: &[Row], window_steps: usize) -> Option<Bursts> {
     if steps.len() < MIN_STEPS {
         return None;
     }
+    // Kept steps that do not advance the stamp.
+    let repeated_stamp_share = (kept - 1 - steps.len()) as f64 / (kept - 1) as f64;
     steps.sort_by(f64::total_cmp);
     let median_step_s = steps[steps.len() / 2];
     let off = steps
@@ -76,7 +92,8 @@ pub fn classify(rows: &[Row], window_steps: usize) -> Option<Bursts> {
     let off_grid_share = off as f64 / steps.len() as f64;
     let span_s = window.last()?.time_s - window.first()?.time_s;
     let mean_step_s = span_s / (kept - 1) as f64;
-    if off_grid_share <= BURSTY_SHARE || !(mean_step_s.is_finite() && mean_step_s > 0.0) {
+    let bursty = off_grid_share > BURSTY_SHARE || repeated_stamp_share > REPEATED_LIMIT;
+    if !(bursty && mean_step_s.is_finite() && mean_step_s > 0.0) {
         return None;
     }
     let p99 = steps[(steps.len() * 99 / 100).min(steps.len() - 1)];
@@ -85,6 +102,7 @@ pub fn classify(rows: &[Row], window_steps: usize) -> Option<Bursts> {
         mean_step_s,
         off_grid_share,
         gap_step_s: (2.0 * p99).max(1.5 * mean_step_s),
+        repeated_stamp_share,
     })
 }
 
@@ -401,6 +419,42 @@ mod tests {
         );
         let end_s = per_row.slots.last().unwrap().time_s;
         assert!((integral_deg(&per_row) - on_stamps_deg(&log, end_s)).abs() < 1e-9);
+    }
+
+    /// Rows sharing a stamp: a row per slot would give each a period its stamp does not
+    /// (packets of four stamped on arrival: time four times too long; a 100 Hz stream
+    /// stamped to 20 ms: twice). Every positive step is on the grid, so only the repeated
+    /// stamps tell; the rate is the mean row rate and the turn keeps its angle.
+    #[test]
+    fn rows_sharing_a_stamp_are_bursts_and_keep_their_angle() {
+        // Sensor noise (a deterministic ±0.01 °/s pattern): rows of the same stamp differ,
+        // as real samples do (exact copies are duplicates, dropped).
+        let noisy = |mut log: Log| {
+            for (k, row) in log.rows.iter_mut().enumerate() {
+                row.rate_dps = row.rate_dps.map(|r| r + 0.005 * ((k * 7 % 5) as f64 - 2.0));
+            }
+            log
+        };
+        let packets = noisy(turn_log(|k, _| 0.04 * (k / 4) as f64 + 0.035));
+        let coarse = noisy(turn_log(|_, t| (t / 0.02 + 1e-9).floor() * 0.02));
+        for (log, share) in [(packets, 0.75), (coarse, 0.5)] {
+            let b = classify(&log.rows, RATE_WINDOW_STEPS).unwrap();
+            assert!(b.off_grid_share < BURSTY_SHARE, "{b:?}");
+            assert!((b.repeated_stamp_share - share).abs() < 0.01, "{b:?}");
+            let placed = regularize(&log, &GridOptions::default()).unwrap();
+            assert_eq!(placed.quality.sample_rate_source, "mean_step");
+            assert!(
+                (placed.sample_rate_hz - 100.0).abs() < 1.5,
+                "{}",
+                placed.sample_rate_hz
+            );
+            let span_s = placed.slots.last().unwrap().time_s - placed.slots[0].time_s;
+            let turn_deg = integral_deg(&placed) - 0.5 * span_s;
+            assert!((turn_deg - 90.0).abs() < 1.5, "{turn_deg}");
+        }
+        // A repeated stamp now and then (under 1% of the steps) is not a burst.
+        let rare = turn_log(|k, t| if k == 200 { t - 0.01 } else { t });
+        assert_eq!(classify(&rare.rows, RATE_WINDOW_STEPS), None);
     }
 
     /// A rate the stamps contradict (here 4x) is refused, naming both.

@@ -8,7 +8,8 @@
 //! - an exact copy of the previous row (time and every value) is a *duplicate*: dropped
 //!   (loggers repeat the last row when a sample is lost; the gap after it is filled);
 //! - the same time stamp with different values, or a small step back in time, is kept
-//!   as the next slot and counted; a step back of more than `max_gap_s` is an error;
+//!   as the next slot and counted (when more than 1% of the steps are such, the rows are
+//!   resampled as rows in bursts instead: [`crate::bursts`]); a step back of more than `max_gap_s` is an error;
 //! - a missing or non-finite rate, and the slots of a gap, are filled by linear
 //!   interpolation between their neighbours, counted; a run longer than `max_gap_s` is an
 //!   error naming the line after it; missing slots at the very start or end are trimmed;

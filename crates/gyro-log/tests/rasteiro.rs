@@ -195,3 +195,91 @@ fn a_wrap_during_a_turn_keeps_the_pose_s_own_angle() {
         );
     }
 }
+
+/// The same recordings as other loggers would stamp them: packets of four rows stamped on
+/// the last one's arrival, and stamps rounded to 10 ms (steps of 0, 10 and 20 ms, every
+/// positive one on the grid). Rows sharing a stamp make the log bursty (a row per slot
+/// would stretch time by 18% to 300%), and the angle follows the recording's own to within
+/// 3° (0.1–2.1°), once the shift the coarser stamps make is allowed for (the backlog files
+/// aside: their stall's rows, once stamped alike, no longer show it).
+#[test]
+fn rows_sharing_a_stamp_keep_the_recording_s_angle() {
+    let cumulative = |log: &gyro_log::RegularLog| -> (Vec<f64>, Vec<f64>) {
+        let period_s = 1.0 / log.sample_rate_hz;
+        let mut angle_deg = 0.0;
+        let angles = log
+            .slots
+            .iter()
+            .enumerate()
+            .map(|(k, s)| {
+                if k > 0 {
+                    angle_deg += s.rate_dps * period_s;
+                }
+                angle_deg
+            })
+            .collect();
+        (log.slots.iter().map(|s| s.time_s).collect(), angles)
+    };
+    let at = |(times, angles): &(Vec<f64>, Vec<f64>), t: f64| -> f64 {
+        let k = times.partition_point(|&x| x < t).clamp(1, times.len() - 1);
+        let w = ((t - times[k - 1]) / (times[k] - times[k - 1])).clamp(0.0, 1.0);
+        angles[k - 1] + w * (angles[k] - angles[k - 1])
+    };
+    let mut checked = 0;
+    for path in recordings() {
+        let raw = read_log(&path, &LogOptions::default()).unwrap();
+        let original = gyro_log::regularize(&raw, &GridOptions::default()).unwrap();
+        if original.quality.backlogs > 0 {
+            continue;
+        }
+        let reference = cumulative(&original);
+        let n = raw.rows.len();
+        type Stamp<'a> = Box<dyn Fn(usize, f64) -> f64 + 'a>;
+        let stampings: [(&str, Stamp); 2] = [
+            (
+                "packets of four",
+                Box::new(|k, _| raw.rows[(k / 4 * 4 + 3).min(n - 1)].time_s),
+            ),
+            ("10 ms", Box::new(|_, t| (t / 0.01).round() * 0.01)),
+        ];
+        for (what, stamp) in &stampings {
+            let mut log = raw.clone();
+            for (k, row) in log.rows.iter_mut().enumerate() {
+                row.time_s = stamp(k, row.time_s);
+            }
+            let placed = gyro_log::regularize(&log, &GridOptions::default()).unwrap();
+            let name = format!("{} stamped in {what}", path.display());
+            let b = placed
+                .quality
+                .bursts
+                .unwrap_or_else(|| panic!("{name}: not bursts"));
+            assert!(b.repeated_stamp_share > 0.1, "{name}: {b:?}");
+            let (times, angles) = cumulative(&placed);
+            // Against the recording's angle over the 50 ms around each time (packets hold
+            // rows back by up to three periods, rounding moves them by 5 ms).
+            let worst = times
+                .iter()
+                .zip(&angles)
+                .map(|(&t, &a)| {
+                    let around = [-0.05, -0.025, 0.0, 0.025, 0.05].map(|d| at(&reference, t + d));
+                    let lo = around.iter().copied().fold(f64::INFINITY, f64::min);
+                    let hi = around.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    (lo - a).max(a - hi).max(0.0)
+                })
+                .fold(0.0, f64::max);
+            assert!(worst < 3.0, "{name}: {worst} deg off the recording's angle");
+            // One slot per period of the stamps' span: no time invented.
+            let span_s = log.rows[n - 1].time_s - log.rows[0].time_s;
+            let expected = span_s * placed.sample_rate_hz;
+            assert!(
+                (placed.slots.len() as f64 - expected).abs() < 2.0,
+                "{name}: {} slots, {expected}",
+                placed.slots.len()
+            );
+            checked += 1;
+        }
+    }
+    if checked > 0 {
+        assert!(checked >= 30, "{checked}");
+    }
+}

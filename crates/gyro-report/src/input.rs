@@ -28,11 +28,12 @@ pub fn table(q: &Quality) -> String {
         let _ = writeln!(
             s,
             "  rows arrive in bursts: {:.0}% of steps off the grid of the median step {:.1} ms \
-             (mean {:.2} ms); the integral of the rate was resampled onto the grid, not placed \
-             row by row",
+             (mean {:.2} ms), {:.0}% of steps a repeated stamp; the integral of the rate \
+             was resampled onto the grid, not placed row by row",
             100.0 * b.off_grid_share,
             1e3 * b.median_step_s,
-            1e3 * b.mean_step_s
+            1e3 * b.mean_step_s,
+            100.0 * b.repeated_stamp_share
         );
     }
     let issues: Vec<String> = [
