@@ -26,9 +26,11 @@ pub const MIN_CORRELATION: f64 = 0.5;
 /// The lag of a whole log (s; positive: the gyro lags): the peak of the cross-correlation
 /// of its gyro rate with its reference rate on the grid within ±[`SEARCH_S`], normalised
 /// by the log's length (motion inside the log does not lean it towards longer lags).
-/// `None` without a reference or a peak.
+/// `None` without a reference or a peak, or with the peak on the edge of the search: a
+/// bound, not a measurement (a reference that turns against the gyro puts it there).
 pub fn log_lag_s(log: &RegularLog) -> Option<f64> {
     let r = residuals(log).ok()?;
+    let edge_s = (SEARCH_S * r.sample_rate_hz).round().max(1.0) / r.sample_rate_hz;
     xcorr_peak_lag_within(
         &r.rate_dps,
         &r.reference_rate_dps,
@@ -36,7 +38,7 @@ pub fn log_lag_s(log: &RegularLog) -> Option<f64> {
         SEARCH_S,
         Overlap::Whole,
     )
-    .filter(|lag| lag.is_finite())
+    .filter(|lag| lag.is_finite() && lag.abs() < edge_s * (1.0 - 1e-9))
 }
 
 /// The offset (in lags, within ±½) of the vertex of the parabola through the correlation

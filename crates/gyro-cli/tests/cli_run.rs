@@ -687,3 +687,107 @@ fn a_stalled_link_s_backlog_is_not_counted_twice() {
     assert!((m["angle_deg"].as_f64().unwrap() - 90.0).abs() < 0.5, "{m}");
     assert_eq!(m["verdict"].as_str(), Some("ok"), "{m}");
 }
+
+/// The bench fixture with `column`'s values mapped by `f`.
+fn bench_with(column: &str, f: impl Fn(f64) -> f64) -> String {
+    let text = std::fs::read_to_string(bench_log()).unwrap();
+    let mut out = String::new();
+    let mut index = None;
+    for line in text.lines() {
+        if line.starts_with('#') {
+            out.push_str(line);
+        } else if index.is_none() {
+            index = line.split(',').position(|c| c == column);
+            out.push_str(line);
+        } else {
+            let k = index.unwrap();
+            let fields: Vec<String> = line
+                .split(',')
+                .enumerate()
+                .map(|(i, v)| match (i == k, v.parse::<f64>()) {
+                    (true, Ok(x)) => f(x).to_string(),
+                    _ => v.to_string(),
+                })
+                .collect();
+            out.push_str(&fields.join(","));
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// Everything `gyro-cli ARGS` printed, stdout then stderr.
+fn printed(args: &[&str]) -> String {
+    let out = gyro(args);
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+/// An encoder wired the other way: the reference turns against the gyro. `run` (table and
+/// JSON) and `calibrate` say so, with the correlation of their turns; the log as made
+/// follows the gyro and says nothing of it. A rate in rad/s read as deg/s: the reference
+/// turns 57 times as far, and the warning names `--rate-unit rads`, which removes it.
+#[test]
+fn a_reference_of_the_opposite_sense_is_said() {
+    let dir = temp_dir("opposite-sense");
+    let log = write(&dir, "negated.csv", &bench_with("reference_deg", |v| -v));
+
+    let bench = bench_log();
+    let as_made = json_of(&gyro(&["run", bench.to_str().unwrap(), "--format", "json"]));
+    let c = as_made["input"]["reference_correlation"].as_f64().unwrap();
+    assert!(c > 0.9, "{c}");
+    let gain = as_made["input"]["reference_gain"].as_f64().unwrap();
+    assert!((gain - 1.0).abs() < 0.1, "{gain}");
+    let text = as_made.to_string();
+    assert!(!text.contains("turns against") && !text.contains("times as far"));
+
+    let report = json_of(&gyro(&["run", &log, "--format", "json"]));
+    let c = report["input"]["reference_correlation"].as_f64().unwrap();
+    assert!(c < -0.9, "{c}");
+    let warned = report["input"]["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|w| {
+            w.as_str()
+                .unwrap()
+                .contains("the reference turns against the gyro")
+        });
+    assert!(warned, "{}", report["input"]);
+    let all = printed(&["run", &log]);
+    assert!(
+        all.contains("warning: the reference turns against the gyro"),
+        "{all}"
+    );
+    let model = dir.join("model.json");
+    let all = printed(&["calibrate", &log, "-o", model.to_str().unwrap(), "--force"]);
+    assert!(
+        all.contains("warning: the reference turns against the gyro"),
+        "{all}"
+    );
+
+    let radians = write(
+        &dir,
+        "radians.csv",
+        &bench_with("rate_dps", f64::to_radians),
+    );
+    let all = printed(&["run", &radians]);
+    assert!(
+        all.contains("warning: the reference turns 57.") && all.contains("--rate-unit rads"),
+        "{all}"
+    );
+    let read_right = json_of(&gyro(&[
+        "run",
+        &radians,
+        "--rate-unit",
+        "rads",
+        "--format",
+        "json",
+    ]));
+    let gain = read_right["input"]["reference_gain"].as_f64().unwrap();
+    assert!((gain - 1.0).abs() < 0.1, "{gain}");
+    assert!(!read_right.to_string().contains("times as far"));
+}

@@ -66,6 +66,8 @@ pub(crate) struct ReferenceJumps {
     /// The first few jumps' notes, given to the report at the end (after the placement's
     /// own examples, in the same order however the slots were delivered).
     notes: Vec<(String, u64)>,
+    /// Whether the reference turns the way the gyro does (suspect steps left out).
+    sense: crate::sense::Sense,
 }
 
 impl ReferenceJumps {
@@ -91,12 +93,15 @@ impl ReferenceJumps {
             return;
         };
         let gyro_deg = std::mem::take(&mut self.gyro_since_deg);
-        let mismatch_deg = self
-            .last_raw_deg
-            .map_or(0.0, |last| (raw_deg - last) - gyro_deg);
-        self.last_raw_deg = Some(raw_deg);
+        let last_raw_deg = self.last_raw_deg.replace(raw_deg);
+        let mismatch_deg = last_raw_deg.map_or(0.0, |last| (raw_deg - last) - gyro_deg);
         let suspect =
             mismatch_deg.abs() > SUSPECT_DEG && gyro_deg.abs() < GYRO_SHARE * mismatch_deg.abs();
+        if !suspect {
+            if let Some(last) = last_raw_deg {
+                self.sense.step(slot.time_s, gyro_deg, raw_deg - last);
+            }
+        }
         if suspect && !self.drifting {
             self.held_gyro_deg += gyro_deg;
             self.hold(slot, mismatch_deg, quality, out);
@@ -115,6 +120,9 @@ impl ReferenceJumps {
         for (what, line) in self.notes.drain(..) {
             quality.note(&what, line);
         }
+        quality.reference_correlation = self.sense.correlation();
+        quality.reference_gain = self.sense.gain();
+        quality.warnings.extend(self.sense.warning());
         if quality.reference_jumps > 0 {
             quality.warnings.push(format!(
                 "the reference jumps {} time(s) (largest {:+.1} deg) while the gyro barely turns: a pose that wraps or flips, or a counter that overflows, not motion; each later reference value is re-based by the jump, and over the jump the reference follows the gyro",

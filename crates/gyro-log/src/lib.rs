@@ -26,6 +26,7 @@ pub mod jumps;
 mod load;
 pub mod mcap;
 mod regular;
+pub mod sense;
 pub mod value;
 pub mod whole;
 

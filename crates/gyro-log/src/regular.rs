@@ -112,6 +112,18 @@ pub struct Quality {
     /// Jumps of the reference while the gyro barely turns (a pose that wraps or flips):
     /// the reference after each is re-based ([`crate::jumps`]).
     pub reference_jumps: u64,
+    /// Correlation of the gyro's and the reference's turns over blocks of
+    /// [`crate::sense::BLOCK_S`] (−1 to 1), when the log has a reference and the gyro
+    /// turns: near 1 when the reference follows the gyro; at or below
+    /// [`crate::sense::OPPOSED_CORRELATION`] a reference of the opposite sense, warned of
+    /// ([`crate::sense`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference_correlation: Option<f64>,
+    /// The reference's turn per degree of the gyro's over the same blocks (least squares):
+    /// about 1; beyond a factor of [`crate::sense::GAIN_LIMIT`] either way, units or
+    /// scales that differ, warned of.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference_gain: Option<f64>,
     /// The first few irregular lines: (what, line).
     pub examples: Vec<(String, u64)>,
     /// Set if the rows arrive in bursts: their arrival statistics. The rate's integral was
@@ -1558,6 +1570,9 @@ mod tests {
         }
         let rounded = |log: &RegularLog| {
             let mut log = log.clone();
+            // Sums over the rates: compared below, to rounding.
+            log.quality.reference_correlation = None;
+            log.quality.reference_gain = None;
             for slot in &mut log.slots {
                 slot.rate_dps = 0.0;
                 slot.reference_deg = slot.reference_deg.map(|_| 0.0);
@@ -1568,6 +1583,26 @@ mod tests {
             return Err(format!("{}\n!=\n{}", rounded(a), rounded(b)));
         }
         let close = |x: f64, y: f64| (x - y).abs() <= 1e-8 * (1.0 + y.abs());
+        for (what, x, y) in [
+            (
+                "reference_correlation",
+                a.quality.reference_correlation,
+                b.quality.reference_correlation,
+            ),
+            (
+                "reference_gain",
+                a.quality.reference_gain,
+                b.quality.reference_gain,
+            ),
+        ] {
+            let agree = match (x, y) {
+                (Some(x), Some(y)) => close(x, y),
+                (x, y) => x == y,
+            };
+            if !agree {
+                return Err(format!("{what}: {x:?} != {y:?}"));
+            }
+        }
         for (k, (x, y)) in a.slots.iter().zip(&b.slots).enumerate() {
             if !close(x.rate_dps, y.rate_dps) {
                 return Err(format!("slot {k}: rate {} != {}", x.rate_dps, y.rate_dps));

@@ -283,3 +283,61 @@ fn rows_sharing_a_stamp_keep_the_recording_s_angle() {
         assert!(checked >= 30, "{checked}");
     }
 }
+
+/// The pose follows the gyro on every recording (the correlation of their turns over
+/// 0.5 s blocks 0.89–0.99, the pose's turn per degree of the gyro's 0.77–1.19); negated,
+/// as an encoder wired the other way would give it, it is found turning against the gyro,
+/// and with the rate in rad/s read as deg/s, turning 57 times as far; both are warned of.
+#[test]
+fn a_reference_of_the_opposite_sense_or_other_units_is_warned_of() {
+    for path in recordings() {
+        let name = path.display().to_string();
+        let raw = read_log(&path, &LogOptions::default()).unwrap();
+        let placed = gyro_log::regularize(&raw, &GridOptions::default()).unwrap();
+        let c = placed.quality.reference_correlation.unwrap();
+        assert!(c > 0.85, "{name}: {c}");
+        let gain = placed.quality.reference_gain.unwrap();
+        assert!((0.7..1.3).contains(&gain), "{name}: {gain}");
+        assert!(
+            !placed
+                .quality
+                .warnings
+                .iter()
+                .any(|w| w.contains("against") || w.contains("times as far")),
+            "{name}"
+        );
+        // The rate in rad/s, read as deg/s.
+        let mut radians = raw.clone();
+        for row in &mut radians.rows {
+            row.rate_dps = row.rate_dps.map(f64::to_radians);
+        }
+        let placed = gyro_log::regularize(&radians, &GridOptions::default()).unwrap();
+        let gain = placed.quality.reference_gain.unwrap();
+        assert!((40.0..80.0).contains(&gain), "{name} in rad/s: {gain}");
+        assert!(
+            placed
+                .quality
+                .warnings
+                .iter()
+                .any(|w| w.contains("--rate-unit rads")),
+            "{name} in rad/s: {:?}",
+            placed.quality.warnings
+        );
+        let mut negated = raw.clone();
+        for row in &mut negated.rows {
+            row.reference_deg = row.reference_deg.map(|r| -r);
+        }
+        let placed = gyro_log::regularize(&negated, &GridOptions::default()).unwrap();
+        let c = placed.quality.reference_correlation.unwrap();
+        assert!(c < -0.85, "{name} negated: {c}");
+        assert!(
+            placed
+                .quality
+                .warnings
+                .iter()
+                .any(|w| w.contains("the reference turns against the gyro")),
+            "{name} negated: {:?}",
+            placed.quality.warnings
+        );
+    }
+}
