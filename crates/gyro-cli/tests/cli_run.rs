@@ -791,3 +791,29 @@ fn a_reference_of_the_opposite_sense_is_said() {
     assert!((gain - 1.0).abs() < 0.1, "{gain}");
     assert!(!read_right.to_string().contains("times as far"));
 }
+
+/// The 1 kHz bench fixture stamped by a 64 Hz PC timer (15.625 ms ticks: 15 or 16 rows
+/// share each stamp). Placed a row per slot it would take 16 times its time; resampled as
+/// rows in bursts, every movement keeps its angle, and the report says what was done.
+#[test]
+fn rows_stamped_by_a_coarse_timer_keep_their_angles() {
+    let dir = temp_dir("coarse-timer");
+    let log = write(
+        &dir,
+        "timer.csv",
+        &bench_with("time_s", |t| (t / 0.015625).floor() * 0.015625),
+    );
+    let table = printed(&["run", &log]);
+    assert!(table.contains("% of steps a repeated stamp"), "{table}");
+    let report = json_of(&gyro(&["run", &log, "--format", "json"]));
+    let share = report["input"]["bursts"]["repeated_stamp_share"]
+        .as_f64()
+        .unwrap();
+    assert!(share > 0.9, "{share}");
+    let movements = report["movements"].as_array().unwrap();
+    assert_eq!(movements.len(), 6, "{}", report["movements"]);
+    for m in movements {
+        let error = m["error_deg"].as_f64().unwrap();
+        assert!(error.abs() < 0.1, "{m}");
+    }
+}
