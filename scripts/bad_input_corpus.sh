@@ -74,6 +74,8 @@ data 50 >in/no_header.csv
 { printf '# operator: Jos\xe9\n'; echo "$hdr"; data 3000; } >in/latin1_comment.csv
 { printf '\xef\xbb\xbf'; echo "$hdr"; data 3000; } >in/bom.csv
 { echo "$hdr"; data 3000 | sed 's/$/\r/'; } >in/crlf.csv
+{ echo "$hdr"; data 100; } | tr ',' '\t' >in/tab_separated.csv
+{ echo "$hdr"; data 100; } | sed 's/,/;/g; s/\./,/g' >in/semicolon_separated.csv
 iconv -f UTF-8 -t UTF-16 in/good.csv >in/utf16.csv 2>/dev/null || printf '\xff\xfet\x00i\x00' >in/utf16.csv
 dd if="$ROOT/fixtures/mcap/ros2_imu.mcap" bs=1 skip=3000 count=4096 status=none >in/binary.csv
 head -c 4096 /dev/zero >in/nul_bytes.csv
@@ -125,7 +127,7 @@ for f in empty header_only no_header no_rate_column no_time_column two_rate_colu
     not_a_number short_row long_row nan_time inf_time huge_time time_backwards long_gap \
     no_rates one_row meta_rate_negative meta_rate_zero meta_rate_nan meta_rate_word \
     meta_rate_unit meta_rate_twice meta_rate_wrong meta_rate_1e9 utf16 binary nul_bytes \
-    million_char_line; do
+    million_char_line tab_separated semicolon_separated; do
     c "run $f.csv" refuse "$f.csv" "\$G run in/$f.csv"
 done
 for f in empty no_rate_column not_a_number meta_rate_wrong utf16 binary rates_1e300; do

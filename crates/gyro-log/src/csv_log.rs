@@ -304,6 +304,25 @@ impl CsvRows {
             .iter()
             .map(|h| String::from_utf8_lossy(h).trim().to_string())
             .collect();
+        // One field holding tabs or semicolons: another separator, not a missing column.
+        if let [only] = names.as_slice() {
+            let separator = [
+                ('\t', "tabs", r"tr '\t' ','"),
+                (';', "semicolons", "sed 's/,/./g; s/;/,/g'"),
+            ]
+            .into_iter()
+            .find(|(c, _, _)| only.contains(*c));
+            if let Some((_, what, fix)) = separator {
+                return Err(LogError::Csv {
+                    path: path.to_path_buf(),
+                    line: header_line,
+                    message: format!(
+                        "the header is separated by {what}, not commas (`{}`): a log must be comma-separated with `.` as the decimal point (for example `{fix}`)",
+                        excerpt(only.as_bytes())
+                    ),
+                });
+            }
+        }
         // Two columns of one name: which one is meant cannot be known.
         for (i, name) in names.iter().enumerate() {
             if let Some(j) = names[..i].iter().position(|n| !n.is_empty() && n == name) {
@@ -1082,6 +1101,25 @@ mod tests {
             .to_string();
         assert!(err.contains("nocol.csv:1: no column `rate_dps`"), "{err}");
         assert!(err.contains("time_s, gyro"), "{err}");
+
+        // Other separators are named, with a way to convert.
+        let path = write_temp("tabs.tsv", "# a: b\ntime_s\trate_dps\n0.0\t1.0\n");
+        let err = read_csv(&path, &ColumnOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("tabs.tsv:2: the header is separated by tabs, not commas"),
+            "{err}"
+        );
+        let path = write_temp("semicolons.csv", "time_s;rate_dps\n0,0;1,5\n");
+        let err = read_csv(&path, &ColumnOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("semicolons.csv:1: the header is separated by semicolons")
+                && err.contains("s/;/,/g"),
+            "{err}"
+        );
 
         let path = write_temp("ragged.csv", "time_s,rate_dps\n0.0,1.0\n0.001,1.0,7\n");
         let err = read_csv(&path, &ColumnOptions::default())
