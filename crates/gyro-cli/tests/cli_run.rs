@@ -605,7 +605,8 @@ fn a_lagging_reference_is_measured_and_said() {
 }
 
 /// Verdicts without a σ (any compensation but the Kalman form) are said to be unguarded
-/// in every output; with the Kalman form they are not.
+/// in every output; with the Kalman form they are not, and without a scale uncertainty
+/// every output says the guard band leaves the scale error out.
 #[test]
 fn verdicts_without_a_sigma_are_said_to_be_unguarded() {
     let bench = bench_log();
@@ -633,9 +634,30 @@ fn verdicts_without_a_sigma_are_said_to_be_unguarded() {
         table.contains("guard band is only the scale term (1% of the angle)"),
         "{table}"
     );
-    let mut args = vec!["run", log, "--format", "json"];
+    // The Kalman form with a scale uncertainty: guarded, nothing to say.
+    let mut args = vec!["run", log, "--format", "json", "--scale-sigma", "0.001"];
     args.extend(window);
     assert!(json_of(&gyro(&args)).get("warnings").is_none());
+    // Without one, the guard band does not hold the scale error, and every output says so.
+    let mut args = vec!["run", log, "--format", "json"];
+    args.extend(window);
+    let report = json_of(&gyro(&args));
+    let warnings = report["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0]
+            .as_str()
+            .unwrap()
+            .contains("not the gyro's scale error"),
+        "{warnings:?}"
+    );
+    let mut args = vec!["run", log];
+    args.extend(window);
+    let table = String::from_utf8_lossy(&gyro(&args).stdout).to_string();
+    assert!(
+        table.contains("warning: the guard band holds the bias"),
+        "{table}"
+    );
 }
 
 /// A 100 Hz log whose PC stalls for 0.2 s at the peak of a 90° turn and then reads the

@@ -161,7 +161,10 @@ pub fn table(file: &str, report: &RunReport) -> String {
                 count(Verdict::Invalid),
                 other_way
             );
-            if let Some(warning) = unguarded_warning(report) {
+            for warning in unguarded_warning(report)
+                .into_iter()
+                .chain(scale_warning(report))
+            {
                 let _ = writeln!(s, "warning: {warning}");
             }
         }
@@ -201,6 +204,7 @@ pub fn table(file: &str, report: &RunReport) -> String {
 pub fn warnings(report: &RunReport) -> Vec<String> {
     unguarded_warning(report)
         .into_iter()
+        .chain(scale_warning(report))
         .chain(lag_warning(report))
         .collect()
 }
@@ -225,6 +229,16 @@ pub fn unguarded_warning(report: &RunReport) -> Option<String> {
             "zero".to_string()
         }
     ))
+}
+
+/// The warning for tightening verdicts without a scale uncertainty: σ holds the bias and
+/// the noise, not the scale factor, which on an uncalibrated MEMS gyro is off by 0.5–2%
+/// (1–3° on a 150° turn, the rasteiro recordings), far beyond σ (0.03–0.25° there).
+pub fn scale_warning(report: &RunReport) -> Option<String> {
+    let t = report.config.tightening.as_ref()?;
+    (t.scale_sigma == 0.0).then(|| {
+        "the guard band holds the bias and the noise (σ), not the gyro's scale error: uncalibrated, a MEMS gyro's scale is off by 0.5-2% (1-3 deg on a 150 deg turn), far beyond σ; give --scale-sigma (a datasheet's tolerance, e.g. 0.02) or a model from `calibrate` (its scale_sigma)".to_string()
+    })
 }
 
 /// The warning for a gyro that lags (or leads) the reference it is scored against by at
