@@ -781,13 +781,13 @@ fn a_reference_of_the_opposite_sense_is_said() {
     assert!(warned, "{}", report["input"]);
     let all = printed(&["run", &log]);
     assert!(
-        all.contains("warning: the reference turns against the gyro"),
+        all.contains("negated.csv: the reference turns against the gyro"),
         "{all}"
     );
     let model = dir.join("model.json");
     let all = printed(&["calibrate", &log, "-o", model.to_str().unwrap(), "--force"]);
     assert!(
-        all.contains("warning: the reference turns against the gyro"),
+        all.contains("negated.csv: the reference turns against the gyro"),
         "{all}"
     );
 
@@ -798,7 +798,7 @@ fn a_reference_of_the_opposite_sense_is_said() {
     );
     let all = printed(&["run", &radians]);
     assert!(
-        all.contains("warning: the reference turns 57.") && all.contains("--rate-unit rads"),
+        all.contains("radians.csv: the reference turns 57.") && all.contains("--rate-unit rads"),
         "{all}"
     );
     let read_right = json_of(&gyro(&[

@@ -330,3 +330,70 @@ fn bad_input_is_refused_with_a_clear_message() {
         "missing.csv",
     );
 }
+
+/// Runs whose reference counts the other way (an encoder wired in reverse): the diagnosis
+/// leads with it, in the table's headline and the JSON's `reference_warnings`, since every
+/// effect it fits against such a reference measures the mismatch.
+#[test]
+fn a_reference_of_the_opposite_sense_leads_the_diagnosis() {
+    let dir = temp_dir("diagnose_opposite");
+    let negate = |paths: Vec<String>, prefix: &str| -> Vec<String> {
+        paths
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let mut column = None;
+                let mut out = String::new();
+                for line in std::fs::read_to_string(p).unwrap().lines() {
+                    if line.starts_with('#') {
+                        out.push_str(line);
+                    } else if column.is_none() {
+                        column = line.split(',').position(|c| c == "reference_deg");
+                        out.push_str(line);
+                    } else {
+                        let k = column.unwrap();
+                        let fields: Vec<String> = line
+                            .split(',')
+                            .enumerate()
+                            .map(|(j, v)| match (j == k, v.parse::<f64>()) {
+                                (true, Ok(x)) => (-x).to_string(),
+                                _ => v.to_string(),
+                            })
+                            .collect();
+                        out.push_str(&fields.join(","));
+                    }
+                    out.push('\n');
+                }
+                write(&dir, &format!("{prefix}{i}.csv"), &out)
+            })
+            .collect()
+    };
+    let train = negate(runs(&dir, "train", 3, &[], 400), "negated_train");
+    let holdout = negate(runs(&dir, "hold", 2, &[], 500), "negated_hold");
+    let mut args = vec![
+        "diagnose",
+        "--members",
+        "8",
+        "--candidate-members",
+        "4",
+        "--train",
+    ];
+    args.extend(train.iter().map(String::as_str));
+    args.push("--holdout");
+    args.extend(holdout.iter().map(String::as_str));
+    let table = ok(&gyro(&args));
+    let headline: Vec<&str> = table
+        .lines()
+        .skip_while(|l| !l.starts_with("diagnosis"))
+        .collect();
+    assert!(
+        headline.get(1).is_some_and(
+            |l| l.contains("warning: on 5 of 5 runs the reference turns against the gyro")
+        ),
+        "{table}"
+    );
+    args.extend(["--format", "json"]);
+    let d = json_of(&gyro(&args));
+    let first = d["reference_warnings"][0].as_str().unwrap();
+    assert!(first.contains("turns against the gyro"), "{first}");
+}

@@ -115,18 +115,29 @@ impl ReferenceJumps {
 
     /// The end of the slots: the held stretch decided and handed on, and the warning if
     /// there was any jump.
-    pub(crate) fn finish(&mut self, quality: &mut Quality, out: &mut dyn FnMut(Slot)) {
+    pub(crate) fn finish(
+        &mut self,
+        path: &std::path::Path,
+        quality: &mut Quality,
+        out: &mut dyn FnMut(Slot),
+    ) {
         self.release(quality, out);
         for (what, line) in self.notes.drain(..) {
             quality.note(&what, line);
         }
         quality.reference_correlation = self.sense.correlation();
         quality.reference_gain = self.sense.gain();
-        quality.warnings.extend(self.sense.warning());
+        quality.warnings.extend(
+            self.sense
+                .warning()
+                .map(|w| format!("{}: {w}", path.display())),
+        );
         if quality.reference_jumps > 0 {
             quality.warnings.push(format!(
-                "the reference jumps {} time(s) (largest {:+.1} deg) while the gyro barely turns: a pose that wraps or flips, or a counter that overflows, not motion; each later reference value is re-based by the jump, and over the jump the reference follows the gyro",
-                quality.reference_jumps, self.largest_deg
+                "{}: the reference jumps {} time(s) (largest {:+.1} deg) while the gyro barely turns: a pose that wraps or flips, or a counter that overflows, not motion; each later reference value is re-based by the jump, and over the jump the reference follows the gyro",
+                path.display(),
+                quality.reference_jumps,
+                self.largest_deg
             ));
         }
     }
@@ -214,7 +225,9 @@ mod tests {
         for (k, &(rate, reference)) in slots.iter().enumerate() {
             j.push(slot(k, rate, reference), &mut q, &mut |s| out.push(s));
         }
-        j.finish(&mut q, &mut |s| out.push(s));
+        j.finish(std::path::Path::new("jumps.csv"), &mut q, &mut |s| {
+            out.push(s)
+        });
         assert_eq!(out.len(), slots.len(), "every slot once");
         assert!(
             out.iter().enumerate().all(|(k, s)| s.line == k as u64 + 2),

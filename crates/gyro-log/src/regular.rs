@@ -880,7 +880,8 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
             + self.resampler.as_ref().map_or(0, Resampler::trimmed_rows);
         self.deliver(true);
         let sink = &mut self.sink;
-        self.jumps.finish(&mut self.quality, &mut |s| sink.slot(&s));
+        self.jumps
+            .finish(self.path, &mut self.quality, &mut |s| sink.slot(&s));
         let mut quality = self.quality;
         let first_time_s = self.first_time_s.unwrap_or(self.last_time_s);
         let span_s = self.last_time_s - first_time_s;
@@ -1230,7 +1231,7 @@ mod tests {
                 for slot in slots {
                     jumps.push(slot, &mut quality, &mut |s| rebased.push(s));
                 }
-                jumps.finish(&mut quality, &mut |s| rebased.push(s));
+                jumps.finish(&log.path, &mut quality, &mut |s| rebased.push(s));
                 slots = rebased;
             }
             if log.has_temperature {

@@ -132,6 +132,11 @@ pub struct Diagnosis {
     pub runs: Vec<RunSummary>,
     /// Angle error with the correctable effects compensated, if any were selected.
     pub compensation: Option<CompensationSummary>,
+    /// What makes the whole diagnosis meaningless, one sentence each: a reference that
+    /// turns against the gyro, or by more than a factor of two, on some runs
+    /// ([`gyro_log::sense`]); left out when empty. The headline leads with them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub reference_warnings: Vec<String>,
     /// What makes part of the diagnosis unreliable, one sentence each (e.g. a gyro–reference
     /// lag beyond the cross-correlation's search); left out when empty.
     #[serde(skip_serializing_if = "Vec::is_empty")]

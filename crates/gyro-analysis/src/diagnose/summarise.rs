@@ -212,6 +212,7 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         },
         runs,
         compensation: f.compensation,
+        reference_warnings: sense_warnings(f.runs),
         warnings: lag_warnings(f.runs),
         effective_noise: super::effective::EffectiveNoise::measure(
             &f.runs.train,
@@ -230,6 +231,56 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         corrected_model: f.corrected_model,
         selected_sensor: f.selected_sensor,
     }
+}
+
+/// A warning when the reference of some runs turns against the gyro, or by more than a
+/// factor of [`gyro_log::sense::GAIN_LIMIT`] ([`gyro_log::sense`]): every statistic of
+/// gyro against reference then measures the mismatch, not the sensor.
+fn sense_warnings(runs: &Runs) -> Vec<String> {
+    let all: Vec<&RealRun> = runs.train.iter().chain(&runs.holdout).copied().collect();
+    let measured = |r: &&RealRun| {
+        let q = &r.log.quality;
+        q.reference_correlation.zip(q.reference_gain)
+    };
+    let opposed: Vec<f64> = all
+        .iter()
+        .filter_map(measured)
+        .map(|(c, _)| c)
+        .filter(|c| *c <= gyro_log::sense::OPPOSED_CORRELATION)
+        .collect();
+    let limit = gyro_log::sense::GAIN_LIMIT;
+    let scaled: Vec<f64> = all
+        .iter()
+        .filter_map(measured)
+        .filter(|(c, g)| {
+            *c >= -gyro_log::sense::OPPOSED_CORRELATION && !(1.0 / limit..=limit).contains(g)
+        })
+        .map(|(_, g)| g)
+        .collect();
+    let range = |v: &[f64], digits: usize| {
+        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        format!("{lo:.digits$} to {hi:.digits$}")
+    };
+    let mut out = Vec::new();
+    if !opposed.is_empty() {
+        out.push(format!(
+            "on {} of {} runs the reference turns against the gyro (correlation of their turns over {} s: {}): one of them counts the other way, and every effect fitted or checked against it measures that, not the sensor; negate one of them",
+            opposed.len(),
+            all.len(),
+            gyro_log::sense::BLOCK_S,
+            range(&opposed, 2)
+        ));
+    }
+    if !scaled.is_empty() {
+        out.push(format!(
+            "on {} of {} runs the reference turns {} times as far as the gyro: their units or scales differ (a rate in rad/s read as deg/s makes 57.3: --rate-unit rads), and every effect fitted or checked against it measures that, not the sensor",
+            scaled.len(),
+            all.len(),
+            range(&scaled, 3)
+        ));
+    }
+    out
 }
 
 /// A warning when the gyro–reference lag of some runs lies beyond the cross-correlation's

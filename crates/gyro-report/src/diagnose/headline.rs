@@ -139,23 +139,26 @@ pub fn sentence(e: &EffectResult) -> String {
     }
 }
 
-/// The headline: one line per named effect (in the order named), then what the written
-/// model corrects and what it does to the held-out angle error; or that nothing is named.
+/// The headline: a reference that does not measure the gyro's motion first (it makes the
+/// rest meaningless), then one line per named effect (in the order named), then what the
+/// written model corrects and what it does to the held-out angle error; or that nothing is
+/// named.
 pub fn headline(d: &Diagnosis) -> Vec<String> {
     let mut lines: Vec<String> = d
-        .effects
+        .reference_warnings
         .iter()
-        .filter(|e| e.significant)
-        .map(|e| {
-            format!(
-                "{}: {} (evidence on the held-out runs {})",
-                e.id,
-                sentence(e),
-                evidence(e.delta_bic)
-            )
-        })
+        .map(|w| format!("warning: {w}"))
         .collect();
-    if lines.is_empty() {
+    let leading = lines.len();
+    lines.extend(d.effects.iter().filter(|e| e.significant).map(|e| {
+        format!(
+            "{}: {} (evidence on the held-out runs {})",
+            e.id,
+            sentence(e),
+            evidence(e.delta_bic)
+        )
+    }));
+    if lines.len() == leading {
         lines.push("no effect of the vocabulary is named: the nominal model holds on these runs, or what differs is not in the vocabulary (see the where-statistics)".into());
     }
     lines.extend(turn_lines(d));

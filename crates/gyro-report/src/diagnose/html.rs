@@ -1324,6 +1324,7 @@ mod tests {
                     max_abs_error_after_deg: 0.2,
                 }],
             }),
+            reference_warnings: Vec::new(),
             warnings: Vec::new(),
             effective_noise: Default::default(),
             motion_lines: Vec::new(),
