@@ -27,8 +27,15 @@ A rest-to-rest span also holds what the other axes' turns leak into this axis, w
 nominal truth leaves out: where a slow leak (under 1 °/s) sits next to a rest, the two
 estimators differ by up to 1° for that reason alone.
 
-Usage: python3 scripts/rasteiro_more.py DATASET_DIR [--gyro target/release/gyro-cli]
-(DATASET_DIR: the clone's root, holding DataSets/). Needs numpy, pandas and scipy.
+Then, calibrated on the bundled recordings and held out on the speeds they do not have:
+per sensor that is bundled (MPU6050, MPU6500) and axis, `gyro-cli calibrate --objective
+movement-rms` on its three bundled speeds, and `gyro-cli run --model` on V_500, V1000 and
+eV50p; beside it the plain estimator with the scale of a least-squares line of its own turn
+errors on the same bundled recordings (scripts/rasteiro_calibrated.py's plain line).
+
+Usage: python3 scripts/rasteiro_more.py DATASET_DIR [BUNDLED_DIR] [--gyro target/release/gyro-cli]
+(DATASET_DIR: the clone's root, holding DataSets/; BUNDLED_DIR: default
+../shared/data/real/rasteiro). Needs numpy, pandas and scipy.
 """
 import os
 import subprocess
@@ -40,8 +47,13 @@ import numpy as np
 import pandas as pd
 import scipy.io as sio
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from rasteiro_calibrated import calibrate, plain_scale  # noqa: E402
+from rasteiro_turns import turns  # noqa: E402
+
 SENSORS = ["MPU6050RM3100", "MPU6500RM3100", "MPU9150", "LSM9DS0"]
 SPEEDS = ["V_300", "V_500", "V_800", "V1000", "V1500", "eV50p"]
+BUNDLED_SPEEDS = ["V_300", "V_800", "V1500"]
 IN_RADIANS = {"LSM9DS0"}
 MAGNITUDES_DEG = np.array([135.0, 150.0, 180.0, 270.0])
 MIN_TURN_DEG = 100.0
@@ -96,11 +108,12 @@ def plain(t, w, rest, t0, t1):
     return np.sum(0.5 * (sw[1:] + sw[:-1]) * np.diff(st)) - bias * (st[-1] - st[0])
 
 
-def run_series(gyro, t, w_logged, radians):
+def run_series(gyro, t, w_logged, radians, model=None):
     with tempfile.TemporaryDirectory() as tmp:
         path, out = os.path.join(tmp, "axis.csv"), os.path.join(tmp, "series.csv")
         pd.DataFrame({"time_s": t, "rate_dps": w_logged}).to_csv(path, index=False, float_format="%.9g")
         args = [gyro, "run", path, "--out", out] + (["--rate-unit", "rads"] if radians else [])
+        args += ["--model", model] if model else []
         subprocess.run(args, check=True, capture_output=True)
         s = pd.read_csv(out, comment="#")
     return s["time_s"].to_numpy(), s["angle_deg"].to_numpy()
@@ -111,8 +124,22 @@ def main():
     if not args:
         sys.exit(__doc__)
     root = os.path.join(args[0], "DataSets")
+    bundled = args[1] if len(args) > 1 else os.path.join(os.path.dirname(__file__), "../../shared/data/real/rasteiro")
     gyro = sys.argv[sys.argv.index("--gyro") + 1] if "--gyro" in sys.argv else "target/release/gyro-cli"
-    rows = []
+    tmp = tempfile.TemporaryDirectory()
+    # Per bundled sensor and axis: the model calibrated on its bundled speeds, and the
+    # plain line's scale from the same recordings.
+    models = {}
+    for sensor in SENSORS:
+        for axis in "xyz":
+            train = [os.path.join(bundled, f"rasteiro_{sensor}_{speed}_{axis}.csv") for speed in BUNDLED_SPEEDS]
+            if not all(os.path.exists(p) for p in train):
+                continue
+            model = os.path.join(tmp.name, f"{sensor}_{axis}.json")
+            calibrate(gyro, train, model)
+            k_plain = plain_scale([f for p in train for f in turns(p, gyro)])
+            models[(sensor, axis)] = (model, k_plain)
+    rows, held = [], []
     for sensor in SENSORS:
         for speed in SPEEDS:
             path = os.path.join(root, speed, "Sequencia1", sensor + ".mat")
@@ -124,6 +151,9 @@ def main():
                 logged = g[axis]
                 w = np.degrees(logged) if radians else logged
                 st, sa = run_series(gyro, t, logged, radians)
+                calibrated = models.get((sensor, "xyz"[axis])) if speed not in BUNDLED_SPEEDS else None
+                if calibrated:
+                    mt, ma = run_series(gyro, t, logged, radians, calibrated[0])
                 found = rests(t, w)
                 for before, after in zip(found, found[1:]):
                     t0 = 0.5 * (t[before[0]] + t[before[1]])
@@ -134,6 +164,9 @@ def main():
                     truth = np.sign(p) * MAGNITUDES_DEG[np.argmin(np.abs(MAGNITUDES_DEG - abs(p)))]
                     r = np.interp(t1, st, sa) - np.interp(t0, st, sa)
                     rows.append((sensor, speed, "xyz"[axis], truth, p - truth, r - truth))
+                    if calibrated:
+                        m = np.interp(t1, mt, ma) - np.interp(t0, mt, ma)
+                        held.append((sensor, speed, p - truth, p / (1.0 + calibrated[1]) - truth, r - truth, m - truth))
     df = pd.DataFrame(rows, columns=["sensor", "speed", "axis", "truth", "plain", "run"])
     print(f"{'sensor':<14} {'speed':<6} {'turns':>5}  {'plain med':>9} {'p90':>6}  {'run med':>8} {'p90':>6}  run/plain")
 
@@ -153,6 +186,27 @@ def main():
         g = df[df.sensor == sensor]
         if len(g):
             line(sensor, "all", g)
+    if not held:
+        return
+    print()
+    print("calibrated on the bundled speeds (V_300, V_800, V1500), held out on the others")
+    h = pd.DataFrame(held, columns=["sensor", "speed", "plain", "plain_scaled", "run", "model"])
+    cols = ["plain", "plain_scaled", "run", "model"]
+    print(f"{'sensor':<14} {'speed':<6} {'turns':>5}  {'plain':>13}  {'plain+scale':>13}  {'run':>13}  {'run --model':>13}  model / plain+scale")
+
+    def held_line(sensor, speed, g):
+        a = g[cols].abs()
+        cells = "  ".join(f"{a[c].median():5.2f} ({a[c].quantile(0.9):5.2f})" for c in cols)
+        print(f"{sensor:<14} {speed:<6} {len(g):>5}  {cells}  {a['model'].median() / a['plain_scaled'].median():>9.2f}")
+
+    for sensor in SENSORS:
+        for speed in SPEEDS:
+            g = h[(h.sensor == sensor) & (h.speed == speed)]
+            if len(g):
+                held_line(sensor, speed, g)
+        g = h[h.sensor == sensor]
+        if len(g):
+            held_line(sensor, "all", g)
 
 
 if __name__ == "__main__":
