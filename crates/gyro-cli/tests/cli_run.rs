@@ -2,7 +2,7 @@
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 mod common;
-use common::{bench_log, gyro, json_of, temp_dir, write};
+use common::{bench_log, gyro, json_of, map_column, temp_dir, write};
 
 #[test]
 fn bench_fixture_json_contract_and_accuracy_by_mode() {
@@ -712,30 +712,7 @@ fn a_stalled_link_s_backlog_is_not_counted_twice() {
 
 /// The bench fixture with `column`'s values mapped by `f`.
 fn bench_with(column: &str, f: impl Fn(f64) -> f64) -> String {
-    let text = std::fs::read_to_string(bench_log()).unwrap();
-    let mut out = String::new();
-    let mut index = None;
-    for line in text.lines() {
-        if line.starts_with('#') {
-            out.push_str(line);
-        } else if index.is_none() {
-            index = line.split(',').position(|c| c == column);
-            out.push_str(line);
-        } else {
-            let k = index.unwrap();
-            let fields: Vec<String> = line
-                .split(',')
-                .enumerate()
-                .map(|(i, v)| match (i == k, v.parse::<f64>()) {
-                    (true, Ok(x)) => f(x).to_string(),
-                    _ => v.to_string(),
-                })
-                .collect();
-            out.push_str(&fields.join(","));
-        }
-        out.push('\n');
-    }
-    out
+    map_column(&std::fs::read_to_string(bench_log()).unwrap(), column, f)
 }
 
 /// Everything `gyro-cli ARGS` printed, stdout then stderr.

@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 mod common;
-use common::{gyro, json_of, ok, temp_dir, write};
+use common::{gyro, json_of, map_column, ok, temp_dir, write};
 
 use gyro_log as log;
 use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
@@ -342,29 +342,9 @@ fn a_reference_of_the_opposite_sense_leads_the_diagnosis() {
             .iter()
             .enumerate()
             .map(|(i, p)| {
-                let mut column = None;
-                let mut out = String::new();
-                for line in std::fs::read_to_string(p).unwrap().lines() {
-                    if line.starts_with('#') {
-                        out.push_str(line);
-                    } else if column.is_none() {
-                        column = line.split(',').position(|c| c == "reference_deg");
-                        out.push_str(line);
-                    } else {
-                        let k = column.unwrap();
-                        let fields: Vec<String> = line
-                            .split(',')
-                            .enumerate()
-                            .map(|(j, v)| match (j == k, v.parse::<f64>()) {
-                                (true, Ok(x)) => (-x).to_string(),
-                                _ => v.to_string(),
-                            })
-                            .collect();
-                        out.push_str(&fields.join(","));
-                    }
-                    out.push('\n');
-                }
-                write(&dir, &format!("{prefix}{i}.csv"), &out)
+                let text = std::fs::read_to_string(p).unwrap();
+                let negated = map_column(&text, "reference_deg", |x| -x);
+                write(&dir, &format!("{prefix}{i}.csv"), &negated)
             })
             .collect()
     };

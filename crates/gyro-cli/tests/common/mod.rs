@@ -91,3 +91,31 @@ pub fn ok(out: &Output) -> String {
 pub fn json_of(out: &Output) -> serde_json::Value {
     serde_json::from_str(&ok(out)).expect("valid JSON on stdout")
 }
+
+/// The CSV `text` with the values of `column` mapped by `f` (metadata, header and other
+/// fields as they are; a field that is not a number is kept).
+pub fn map_column(text: &str, column: &str, f: impl Fn(f64) -> f64) -> String {
+    let mut out = String::new();
+    let mut index = None;
+    for line in text.lines() {
+        if line.starts_with('#') {
+            out.push_str(line);
+        } else if index.is_none() {
+            index = line.split(',').position(|c| c == column);
+            out.push_str(line);
+        } else {
+            let k = index.unwrap();
+            let fields: Vec<String> = line
+                .split(',')
+                .enumerate()
+                .map(|(i, v)| match (i == k, v.parse::<f64>()) {
+                    (true, Ok(x)) => f(x).to_string(),
+                    _ => v.to_string(),
+                })
+                .collect();
+            out.push_str(&fields.join(","));
+        }
+        out.push('\n');
+    }
+    out
+}
