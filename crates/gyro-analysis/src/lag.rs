@@ -7,7 +7,7 @@
 //! path, then looks like a bad sensor. `run` measures the lag on every log with a
 //! reference and says so when it is at least [`NOTABLE_S`].
 
-use crate::diagnose::stats::{residuals, xcorr_peak_lag_within, Overlap};
+use crate::diagnose::stats::{is_at_edge_of, residuals, xcorr_peak_lag_within, Overlap};
 use gyro_log::RegularLog;
 use std::collections::VecDeque;
 
@@ -30,7 +30,6 @@ pub const MIN_CORRELATION: f64 = 0.5;
 /// bound, not a measurement (a reference that turns against the gyro puts it there).
 pub fn log_lag_s(log: &RegularLog) -> Option<f64> {
     let r = residuals(log).ok()?;
-    let edge_s = (SEARCH_S * r.sample_rate_hz).round().max(1.0) / r.sample_rate_hz;
     xcorr_peak_lag_within(
         &r.rate_dps,
         &r.reference_rate_dps,
@@ -38,7 +37,7 @@ pub fn log_lag_s(log: &RegularLog) -> Option<f64> {
         SEARCH_S,
         Overlap::Whole,
     )
-    .filter(|lag| lag.is_finite() && lag.abs() < edge_s * (1.0 - 1e-9))
+    .filter(|lag| lag.is_finite() && !is_at_edge_of(*lag, r.sample_rate_hz, SEARCH_S))
 }
 
 /// The offset (in lags, within ±½) of the vertex of the parabola through the correlation

@@ -31,6 +31,30 @@ pub const OPPOSED_CORRELATION: f64 = -0.5;
 /// inverse, is warned of.
 pub const GAIN_LIMIT: f64 = 2.0;
 
+/// How a reference fails to measure the gyro's motion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mismatch {
+    /// It turns against the gyro: correlation at or below [`OPPOSED_CORRELATION`].
+    Opposed,
+    /// It turns with the gyro, by more than [`GAIN_LIMIT`] times as far or less than its
+    /// inverse.
+    Scaled,
+}
+
+/// The mismatch that a log's `reference_correlation` and `reference_gain` show, if any
+/// (the one rule [`Sense`]'s warning and every summary of many logs follow).
+pub fn mismatch(correlation: f64, gain: f64) -> Option<Mismatch> {
+    if correlation <= OPPOSED_CORRELATION {
+        Some(Mismatch::Opposed)
+    } else if correlation >= -OPPOSED_CORRELATION
+        && !(1.0 / GAIN_LIMIT..=GAIN_LIMIT).contains(&gain)
+    {
+        Some(Mismatch::Scaled)
+    } else {
+        None
+    }
+}
+
 /// Running sums of the blocks' turns.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Sense {
@@ -86,18 +110,15 @@ impl Sense {
     /// The warning for a reference that turns against the gyro, or by a different
     /// amount, if it does.
     pub(crate) fn warning(&self) -> Option<String> {
-        let c = self.correlation()?;
-        if c <= OPPOSED_CORRELATION {
-            return Some(format!(
+        let (c, gain) = self.correlation().zip(self.gain())?;
+        Some(match mismatch(c, gain)? {
+            Mismatch::Opposed => format!(
                 "the reference turns against the gyro (correlation of their turns over {BLOCK_S} s: {c:.2}): one of them counts the other way (an encoder or axis of the opposite sense, a board mounted upside down), so every error against it is the motion twice over and every fit to it is meaningless; negate one of them"
-            ));
-        }
-        let gain = self.gain().filter(|g| {
-            c >= -OPPOSED_CORRELATION && !(1.0 / GAIN_LIMIT..=GAIN_LIMIT).contains(g)
-        })?;
-        Some(format!(
-            "the reference turns {gain:.3} times as far as the gyro (least squares over {BLOCK_S} s blocks, correlation {c:.2}): their units or scales differ (a rate in rad/s read as deg/s makes 57.3: --rate-unit rads; a reference in radians 0.017; a gear ratio its ratio), so the errors against it are mostly that, not the sensor's"
-        ))
+            ),
+            Mismatch::Scaled => format!(
+                "the reference turns {gain:.3} times as far as the gyro (least squares over {BLOCK_S} s blocks, correlation {c:.2}): their units or scales differ (a rate in rad/s read as deg/s makes 57.3: --rate-unit rads; a reference in radians 0.017; a gear ratio its ratio), so the errors against it are mostly that, not the sensor's"
+            ),
+        })
     }
 }
 

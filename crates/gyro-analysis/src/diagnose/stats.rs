@@ -427,7 +427,13 @@ pub fn lag_at_search_edge(stats: &[Stat], fs: f64) -> Option<f64> {
 /// True if a cross-correlation peak lag `lag_s` (at sample rate `fs`) sits on the edge of
 /// the search, ±[`MAX_LAG_S`] rounded to whole samples: the true lag is at least that.
 pub fn is_at_search_edge(lag_s: f64, fs: f64) -> bool {
-    let edge_s = ((MAX_LAG_S * fs).round()).max(1.0) / fs;
+    is_at_edge_of(lag_s, fs, MAX_LAG_S)
+}
+
+/// True if a cross-correlation peak lag `lag_s` (at sample rate `fs`) sits on the edge of
+/// a search of ±`max_lag_s` rounded to whole samples.
+pub(crate) fn is_at_edge_of(lag_s: f64, fs: f64, max_lag_s: f64) -> bool {
+    let edge_s = ((max_lag_s * fs).round()).max(1.0) / fs;
     lag_s.abs() >= edge_s * (1.0 - 1e-9)
 }
 

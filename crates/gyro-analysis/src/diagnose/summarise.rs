@@ -238,24 +238,25 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
 /// gyro against reference then measures the mismatch, not the sensor.
 fn sense_warnings(runs: &Runs) -> Vec<String> {
     let all: Vec<&RealRun> = runs.train.iter().chain(&runs.holdout).copied().collect();
-    let measured = |r: &&RealRun| {
-        let q = &r.log.quality;
-        q.reference_correlation.zip(q.reference_gain)
-    };
-    let opposed: Vec<f64> = all
+    use gyro_log::sense::{mismatch, Mismatch};
+    // Each measured run's correlation and gain, with the mismatch they show.
+    let measured: Vec<(f64, f64, Mismatch)> = all
         .iter()
-        .filter_map(measured)
-        .map(|(c, _)| c)
-        .filter(|c| *c <= gyro_log::sense::OPPOSED_CORRELATION)
-        .collect();
-    let limit = gyro_log::sense::GAIN_LIMIT;
-    let scaled: Vec<f64> = all
-        .iter()
-        .filter_map(measured)
-        .filter(|(c, g)| {
-            *c >= -gyro_log::sense::OPPOSED_CORRELATION && !(1.0 / limit..=limit).contains(g)
+        .filter_map(|r| {
+            let q = &r.log.quality;
+            let (c, g) = q.reference_correlation.zip(q.reference_gain)?;
+            Some((c, g, mismatch(c, g)?))
         })
-        .map(|(_, g)| g)
+        .collect();
+    let opposed: Vec<f64> = measured
+        .iter()
+        .filter(|m| m.2 == Mismatch::Opposed)
+        .map(|m| m.0)
+        .collect();
+    let scaled: Vec<f64> = measured
+        .iter()
+        .filter(|m| m.2 == Mismatch::Scaled)
+        .map(|m| m.1)
         .collect();
     let range = |v: &[f64], digits: usize| {
         let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
