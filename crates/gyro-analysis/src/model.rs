@@ -81,12 +81,50 @@ impl ModelFile {
 
     /// The sensor's full-scale range (deg/s) the pipeline flags saturation at:
     /// `config.range_dps` if set, else the sensor section's `range_dps` (whose default is
-    /// the CRM100's ±300 deg/s, like the rest of the section).
-    pub fn range_dps(&self) -> f32 {
-        self.config
-            .range_dps
-            .unwrap_or(self.sensor.range_dps as f32)
+    /// the CRM100's ±300 deg/s, like the rest of the section); `None` when that is at or
+    /// above `config.max_abs_rate_dps`, the plausibility limit: no range is known
+    /// ([`ModelFile::drop_contradicted_range`]).
+    pub fn range_dps(&self) -> Option<f32> {
+        match self.config.range_dps {
+            Some(range_dps) => Some(range_dps),
+            None => {
+                let range_dps = self.sensor.range_dps as f32;
+                (range_dps < self.config.max_abs_rate_dps).then_some(range_dps)
+            }
+        }
     }
+
+    /// The sensor section's range is the CRM100's unless something said otherwise: when
+    /// readings of the logs a model is written from reach beyond it
+    /// ([`range_contradicted`]), it is not this sensor's, and it is replaced by the
+    /// plausibility limit (no range known: `run` flags clip plateaus only, `simulate`
+    /// clips nowhere below it). Returns the note that says so, if it was replaced. A
+    /// range set in `config.range_dps` is left alone: someone stated it.
+    pub fn drop_contradicted_range(&mut self, largest_abs_rate_dps: f64) -> Option<String> {
+        let note = contradicted_range_note(self.sensor.range_dps, largest_abs_rate_dps)?;
+        if self.config.range_dps.is_some() {
+            return None;
+        }
+        self.sensor.range_dps = f64::from(self.config.max_abs_rate_dps);
+        Some(note)
+    }
+}
+
+/// Whether readings up to `largest_abs_rate_dps` (deg/s) contradict a full-scale range of
+/// `range_dps`: a sensor reads at most its range, so a reading beyond it by more than
+/// the pipeline's [`gyro_core::RANGE_MARGIN`] means the range is some other sensor's.
+pub fn range_contradicted(range_dps: f64, largest_abs_rate_dps: f64) -> bool {
+    largest_abs_rate_dps > range_dps * (1.0 + f64::from(gyro_core::RANGE_MARGIN))
+}
+
+/// What to say when readings up to `largest_abs_rate_dps` contradict the range
+/// `range_dps` ([`range_contradicted`]); `None` if they do not.
+pub fn contradicted_range_note(range_dps: f64, largest_abs_rate_dps: f64) -> Option<String> {
+    range_contradicted(range_dps, largest_abs_rate_dps).then(|| {
+        format!(
+            "range: the logs read up to {largest_abs_rate_dps:.1} deg/s, beyond the sensor range of ±{range_dps} deg/s: that range is not this sensor's, and none is assumed (saturation is flagged on clip plateaus only, nothing is clipped in simulation); state the sensor's full scale as config.range_dps"
+        )
+    })
 }
 
 /// Why a model file could not be used.
@@ -250,6 +288,27 @@ pub fn save(path: &Path, model: &ModelFile) -> Result<(), ModelError> {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn a_range_the_logs_read_beyond_is_dropped_and_one_they_keep_within_is_not() {
+        let mut model = ModelFile::new(Config::default());
+        assert_eq!(model.range_dps(), Some(300.0));
+        // Within the range and its margin: kept.
+        assert_eq!(model.drop_contradicted_range(301.4), None);
+        assert_eq!(model.range_dps(), Some(300.0));
+        // Beyond: no range, and a note that says why.
+        let note = model.drop_contradicted_range(450.5).expect("dropped");
+        assert!(note.contains("450.5") && note.contains("±300"), "{note}");
+        assert_eq!(model.range_dps(), None);
+        // A range stated in the configuration is someone's word: kept, whatever the logs.
+        let mut stated = ModelFile::new(Config {
+            range_dps: Some(250.0),
+            ..Config::default()
+        });
+        assert_eq!(stated.drop_contradicted_range(450.5), None);
+        assert_eq!(stated.range_dps(), Some(250.0));
+    }
+
     use super::*;
     use gyro_core::Compensation;
 

@@ -33,6 +33,10 @@ fn json_carries_saturated_on_every_movement() {
         for m in movements {
             assert_eq!(m["saturated"].as_bool(), Some(false), "{m}");
         }
+        assert!(
+            !report.to_string().contains("beyond the sensor range"),
+            "{report}"
+        );
     }
 
     // Told the sensor's range is ±120 deg/s: exactly the movements with a reading within
@@ -62,6 +66,69 @@ fn json_carries_saturated_on_every_movement() {
         flagged += usize::from(reached);
     }
     assert_eq!(flagged, 3);
+    // The fixture reads up to 208 deg/s, which no sensor of that range could: said.
+    let said = report["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|w| w.as_str())
+        .any(|w| w.contains("beyond the sensor range of ±120 deg/s in use"));
+    assert!(said, "{}", report["warnings"]);
+    assert!(report["summary"]["largest_abs_rate_dps"].as_f64().unwrap() > 200.0);
+}
+
+/// A model written from logs of a sensor that reads beyond the CRM100's ±300 deg/s
+/// (the rasteiro MPU6500 at up to 450 deg/s) says no range, and `run` with it flags no
+/// turn saturated; the same logs with an explicit `--range-dps 300` are flagged and warned.
+#[test]
+fn a_model_from_a_faster_sensor_claims_no_range() {
+    let real = common::workspace_root().join("../shared/data/real/rasteiro");
+    let log = real.join("rasteiro_MPU6500RM3100_V1500_z.csv");
+    if !log.exists() {
+        eprintln!("skipped: {} is not here", log.display());
+        return;
+    }
+    let log = log.to_str().unwrap();
+    let dir = temp_dir("saturation-range-dropped");
+    let model = dir.join("m.json");
+    let model = model.to_str().unwrap();
+    let out = gyro(&["calibrate", log, "--objective", "movement-rms", "-o", model]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("that range is not this sensor's"),
+        "{stderr}"
+    );
+    let report = json_of(&gyro(&["run", log, "--format", "json", "--model", model]));
+    assert!(
+        report["config"]["range_dps"].is_null(),
+        "{}",
+        report["config"]
+    );
+    let movements = report["movements"].as_array().unwrap();
+    assert!(movements.len() >= 2);
+    assert!(
+        movements.iter().all(|m| m["saturated"] == false),
+        "{movements:?}"
+    );
+    let told = json_of(&gyro(&[
+        "run",
+        log,
+        "--format",
+        "json",
+        "--model",
+        model,
+        "--range-dps",
+        "300",
+    ]));
+    assert!(told["movements"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|m| m["saturated"] == true));
+    assert!(told["warnings"]
+        .to_string()
+        .contains("beyond the sensor range of ±300"));
 }
 
 #[test]

@@ -120,6 +120,9 @@ pub fn table(file: &str, report: &RunReport) -> String {
         for m in report.movements.iter().filter(|m| m.saturated) {
             let _ = writeln!(s, "warning: {}", saturation_warning(m.index, c.range_dps));
         }
+        if let Some(warning) = range_warning(report) {
+            let _ = writeln!(s, "warning: {warning}");
+        }
         for m in report.movements.iter().filter(|m| m.filled_samples > 0) {
             let _ = writeln!(
                 s,
@@ -202,11 +205,26 @@ pub fn table(file: &str, report: &RunReport) -> String {
 /// Every warning about what the figures and verdicts mean, in the order the table gives
 /// them: the JSON's `warnings`, and stderr for the CSV.
 pub fn warnings(report: &RunReport) -> Vec<String> {
-    unguarded_warning(report)
+    range_warning(report)
         .into_iter()
+        .chain(unguarded_warning(report))
         .chain(scale_warning(report))
         .chain(lag_warning(report))
         .collect()
+}
+
+/// The warning for readings beyond the sensor range in use: a sensor reads at most its
+/// range, so that range is not this one's (a model file's sensor section holds the
+/// CRM100's ±300 deg/s unless it says otherwise), and a movement flagged saturated for
+/// reaching it may not be.
+pub fn range_warning(report: &RunReport) -> Option<String> {
+    let range_dps = report.config.range_dps?;
+    let largest = report.summary.largest_abs_rate_dps;
+    gyro_analysis::model::range_contradicted(f64::from(range_dps), largest).then(|| {
+        format!(
+            "readings reach {largest:.1} deg/s, beyond the sensor range of ±{range_dps} deg/s in use: that range is not this sensor's, so a movement flagged saturated for reaching it may not be; give --range-dps with the sensor's full scale"
+        )
+    })
 }
 
 /// The warning for tightening verdicts without a σ: only the Kalman form gives a movement

@@ -126,6 +126,16 @@ pub fn run(args: &Args) -> Result<()> {
     {
         out.scale_sigma = u;
     }
+    let largest = train
+        .iter()
+        .chain(&holdout)
+        .flat_map(|run| &run.log.slots)
+        .map(|slot| slot.rate_dps.abs())
+        .filter(|x| *x <= f64::from(base.config.max_abs_rate_dps))
+        .fold(0.0, f64::max);
+    if let Some(note) = out.drop_contradicted_range(largest) {
+        say!("{}: {note}", args.out.display());
+    }
     model::save(&args.out, &out).with_context(|| "writing the model file".to_string())?;
     let inputs: Vec<_> = train
         .iter()

@@ -221,10 +221,19 @@ pub fn run(args: &Args) -> Result<()> {
         write_noise_yaml(out, args, &result)?;
     }
     if let Some(out) = &args.out {
-        let file = result
+        let mut file = result
             .corrected_model
             .clone()
             .unwrap_or_else(|| options.base_model.clone());
+        let largest = train
+            .iter()
+            .chain(&holdout)
+            .map(|r| r.features.max_abs_rate_dps)
+            .filter(|x| *x <= f64::from(options.base_model.config.max_abs_rate_dps))
+            .fold(0.0, f64::max);
+        if let Some(note) = file.drop_contradicted_range(largest) {
+            say!("{}: {note}", out.display());
+        }
         model::save(out, &file)?;
         say!(
             "wrote {} ({})",

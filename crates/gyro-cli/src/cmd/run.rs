@@ -112,7 +112,7 @@ pub fn run(args: &Args) -> Result<()> {
         Some(path) => {
             let model = model::load(path)?;
             let config = Config {
-                range_dps: Some(model.range_dps()),
+                range_dps: model.range_dps(),
                 ..model.config
             };
             (
