@@ -70,6 +70,19 @@ pub const CORRECTION_P: f64 = 0.05;
 /// Id of the bias correction in [`CompensationSummary`]: the nominal model's bias.
 pub const BIAS_ID: &str = "bias";
 
+/// Why a scale-type correction is not written when the reference lags beyond the
+/// per-sample statistic ([`super::turns::lag_beyond_statistic`]).
+pub const SCALE_FROM_TURNS: &str = "the reference lags beyond the per-sample statistic's reach, so the per-sample residual during turns is the rate times the lag, which a fit on the rate reads as a scale: the turns' totals, rest to rest, measure the scale instead";
+
+/// Whether `effect`'s correction scales the rate (a fit of the residual on the rate, or
+/// on the rate times the temperature).
+fn is_scale(effect: &Effect) -> bool {
+    matches!(
+        effect.info().correction,
+        CoreCorrection::ScaleK { .. } | CoreCorrection::AsymmetryK | CoreCorrection::ScalePerC
+    )
+}
+
 /// A correction to try.
 #[derive(Clone, Copy)]
 enum Try {
@@ -109,6 +122,7 @@ fn with_tries(base: &ModelFile, tries: &[Try]) -> (ModelFile, Vec<&'static str>)
 pub(crate) fn compensate(
     holdout: &[RealRun],
     options: &super::Options,
+    scale_from_turns: bool,
     bias_dps: f64,
     selected: &[Effect],
     progress: &dyn super::Progress,
@@ -140,7 +154,11 @@ pub(crate) fn compensate(
         let paired = paired_gains(&current, &after);
         let seed = crate::seed::derive_seed(options.seed, "correction", k as u64);
         let p = super::score::bootstrap_p(&paired, options.bootstrap.max(1), seed);
-        if !paired.is_empty() && p < CORRECTION_P {
+        let reason = match t {
+            Try::Effect(e) if scale_from_turns && is_scale(e) => Some(SCALE_FROM_TURNS),
+            _ => None,
+        };
+        if reason.is_none() && !paired.is_empty() && p < CORRECTION_P {
             kept = trial;
             current = after;
         } else {
@@ -154,6 +172,7 @@ pub(crate) fn compensate(
                 runs_better: paired.iter().filter(|d| **d > 0.0).count(),
                 runs: paired.len(),
                 bootstrap_p: p,
+                reason,
             });
         }
     }

@@ -251,6 +251,10 @@ pub struct NotCorrected {
     pub runs: usize,
     /// Bootstrap over held-out runs: P(no lower total max abs error).
     pub bootstrap_p: f64,
+    /// Why it is not written whatever the held-out runs say, if so
+    /// ([`super::compensate::SCALE_FROM_TURNS`]); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<&'static str>,
 }
 
 /// One run's angle error without and with compensation.

@@ -47,7 +47,7 @@ pub(crate) mod stats;
 mod summarise;
 pub mod turns;
 
-pub use compensate::BIAS_ID;
+pub use compensate::{BIAS_ID, SCALE_FROM_TURNS};
 pub use diagnosis::{
     CompensationRun, CompensationSummary, Diagnosis, EffectResult, GapSummary, InputEntry,
     ModelSummary, NotCorrected, RunSummary, Unexplained, UntestableEntry, Verdict, Where,
@@ -220,10 +220,13 @@ pub fn diagnose(
     let selected_effects = select::joint_refit(&joint, &mut candidates, &selection.selected);
     let selected_sensor = fit::model_with(&base.nominal, &selected_effects, base.white_target);
 
-    // 5. Compensate the correctable effects.
+    // 5. Compensate the correctable effects (scales from the turns when the reference
+    // lags beyond the per-sample statistic).
+    let train_lags_s = turns::run_lags_s(train);
     let (compensation, corrected_model) = compensate::compensate(
         holdout,
         options,
+        turns::lag_beyond_statistic(&train_lags_s),
         // The nominal model's bias is fitted on the training runs unless it was given.
         if options.fixed_model {
             0.0
@@ -238,7 +241,8 @@ pub fn diagnose(
     let turn_base = corrected_model
         .clone()
         .unwrap_or_else(|| options.base_model.clone());
-    let (turns, turn_model) = turns::turn_evidence(train, holdout, &turn_base, options);
+    let (turns, turn_model) =
+        turns::turn_evidence(train, &train_lags_s, holdout, &turn_base, options);
     let corrected_model = turn_model.or(corrected_model);
 
     // 6. Summarise.

@@ -154,6 +154,7 @@ fn median(values: &[f64]) -> Option<f64> {
 /// writes anything.
 pub(crate) fn turn_evidence(
     train: &[RealRun],
+    train_lags_s: &[f64],
     holdout: &[RealRun],
     model: &ModelFile,
     options: &super::Options,
@@ -161,7 +162,7 @@ pub(crate) fn turn_evidence(
     let mut written = model.clone();
     let mut changed = false;
 
-    let lag = wide_lag(train, holdout, &mut written, &mut changed, options);
+    let lag = wide_lag(train_lags_s, holdout, &mut written, &mut changed, options);
 
     // The totals with the model as it stands after the lag (read at mid-rest, they barely
     // depend on it, but every figure below is then of one model).
@@ -197,28 +198,37 @@ pub(crate) fn turn_evidence(
     (Some(evidence), changed.then_some(written))
 }
 
+/// Each run's gyro–reference lag searched wide (s), where it is measured
+/// ([`crate::lag::log_lag_s`]).
+pub(crate) fn run_lags_s(runs: &[RealRun]) -> Vec<f64> {
+    runs.par_iter()
+        .filter_map(|r| crate::lag::log_lag_s(&r.log))
+        .collect()
+}
+
+/// Whether the median of the training runs' lags `lags_s` lies beyond the per-sample
+/// statistic's reach: the per-sample residual during turns is then the rate times the lag,
+/// which a fit of the residual on the rate reads as a scale, and the turns' totals, rest
+/// to rest, measure the scale instead.
+pub(crate) fn lag_beyond_statistic(lags_s: &[f64]) -> bool {
+    median(lags_s).is_some_and(|m| m.abs() > MAX_LAG_S)
+}
+
 /// The lag searched wide; written into `model` (and `changed` set) when it lies beyond
 /// the per-sample statistic, `model` has no reference delay yet, and it lowers the
 /// held-out runs' max abs angle error.
 fn wide_lag(
-    train: &[RealRun],
+    lags: &[f64],
     holdout: &[RealRun],
     model: &mut ModelFile,
     changed: &mut bool,
     options: &super::Options,
 ) -> Option<WideLag> {
-    let lags: Vec<f64> = train
-        .par_iter()
-        .filter_map(|r| crate::lag::log_lag_s(&r.log))
-        .collect();
-    let median_s = median(&lags)?;
+    let median_s = median(lags)?;
     let lo = lags.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = lags.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let held: Vec<f64> = holdout
-        .par_iter()
-        .filter_map(|r| crate::lag::log_lag_s(&r.log))
-        .collect();
-    let beyond_statistic = median_s.abs() > MAX_LAG_S;
+    let held = run_lags_s(holdout);
+    let beyond_statistic = lag_beyond_statistic(lags);
     let mut out = WideLag {
         median_s,
         train_range_s: (lo, hi),
@@ -378,8 +388,13 @@ mod tests {
     fn a_scale_and_a_long_lag_are_found_written_and_checked() {
         let (train, holdout) = runs(0.02, 0.1);
         let base = ModelFile::new(gyro_core::Config::default());
-        let (evidence, model) =
-            turn_evidence(&train, &holdout, &base, &super::super::Options::default());
+        let (evidence, model) = turn_evidence(
+            &train,
+            &run_lags_s(&train),
+            &holdout,
+            &base,
+            &super::super::Options::default(),
+        );
         let t = evidence.unwrap();
         assert_eq!((t.train_turns, t.holdout_turns), (4, 4));
         let lag = t.lag.unwrap();
@@ -411,8 +426,13 @@ mod tests {
     fn no_scale_and_no_lag_write_nothing() {
         let (train, holdout) = runs(0.0, 0.0);
         let base = ModelFile::new(gyro_core::Config::default());
-        let (evidence, model) =
-            turn_evidence(&train, &holdout, &base, &super::super::Options::default());
+        let (evidence, model) = turn_evidence(
+            &train,
+            &run_lags_s(&train),
+            &holdout,
+            &base,
+            &super::super::Options::default(),
+        );
         let t = evidence.unwrap();
         let lag = t.lag.unwrap();
         assert!(lag.median_s.abs() < 0.005 && !lag.beyond_statistic && !lag.written);

@@ -212,8 +212,10 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
                 ));
             } else {
                 lines.push(format!(
-                    "{}: named, not corrected (its correction did not lower the held-out error)",
-                    n.id
+                    "{}: named, not corrected ({})",
+                    n.id,
+                    n.reason
+                        .unwrap_or("its correction did not lower the held-out error")
                 ));
             }
         }

@@ -277,8 +277,9 @@ pub fn table(d: &Diagnosis) -> String {
         for n in &c.not_corrected {
             let _ = writeln!(
                 s,
-                "\n{}: named, not corrected: its correction gives a median held-out max abs angle error of {:.2} deg against {:.2} without, better on {} of {} runs (bootstrap P {:.2})",
+                "\n{}: named, not corrected: {}its correction gives a median held-out max abs angle error of {:.2} deg against {:.2} without, better on {} of {} runs (bootstrap P {:.2})",
                 n.id,
+                n.reason.map_or(String::new(), |r| format!("{r}; ")),
                 n.median_max_abs_error_with_deg,
                 n.median_max_abs_error_without_deg,
                 n.runs_better,
