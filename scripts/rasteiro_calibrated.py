@@ -116,9 +116,9 @@ def matched(moves, truth):
 
 
 def decisions(gyro, path, truth, extra):
-    """(wrong ok, wrong nok, recheck, decided) over the windows around `truth`."""
+    """(wrong ok, wrong nok, recheck, decided, invalid) over the windows around `truth`."""
     sign = 1.0 if truth > 0 else -1.0
-    wrong_ok = wrong_nok = recheck = decided = 0
+    wrong_ok = wrong_nok = recheck = decided = invalid = 0
     for d in HALF_WIDTHS:
         for o in OFFSETS:
             target = abs(truth) + o * d
@@ -133,14 +133,21 @@ def decisions(gyro, path, truth, extra):
             v = m["verdict"]
             decided += 1
             wrong_ok += v == "ok" and not inside
+            if v == "ok" and not inside and extra:
+                print(
+                    f"wrong ok with the model: {os.path.basename(path)} turn {truth:+.2f}, "
+                    f"window {target:.2f} ± {d}, measured {m['angle_deg']:+.2f} (σ {m['angle_std_deg']:.3f})",
+                    file=sys.stderr,
+                )
             wrong_nok += v == "nok" and inside
             recheck += v == "recheck"
-    return wrong_ok, wrong_nok, recheck, decided
+            invalid += v == "invalid"
+    return wrong_ok, wrong_nok, recheck, decided, invalid
 
 
 def trust(gyro, data, cache):
     """Coverage and decisions on each speed held out, default and calibrated."""
-    rows = {"default": [0] * 6, "calibrated": [0] * 6}
+    rows = {"default": [0] * 7, "calibrated": [0] * 7}
     residuals = []
     for sensor in SENSORS:
         for axis in "xyz":
@@ -176,11 +183,11 @@ def trust(gyro, data, cache):
             f"scale_sigma: left-out relative RMS {100 * low:.2f}-{100 * high:.2f}%, "
             f"95% upper bound {100 * low_u:.2f}-{100 * high_u:.2f}% ({len(residuals)} folds)"
         )
-    print(f"{'held out by speed':<20} {'turns':>5} {'95% covers':>10} {'decisions':>9} {'wrong ok':>8} {'wrong nok':>9} {'recheck':>8}")
+    print(f"{'held out by speed':<20} {'turns':>5} {'95% covers':>10} {'decisions':>9} {'wrong ok':>8} {'wrong nok':>9} {'recheck':>8} {'invalid':>8}")
     for name, r in rows.items():
         print(
             f"{name:<20} {r[0]:>5} {100 * r[1] / max(r[0], 1):>9.0f}% {r[5]:>9} {r[2]:>8} {r[3]:>9}"
-            f" {100 * r[4] / max(r[5], 1):>7.1f}%"
+            f" {100 * r[4] / max(r[5], 1):>7.1f}% {100 * r[6] / max(r[5], 1):>7.1f}%"
         )
 
 

@@ -111,10 +111,10 @@ impl ModelFile {
 }
 
 /// Whether readings up to `largest_abs_rate_dps` (deg/s) contradict a full-scale range of
-/// `range_dps`: a sensor reads at most its range, so a reading beyond it by more than
-/// the pipeline's [`gyro_core::RANGE_MARGIN`] means the range is some other sensor's.
+/// `range_dps`: the pipeline's rule ([`gyro_core::beyond_range`]), a reading beyond the
+/// range by more than its margin.
 pub fn range_contradicted(range_dps: f64, largest_abs_rate_dps: f64) -> bool {
-    largest_abs_rate_dps > range_dps * (1.0 + f64::from(gyro_core::RANGE_MARGIN))
+    gyro_core::beyond_range(range_dps as f32, largest_abs_rate_dps as f32)
 }
 
 /// What to say when readings up to `largest_abs_rate_dps` contradict the range

@@ -127,10 +127,11 @@ pub struct Summary {
     /// from the output series' rates ([`crate::lag::LagMeter`]); `None` without a
     /// reference, without motion both show, or beyond ±[`crate::lag::SEARCH_S`].
     pub reference_lag_s: Option<f64>,
-    /// The largest |rate| among the input samples the pipeline accepted (deg/s): beyond
-    /// the configured range it shows that range is not the sensor's
-    /// ([`crate::model::range_contradicted`]).
+    /// The largest |rate| among the input samples the pipeline accepted (deg/s).
     pub largest_abs_rate_dps: f64,
+    /// A reading went beyond the configured range ([`Pipeline::range_contradicted`]): it
+    /// is not the sensor's, and from then on only clip plateaus flag a movement saturated.
+    pub range_contradicted: bool,
 }
 
 /// How a replay is scored, beyond the pipeline's configuration.
@@ -799,6 +800,7 @@ impl Replayer {
             raw_final_error_deg: raw_final,
             reference_lag_s: self.lag.lag_s(),
             largest_abs_rate_dps: self.largest_abs_rate_dps,
+            range_contradicted: self.pipeline.range_contradicted(),
         };
         RunReport {
             sample_rate_hz: self.sample_rate_hz,

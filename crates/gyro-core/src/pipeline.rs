@@ -177,7 +177,10 @@ pub struct Movement {
     /// A reading during the movement (its confirming run included) reached the sensor's
     /// range ([`Config::range_dps`], within [`RANGE_MARGIN`]) or sat on a clip plateau
     /// ([`CLIP_PLATEAU_SAMPLES`] identical readings at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`]):
-    /// the angle is then a lower bound of the turn.
+    /// the angle is then a lower bound of the turn. Reaching the range does not count once
+    /// a reading has gone beyond it by more than [`RANGE_MARGIN`] (since the start, up to
+    /// the movement's end): a sensor reads at most its range, so that range is not this
+    /// sensor's ([`Pipeline::range_contradicted`]); a clip plateau still counts.
     pub saturated: bool,
     /// Standard deviation of `angle_deg` (deg), in Kalman mode: what the filter's bias
     /// uncertainty and rate noise make of this movement's angle (the input to a
@@ -220,8 +223,9 @@ struct Track {
     settle_index: Option<u32>,
     raw_at_start_deg: f32,
     angle_at_start_deg: f32,
-    /// A reading reached the range or a clip plateau (in the struct's padding).
-    saturated: bool,
+    /// What the clip watch saw during the movement ([`CLIP_RANGE`], [`CLIP_PLATEAU`]; in
+    /// the struct's padding).
+    saturation: u8,
 }
 
 impl Track {
@@ -309,19 +313,55 @@ impl RestBlocks {
 /// compensations, whose chains of additions overlap.
 const SIDE_BY_SIDE: usize = 8;
 
-/// One reading through the clip watch: `last` and `run` (the last reading and how many
-/// times in a row it came, up to the plateau) move on; true if it reaches the range
-/// (`level_dps`) or completes a clip plateau (see [`Movement::saturated`]). Judged on the
-/// reading, before correction.
+/// Clip watch flag: a reading reached the range.
+const CLIP_RANGE: u8 = 1;
+/// Clip watch flag: a reading completed a clip plateau.
+const CLIP_PLATEAU: u8 = 2;
+/// Clip watch flag: a reading went beyond the range by more than [`RANGE_MARGIN`] (kept
+/// for the whole run: the range is not this sensor's).
+const CLIP_BEYOND: u8 = 4;
+/// The flags of one stretch of readings that go to the movement in progress.
+const CLIP_PENDING: u8 = CLIP_RANGE | CLIP_PLATEAU;
+/// |reading| beyond which the range is contradicted, as a multiple of the level at which
+/// it counts as reached: `(1 + RANGE_MARGIN) / (1 − RANGE_MARGIN)`.
+const BEYOND_FACTOR: f32 = (1.0 + RANGE_MARGIN) / (1.0 - RANGE_MARGIN);
+
+/// Whether a reading of magnitude `magnitude_dps` goes beyond a sensor range of
+/// `range_dps` by more than [`RANGE_MARGIN`]: a sensor reads at most its range, so such a
+/// reading shows the range is not this sensor's ([`Pipeline::range_contradicted`]). The
+/// pipeline's own test, in its arithmetic.
+pub fn beyond_range(range_dps: f32, magnitude_dps: f32) -> bool {
+    range_flags(range_dps * (1.0 - RANGE_MARGIN), magnitude_dps) & CLIP_BEYOND != 0
+}
+
+/// Whether flags `seen` during a movement make it saturated: a clip plateau, or the range
+/// reached while no reading has gone beyond it.
 #[inline(always)]
-fn clip_seen(level_dps: f32, last: &mut f32, run: &mut u8, reading_dps: f32) -> bool {
+fn saturated_by(seen: u8) -> bool {
+    (seen & CLIP_PLATEAU != 0) | ((seen & CLIP_RANGE != 0) & (seen & CLIP_BEYOND == 0))
+}
+
+/// The range flags of a reading of magnitude `magnitude` against the range level
+/// `level_dps`: [`CLIP_RANGE`] if it reaches it, and [`CLIP_BEYOND`] too if it goes beyond
+/// it by more than the margin.
+#[inline(always)]
+fn range_flags(level_dps: f32, magnitude: f32) -> u8 {
+    u8::from(magnitude >= level_dps) | (u8::from(magnitude > level_dps * BEYOND_FACTOR) << 2)
+}
+
+/// One reading through the clip watch: `last` and `run` (the last reading and how many
+/// times in a row it came, up to the plateau) move on; its flags: whether it reaches the
+/// range (`level_dps`) or goes beyond it ([`range_flags`]), or completes a clip plateau
+/// (see [`Movement::saturated`]). Judged on the reading, before correction.
+#[inline(always)]
+fn clip_seen(level_dps: f32, last: &mut f32, run: &mut u8, reading_dps: f32) -> u8 {
     // Without branches: whether a reading repeats is a coin toss on a quantised sensor.
     let repeat = u8::from(reading_dps == *last);
     *run = (run.saturating_add(1) & 0_u8.wrapping_sub(repeat)) | (1 - repeat);
     *last = reading_dps;
     let magnitude = libm::fabsf(reading_dps);
-    (magnitude >= level_dps)
-        | ((*run >= CLIP_PLATEAU_SAMPLES) & (magnitude >= CLIP_PLATEAU_MIN_DPS))
+    range_flags(level_dps, magnitude)
+        | (u8::from((*run >= CLIP_PLATEAU_SAMPLES) & (magnitude >= CLIP_PLATEAU_MIN_DPS)) << 1)
 }
 
 /// Where the clip watch ends over readings none of which repeats the one before it (the
@@ -351,7 +391,7 @@ fn distinct_run(rates_dps: &[f32], last_dps: f32, run: u8) -> Option<DistinctRun
 
 /// See [`distinct_run`].
 struct DistinctRun {
-    first_clipped: bool,
+    first_clipped: u8,
     last_dps: f32,
     run: u8,
 }
@@ -383,9 +423,10 @@ pub struct Pipeline {
     /// The last accepted reading and how many times in a row it came (up to the plateau).
     clip_last_dps: f32,
     clip_run: u8,
-    /// A reading reached the range or a plateau since the last output step, or during the
-    /// run that may become a movement.
-    clip_pending: bool,
+    /// The clip watch's flags: [`CLIP_RANGE`] and [`CLIP_PLATEAU`] seen since the last
+    /// output step, or during the run that may become a movement; [`CLIP_BEYOND`] once
+    /// seen, for good.
+    clip_flags: u8,
     corrector: Corrector,
     /// The correction is not the identity: with the identity (the default) the per-sample
     /// path skips it, since it would return every accepted reading unchanged (in the one
@@ -445,7 +486,7 @@ impl Pipeline {
             clip_level_dps,
             clip_last_dps: f32::NAN,
             clip_run: 0,
-            clip_pending: false,
+            clip_flags: 0,
             corrector: Corrector::try_new(&config.correction)?,
             corrects: !config.correction.is_identity(),
             compensation: config.compensation,
@@ -684,7 +725,7 @@ impl Pipeline {
 
         let mut block = self.decimator.run();
         let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
-        let mut clipped = false;
+        let mut clipped = 0;
         for (i, &reading) in rates_dps.iter().enumerate() {
             if TEMPERATURE {
                 self.corrector.observe_temperature(temperatures_c[i]);
@@ -700,7 +741,7 @@ impl Pipeline {
             block.add(rate);
         }
         (self.clip_last_dps, self.clip_run) = (clip_last, clip_run);
-        self.clip_pending |= clipped;
+        self.clip_flags |= clipped;
         let mean_dps = self.decimator.close(block)?;
         Some(self.end_block(last_s, mean_dps))
     }
@@ -743,7 +784,7 @@ impl Pipeline {
             let times_s = &times_s[k * factor..(k + 1) * factor];
             self.block_start_time_s = self.time_of(times_s, 0);
             self.last_time_s = self.time_of_last(times_s, self.block_start_time_s);
-            self.clip_pending |= clipped[k];
+            self.clip_flags |= clipped[k];
             let last = self.corrected::<false>(row[factor - 1]);
             let mean_dps = self.decimator.complete(sum, last);
             sink(self.end_block(self.last_time_s, mean_dps));
@@ -788,8 +829,8 @@ impl Pipeline {
     }
 
     /// The plausibility test and the clip watch over whole blocks of `factor` samples in
-    /// order: each block's clip flag, or `None` (and nothing changed) if a sample is
-    /// implausible.
+    /// order: each block's clip flags ([`clip_seen`]), or `None` (and nothing changed) if a
+    /// sample is implausible.
     ///
     /// Blocks that stay below both the clip plateau's level and the range, as rests do,
     /// need no watch sample by sample: their test reads all samples at once, and the watch
@@ -799,7 +840,7 @@ impl Pipeline {
         &mut self,
         rates_dps: &[f32],
         factor: usize,
-    ) -> Option<[bool; LANES]> {
+    ) -> Option<[u8; LANES]> {
         let quiet_dps = self.clip_level_dps.min(CLIP_PLATEAU_MIN_DPS);
         let max_dps = self.max_abs_rate_dps;
         // Below the quiet level (and plausible): NaN fails both.
@@ -815,7 +856,7 @@ impl Pipeline {
         if !plausible {
             return None;
         }
-        let mut clipped = [false; LANES];
+        let mut clipped = [0; LANES];
         if quiet {
             let (&last, before) = rates_dps.split_last()?;
             let repeats = before.iter().rev().take_while(|&&x| x == last).count();
@@ -833,7 +874,7 @@ impl Pipeline {
             for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
                 *clipped = block
                     .iter()
-                    .fold(false, |seen, &x| seen | (libm::fabsf(x) >= level_dps));
+                    .fold(0, |seen, &x| seen | range_flags(level_dps, libm::fabsf(x)));
             }
             clipped[0] |= distinct.first_clipped;
             (self.clip_last_dps, self.clip_run) = (distinct.last_dps, distinct.run);
@@ -934,10 +975,26 @@ impl Pipeline {
         self.step(centre_s, mean_dps)
     }
 
+    /// The pending clip flags, cleared ([`CLIP_BEYOND`] stays).
+    #[inline(always)]
+    fn take_pending(&mut self) -> u8 {
+        let pending = self.clip_flags & CLIP_PENDING;
+        self.clip_flags &= CLIP_BEYOND;
+        pending
+    }
+
+    /// Whether an accepted reading has gone beyond [`Config::range_dps`] by more than
+    /// [`RANGE_MARGIN`]: the configured range is not this sensor's, and reaching it no
+    /// longer makes a movement saturated (a clip plateau still does).
+    pub fn range_contradicted(&self) -> bool {
+        self.clip_flags & CLIP_BEYOND != 0
+    }
+
     /// Whether the movement in progress (its confirming run included) is saturated so far;
     /// `false` at rest. For a host whose log ends while moving.
     pub fn movement_saturated(&self) -> bool {
-        self.clip_pending || self.track.as_ref().is_some_and(|track| track.saturated)
+        let seen = self.clip_flags | self.track.as_ref().map_or(0, |track| track.saturation);
+        saturated_by(seen & (CLIP_PENDING | (self.clip_flags & CLIP_BEYOND)))
     }
 
     /// One step at the output rate.
@@ -977,10 +1034,13 @@ impl Pipeline {
         // Saturation seen in this block goes to the movement in progress; during a run that
         // may become one it waits; at rest, or when the run is dropped, it is forgotten.
         match (phase, self.track.as_mut()) {
-            (Phase::Rest | Phase::Aborted, _) => self.clip_pending = false,
+            (Phase::Rest | Phase::Aborted, _) => self.clip_flags &= CLIP_BEYOND,
             (Phase::Onset | Phase::Started { .. }, _) => {}
-            (_, Some(track)) => track.saturated |= core::mem::take(&mut self.clip_pending),
-            (_, None) => self.clip_pending = false,
+            (_, Some(track)) => {
+                track.saturation |= self.clip_flags & CLIP_PENDING;
+                self.clip_flags &= CLIP_BEYOND;
+            }
+            (_, None) => self.clip_flags &= CLIP_BEYOND,
         }
 
         let event = match phase {
@@ -1019,7 +1079,7 @@ impl Pipeline {
                     angle_at_start_deg: self.committed_angle_deg(),
                     settle_time_s: 0.0,
                     settle_index: None,
-                    saturated: core::mem::take(&mut self.clip_pending),
+                    saturation: self.take_pending(),
                 });
                 self.commit();
                 Some(Event::MovementStarted {
@@ -1097,7 +1157,7 @@ impl Pipeline {
             end_index,
             angle_deg: self.angle_deg() - track.angle_at_start_deg,
             raw_angle_deg,
-            saturated: track.saturated,
+            saturated: saturated_by(track.saturation | (self.clip_flags & CLIP_BEYOND)),
             angle_std_deg: (self.compensation == Compensation::Kalman)
                 .then(|| self.kalman.movement_std_deg(end_index - track.start_index)),
         })

@@ -87,6 +87,35 @@ fn the_same_turn_unclipped_is_not_flagged() {
     }
 }
 
+/// A configured range the readings go beyond is not the sensor's: reaching it no longer
+/// flags a movement (the MPU6500 at 450 deg/s against the CRM100's ±300), a clip plateau
+/// still does, and the pipeline says the range is contradicted. Within the margin
+/// (0.5%) a reading is still at the range.
+#[test]
+fn a_range_the_readings_go_beyond_flags_plateaus_only() {
+    // 91.2° in 1.2 s peaks at 152 deg/s: told the range is ±100, it goes beyond.
+    let fast = readings(&one_turn(), 0.3, LSB_DPS, 1000.0, 3);
+    let config = with_range(Some(100.0));
+    assert_eq!(flags(&config, &fast), [false]);
+    let mut pipeline = Pipeline::try_new(&config).unwrap();
+    for (i, &x) in fast.iter().enumerate() {
+        pipeline.push(i as f64 / FS_HZ, x);
+    }
+    assert!(pipeline.range_contradicted());
+    // The same turn clipped at 100.4 deg/s (within the margin of ±100): flagged, and the
+    // range stands.
+    let clipped = readings(&one_turn(), 0.3, LSB_DPS, 100.4, 3);
+    assert_eq!(flags(&config, &clipped), [true]);
+    let mut pipeline = Pipeline::try_new(&config).unwrap();
+    for (i, &x) in clipped.iter().enumerate() {
+        pipeline.push(i as f64 / FS_HZ, x);
+    }
+    assert!(!pipeline.range_contradicted());
+    // Clipped at 120 deg/s with a range of ±100: beyond it, but the plateau flags it.
+    let plateau = readings(&one_turn(), 0.3, LSB_DPS, 120.0, 3);
+    assert_eq!(flags(&config, &plateau), [true]);
+}
+
 /// A rest on a quantised output repeats one reading for seconds: below
 /// [`CLIP_PLATEAU_MIN_DPS`] that is no clip, and it does not reach a known range either.
 #[test]

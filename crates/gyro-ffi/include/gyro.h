@@ -369,7 +369,9 @@ typedef struct GyroConfig {
     // 1: `range_dps` is the sensor's full-scale range; 0: unknown (the default).
     uint8_t has_range_dps;
     // The sensor's full-scale range (deg/s), used when `has_range_dps` is 1: a movement
-    // during which a reading reaches it is flagged saturated.
+    // during which a reading reaches it is flagged saturated, until a reading goes
+    // beyond it (then it is not this sensor's range; see
+    // `GyroPipelineInfo::range_contradicted`).
     float range_dps;
     // The tightening window.
     struct GyroTighteningConfig tightening;
@@ -396,7 +398,8 @@ typedef struct GyroMovement {
     float angle_std_deg;
     // `angle_std_deg` is known (Kalman compensation).
     bool has_angle_std;
-    // A reading during the movement reached the sensor's range or sat on a clip plateau:
+    // A reading during the movement reached the sensor's range (while none had gone
+    // beyond it: see `GyroPipelineInfo::range_contradicted`) or sat on a clip plateau:
     // the angle is a lower bound of the turn.
     bool saturated;
     // An input sample was rejected (not finite, or beyond `max_abs_rate_dps`) between the
@@ -450,6 +453,9 @@ typedef struct GyroPipelineInfo {
     // The movement in progress is saturated so far (`false` at rest): for a caller whose
     // recording ends while moving.
     bool movement_saturated;
+    // A reading went beyond `range_dps` by more than 0.5%: that range is not the
+    // sensor's, and from then on only a clip plateau flags a movement saturated.
+    bool range_contradicted;
 } GyroPipelineInfo;
 
 #ifdef __cplusplus

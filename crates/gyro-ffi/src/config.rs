@@ -154,7 +154,9 @@ pub struct GyroConfig {
     /// 1: `range_dps` is the sensor's full-scale range; 0: unknown (the default).
     pub has_range_dps: u8,
     /// The sensor's full-scale range (deg/s), used when `has_range_dps` is 1: a movement
-    /// during which a reading reaches it is flagged saturated.
+    /// during which a reading reaches it is flagged saturated, until a reading goes
+    /// beyond it (then it is not this sensor's range; see
+    /// `GyroPipelineInfo::range_contradicted`).
     pub range_dps: f32,
     /// The tightening window.
     pub tightening: GyroTighteningConfig,

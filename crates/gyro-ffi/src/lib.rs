@@ -448,6 +448,7 @@ pub unsafe extern "C" fn gyro_pipeline_info(
         outputs: state.outputs,
         finite: core.is_finite(),
         movement_saturated: core.movement_saturated(),
+        range_contradicted: core.range_contradicted(),
     };
     // SAFETY: not NULL, aligned (checked above), outside the pipeline; the caller promises
     // a writable GyroPipelineInfo.

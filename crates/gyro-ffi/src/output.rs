@@ -65,7 +65,8 @@ pub struct GyroMovement {
     pub angle_std_deg: f32,
     /// `angle_std_deg` is known (Kalman compensation).
     pub has_angle_std: bool,
-    /// A reading during the movement reached the sensor's range or sat on a clip plateau:
+    /// A reading during the movement reached the sensor's range (while none had gone
+    /// beyond it: see `GyroPipelineInfo::range_contradicted`) or sat on a clip plateau:
     /// the angle is a lower bound of the turn.
     pub saturated: bool,
     /// An input sample was rejected (not finite, or beyond `max_abs_rate_dps`) between the
@@ -208,4 +209,7 @@ pub struct GyroPipelineInfo {
     /// The movement in progress is saturated so far (`false` at rest): for a caller whose
     /// recording ends while moving.
     pub movement_saturated: bool,
+    /// A reading went beyond `range_dps` by more than 0.5%: that range is not the
+    /// sensor's, and from then on only a clip plateau flags a movement saturated.
+    pub range_contradicted: bool,
 }

@@ -215,14 +215,15 @@ pub fn warnings(report: &RunReport) -> Vec<String> {
 
 /// The warning for readings beyond the sensor range in use: a sensor reads at most its
 /// range, so that range is not this one's (a model file's sensor section holds the
-/// CRM100's ±300 deg/s unless it says otherwise), and a movement flagged saturated for
-/// reaching it may not be.
+/// CRM100's ±300 deg/s unless it says otherwise). From the first such reading the core
+/// flags saturation on clip plateaus only; a movement that ended before it may still be
+/// flagged for reaching the range.
 pub fn range_warning(report: &RunReport) -> Option<String> {
     let range_dps = report.config.range_dps?;
-    let largest = report.summary.largest_abs_rate_dps;
-    gyro_analysis::model::range_contradicted(f64::from(range_dps), largest).then(|| {
+    report.summary.range_contradicted.then(|| {
         format!(
-            "readings reach {largest:.1} deg/s, beyond the sensor range of ±{range_dps} deg/s in use: that range is not this sensor's, so a movement flagged saturated for reaching it may not be; give --range-dps with the sensor's full scale"
+            "readings reach {:.1} deg/s, beyond the sensor range of ±{range_dps} deg/s in use: that range is not this sensor's, so from the first such reading only clip plateaus flag a movement saturated (one that ended before it may still be flagged for reaching the range); give --range-dps with the sensor's full scale",
+            report.summary.largest_abs_rate_dps
         )
     })
 }

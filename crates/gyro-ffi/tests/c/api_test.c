@@ -282,7 +282,7 @@ static void synthetic_turn(void) {
     CHECK(info.outputs == 250 && info.rejected_samples == 0 && info.finite);
     CHECK(info.output_period_s == 0.02f);
     CHECK(info.filter_delay_s > 0.0 && info.filter_delay_s < 0.1);
-    CHECK(!info.movement_saturated);
+    CHECK(!info.movement_saturated && !info.range_contradicted);
 
     /* With the temperature (and the identity correction): the same, bit for bit. */
     pipeline = setup(&config);
@@ -319,12 +319,22 @@ static void verdicts(void) {
     CHECK(run.ended == 1 && run.movement.verdict == GYRO_VERDICT_OK);
     config.tightening.direction = GYRO_DIRECTION_POSITIVE;
 
-    /* The turn peaks at 180 deg/s: a ±150 deg/s sensor saturates. */
+    /* The turn peaks at 180 deg/s, the full scale of a ±180 deg/s sensor: saturated. */
     config.has_range_dps = 1;
-    config.range_dps = 150.0f;
+    config.range_dps = 180.0f;
     run = turn(setup(&config), 90.0f, -1, 0);
     CHECK(run.ended == 1 && run.movement.saturated);
     CHECK(run.movement.verdict == GYRO_VERDICT_INVALID);
+    /* Told ±150 deg/s, the readings go beyond it: not that sensor's range, and without a
+     * clip plateau the turn is not flagged. */
+    config.range_dps = 150.0f;
+    GyroPipeline *told = setup(&config);
+    run = turn(told, 90.0f, -1, 0);
+    CHECK(run.ended == 1 && !run.movement.saturated);
+    CHECK(run.movement.verdict == GYRO_VERDICT_OK);
+    GyroPipelineInfo told_info;
+    CHECK_STATUS(gyro_pipeline_info(told, &told_info), GYRO_STATUS_OK);
+    CHECK(told_info.range_contradicted);
     config.has_range_dps = 0;
 
     /* A NaN in the middle of the turn: taken as the last rate, counted, judged invalid. */
