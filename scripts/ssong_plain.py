@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 from scipy.signal import butter, sosfiltfilt
 
-root = sys.argv[1] if len(sys.argv) > 1 else "../shared/data/real"
+root = sys.argv[1] if len(sys.argv) > 1 and __name__ == "__main__" else "../shared/data/real"
 sos = butter(4, 5.0, fs=1000.0, output="sos")
 
 
@@ -46,27 +46,43 @@ def effective_arw(g, ref, fs=100.0, window_s=100.0):
     return 60.0 * best
 
 
-print("recording            lag_ms   k_vs_encoder   bias_dps   N_deg_per_rt_h")
-for axis in "xyz":
-    for speed in ("slow", "medium"):
-        d = pd.read_csv(f"{root}/ssong_{axis}_{speed}.csv", comment="#").drop_duplicates("time_s")
-        t, g, ref = d.time_s.values, d.rate_dps.values, d.reference_deg.values
-        grid = np.arange(t[0], t[-1], 0.001)
-        gyro = sosfiltfilt(sos, np.interp(grid, t, g))
-        enc = sosfiltfilt(sos, np.gradient(np.interp(grid, t, ref), 0.001))
-        n, m = len(grid), 2000
-        def fit(lag):
-            a, b = gyro[m + lag:n - m + lag], enc[m:n - m]
-            design = np.c_[b, np.ones_like(b)]
-            c = np.linalg.lstsq(design, a, rcond=None)[0]
-            return np.sum((a - design @ c) ** 2), c
-        lags = range(-10, 40)
-        res = [fit(lag)[0] for lag in lags]
-        i = int(np.argmin(res))
-        best = lags[i]
-        if 0 < i < len(res) - 1:  # parabola through the minimum and its neighbours
-            y0, y1, y2 = res[i - 1], res[i], res[i + 1]
-            best = lags[i] + 0.5 * (y0 - y2) / (y0 - 2 * y1 + y2)
-        _, (scale, bias) = fit(lags[i])
-        arw = effective_arw(g, ref)
-        print(f"ssong_{axis}_{speed:<8} {best:8.2f}   {100 * (scale - 1):+8.2f} %   {bias:+8.3f}   {arw:8.1f}")
+def plain_fit(path):
+    """(lag in ms, refined by a parabola through the minimum; k; bias in deg/s) of one
+    recording: the shift and the least-squares fit gyro = (1 + k) * encoder_rate + b."""
+    d = pd.read_csv(path, comment="#").drop_duplicates("time_s")
+    t, g, ref = d.time_s.values, d.rate_dps.values, d.reference_deg.values
+    grid = np.arange(t[0], t[-1], 0.001)
+    gyro = sosfiltfilt(sos, np.interp(grid, t, g))
+    enc = sosfiltfilt(sos, np.gradient(np.interp(grid, t, ref), 0.001))
+    n, m = len(grid), 2000
+
+    def fit(lag):
+        a, b = gyro[m + lag:n - m + lag], enc[m:n - m]
+        design = np.c_[b, np.ones_like(b)]
+        c = np.linalg.lstsq(design, a, rcond=None)[0]
+        return np.sum((a - design @ c) ** 2), c
+
+    lags = range(-10, 40)
+    res = [fit(lag)[0] for lag in lags]
+    i = int(np.argmin(res))
+    best = lags[i]
+    if 0 < i < len(res) - 1:  # parabola through the minimum and its neighbours
+        y0, y1, y2 = res[i - 1], res[i], res[i + 1]
+        best = lags[i] + 0.5 * (y0 - y2) / (y0 - 2 * y1 + y2)
+    _, (scale, bias) = fit(lags[i])
+    return best, scale - 1.0, bias
+
+
+def main():
+    print("recording            lag_ms   k_vs_encoder   bias_dps   N_deg_per_rt_h")
+    for axis in "xyz":
+        for speed in ("slow", "medium"):
+            path = f"{root}/ssong_{axis}_{speed}.csv"
+            best, k, bias = plain_fit(path)
+            d = pd.read_csv(path, comment="#").drop_duplicates("time_s")
+            arw = effective_arw(d.rate_dps.values, d.reference_deg.values)
+            print(f"ssong_{axis}_{speed:<8} {best:8.2f}   {100 * k:+8.2f} %   {bias:+8.3f}   {arw:8.1f}")
+
+
+if __name__ == "__main__":
+    main()
