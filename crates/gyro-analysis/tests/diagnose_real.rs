@@ -36,6 +36,24 @@ fn load_at_100(name: String) -> Option<RealRun> {
     Some(RealRun::prepare(name, log).unwrap())
 }
 
+/// The rasteiro x recordings of both boards: at the speeds `train`, and at `holdout`;
+/// `None` when they are not beside the workspace.
+fn rasteiro_x(train: [&str; 2], holdout: &str) -> Option<(Vec<RealRun>, Vec<RealRun>)> {
+    let file =
+        |sensor: &str, speed: &str| format!("rasteiro/rasteiro_{sensor}RM3100_{speed}_x.csv");
+    let boards = ["MPU6050", "MPU6500"];
+    let train = boards
+        .iter()
+        .flat_map(|b| train.map(|v| file(b, v)))
+        .map(load_at_100)
+        .collect::<Option<Vec<_>>>()?;
+    let holdout = boards
+        .iter()
+        .map(|b| load_at_100(file(b, holdout)))
+        .collect::<Option<Vec<_>>>()?;
+    Some((train, holdout))
+}
+
 fn windows(file: &str, take: usize) -> Option<Vec<RealRun>> {
     let log = real_log(file, &GridOptions::default())?;
     Some(
@@ -181,20 +199,7 @@ fn a_lag_beyond_the_search_is_said() {
 /// as movements the reference does not follow.
 #[test]
 fn the_turns_show_the_lag_the_scale_and_the_tilt() {
-    let file =
-        |sensor: &str, speed: &str| format!("rasteiro/rasteiro_{sensor}RM3100_{speed}_x.csv");
-    let boards = ["MPU6050", "MPU6500"];
-    let (Some(train), Some(holdout)) = (
-        boards
-            .iter()
-            .flat_map(|b| ["V_300", "V_800"].map(|v| file(b, v)))
-            .map(load_at_100)
-            .collect::<Option<Vec<_>>>(),
-        boards
-            .iter()
-            .map(|b| load_at_100(file(b, "V1500")))
-            .collect::<Option<Vec<_>>>(),
-    ) else {
+    let Some((train, holdout)) = rasteiro_x(["V_300", "V_800"], "V1500") else {
         return;
     };
     let d = diagnose(&train, &holdout, &quick(500), &Silent).unwrap();
@@ -229,20 +234,7 @@ fn the_turns_show_the_lag_the_scale_and_the_tilt() {
 /// written; the turns' own, rest to rest (the plain line's −0.9% to −1.3% on x), is.
 #[test]
 fn a_lag_beyond_the_statistic_leaves_the_scale_to_the_turns() {
-    let file =
-        |sensor: &str, speed: &str| format!("rasteiro/rasteiro_{sensor}RM3100_{speed}_x.csv");
-    let boards = ["MPU6050", "MPU6500"];
-    let (Some(train), Some(holdout)) = (
-        boards
-            .iter()
-            .flat_map(|b| ["V_800", "V1500"].map(|v| file(b, v)))
-            .map(load_at_100)
-            .collect::<Option<Vec<_>>>(),
-        boards
-            .iter()
-            .map(|b| load_at_100(file(b, "V_300")))
-            .collect::<Option<Vec<_>>>(),
-    ) else {
+    let Some((train, holdout)) = rasteiro_x(["V_800", "V1500"], "V_300") else {
         return;
     };
     let d = diagnose(&train, &holdout, &quick(500), &Silent).unwrap();

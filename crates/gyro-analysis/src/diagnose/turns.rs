@@ -384,17 +384,21 @@ mod tests {
         (make(&[0.2, -0.1], "train"), make(&[0.05, -0.25], "held"))
     }
 
+    /// The turn evidence of `train` and `holdout` on top of `base`, default options.
+    fn evidence_of(
+        train: &[RealRun],
+        holdout: &[RealRun],
+        base: &ModelFile,
+    ) -> (Option<TurnEvidence>, Option<ModelFile>) {
+        let options = super::super::Options::default();
+        turn_evidence(train, &run_lags_s(train), holdout, base, &options)
+    }
+
     #[test]
     fn a_scale_and_a_long_lag_are_found_written_and_checked() {
         let (train, holdout) = runs(0.02, 0.1);
         let base = ModelFile::new(gyro_core::Config::default());
-        let (evidence, model) = turn_evidence(
-            &train,
-            &run_lags_s(&train),
-            &holdout,
-            &base,
-            &super::super::Options::default(),
-        );
+        let (evidence, model) = evidence_of(&train, &holdout, &base);
         let t = evidence.unwrap();
         assert_eq!((t.train_turns, t.holdout_turns), (4, 4));
         let lag = t.lag.unwrap();
@@ -426,13 +430,7 @@ mod tests {
     fn no_scale_and_no_lag_write_nothing() {
         let (train, holdout) = runs(0.0, 0.0);
         let base = ModelFile::new(gyro_core::Config::default());
-        let (evidence, model) = turn_evidence(
-            &train,
-            &run_lags_s(&train),
-            &holdout,
-            &base,
-            &super::super::Options::default(),
-        );
+        let (evidence, model) = evidence_of(&train, &holdout, &base);
         let t = evidence.unwrap();
         let lag = t.lag.unwrap();
         assert!(lag.median_s.abs() < 0.005 && !lag.beyond_statistic && !lag.written);
