@@ -110,6 +110,19 @@ impl ModelFile {
     }
 }
 
+/// The largest |rate| (deg/s) among `rates_dps` that the pipeline would accept (finite,
+/// within `max_abs_rate_dps`): what a log says of its sensor's range. 0 if none.
+pub fn largest_plausible_abs_rate(
+    rates_dps: impl IntoIterator<Item = f64>,
+    max_abs_rate_dps: f32,
+) -> f64 {
+    rates_dps
+        .into_iter()
+        .map(f64::abs)
+        .filter(|x| *x <= f64::from(max_abs_rate_dps))
+        .fold(0.0, f64::max)
+}
+
 /// Whether readings up to `largest_abs_rate_dps` (deg/s) contradict a full-scale range of
 /// `range_dps`: the pipeline's rule ([`gyro_core::beyond_range`]), a reading beyond the
 /// range by more than its margin.
@@ -307,6 +320,10 @@ mod tests {
         });
         assert_eq!(stated.drop_contradicted_range(450.5), None);
         assert_eq!(stated.range_dps(), Some(250.0));
+        // What a log says of the range: its largest reading the pipeline would accept.
+        let rates = [3.0, -451.0, f64::NAN, 2e4, -f64::INFINITY];
+        assert_eq!(largest_plausible_abs_rate(rates, 1e4), 451.0);
+        assert_eq!(largest_plausible_abs_rate([], 1e4), 0.0);
     }
 
     use super::*;

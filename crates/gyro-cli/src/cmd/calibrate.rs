@@ -126,13 +126,14 @@ pub fn run(args: &Args) -> Result<()> {
     {
         out.scale_sigma = u;
     }
-    let largest = train
-        .iter()
-        .chain(&holdout)
-        .flat_map(|run| &run.log.slots)
-        .map(|slot| slot.rate_dps.abs())
-        .filter(|x| *x <= f64::from(base.config.max_abs_rate_dps))
-        .fold(0.0, f64::max);
+    let largest = model::largest_plausible_abs_rate(
+        train
+            .iter()
+            .chain(&holdout)
+            .flat_map(|run| &run.log.slots)
+            .map(|slot| slot.rate_dps),
+        base.config.max_abs_rate_dps,
+    );
     if let Some(note) = out.drop_contradicted_range(largest) {
         say!("{}: {note}", args.out.display());
     }

@@ -225,12 +225,13 @@ pub fn run(args: &Args) -> Result<()> {
             .corrected_model
             .clone()
             .unwrap_or_else(|| options.base_model.clone());
-        let largest = train
-            .iter()
-            .chain(&holdout)
-            .map(|r| r.features.max_abs_rate_dps)
-            .filter(|x| *x <= f64::from(options.base_model.config.max_abs_rate_dps))
-            .fold(0.0, f64::max);
+        let largest = model::largest_plausible_abs_rate(
+            train
+                .iter()
+                .chain(&holdout)
+                .map(|r| r.features.max_abs_rate_dps),
+            options.base_model.config.max_abs_rate_dps,
+        );
         if let Some(note) = file.drop_contradicted_range(largest) {
             say!("{}: {note}", out.display());
         }

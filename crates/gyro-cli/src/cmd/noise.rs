@@ -207,7 +207,7 @@ pub fn run(args: &Args) -> Result<()> {
         let Some(source) = run.single() else {
             bail!("--model-out needs one log, or logs of one sample rate to pool")
         };
-        let file = match base {
+        let mut file = match base {
             Some(base) => model::ModelFile {
                 sensor: gyro_sim::SensorModel {
                     range_dps: base.sensor.range_dps,
@@ -217,6 +217,13 @@ pub fn run(args: &Args) -> Result<()> {
             },
             None => source.model_file(),
         };
+        let largest = model::largest_plausible_abs_rate(
+            loaded.iter().flat_map(|l| l.rate_dps.iter().copied()),
+            file.config.max_abs_rate_dps,
+        );
+        if let Some(note) = file.drop_contradicted_range(largest) {
+            say!("{}: {note}", out.display());
+        }
         model::save(out, &file)?;
         let s = &file.sensor;
         say!(
