@@ -78,6 +78,9 @@ fn static_log_json_table_and_model_file() {
     let json = json_of(&out);
     let entry = &json["logs"][0];
     assert_eq!(entry["file"], log.as_str());
+    // A static log is not said to move.
+    assert_eq!(f(&entry["moving_share"]), 0.0);
+    assert!(entry["warnings"].is_null());
     assert!(json["combined"].is_null());
     assert_eq!(entry["samples"], 100_001);
     let fit = &entry["fit"];
@@ -238,6 +241,21 @@ fn static_only_uses_the_rest_stretches_of_a_log_with_motion() {
         "{} vs {}",
         at_1s(&whole),
         at_1s(&rest)
+    );
+    // Taken whole, the log is said to move, in the JSON and the table (8 turns of 1.5 s
+    // and their filter tails in 210 s: about 6%); its rests alone are not.
+    let share = f(&whole["logs"][0]["moving_share"]);
+    assert!((0.04..0.1).contains(&share), "{share}");
+    let warnings = whole["logs"][0]["warnings"].to_string();
+    assert!(
+        warnings.contains("in motion by the motion detector"),
+        "{warnings}"
+    );
+    assert!(entry["moving_share"].is_null() && entry["warnings"].is_null());
+    let table = String::from_utf8_lossy(&gyro(&["noise", &log]).stdout).into_owned();
+    assert!(
+        table.contains("warning: ") && table.contains("--static-only"),
+        "{table}"
     );
 }
 

@@ -203,6 +203,9 @@ pub fn tables(logs: &[NoiseLog], run: &NoiseRun) -> String {
         } else {
             l.file.clone()
         };
+        if let Some(warning) = gyro_analysis::noise::moving_warning(l) {
+            let _ = writeln!(s, "warning: {warning}");
+        }
         let _ = writeln!(s, "{}", table(&label, r));
     }
     if let Some(c) = &run.combined {
@@ -219,6 +222,12 @@ struct LogJson<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     rest_stretches_s: Option<Vec<(f64, f64)>>,
     input: &'a gyro_log::Quality,
+    /// Share of the log in motion, when taken whole.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    moving_share: Option<f64>,
+    /// What makes the figures mean less than they seem (a log taken whole that moves).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    warnings: Vec<String>,
     #[serde(flatten)]
     result: &'a Characterization,
 }
@@ -246,6 +255,10 @@ pub fn json(
                 file: &l.file,
                 rest_stretches_s: rests_only.then(|| l.stretches_s()),
                 input: &l.input,
+                moving_share: l.moving_share,
+                warnings: gyro_analysis::noise::moving_warning(l)
+                    .into_iter()
+                    .collect(),
                 result: r,
             })
             .collect(),

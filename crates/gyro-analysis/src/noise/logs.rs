@@ -18,6 +18,23 @@ pub struct NoiseLog {
     pub segments: Vec<Range<usize>>,
     /// What was irregular in the log.
     pub input: Quality,
+    /// The share of the stretches used that the motion detector finds moving (0..1), when
+    /// the log is taken whole; `None` when only its rests are used.
+    pub moving_share: Option<f64>,
+}
+
+/// A log taken whole whose stretches are more than this share in motion is not a static
+/// log: its Allan deviation and PSD are the motion's, not the sensor's noise.
+pub const MOVING_SHARE_LIMIT: f64 = 0.01;
+
+/// The warning for `log` when it is taken whole and moves ([`MOVING_SHARE_LIMIT`]).
+pub fn moving_warning(log: &NoiseLog) -> Option<String> {
+    let share = log.moving_share.filter(|s| *s > MOVING_SHARE_LIMIT)?;
+    Some(format!(
+        "{}: {:.0}% of the log is in motion by the motion detector: its Allan deviation, PSD and fit are of the motion, not of the sensor's noise; use --static-only (its rests) or a static log",
+        log.file,
+        100.0 * share
+    ))
 }
 
 impl NoiseLog {

@@ -43,7 +43,9 @@ pub use allan::{AllanDeviation, AllanPoint, NoiseType, TauGrid, ONE_SIGMA};
 pub use chi2::chi2_quantile;
 pub use export::{ExportError, NoiseParams, YamlFormat};
 pub use fit::{fit, AllanFloor, FitOptions, FitTerm, GaussMarkovFit, NoiseFit};
-pub use logs::{characterize_logs, NoiseLog, NoiseLogsError, NoiseRun};
+pub use logs::{
+    characterize_logs, moving_warning, NoiseLog, NoiseLogsError, NoiseRun, MOVING_SHARE_LIMIT,
+};
 pub use psd::{welch, Psd, PsdBand, PsdOptions};
 pub use rest::rest_segments;
 

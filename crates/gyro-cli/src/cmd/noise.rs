@@ -87,14 +87,17 @@ pub struct Args {
 fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<NoiseLog> {
     let regular = super::load(path, &args.input, &args.grid)?;
     let rate: Vec<f64> = regular.slots.iter().map(|s| s.rate_dps).collect();
+    let rests = |margin_s: f64, min_rest_s: f64| {
+        noise::rest_segments(&regular, config, margin_s, min_rest_s).with_context(|| {
+            format!(
+                "{}: cannot configure the pipeline for this log",
+                path.display()
+            )
+        })
+    };
+    let mut moving_share = None;
     let segments = if args.static_only {
-        let segments = noise::rest_segments(&regular, config, args.margin_s, args.min_rest_s)
-            .with_context(|| {
-                format!(
-                    "{}: cannot configure the pipeline for this log",
-                    path.display()
-                )
-            })?;
+        let segments = rests(args.margin_s, args.min_rest_s)?;
         if segments.is_empty() {
             bail!(
                 "{}: no rest stretch of at least {} s found (--static-only)",
@@ -104,6 +107,9 @@ fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<NoiseLog
         }
         segments
     } else {
+        // Taken whole: how much of it moves (movements themselves, no margin).
+        let at_rest: usize = rests(0.0, 0.0)?.iter().map(ExactSizeIterator::len).sum();
+        moving_share = Some(1.0 - at_rest as f64 / rate.len().max(1) as f64);
         std::iter::once(0..rate.len()).collect()
     };
     Ok(NoiseLog {
@@ -112,6 +118,7 @@ fn load(path: &Path, args: &Args, config: &gyro_core::Config) -> Result<NoiseLog
         sample_rate_hz: regular.sample_rate_hz,
         segments,
         input: regular.quality,
+        moving_share,
     })
 }
 
@@ -250,9 +257,13 @@ pub fn run(args: &Args) -> Result<()> {
                 all => format!("{} logs pooled: {}", all.len(), all.join(", ")),
             },
             if args.static_only {
-                ", rest stretches only (--static-only)"
+                ", rest stretches only (--static-only)".to_string()
             } else {
-                ""
+                loaded
+                    .iter()
+                    .filter_map(noise::moving_warning)
+                    .map(|w| format!("; warning: {w}"))
+                    .collect()
             }
         );
         let params = noise::NoiseParams::from_allan(fitted, source)?;
