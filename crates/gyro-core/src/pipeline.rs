@@ -331,7 +331,35 @@ const BEYOND_FACTOR: f32 = (1.0 + RANGE_MARGIN) / (1.0 - RANGE_MARGIN);
 /// reading shows the range is not this sensor's ([`Pipeline::range_contradicted`]). The
 /// pipeline's own test, in its arithmetic.
 pub fn beyond_range(range_dps: f32, magnitude_dps: f32) -> bool {
-    range_flags(range_dps * (1.0 - RANGE_MARGIN), magnitude_dps) & CLIP_BEYOND != 0
+    let levels = ClipLevels::at(range_dps * (1.0 - RANGE_MARGIN));
+    range_flags(levels, magnitude_dps) & CLIP_BEYOND != 0
+}
+
+/// The |reading| levels the clip watch compares with, worked out once per call rather
+/// than per reading.
+#[derive(Clone, Copy)]
+struct ClipLevels {
+    /// A reading at or above it reaches the range.
+    reach_dps: f32,
+    /// A reading above it goes beyond the range.
+    beyond_dps: f32,
+}
+
+impl ClipLevels {
+    /// No range: neither level is ever met.
+    const NONE: Self = Self {
+        reach_dps: f32::INFINITY,
+        beyond_dps: f32::INFINITY,
+    };
+
+    /// The levels of a range reached at `reach_dps`.
+    #[inline(always)]
+    fn at(reach_dps: f32) -> Self {
+        Self {
+            reach_dps,
+            beyond_dps: reach_dps * BEYOND_FACTOR,
+        }
+    }
 }
 
 /// Whether flags `seen` during a movement make it saturated: a clip plateau, or the range
@@ -341,26 +369,25 @@ fn saturated_by(seen: u8) -> bool {
     (seen & CLIP_PLATEAU != 0) | ((seen & CLIP_RANGE != 0) & (seen & CLIP_BEYOND == 0))
 }
 
-/// The range flags of a reading of magnitude `magnitude` against the range level
-/// `level_dps`: [`CLIP_RANGE`] if it reaches it, and [`CLIP_BEYOND`] too if it goes beyond
-/// it by more than the margin.
+/// The range flags of a reading of magnitude `magnitude`: [`CLIP_RANGE`] if it reaches
+/// the range, and [`CLIP_BEYOND`] too if it goes beyond it by more than the margin.
 #[inline(always)]
-fn range_flags(level_dps: f32, magnitude: f32) -> u8 {
-    u8::from(magnitude >= level_dps) | (u8::from(magnitude > level_dps * BEYOND_FACTOR) << 2)
+fn range_flags(levels: ClipLevels, magnitude: f32) -> u8 {
+    u8::from(magnitude >= levels.reach_dps) | (u8::from(magnitude > levels.beyond_dps) << 2)
 }
 
 /// One reading through the clip watch: `last` and `run` (the last reading and how many
 /// times in a row it came, up to the plateau) move on; its flags: whether it reaches the
-/// range (`level_dps`) or goes beyond it ([`range_flags`]), or completes a clip plateau
-/// (see [`Movement::saturated`]). Judged on the reading, before correction.
+/// range or goes beyond it ([`range_flags`]), or completes a clip plateau (see
+/// [`Movement::saturated`]). Judged on the reading, before correction.
 #[inline(always)]
-fn clip_seen(level_dps: f32, last: &mut f32, run: &mut u8, reading_dps: f32) -> u8 {
+fn clip_seen(levels: ClipLevels, last: &mut f32, run: &mut u8, reading_dps: f32) -> u8 {
     // Without branches: whether a reading repeats is a coin toss on a quantised sensor.
     let repeat = u8::from(reading_dps == *last);
     *run = (run.saturating_add(1) & 0_u8.wrapping_sub(repeat)) | (1 - repeat);
     *last = reading_dps;
     let magnitude = libm::fabsf(reading_dps);
-    range_flags(level_dps, magnitude)
+    range_flags(levels, magnitude)
         | (u8::from((*run >= CLIP_PLATEAU_SAMPLES) & (magnitude >= CLIP_PLATEAU_MIN_DPS)) << 1)
 }
 
@@ -381,7 +408,7 @@ fn distinct_run(rates_dps: &[f32], last_dps: f32, run: u8) -> Option<DistinctRun
         return None;
     }
     let (mut last, mut run) = (last_dps, run);
-    let first_clipped = clip_seen(f32::INFINITY, &mut last, &mut run, first);
+    let first_clipped = clip_seen(ClipLevels::NONE, &mut last, &mut run, first);
     Some(DistinctRun {
         first_clipped,
         last_dps: rates_dps[rates_dps.len() - 1],
@@ -725,13 +752,14 @@ impl Pipeline {
 
         let mut block = self.decimator.run();
         let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
+        let levels = ClipLevels::at(self.clip_level_dps);
         let mut clipped = 0;
         for (i, &reading) in rates_dps.iter().enumerate() {
             if TEMPERATURE {
                 self.corrector.observe_temperature(temperatures_c[i]);
             }
             let rate = if self.plausible(reading) {
-                clipped |= clip_seen(self.clip_level_dps, &mut clip_last, &mut clip_run, reading);
+                clipped |= clip_seen(levels, &mut clip_last, &mut clip_run, reading);
                 self.corrected::<TEMPERATURE>(reading)
             } else {
                 // Replaced by the last rate the decimator took (0 before the first).
@@ -870,20 +898,20 @@ impl Pipeline {
         } else if let Some(distinct) = distinct_run(rates_dps, self.clip_last_dps, self.clip_run) {
             // No reading repeats the one before it, but perhaps the first: a plateau can
             // only complete there, and the watch ends on a run of one (or the first's).
-            let level_dps = self.clip_level_dps;
+            let levels = ClipLevels::at(self.clip_level_dps);
             for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
                 *clipped = block
                     .iter()
-                    .fold(0, |seen, &x| seen | range_flags(level_dps, libm::fabsf(x)));
+                    .fold(0, |seen, &x| seen | range_flags(levels, libm::fabsf(x)));
             }
             clipped[0] |= distinct.first_clipped;
             (self.clip_last_dps, self.clip_run) = (distinct.last_dps, distinct.run);
         } else {
             let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
+            let levels = ClipLevels::at(self.clip_level_dps);
             for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
                 for &reading in block {
-                    *clipped |=
-                        clip_seen(self.clip_level_dps, &mut clip_last, &mut clip_run, reading);
+                    *clipped |= clip_seen(levels, &mut clip_last, &mut clip_run, reading);
                 }
             }
             (self.clip_last_dps, self.clip_run) = (clip_last, clip_run);
@@ -993,8 +1021,14 @@ impl Pipeline {
     /// Whether the movement in progress (its confirming run included) is saturated so far;
     /// `false` at rest. For a host whose log ends while moving.
     pub fn movement_saturated(&self) -> bool {
-        let seen = self.clip_flags | self.track.as_ref().map_or(0, |track| track.saturation);
-        saturated_by(seen & (CLIP_PENDING | (self.clip_flags & CLIP_BEYOND)))
+        self.saturated(self.track.as_ref().map_or(0, |track| track.saturation))
+    }
+
+    /// Whether a movement whose clip flags are `seen` is saturated, with the flags not yet
+    /// handed to it and whether the range has been contradicted ([`saturated_by`]).
+    #[inline(always)]
+    fn saturated(&self, seen: u8) -> bool {
+        saturated_by(seen | self.clip_flags)
     }
 
     /// One step at the output rate.
@@ -1033,14 +1067,14 @@ impl Pipeline {
 
         // Saturation seen in this block goes to the movement in progress; during a run that
         // may become one it waits; at rest, or when the run is dropped, it is forgotten.
-        match (phase, self.track.as_mut()) {
-            (Phase::Rest | Phase::Aborted, _) => self.clip_flags &= CLIP_BEYOND,
-            (Phase::Onset | Phase::Started { .. }, _) => {}
-            (_, Some(track)) => {
-                track.saturation |= self.clip_flags & CLIP_PENDING;
-                self.clip_flags &= CLIP_BEYOND;
+        if !matches!(phase, Phase::Onset | Phase::Started { .. }) {
+            let pending = self.take_pending();
+            if let (false, Some(track)) = (
+                matches!(phase, Phase::Rest | Phase::Aborted),
+                self.track.as_mut(),
+            ) {
+                track.saturation |= pending;
             }
-            (_, None) => self.clip_flags &= CLIP_BEYOND,
         }
 
         let event = match phase {
@@ -1157,7 +1191,7 @@ impl Pipeline {
             end_index,
             angle_deg: self.angle_deg() - track.angle_at_start_deg,
             raw_angle_deg,
-            saturated: saturated_by(track.saturation | (self.clip_flags & CLIP_BEYOND)),
+            saturated: self.saturated(track.saturation),
             angle_std_deg: (self.compensation == Compensation::Kalman)
                 .then(|| self.kalman.movement_std_deg(end_index - track.start_index)),
         })
