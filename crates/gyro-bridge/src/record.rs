@@ -10,8 +10,9 @@
 //! | `/crm100/stats` (`crm100.Stats`) | the cumulative counters ([`RecordStats`]), every flush (0.25 s) and at the end | bridge time of the last good frame |
 //!
 //! plus a `gyro` metadata record: `sensor`, `sample_rate_hz`, `range_dps`, `lsb_per_dps`,
-//! `bridge_format`, `time_base`, `source`, `checks`. Every channel is a JSON channel with a
-//! `"type": "object"` JSON schema (Foxglove plots the fields directly).
+//! `bridge_format`, `time_base`, `source`, `checks`. `/gyro` is a ROS 2 message in CDR
+//! (`gyro_msgs/msg/Sample`), every other channel a JSON channel with a `"type": "object"`
+//! JSON schema (Foxglove plots the fields of both directly).
 //!
 //! # Frames that fail a check
 //! The raw frame is always written to `/crm100/raw` and the failure is counted and written

@@ -89,10 +89,21 @@ fn messages(path: &Path) -> Vec<Message> {
         .unwrap()
         .map(|m| {
             let m = m.unwrap();
+            // `/gyro` is CDR (gyro_msgs/msg/Sample): seen here as the same JSON fields.
+            let value = if m.channel.message_encoding == "cdr" {
+                let sample = log::decode_sample(&m.data).unwrap();
+                serde_json::json!({
+                    "rate_dps": sample.rate_dps,
+                    "temperature_c": sample.temperature_c,
+                    "status": sample.status,
+                })
+            } else {
+                serde_json::from_slice(&m.data).unwrap()
+            };
             Message {
                 topic: m.channel.topic.clone(),
                 log_time: m.log_time,
-                value: serde_json::from_slice(&m.data).unwrap(),
+                value,
             }
         })
         .collect()
@@ -227,7 +238,8 @@ fn sixty_seconds_with_faults_every_intact_frame_once_every_loss_counted() {
     assert_eq!(last_stats["frames"], stats.frames);
     assert_eq!(last_stats["crc_errors"], stats.crc_errors);
 
-    // Foxglove: every channel JSON with a "type": "object" JSON schema; the metadata.
+    // Foxglove: `/gyro` in CDR, every other channel JSON with a "type": "object" JSON
+    // schema; the metadata.
     let bytes = std::fs::read(&path).unwrap();
     let summary_section = mcap::Summary::read(&bytes).unwrap().unwrap();
     let mut topics: Vec<&str> = summary_section
@@ -241,6 +253,15 @@ fn sixty_seconds_with_faults_every_intact_frame_once_every_loss_counted() {
         ["/crm100/events", "/crm100/raw", "/crm100/stats", "/gyro"]
     );
     for channel in summary_section.channels.values() {
+        if channel.topic == "/gyro" {
+            // A ROS 2 message definition in CDR, which Foxglove plots as well.
+            let schema = channel.schema.as_ref().unwrap();
+            assert_eq!(channel.message_encoding, "cdr");
+            assert_eq!(schema.encoding, "ros2msg");
+            assert_eq!(schema.name, log::SAMPLE_SCHEMA_NAME);
+            assert_eq!(channel.metadata[log::HAS_TEMPERATURE_KEY], "true");
+            continue;
+        }
         assert_eq!(channel.message_encoding, "json");
         let schema = channel.schema.as_ref().unwrap();
         assert_eq!(schema.encoding, "jsonschema");

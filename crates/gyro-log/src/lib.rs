@@ -39,8 +39,9 @@ pub use csv_log::{
 };
 pub use load::{load, stream};
 pub use mcap::{
-    read_mcap, write_mcap, Axis, JsonChannel, McapLogWriter, McapOptions, McapRead, McapRows,
-    McapWriteOptions, TimeSource,
+    decode_reference, decode_sample, encode_reference, encode_sample, read_mcap, write_mcap, Axis,
+    GyroSample, JsonChannel, McapLogWriter, McapOptions, McapRead, McapRows, McapWriteOptions,
+    TimeSource, HAS_TEMPERATURE_KEY, REFERENCE_SCHEMA_NAME, SAMPLE_SCHEMA_NAME,
 };
 pub use regular::{
     place, regularize, GridOptions, LogInfo, Quality, RegularLog, Slot, SlotSink,
@@ -56,7 +57,7 @@ use std::path::{Path, PathBuf};
 pub enum LogFormat {
     /// CSV with `# key: value` metadata lines and a header.
     Csv,
-    /// MCAP (JSON channels `/gyro`, `/reference`; or a ROS 2 bag with an Imu channel).
+    /// MCAP (`/gyro`, `/reference` in CDR or JSON; or a ROS 2 bag with an Imu channel).
     Mcap,
 }
 

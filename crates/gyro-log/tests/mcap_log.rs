@@ -133,9 +133,10 @@ fn missing_values_columns_and_full_precision_survive() {
     assert!(e.contains("missing.mcap") && e.contains("row 7"), "{e}");
 }
 
-/// The written file, as the `mcap` crate sees it: what Foxglove needs to plot it.
+/// The written file, as the `mcap` crate sees it: what Foxglove needs to plot it (ROS 2
+/// message definitions in CDR, lz4 chunks).
 #[test]
-fn written_file_has_json_schemas_foxglove_plots() {
+fn written_file_has_ros_2_schemas_foxglove_plots() {
     let dir = temp_dir("schemas");
     let path = bench_mcap(&dir);
     let bytes = std::fs::read(&path).unwrap();
@@ -144,19 +145,37 @@ fn written_file_has_json_schemas_foxglove_plots() {
     topics.sort_unstable();
     assert_eq!(topics, ["/gyro", "/reference"]);
     for channel in summary.channels.values() {
-        assert_eq!(channel.message_encoding, "json");
+        assert_eq!(channel.message_encoding, "cdr");
         let schema = channel.schema.as_ref().unwrap();
-        assert_eq!(schema.encoding, "jsonschema");
-        let value: serde_json::Value = serde_json::from_slice(&schema.data).unwrap();
-        assert_eq!(value["type"], "object");
-        let fields: &[&str] = if channel.topic == "/gyro" {
-            &["rate_dps", "temperature_c", "status"]
+        assert_eq!(schema.encoding, "ros2msg");
+        let definition = std::str::from_utf8(&schema.data).unwrap();
+        let (name, fields): (&str, &[&str]) = if channel.topic == "/gyro" {
+            assert_eq!(channel.metadata["has_temperature"], "true");
+            (
+                "gyro_msgs/msg/Sample",
+                &["float64 rate_dps", "float64 temperature_c", "int64 status"],
+            )
         } else {
-            &["angle_deg"]
+            ("gyro_msgs/msg/Reference", &["float64 angle_deg"])
         };
-        for field in fields {
-            assert!(value["properties"][field].is_object(), "{field}");
-        }
+        assert_eq!(schema.name, name);
+        // The fields, in order, one per line before any comment.
+        let declared: Vec<String> = definition
+            .lines()
+            .map(|l| {
+                l.split('#')
+                    .next()
+                    .unwrap()
+                    .split_whitespace()
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            })
+            .filter(|l| !l.is_empty())
+            .collect();
+        assert_eq!(declared, fields, "{}", channel.topic);
+    }
+    for chunk in &summary.chunk_indexes {
+        assert_eq!(chunk.compression, "lz4");
     }
     let stats = summary.stats.as_ref().unwrap();
     assert_eq!(stats.message_count, 80_000);
@@ -171,14 +190,16 @@ fn written_file_has_json_schemas_foxglove_plots() {
         let message = message.unwrap();
         assert_eq!(message.log_time, message.publish_time);
         if seen < 2 {
-            let value: serde_json::Value = serde_json::from_slice(&message.data).unwrap();
             if message.channel.topic == "/gyro" {
+                // CDR little-endian: the header, then the fields at 8-byte alignment.
+                assert_eq!(message.data.len(), 28);
+                assert_eq!(message.data[..4], [0, 1, 0, 0]);
+                assert_eq!(message.data[4..12], 0.2083_f64.to_le_bytes());
+                assert_eq!(message.data[12..20], 25.03_f64.to_le_bytes());
+                assert_eq!(message.data[20..28], (-1_i64).to_le_bytes());
                 assert_eq!(message.log_time, 0);
-                assert_eq!(value["rate_dps"], 0.2083);
-                assert_eq!(value["temperature_c"], 25.03);
-                assert!(value["status"].is_null());
             } else {
-                assert_eq!(value["angle_deg"], 0.0);
+                assert_eq!(*message.data, [0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]);
             }
         }
         seen += 1;
@@ -225,7 +246,7 @@ fn incremental_writer_chunks_by_time_and_writes_extra_channels() {
         summary.chunk_indexes.len()
     );
     for chunk in &summary.chunk_indexes {
-        assert_eq!(chunk.compression, "zstd");
+        assert_eq!(chunk.compression, "lz4");
         let span = chunk.message_end_time - chunk.message_start_time;
         assert!(span < 500_000_000, "chunk spans {span} ns");
     }
@@ -233,6 +254,11 @@ fn incremental_writer_chunks_by_time_and_writes_extra_channels() {
     let mut stats = Vec::new();
     for message in mcap::MessageStream::new(&bytes).unwrap() {
         let message = message.unwrap();
+        if message.channel.topic == "/gyro" {
+            let sample = gyro_log::decode_sample(&message.data).unwrap();
+            assert_eq!(sample.status, Some(0x80));
+            continue;
+        }
         let value: serde_json::Value = serde_json::from_slice(&message.data).unwrap();
         match &*message.channel.topic {
             "/crm100/raw" => {
@@ -242,7 +268,6 @@ fn incremental_writer_chunks_by_time_and_writes_extra_channels() {
                 raw += 1;
             }
             "/crm100/stats" => stats.push(value["seq"].as_u64().unwrap()),
-            "/gyro" => assert_eq!(value["status"], 0x80),
             other => panic!("unexpected channel {other}"),
         }
     }
@@ -427,9 +452,64 @@ fn wrong_schemas_and_bad_messages_name_channel_and_message() {
     );
     let e = err(&path, &opts);
     assert!(
-        e.contains("s.mcap: channel `/gyro`: message encoding `cdr`, expected `json`"),
+        e.contains(
+            "s.mcap: channel `/gyro`: neither gyro_msgs/msg/Sample nor sensor_msgs/msg/Imu in \
+             CDR: schema `Foo`, expected gyro_msgs/msg/Sample"
+        ),
         "{e}"
     );
+
+    // The written CDR channels: a wrong schema encoding, a reference of another type, a
+    // message too short or in another CDR form, named by channel and message.
+    let sample = (
+        "/gyro",
+        "gyro_msgs/msg/Sample",
+        "ros2msg",
+        "float64 rate_dps\nfloat64 temperature_c\nint64 status",
+        "cdr",
+    );
+    handmade(
+        &path,
+        &[("/gyro", "gyro_msgs/msg/Sample", "ros2idl", "", "cdr")],
+        &[],
+    );
+    let e = err(&path, &opts);
+    assert!(
+        e.contains("schema `gyro_msgs/msg/Sample` has encoding `ros2idl`, expected `ros2msg`"),
+        "{e}"
+    );
+    handmade(
+        &path,
+        &[sample, ("/reference", "R", "ros2msg", "float64 deg", "cdr")],
+        &[],
+    );
+    let e = err(&path, &opts);
+    assert!(
+        e.contains("channel `/reference`: schema `R`, expected gyro_msgs/msg/Reference"),
+        "{e}"
+    );
+    let good = gyro_log::encode_sample(&gyro_log::GyroSample {
+        rate_dps: Some(1.5),
+        temperature_c: None,
+        status: None,
+    });
+    handmade(
+        &path,
+        &[sample],
+        &[(0, 0, &good), (0, 1000, b"\x00\x01\x00\x00")],
+    );
+    let e = err(&path, &opts);
+    assert!(
+        e.contains(
+            "channel `/gyro` message 2: 4 bytes, a gyro_msgs/msg/Sample message in CDR has 28"
+        ),
+        "{e}"
+    );
+    let mut xcdr = good;
+    xcdr[1] = 0x07;
+    handmade(&path, &[sample], &[(0, 0, &xcdr)]);
+    let e = err(&path, &opts);
+    assert!(e.contains("message 1: CDR encapsulation 0x0007"), "{e}");
 
     handmade(
         &path,
@@ -505,7 +585,7 @@ fn wrong_schemas_and_bad_messages_name_channel_and_message() {
     );
     let e = err(&path, &opts);
     assert!(
-        e.contains("no `/gyro` JSON channel") && e.contains("/other [O] (0 messages)"),
+        e.contains("no `/gyro` channel") && e.contains("/other [O] (0 messages)"),
         "{e}"
     );
     handmade(&path, &[gyro], &[]);
@@ -639,7 +719,9 @@ fn ros2_imu_bag_each_axis_sign_and_time_source() {
         &ros(Some("/chatter"), Axis::Z, false, TimeSource::Header),
     );
     assert!(
-        e.contains("channel `/chatter`: neither a gyro JSON channel nor sensor_msgs/msg/Imu"),
+        e.contains(
+            "channel `/chatter`: neither gyro_msgs/msg/Sample nor sensor_msgs/msg/Imu in CDR"
+        ),
         "{e}"
     );
 }

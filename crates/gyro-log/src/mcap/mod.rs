@@ -1,36 +1,42 @@
-//! MCAP logs (docs/log-formats.md, "MCAP"): JSON channels Foxglove plots directly, written
-//! incrementally in small zstd chunks, read chunk by chunk in constant memory; ROS 2 bags (`sensor_msgs/msg/Imu`
-//! in CDR) are read too.
+//! MCAP logs (docs/log-formats.md, "MCAP"): the samples as ROS 2 messages in CDR, which
+//! Foxglove plots, written incrementally in small lz4 chunks, read chunk by chunk in
+//! constant memory; earlier files with JSON samples, and ROS 2 bags
+//! (`sensor_msgs/msg/Imu` in CDR), are read too.
 //!
 //! # Layout written
 //!
-//! | channel | schema (encoding `jsonschema`) | message (encoding `json`) |
+//! | channel | schema | message |
 //! |---|---|---|
-//! | `/gyro` | `gyro.Sample` | `{"rate_dps": f64\|null, "temperature_c": f64\|null, "status": u32\|null}` |
-//! | `/reference` | `gyro.Reference` | `{"angle_deg": f64\|null}` |
-//! | `/crm100/raw` (from `record`) | `gyro.RawFrame` | `{"hex": "..."}` or any JSON object |
+//! | `/gyro` | `gyro_msgs/msg/Sample` (`ros2msg`) | CDR: `float64 rate_dps`, `float64 temperature_c`, `int64 status` |
+//! | `/reference` | `gyro_msgs/msg/Reference` (`ros2msg`) | CDR: `float64 angle_deg` |
+//! | `/crm100/raw` (from `record`) | `gyro.RawFrame` (`jsonschema`) | JSON `{"hex": "..."}` or any JSON object |
 //!
-//! Every schema is a JSON schema with `"type": "object"`. A message's `log_time` and
-//! `publish_time` are both the sample time in ns. `null` marks a missing value (an empty
-//! CSV field); `temperature_c` is left out of every message if the log has no temperature.
-//! The log's `# key: value` metadata is one MCAP metadata record named `gyro`.
+//! A message's `log_time` and `publish_time` are both the sample time in ns. NaN marks a
+//! missing value (an empty CSV field), −1 an unknown status; `/gyro`'s channel metadata
+//! `has_temperature` says whether the log has a temperature column. The log's
+//! `# key: value` metadata is one MCAP metadata record named `gyro`.
 //!
-//! Chunks are zstd-compressed and closed every 0.5 s of log time (see [`McapWriteOptions`]),
-//! with message indexes (Foxglove's indexed reader needs them; they are most of the size:
-//! about 52 bytes per 1 kHz sample with a reference, 187 MB per hour, against 134 MB of CSV).
+//! Chunks are lz4-compressed and closed every 0.5 s of log time (see [`McapWriteOptions`]),
+//! with message indexes (Foxglove's indexed reader needs them; they are half the size:
+//! 32 bytes per 1 kHz sample with a reference, 115 MB per hour, against 126 MB of CSV).
 //!
 //! Times are whole nanoseconds (u64): a CSV time with up to 9 decimals survives the trip
-//! exactly, values are JSON numbers in their shortest round-trip form and come back
-//! bit for bit.
+//! exactly; values are f64 and come back bit for bit.
 
 mod attach;
+mod binary;
 mod json;
 mod layout;
+mod lz4;
 mod read;
 mod ros2;
 mod unit;
 mod write;
 
+pub use binary::{
+    decode_reference, decode_sample, encode_reference, encode_sample, GyroSample,
+    HAS_TEMPERATURE_KEY, REFERENCE_LEN, REFERENCE_SCHEMA_NAME, SAMPLE_LEN, SAMPLE_SCHEMA_NAME,
+};
 pub use read::{read_mcap, McapOptions, McapRead, McapRows, REFERENCE_MAX_SPAN_S, TIME_ORIGIN_KEY};
 pub use ros2::{Axis, TimeSource, IMU_SCHEMA_NAME};
 pub use write::{write_mcap, JsonChannel, McapLogWriter, McapWriteOptions};

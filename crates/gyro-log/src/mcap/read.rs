@@ -3,13 +3,14 @@
 //! reference samples attached by time.
 //!
 //! # Which channel gives the rate
-//! `--topic` if given (a JSON channel like `/gyro`, or a ROS 2 `sensor_msgs/msg/Imu`);
+//! `--topic` if given (a `gyro_msgs/msg/Sample` channel like `/gyro`, a JSON channel of
+//! earlier files, or a ROS 2 `sensor_msgs/msg/Imu`);
 //! otherwise `/gyro`, or else the one `sensor_msgs/msg/Imu` channel in CDR. If two such
 //! channels carry messages, reading fails and asks for `--topic`. Other channels are
 //! skipped without being decoded.
 //!
 //! # Time
-//! `time_s` is the log time (JSON channels) or the chosen ROS 2 stamp, in seconds. ROS 2
+//! `time_s` is the log time (`/gyro` and JSON channels) or the chosen ROS 2 stamp, in seconds. ROS 2
 //! stamps count from the Unix epoch, where an `f64` second resolves only about 0.24 µs; so
 //! for an Imu channel `time_s` counts from the whole second at or before the earliest
 //! sample, and the metadata key [`TIME_ORIGIN_KEY`] holds that second.
@@ -25,11 +26,12 @@
 //! channels share chunks in time order, at most a chunk's worth), never the log.
 //!
 //! # Reference attachment
-//! Reference samples (`/reference`, `{"angle_deg": f64|null}`) are attached to rate rows by
+//! Reference samples (`/reference`, `gyro_msgs/msg/Reference` or JSON
+//! `{"angle_deg": f64|null}`) are attached to rate rows by
 //! log time (neither channel needs to be sorted; a row waits until no unread chunk can
 //! hold a reference that decides it):
 //! - a reference message at exactly a row's time gives that row its value (`null`: the row
-//!   has no reference); the k-th of several rows with one time stamp takes the k-th
+//!   has no reference; so does NaN in CDR); the k-th of several rows with one time stamp takes the k-th
 //!   reference message with that time, in the order read;
 //! - otherwise the value is interpolated linearly between the latest earlier and the
 //!   earliest later reference message, if both are non-null and at most
@@ -47,6 +49,7 @@
 //! channel and 1-based message index on that channel).
 
 use super::attach::Attacher;
+use super::binary::{self, HAS_TEMPERATURE_KEY, REFERENCE_SCHEMA_NAME, SAMPLE_SCHEMA_NAME};
 use super::layout::{self, Layout};
 use super::ros2::{decode_imu, Axis, TimeSource, IMU_SCHEMA_NAME};
 use super::unit::{Event, UnitError, Units, UnitsAhead};
@@ -69,11 +72,12 @@ pub const TIME_ORIGIN_KEY: &str = "time_origin_s";
 #[derive(Clone, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct McapOptions {
-    /// MCAP: channel with the rate, a JSON channel like `/gyro` or a ROS 2
+    /// MCAP: channel with the rate, a gyro channel like `/gyro` (CDR or JSON) or a ROS 2
     /// `sensor_msgs/msg/Imu` (default: `/gyro`, else the only Imu channel).
     #[cfg_attr(feature = "clap", arg(long))]
     pub topic: Option<String>,
-    /// MCAP: JSON channel with the reference angle (`{"angle_deg": ...}`).
+    /// MCAP: channel with the reference angle (`gyro_msgs/msg/Reference`, or JSON
+    /// `{"angle_deg": ...}`).
     #[cfg_attr(feature = "clap", arg(long, default_value = REFERENCE_TOPIC))]
     pub reference_topic: String,
     /// ROS 2 Imu: component of `angular_velocity` used as the rate (rad/s → deg/s).
@@ -118,11 +122,16 @@ pub struct McapRead {
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 enum Kind {
+    /// A `gyro_msgs/msg/Sample` channel in CDR (what the writer writes); `temperature`: the
+    /// log has a temperature column.
+    GyroCdr { temperature: bool },
     /// A JSON channel of gyro samples (`rate_dps`, ...).
     GyroJson,
     /// A ROS 2 Imu channel in CDR.
     Imu,
-    /// The JSON reference channel.
+    /// The reference channel in CDR (`gyro_msgs/msg/Reference`).
+    ReferenceCdr,
+    /// The reference channel in JSON.
     Reference,
     /// Not used.
     Ignored,
@@ -611,7 +620,7 @@ impl State {
                     .schemas
                     .get(&channel.schema_id)
                     .map_or(String::new(), |s| s.name.clone());
-                if kind == Kind::Reference {
+                if matches!(kind, Kind::Reference | Kind::ReferenceCdr) {
                     self.has_reference = true;
                 }
                 self.channels.insert(
@@ -654,6 +663,10 @@ impl State {
         };
         let is_imu = schema.is_some_and(|s| s.name == IMU_SCHEMA_NAME);
         if topic == self.options.reference_topic {
+            if channel.message_encoding == binary::MESSAGE_ENCODING {
+                check_cdr(schema, REFERENCE_SCHEMA_NAME).map_err(fail)?;
+                return Ok(Kind::ReferenceCdr);
+            }
             check_json(&channel.message_encoding, schema, "angle_deg").map_err(fail)?;
             return Ok(Kind::Reference);
         }
@@ -676,10 +689,22 @@ impl State {
             }
             return Ok(Kind::Imu);
         }
+        if channel.message_encoding == binary::MESSAGE_ENCODING {
+            check_cdr(schema, SAMPLE_SCHEMA_NAME).map_err(|e| {
+                fail(format!(
+                    "neither {SAMPLE_SCHEMA_NAME} nor {IMU_SCHEMA_NAME} in CDR: {e}"
+                ))
+            })?;
+            let temperature = channel
+                .metadata
+                .get(HAS_TEMPERATURE_KEY)
+                .is_none_or(|v| v != "false");
+            return Ok(Kind::GyroCdr { temperature });
+        }
         check_json(&channel.message_encoding, schema, "rate_dps").map_err(|e| {
             if self.options.topic.is_some() {
                 fail(format!(
-                    "neither a gyro JSON channel nor {IMU_SCHEMA_NAME} in CDR: {e}"
+                    "neither a gyro channel ({SAMPLE_SCHEMA_NAME} in CDR, or JSON) nor {IMU_SCHEMA_NAME} in CDR: {e}"
                 ))
             } else {
                 fail(e)
@@ -716,6 +741,10 @@ impl State {
         };
         match channel.kind {
             Kind::Ignored => {}
+            Kind::ReferenceCdr => {
+                let angle = binary::decode_reference(data).map_err(fail)?;
+                self.attacher.reference(header.log_time, angle);
+            }
             Kind::Reference => {
                 let angle = json::reference(data)
                     .map_err(|e| fail(format!("not a reference JSON message: {e}")))?
@@ -723,7 +752,7 @@ impl State {
                 self.attacher
                     .reference(header.log_time, angle.filter(|a| a.is_finite()));
             }
-            Kind::GyroJson | Kind::Imu => {
+            Kind::GyroCdr { .. } | Kind::GyroJson | Kind::Imu => {
                 match &self.rate_channel {
                     None => {
                         self.rate_channel = Some((
@@ -760,6 +789,10 @@ impl State {
                         }
                     };
                     (time_ns, sample.rate_dps, None)
+                } else if let Kind::GyroCdr { temperature } = channel.kind {
+                    let sample = binary::decode_sample(data).map_err(fail)?;
+                    self.has_temperature |= temperature;
+                    (header.log_time, sample.rate_dps, sample.temperature_c)
                 } else {
                     let message = json::gyro(data)
                         .map_err(|e| fail(format!("not a gyro JSON message: {e}")))?;
@@ -803,12 +836,12 @@ impl State {
             None if self
                 .channels
                 .values()
-                .any(|c| matches!(c.kind, Kind::GyroJson | Kind::Imu)) =>
+                .any(|c| matches!(c.kind, Kind::GyroCdr { .. } | Kind::GyroJson | Kind::Imu)) =>
             {
                 "no messages on the rate channel".to_string()
             }
             None => {
-                format!("no `{GYRO_TOPIC}` JSON channel and no {IMU_SCHEMA_NAME} channel in CDR")
+                format!("no `{GYRO_TOPIC}` channel and no {IMU_SCHEMA_NAME} channel in CDR")
             }
         };
         let damage = if !damaged {
@@ -820,6 +853,20 @@ impl State {
             path: self.path.to_path_buf(),
             message: format!("{what}{damage}; channels: {listed}"),
         }
+    }
+}
+
+/// Check a CDR channel's schema: `name` in `ros2msg`.
+fn check_cdr(schema: Option<&SchemaInfo>, name: &str) -> Result<(), String> {
+    match schema {
+        None => Err(format!("a CDR channel without a schema; expected {name}")),
+        Some(s) if s.name != name => Err(format!("schema `{}`, expected {name}", s.name)),
+        Some(s) if s.encoding != binary::SCHEMA_ENCODING => Err(format!(
+            "schema `{name}` has encoding `{}`, expected `{}`",
+            s.encoding,
+            binary::SCHEMA_ENCODING
+        )),
+        Some(_) => Ok(()),
     }
 }
 

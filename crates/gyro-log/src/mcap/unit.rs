@@ -1,11 +1,13 @@
 //! Reading the data section unit by unit ([`Unit`]: a chunk or a loose message), in the
-//! order the layout gives. A chunk compressed with zstd (or not compressed) is read whole,
+//! order the layout gives. A chunk compressed with lz4 or zstd (or not compressed) is read whole,
 //! decompressed in one call straight into the batch handed to the decoding thread, its
 //! CRC checked (over the decompressed records, before any of them is given), and its
 //! records given in place, without a copy. Any other unit (a loose message, a chunk in
-//! lz4) goes through one `mcap` linear reader, fed the units' bytes one after the other.
+//! another compression) goes through one `mcap` linear reader, fed the units' bytes one
+//! after the other.
 
 use super::layout::{Unit, RECORD_HEADER_LEN, RECORD_LENGTH_LIMIT};
+use super::lz4;
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::McapError;
 use std::fs::File;
@@ -114,7 +116,7 @@ impl Units {
         Ok(true)
     }
 
-    /// The chunk in `raw`, if compressed with zstd or not at all: decompressed into
+    /// The chunk in `raw`, if compressed with lz4, zstd or not at all: decompressed into
     /// `batch.data`, CRC-checked, its records listed. `Ok(false)` for another compression.
     fn chunk(&mut self, offset: u64, batch: &mut Batch) -> Result<bool, UnitError> {
         let damaged = |what: String| UnitError::Damaged { offset, what };
@@ -137,9 +139,10 @@ impl Units {
             .filter(|&end| end <= body.len())
             .ok_or_else(too_short)?;
         let compression = &body[CHUNK_FIXED_LEN..name_end];
-        let zstd = match compression {
-            b"zstd" => true,
-            b"" => false,
+        let codec = match compression {
+            b"zstd" => Codec::Zstd,
+            b"lz4" => Codec::Lz4,
+            b"" => Codec::None,
             _ => return Ok(false),
         };
         let compressed_size = u64_at(name_end).ok_or_else(too_short)?;
@@ -158,8 +161,17 @@ impl Units {
             )));
         }
         let start = batch.data.len();
-        if zstd {
-            let size = uncompressed_size as usize;
+        let size = uncompressed_size as usize;
+        if codec == Codec::Lz4 {
+            batch.data.resize(start + size, 0);
+            let decoded = lz4::decompress_frame(compressed, &mut batch.data[start..]);
+            if let Err(what) = decoded {
+                batch.data.truncate(start);
+                return Err(damaged(format!(
+                    "the chunk does not decompress (lz4: {what})"
+                )));
+            }
+        } else if codec == Codec::Zstd {
             batch.data.reserve(size);
             let decompressor = match &mut self.zstd {
                 Some(d) => d,
@@ -268,6 +280,14 @@ impl Units {
             }
         }
     }
+}
+
+/// How a chunk's records are compressed (the chunk record's `compression`).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Codec {
+    None,
+    Zstd,
+    Lz4,
 }
 
 /// Batches in flight between the threads of [`UnitsAhead`].

@@ -1,6 +1,7 @@
 //! Writing MCAP logs incrementally, in chunks small enough that a killed writer loses at
 //! most the last [`McapWriteOptions::max_chunk_duration_ns`] of data.
 
+use super::binary::{self, GyroSample};
 use super::{seconds_to_ns, GYRO_TOPIC, METADATA_NAME, RAW_TOPIC, REFERENCE_TOPIC};
 use crate::{Log, LogError, Row};
 use mcap::records::{MessageHeader, Metadata};
@@ -10,30 +11,6 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
-
-/// JSON schema of `/gyro` messages.
-pub(super) const GYRO_SCHEMA: &str = r#"{
-  "title": "gyro.Sample",
-  "description": "One gyro sample; log_time is the sample time (ns)",
-  "type": "object",
-  "properties": {
-    "rate_dps": {"type": ["number", "null"], "description": "angular rate (deg/s); null: missing"},
-    "temperature_c": {"type": ["number", "null"], "description": "sensor temperature (degC); null: missing"},
-    "status": {"type": ["integer", "null"], "minimum": 0, "description": "raw sensor status word; null: unknown"}
-  },
-  "required": ["rate_dps"]
-}"#;
-
-/// JSON schema of `/reference` messages.
-pub(super) const REFERENCE_SCHEMA: &str = r#"{
-  "title": "gyro.Reference",
-  "description": "Reference (encoder) angle; log_time is the sample time (ns)",
-  "type": "object",
-  "properties": {
-    "angle_deg": {"type": ["number", "null"], "description": "reference angle (deg); null: missing"}
-  },
-  "required": ["angle_deg"]
-}"#;
 
 /// JSON schema of raw frames written with [`McapLogWriter::write_raw`].
 const RAW_SCHEMA: &str = r#"{
@@ -58,12 +35,13 @@ pub struct McapWriteOptions {
     pub max_chunk_duration_ns: u64,
     /// A chunk is also closed once it holds this many uncompressed bytes. Default 1 MiB.
     pub max_chunk_bytes: usize,
-    /// Write `temperature_c` in `/gyro` messages (`null` when a row has none). Default true.
+    /// The log has a temperature column: the `/gyro` channel's `has_temperature` metadata
+    /// (messages carry `temperature_c` either way, NaN when a row has none). Default true.
     pub has_temperature: bool,
-    /// Create the `/reference` channel up front, and write `null` for rows without a
+    /// Create the `/reference` channel up front, and write NaN for rows without a
     /// reference; otherwise it is created at the first row with one. Default false.
     pub has_reference: bool,
-    /// zstd level (0: zstd's default, 3). Default 0.
+    /// lz4 level (0: lz4's fast default). Default 0.
     pub compression_level: u32,
 }
 
@@ -84,25 +62,12 @@ impl Default for McapWriteOptions {
 pub struct JsonChannel(u16);
 
 #[derive(Serialize)]
-struct GyroMessage {
-    rate_dps: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    temperature_c: Option<Option<f64>>,
-    status: Option<u32>,
-}
-
-#[derive(Serialize)]
-struct ReferenceMessage {
-    angle_deg: Option<f64>,
-}
-
-#[derive(Serialize)]
 struct RawMessage<'a> {
     hex: &'a str,
 }
 
-/// Writes a log as MCAP while it is being recorded: `/gyro`, `/reference` and any extra
-/// JSON channels, zstd chunks closed every [`McapWriteOptions::max_chunk_duration_ns`] of
+/// Writes a log as MCAP while it is being recorded: `/gyro`, `/reference` (CDR, see the
+/// module docs) and any extra JSON channels, lz4 chunks closed every [`McapWriteOptions::max_chunk_duration_ns`] of
 /// log time, metadata as a `gyro` metadata record.
 ///
 /// Call [`finish`](Self::finish) at the end: it writes the summary and footer. A writer
@@ -150,7 +115,7 @@ impl McapLogWriter {
         })?;
         let err = |e| write_error(path, e);
         let mut writer = WriteOptions::new()
-            .compression(Some(Compression::Zstd))
+            .compression(Some(Compression::Lz4))
             .compression_level(options.compression_level)
             // One thread: chunks are small, and the machine is shared with the pipeline.
             .compression_threads(0)
@@ -161,7 +126,18 @@ impl McapLogWriter {
             .library(concat!("gyro-cli ", env!("CARGO_PKG_VERSION")))
             .create(BufWriter::with_capacity(1 << 16, file))
             .map_err(err)?;
-        let gyro = add_channel(&mut writer, GYRO_TOPIC, "gyro.Sample", GYRO_SCHEMA).map_err(err)?;
+        let temperature = [(
+            binary::HAS_TEMPERATURE_KEY.to_string(),
+            options.has_temperature.to_string(),
+        )];
+        let gyro = add_cdr_channel(
+            &mut writer,
+            GYRO_TOPIC,
+            binary::SAMPLE_SCHEMA_NAME,
+            binary::SAMPLE_DEFINITION,
+            &temperature.into(),
+        )
+        .map_err(err)?;
         let mut this = Self {
             path: path.to_path_buf(),
             writer,
@@ -200,7 +176,7 @@ impl McapLogWriter {
         Ok(())
     }
 
-    /// Write one row: a `/gyro` message (status `null`) and, if the row has a reference
+    /// Write one row: a `/gyro` message (status −1, unknown) and, if the row has a reference
     /// or the writer was created with `has_reference`, a `/reference` message, both at the
     /// row's time. Fails on a time below 0 or beyond u64 nanoseconds.
     pub fn write_row(&mut self, row: &Row) -> Result<(), LogError> {
@@ -218,7 +194,8 @@ impl McapLogWriter {
         Ok(())
     }
 
-    /// Write a `/gyro` message. Non-finite values are written as `null`.
+    /// Write a `/gyro` message. Missing and non-finite values are written as NaN, no
+    /// status as −1.
     pub fn write_gyro(
         &mut self,
         time_ns: u64,
@@ -226,12 +203,12 @@ impl McapLogWriter {
         temperature_c: Option<f64>,
         status: Option<u32>,
     ) -> Result<(), LogError> {
-        let message = GyroMessage {
+        let message = binary::encode_sample(&GyroSample {
             rate_dps,
-            temperature_c: self.options.has_temperature.then_some(temperature_c),
+            temperature_c: temperature_c.filter(|_| self.options.has_temperature),
             status,
-        };
-        self.write_serialized(self.gyro, time_ns, &message)
+        });
+        self.write_bytes(self.gyro, time_ns, &message)
     }
 
     /// Write a `/reference` message (creating the channel at the first one).
@@ -241,7 +218,7 @@ impl McapLogWriter {
         angle_deg: Option<f64>,
     ) -> Result<(), LogError> {
         let channel = self.reference_channel()?;
-        self.write_serialized(channel, time_ns, &ReferenceMessage { angle_deg })
+        self.write_bytes(channel, time_ns, &binary::encode_reference(angle_deg))
     }
 
     /// Add a JSON channel: `schema` must be a JSON schema with `"type": "object"` (what
@@ -331,11 +308,12 @@ impl McapLogWriter {
         if let Some(id) = self.reference {
             return Ok(id);
         }
-        let id = add_channel(
+        let id = add_cdr_channel(
             &mut self.writer,
             REFERENCE_TOPIC,
-            "gyro.Reference",
-            REFERENCE_SCHEMA,
+            binary::REFERENCE_SCHEMA_NAME,
+            binary::REFERENCE_DEFINITION,
+            &BTreeMap::new(),
         )
         .map_err(|e| write_error(&self.path, e))?;
         self.reference = Some(id);
@@ -348,11 +326,18 @@ impl McapLogWriter {
         time_ns: u64,
         message: &impl Serialize,
     ) -> Result<(), LogError> {
-        self.buf.clear();
-        serde_json::to_writer(&mut self.buf, message).map_err(|e| LogError::Mcap {
+        let mut buf = std::mem::take(&mut self.buf);
+        buf.clear();
+        let encoded = serde_json::to_writer(&mut buf, message).map_err(|e| LogError::Mcap {
             path: self.path.clone(),
             message: format!("cannot encode a message as JSON: {e}"),
-        })?;
+        });
+        let result = encoded.and_then(|()| self.write_bytes(channel_id, time_ns, &buf));
+        self.buf = buf;
+        result
+    }
+
+    fn write_bytes(&mut self, channel_id: u16, time_ns: u64, data: &[u8]) -> Result<(), LogError> {
         self.roll_chunk(time_ns)?;
         let sequence = self.sequences.entry(channel_id).or_insert(0);
         let header = MessageHeader {
@@ -363,10 +348,10 @@ impl McapLogWriter {
         };
         *sequence = sequence.wrapping_add(1);
         self.writer
-            .write_to_known_channel(&header, &self.buf)
+            .write_to_known_channel(&header, data)
             .map_err(|e| write_error(&self.path, e))?;
         self.chunk_start_ns.get_or_insert(time_ns);
-        self.chunk_bytes += self.buf.len() + MESSAGE_OVERHEAD;
+        self.chunk_bytes += data.len() + MESSAGE_OVERHEAD;
         Ok(())
     }
 
@@ -392,6 +377,18 @@ fn add_channel(
 ) -> Result<u16, McapError> {
     let schema_id = writer.add_schema(schema_name, "jsonschema", schema.as_bytes())?;
     writer.add_channel(schema_id, topic, "json", &BTreeMap::new())
+}
+
+fn add_cdr_channel(
+    writer: &mut Writer<BufWriter<File>>,
+    topic: &str,
+    schema_name: &str,
+    definition: &str,
+    metadata: &BTreeMap<String, String>,
+) -> Result<u16, McapError> {
+    let schema_id =
+        writer.add_schema(schema_name, binary::SCHEMA_ENCODING, definition.as_bytes())?;
+    writer.add_channel(schema_id, topic, binary::MESSAGE_ENCODING, metadata)
 }
 
 fn write_error(path: &Path, e: McapError) -> LogError {
