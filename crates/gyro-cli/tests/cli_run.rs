@@ -816,3 +816,60 @@ fn rows_stamped_by_a_coarse_timer_keep_their_angles() {
         assert!(error.abs() < 0.1, "{m}");
     }
 }
+
+/// Stamps from Arduino's `micros()` (a 32-bit count of µs) that wraps 25 s into the bench
+/// log: read with `--time-unit us`, the wrap is unwrapped and said (`counter_wraps`, the
+/// line), and every movement is the one of the same log without the wrap.
+#[test]
+fn a_micros_counter_that_wraps_is_unwrapped_and_said() {
+    let dir = temp_dir("micros");
+    let span_us = 4_294_967_296.0;
+    let count = |t: f64| (t * 1e6).round() + span_us - 25e6;
+    let unwrapped = write(&dir, "unwrapped.csv", &bench_with("time_s", count));
+    let wrapped = write(
+        &dir,
+        "micros.csv",
+        &bench_with("time_s", |t| count(t).rem_euclid(span_us)),
+    );
+    let run = |log: &str| {
+        json_of(&gyro(&[
+            "run",
+            log,
+            "--format",
+            "json",
+            "--time-unit",
+            "us",
+        ]))
+    };
+    let (expected, got) = (run(&unwrapped), run(&wrapped));
+    let input = &got["input"];
+    assert_eq!(input["counter_wraps"].as_u64(), Some(1), "{input}");
+    assert_eq!(
+        input["counter_span_s"].as_f64(),
+        Some(4294.967296),
+        "{input}"
+    );
+    assert_eq!(input["backward_steps"].as_u64(), Some(0), "{input}");
+    assert_eq!(expected["input"]["counter_wraps"].as_u64(), Some(0));
+    let first = &input["examples"][0];
+    assert_eq!(
+        first[0],
+        "time stamps wrap: a 32-bit count of µs (4294.967296 s), unwrapped"
+    );
+    assert_eq!(first[1].as_u64(), Some(25_005), "{first}"); // 4 header lines, 25 000 rows
+    let movements = |out: &serde_json::Value| -> Vec<f64> {
+        out["movements"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m["angle_deg"].as_f64().unwrap())
+            .collect()
+    };
+    assert!(movements(&got).len() >= 2);
+    assert_eq!(movements(&got), movements(&expected));
+    let table = printed(&["run", &wrapped, "--time-unit", "us"]);
+    assert!(
+        table.contains("1 wraps of the time stamps' counter unwrapped"),
+        "{table}"
+    );
+}

@@ -345,10 +345,11 @@ impl CsvRows {
                 line: header_line,
                 column: excerpt(name.as_bytes()),
                 available: column_list(&names),
+                hint: String::new(),
             })
         };
-        let time = required(&columns.time_column)?;
-        let rate = required(&columns.rate_column)?;
+        let time = required(&columns.time_column).map_err(|e| with_hint(e, &names, Role::Time))?;
+        let rate = required(&columns.rate_column).map_err(|e| with_hint(e, &names, Role::Rate))?;
         let columns = Columns {
             path: path.to_path_buf(),
             names: columns.clone(),
@@ -460,6 +461,67 @@ impl CsvRows {
 
 /// The header's columns as an error lists them: the first few, each as [`excerpt`]
 /// shows it, then how many there are.
+/// Which required column a hint is for.
+#[derive(Clone, Copy)]
+enum Role {
+    Time,
+    Rate,
+}
+
+/// `error` (a missing time or rate column) with a hint naming the option that would read
+/// the header's column that looks meant: the first whose name starts with `time`
+/// (`timestamp`, `time_ms`, …) or is `t`, or starts with `rate`, `gyro` or `omega`; with
+/// the unit its suffix names (`_ms`, `_us`, `_ns`; `_rads`, `_rad_s`, `_radps`).
+fn with_hint(error: LogError, names: &[String], role: Role) -> LogError {
+    let LogError::MissingColumn {
+        path,
+        line,
+        column,
+        available,
+        ..
+    } = error
+    else {
+        return error;
+    };
+    let lower: Vec<String> = names
+        .iter()
+        .map(|n| n.trim().to_ascii_lowercase())
+        .collect();
+    let found = lower.iter().position(|n| match role {
+        Role::Time => n.starts_with("time") || n == "t",
+        Role::Rate => ["rate", "gyro", "omega"].iter().any(|p| n.starts_with(p)),
+    });
+    let hint = found.map_or(String::new(), |i| {
+        let name = &lower[i];
+        let unit = match role {
+            Role::Time => [("_ms", "ms"), ("_us", "us"), ("_ns", "ns")]
+                .iter()
+                .find(|(suffix, _)| name.ends_with(suffix))
+                .map(|(_, unit)| format!(" --time-unit {unit}")),
+            Role::Rate => ["_rads", "_rad_s", "_radps"]
+                .iter()
+                .any(|suffix| name.ends_with(suffix))
+                .then(|| " --rate-unit rads".to_string()),
+        };
+        let option = match role {
+            Role::Time => "--time-column",
+            Role::Rate => "--rate-column",
+        };
+        format!(
+            "; to read `{0}`, give {option} {0}{1}",
+            excerpt(names[i].as_bytes()),
+            unit.unwrap_or_default()
+        )
+    });
+    LogError::MissingColumn {
+        path,
+        line,
+        column,
+        available,
+        hint,
+    }
+}
+
 fn column_list(names: &[String]) -> String {
     const LISTED: usize = 6;
     let mut list = names
@@ -1101,6 +1163,39 @@ mod tests {
             .to_string();
         assert!(err.contains("nocol.csv:1: no column `rate_dps`"), "{err}");
         assert!(err.contains("time_s, gyro"), "{err}");
+        assert!(
+            err.ends_with("; to read `gyro`, give --rate-column gyro"),
+            "{err}"
+        );
+
+        // A time or rate column under another name: the option that reads it, with the
+        // unit its name gives; none when nothing looks meant.
+        for (header, hint) in [
+            (
+                "time_ms,rate_dps",
+                "; to read `time_ms`, give --time-column time_ms --time-unit ms",
+            ),
+            (
+                "Timestamp,rate_dps",
+                "; to read `Timestamp`, give --time-column Timestamp",
+            ),
+            ("t,rate_dps", "; to read `t`, give --time-column t"),
+            (
+                "time_s,gyro_z_rads",
+                "; to read `gyro_z_rads`, give --rate-column gyro_z_rads --rate-unit rads",
+            ),
+            (
+                "time_s,omega",
+                "; to read `omega`, give --rate-column omega",
+            ),
+            ("stamp,rate_dps", ")"),
+        ] {
+            let path = write_temp("other_names.csv", &format!("{header}\n0,1\n"));
+            let err = read_csv(&path, &ColumnOptions::default())
+                .unwrap_err()
+                .to_string();
+            assert!(err.ends_with(hint), "{header}: {err}");
+        }
 
         // Other separators are named, with a way to convert.
         let path = write_temp("tabs.tsv", "# a: b\ntime_s\trate_dps\n0.0\t1.0\n");

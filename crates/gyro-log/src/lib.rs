@@ -29,6 +29,7 @@ mod regular;
 pub mod sense;
 pub mod value;
 pub mod whole;
+pub mod wraps;
 
 pub(crate) use ahead::read_ahead;
 pub use bursts::Bursts;
@@ -358,7 +359,7 @@ pub enum LogError {
         path: PathBuf,
     },
     /// A required column is missing.
-    #[error("{path}:{line}: no column `{column}` in the header (columns: {available})")]
+    #[error("{path}:{line}: no column `{column}` in the header (columns: {available}){hint}")]
     MissingColumn {
         /// File.
         path: PathBuf,
@@ -368,6 +369,9 @@ pub enum LogError {
         column: String,
         /// The header's columns.
         available: String,
+        /// `; …`: the option that would read a column that looks meant (a time or rate
+        /// column under another name, its unit from the name's suffix), or empty.
+        hint: String,
     },
     /// A field is not a number.
     #[error("{path}:{line}: column `{column}`: `{value}` is not a number")]

@@ -22,6 +22,7 @@ use super::{Log, LogError, Row};
 use crate::backlog::Retimer;
 use crate::bursts::{self, Bursts, Resampler};
 use crate::jumps::ReferenceJumps;
+use crate::wraps::{describe_span, Unwrapper};
 use serde::Serialize;
 use std::path::Path;
 
@@ -99,6 +100,11 @@ pub struct Quality {
     pub backlogs: u64,
     /// Rows whose stamps were spread over a backlog's gap.
     pub retimed_rows: u64,
+    /// Wraps of a tick counter in the time stamps, unwrapped ([`crate::wraps`]).
+    pub counter_wraps: u64,
+    /// The span of that counter (s), when it wrapped.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub counter_span_s: Option<f64>,
     /// Longest step between rows (s).
     pub longest_step_s: f64,
     /// Rows whose rate was empty, NaN or infinite.
@@ -431,11 +437,17 @@ pub fn place<S: SlotSink + ?Sized>(
 ) -> Result<Quality, LogError> {
     sink.columns(info.has_reference, info.has_temperature);
     let mut rows = rows.into_iter();
+    // Stamps from a counter that wraps are unwrapped before anything looks at them.
+    let mut unwrapper = Unwrapper::default();
     // Rows held back while the arrival pattern (and, unless given, the rate) is estimated.
     let mut ahead: Vec<Row> = Vec::new();
     while ahead.len() <= RATE_WINDOW_STEPS {
         match rows.next() {
-            Some(row) => ahead.push(row?),
+            Some(row) => {
+                let mut row = row?;
+                unwrapper.unwrap(&mut row);
+                ahead.push(row);
+            }
             None => break,
         }
     }
@@ -474,9 +486,25 @@ pub fn place<S: SlotSink + ?Sized>(
         placer.row(&row);
     }
     for row in rows {
-        placer.row(&row?);
+        let mut row = row?;
+        unwrapper.unwrap(&mut row);
+        placer.row(&row);
     }
-    placer.finish()
+    let mut quality = placer.finish()?;
+    note_wraps(&mut quality, &unwrapper);
+    Ok(quality)
+}
+
+/// What `unwrapper` did, in the quality report: the count, the span, the first line.
+fn note_wraps(quality: &mut Quality, unwrapper: &Unwrapper) {
+    quality.counter_wraps = unwrapper.wraps;
+    quality.counter_span_s = unwrapper.span_s();
+    if let (Some(span_s), Some(line)) = (unwrapper.span_s(), unwrapper.first_line) {
+        // First, so that the report's first lines always show it.
+        let what = format!("time stamps wrap: {}, unwrapped", describe_span(span_s));
+        quality.examples.insert(0, (what, line));
+        quality.examples.truncate(MAX_EXAMPLES);
+    }
 }
 
 /// The streaming form of the rules in the module documentation: rows in, final slots out.
@@ -1048,6 +1076,26 @@ mod tests {
 
         /// The whole-log implementation `place` replaced, kept verbatim as the oracle.
         pub fn regularize_whole(log: &Log, options: &GridOptions) -> Result<RegularLog, LogError> {
+            // The stamps unwrapped first, as in the streaming placement.
+            let mut unwrapper = crate::wraps::Unwrapper::default();
+            let unwrapped = Log {
+                rows: log
+                    .rows
+                    .iter()
+                    .map(|&r| {
+                        let mut r = r;
+                        unwrapper.unwrap(&mut r);
+                        r
+                    })
+                    .collect(),
+                ..log.clone()
+            };
+            let mut whole = placed_whole(&unwrapped, options)?;
+            super::super::note_wraps(&mut whole.quality, &unwrapper);
+            Ok(whole)
+        }
+
+        fn placed_whole(log: &Log, options: &GridOptions) -> Result<RegularLog, LogError> {
             if log.rows.is_empty() {
                 return Err(LogError::NoData {
                     path: log.path.clone(),

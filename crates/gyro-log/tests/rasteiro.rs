@@ -341,3 +341,54 @@ fn a_reference_of_the_opposite_sense_or_other_units_is_warned_of() {
         );
     }
 }
+
+/// The recordings stamped by a tick counter that wraps mid-log, as small loggers stamp:
+/// Arduino's 32-bit `micros()` (read in seconds, wrapping at 4294.967296 s) and a 16-bit
+/// millisecond tick (wrapping at 65.536 s). Unwrapped, every slot is that of the same
+/// stamps without the wrap; not unwrapped, the logs were refused (time goes back).
+#[test]
+fn a_counter_that_wraps_mid_log_is_unwrapped() {
+    let mut checked = 0;
+    for path in recordings() {
+        let raw = read_log(&path, &LogOptions::default()).unwrap();
+        // (span, tick): the counter wraps 8 s into the log.
+        for (span_s, tick_s) in [(4_294.967_296, 1e-6), (65.536, 1e-3)] {
+            let name = format!("{} as a counter of {span_s} s", path.display());
+            let count = |t: f64| ((t + span_s - 8.0) / tick_s).round() * tick_s;
+            let mut unwrapped = raw.clone();
+            let mut wrapped = raw.clone();
+            for (u, w) in unwrapped.rows.iter_mut().zip(wrapped.rows.iter_mut()) {
+                u.time_s = count(u.time_s);
+                w.time_s = u.time_s.rem_euclid(span_s);
+            }
+            let expected = gyro_log::regularize(&unwrapped, &GridOptions::default()).unwrap();
+            let placed = gyro_log::regularize(&wrapped, &GridOptions::default())
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let q = &placed.quality;
+            assert_eq!(
+                (q.counter_wraps, q.counter_span_s),
+                (1, Some(span_s)),
+                "{name}"
+            );
+            assert!(
+                q.examples
+                    .iter()
+                    .any(|(what, _)| what.contains("time stamps wrap")),
+                "{name}: {:?}",
+                q.examples
+            );
+            assert_eq!(placed.slots.len(), expected.slots.len(), "{name}");
+            for (a, b) in placed.slots.iter().zip(&expected.slots) {
+                assert!((a.time_s - b.time_s).abs() < 1e-9, "{name}: {a:?} {b:?}");
+                assert!(
+                    (a.rate_dps - b.rate_dps).abs() < 1e-6,
+                    "{name}: {a:?} {b:?}"
+                );
+            }
+            checked += 1;
+        }
+    }
+    if checked > 0 {
+        assert_eq!(checked, 36);
+    }
+}

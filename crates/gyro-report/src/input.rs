@@ -47,6 +47,10 @@ pub fn table(q: &Quality) -> String {
             "of them a stalled link's backlog (rows re-timed)",
         ),
         (q.retimed_rows, "rows re-timed"),
+        (
+            q.counter_wraps,
+            "wraps of the time stamps' counter unwrapped",
+        ),
         (q.missing_rate_rows, "missing rates"),
         (q.filled_slots, "samples interpolated"),
         (q.trimmed_slots, "samples trimmed at the ends"),

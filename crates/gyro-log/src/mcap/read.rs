@@ -20,9 +20,9 @@
 //! headers finds the chunks (with or without a summary section), then the chunks are read
 //! in order of their first log time (`message_start_time`; equal ones in file order), so
 //! chunks written out of time order are read in time order; the messages of a chunk in
-//! their order in the file. The chunks are read, CRC-checked and decompressed on a thread
-//! of their own, a chunk or two ahead of the decoding (`UnitsAhead`).
-//! Memory holds those few chunks and the rows waiting for their reference (in a file whose
+//! their order in the file. The chunks are read, CRC-checked and decompressed by the
+//! thread that decodes them, a batch of whole chunks at a time (`UnitEvents`).
+//! Memory holds a batch of chunks and the rows waiting for their reference (in a file whose
 //! channels share chunks in time order, at most a chunk's worth), never the log.
 //!
 //! # Reference attachment
@@ -52,7 +52,7 @@ use super::attach::Attacher;
 use super::binary::{self, HAS_TEMPERATURE_KEY, REFERENCE_SCHEMA_NAME, SAMPLE_SCHEMA_NAME};
 use super::layout::{self, Layout};
 use super::ros2::{decode_imu, Axis, TimeSource, IMU_SCHEMA_NAME};
-use super::unit::{Event, UnitError, Units, UnitsAhead};
+use super::unit::{Event, UnitError, UnitEvents, Units};
 use super::{json, ns_to_seconds, GYRO_TOPIC, METADATA_NAME, REFERENCE_TOPIC};
 use crate::{metadata_rate_hz, Log, LogError, Row, RATE_WINDOW_STEPS};
 use mcap::records::{op, Record};
@@ -216,7 +216,7 @@ struct Stop {
 /// read around.
 pub struct McapRows {
     state: State,
-    units: UnitsAhead,
+    units: UnitEvents,
     finished: bool,
     /// Damage the walk over the file met (reading stops there).
     scan_damage: Option<layout::Damage>,
@@ -293,7 +293,7 @@ impl McapRows {
         }
         Ok(Self {
             state,
-            units: UnitsAhead::new(Units::new(file, units)),
+            units: UnitEvents::new(Units::new(file, units)),
             finished,
             scan_damage: damage,
             stop: None,
@@ -472,7 +472,7 @@ impl McapRows {
             cause,
         })?;
         let options = &self.state.options;
-        let mut units = UnitsAhead::here(Units::new(file, self.units.units()));
+        let mut units = UnitEvents::new(Units::new(file, self.units.units()));
         let mut earliest = u64::MAX;
         while let Some(event) = units.next_event() {
             let Ok(Event::Record { opcode, data }) = event else {

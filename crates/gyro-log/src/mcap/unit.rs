@@ -13,9 +13,7 @@ use mcap::McapError;
 use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom};
 use std::ops::Range;
-use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
-use std::sync::{Arc, Mutex};
-use std::thread::JoinHandle;
+use std::sync::Arc;
 
 /// What the stream of units gives.
 pub(super) enum Event<'a> {
@@ -290,11 +288,8 @@ enum Codec {
     Lz4,
 }
 
-/// Batches in flight between the threads of [`UnitsAhead`].
-const BATCHES_AHEAD: usize = 2;
-/// A batch is sent once its records hold this many bytes, at the end of a unit (fewer
-/// hand-overs between the threads than one per chunk; the memory held is about
-/// `BATCHES_AHEAD + 2` batches).
+/// A batch is refilled with whole units until its records hold this many bytes (fewer
+/// refills than one per chunk; the memory held is about one batch).
 const BATCH_BYTES: usize = 1 << 18;
 
 /// One event of a batch.
@@ -321,14 +316,14 @@ struct Batch {
     last_offset: u64,
 }
 
-/// [`Units`] read on a thread of its own: the file is read, CRC-checked and decompressed a
-/// few units ahead while the caller decodes the records. The same events in the same
-/// order, with the same offsets; if the thread cannot be started, the units are read on
-/// the caller's thread.
-pub(super) struct UnitsAhead {
-    units: Arc<[Unit]>,
+/// [`Units`] as events, a batch of whole units at a time, on the caller's thread: the
+/// thread that decodes the messages also reads and decompresses the chunks, and the grid
+/// and the pipeline keep the other core (a third thread that decompressed ahead made
+/// `run` no faster on two cores, and held more chunks).
+pub(super) struct UnitEvents {
+    units: Box<Units>,
+    list: Arc<[Unit]>,
     file_len: u64,
-    source: Source,
     current: Batch,
     /// Next item of `current` to give.
     position: usize,
@@ -337,64 +332,12 @@ pub(super) struct UnitsAhead {
     offset: u64,
 }
 
-enum Source {
-    Thread {
-        batches: Option<Receiver<Batch>>,
-        spare: SyncSender<Batch>,
-        thread: Option<JoinHandle<()>>,
-    },
-    Here(Box<Units>),
-}
-
-impl UnitsAhead {
+impl UnitEvents {
     pub fn new(units: Units) -> Self {
-        let list = units.units();
-        let file_len = units.file_len();
-        let shared = Arc::new(Mutex::new(Some(units)));
-        let (sender, batches) = sync_channel::<Batch>(BATCHES_AHEAD);
-        let (spare, spares) = sync_channel::<Batch>(BATCHES_AHEAD + 2);
-        let theirs = Arc::clone(&shared);
-        let thread = std::thread::Builder::new()
-            .name("gyro-mcap-units".into())
-            .spawn(move || {
-                let Some(units) = theirs.lock().ok().and_then(|mut u| u.take()) else {
-                    return;
-                };
-                produce(units, &sender, &spares);
-            });
-        let source = match thread {
-            Ok(thread) => Source::Thread {
-                batches: Some(batches),
-                spare,
-                thread: Some(thread),
-            },
-            Err(_) => match shared.lock().ok().and_then(|mut u| u.take()) {
-                Some(units) => Source::Here(Box::new(units)),
-                // Not reached: the closure that would have taken them was not run.
-                None => Source::Thread {
-                    batches: None,
-                    spare,
-                    thread: None,
-                },
-            },
-        };
         Self {
-            units: list,
-            file_len,
-            source,
-            current: Batch::default(),
-            position: 0,
-            done: false,
-            offset: 0,
-        }
-    }
-
-    /// The same events, read on the caller's thread.
-    pub fn here(units: Units) -> Self {
-        Self {
-            units: units.units(),
+            list: units.units(),
             file_len: units.file_len(),
-            source: Source::Here(Box::new(units)),
+            units: Box::new(units),
             current: Batch::default(),
             position: 0,
             done: false,
@@ -414,10 +357,11 @@ impl UnitsAhead {
 
     /// The units, in reading order.
     pub fn units(&self) -> Arc<[Unit]> {
-        Arc::clone(&self.units)
+        Arc::clone(&self.list)
     }
 
-    /// [`Units::next_event`].
+    /// The next record of the current unit, the end of a unit, or why reading stopped;
+    /// `None` after the last.
     pub fn next_event(&mut self) -> Option<Result<Event<'_>, UnitError>> {
         loop {
             if let Some((item, offset)) = self.current.items.get(self.position) {
@@ -441,48 +385,8 @@ impl UnitsAhead {
                 self.offset = self.current.last_offset;
                 return last.map(Err);
             }
-            match &mut self.source {
-                Source::Here(units) => fill(units, &mut self.current),
-                Source::Thread { batches, spare, .. } => {
-                    let Some(next) = batches.as_ref().and_then(|b| b.recv().ok()) else {
-                        self.done = true;
-                        return Some(Err(UnitError::Io(io::Error::other(
-                            "the thread reading the file stopped",
-                        ))));
-                    };
-                    let used = std::mem::replace(&mut self.current, next);
-                    let _ = spare.try_send(used);
-                }
-            }
+            fill(&mut self.units, &mut self.current);
             self.position = 0;
-        }
-    }
-}
-
-impl Drop for UnitsAhead {
-    /// The thread stops at its next batch once nobody receives them.
-    fn drop(&mut self) {
-        if let Source::Thread {
-            batches, thread, ..
-        } = &mut self.source
-        {
-            *batches = None;
-            if let Some(thread) = thread.take() {
-                let _ = thread.join();
-            }
-        }
-    }
-}
-
-/// The thread of [`UnitsAhead`]: every event of `units`, in batches of whole units, until
-/// the end, an error, or nobody receives.
-fn produce(mut units: Units, sender: &SyncSender<Batch>, spares: &Receiver<Batch>) {
-    loop {
-        let mut batch = spares.try_recv().unwrap_or_default();
-        fill(&mut units, &mut batch);
-        let last = batch.last.is_some();
-        if sender.send(batch).is_err() || last {
-            return;
         }
     }
 }
