@@ -488,6 +488,26 @@ fn wrong_schemas_and_bad_messages_name_channel_and_message() {
         e.contains("channel `/reference`: schema `R`, expected gyro_msgs/msg/Reference"),
         "{e}"
     );
+    // A message of that name laid out otherwise would be misread: refused.
+    handmade(
+        &path,
+        &[(
+            "/gyro",
+            "gyro_msgs/msg/Sample",
+            "ros2msg",
+            "float32 rate_dps\nfloat64 temperature_c",
+            "cdr",
+        )],
+        &[],
+    );
+    let e = err(&path, &opts);
+    assert!(
+        e.contains(
+            "schema `gyro_msgs/msg/Sample` declares `float32 rate_dps; float64 temperature_c`; \
+             the reader decodes `float64 rate_dps; float64 temperature_c; int64 status`"
+        ),
+        "{e}"
+    );
     let good = gyro_log::encode_sample(&gyro_log::GyroSample {
         rate_dps: Some(1.5),
         temperature_c: None,

@@ -29,6 +29,30 @@ pub(super) const REFERENCE_DEFINITION: &str = "\
 float64 angle_deg      # reference angle (deg); NaN: missing
 ";
 
+/// The definition written for schema `name` (the sample's for any name but the
+/// reference's).
+pub(super) fn definition(name: &str) -> &'static str {
+    if name == REFERENCE_SCHEMA_NAME {
+        REFERENCE_DEFINITION
+    } else {
+        SAMPLE_DEFINITION
+    }
+}
+
+/// The fields a `ros2msg` definition declares, `type name` each, in order: comments,
+/// blank lines and constants (`type NAME=value`) left out, up to the `===` line before
+/// any nested definition.
+pub(super) fn declared_fields(definition: &str) -> Vec<String> {
+    definition
+        .lines()
+        .take_while(|line| !line.starts_with("==="))
+        .map(|line| line.split('#').next().unwrap_or_default())
+        .filter(|line| !line.contains('='))
+        .map(|line| line.split_whitespace().collect::<Vec<_>>().join(" "))
+        .filter(|line| !line.is_empty())
+        .collect()
+}
+
 /// CDR encapsulation header, little-endian (what is written).
 const CDR_LE: [u8; 4] = [0x00, 0x01, 0x00, 0x00];
 /// Bytes of a `/gyro` message: the header and three 8-byte fields.
@@ -191,6 +215,17 @@ mod tests {
         big.extend_from_slice(&(-1_i64).to_be_bytes());
         let sample = decode_sample(&big).unwrap();
         assert_eq!((sample.rate_dps, sample.status), (Some(2.5), None));
+    }
+
+    #[test]
+    fn the_declared_fields_are_read_from_a_definition() {
+        assert_eq!(
+            declared_fields(SAMPLE_DEFINITION),
+            ["float64 rate_dps", "float64 temperature_c", "int64 status"]
+        );
+        assert_eq!(declared_fields(REFERENCE_DEFINITION), ["float64 angle_deg"]);
+        let other = "# c\nint8 OK=0\n  float64   angle_deg  # x\n\n===\nMSG: a/b\nint8 y\n";
+        assert_eq!(declared_fields(other), ["float64 angle_deg"]);
     }
 
     #[test]

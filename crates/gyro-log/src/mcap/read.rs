@@ -856,7 +856,8 @@ impl State {
     }
 }
 
-/// Check a CDR channel's schema: `name` in `ros2msg`.
+/// Check a CDR channel's schema: `name` in `ros2msg`, declaring the fields the reader
+/// decodes (a message of that name laid out otherwise would be read wrong, silently).
 fn check_cdr(schema: Option<&SchemaInfo>, name: &str) -> Result<(), String> {
     match schema {
         None => Err(format!("a CDR channel without a schema; expected {name}")),
@@ -866,7 +867,19 @@ fn check_cdr(schema: Option<&SchemaInfo>, name: &str) -> Result<(), String> {
             s.encoding,
             binary::SCHEMA_ENCODING
         )),
-        Some(_) => Ok(()),
+        Some(s) => {
+            let expected = binary::declared_fields(binary::definition(name));
+            let found = binary::declared_fields(&String::from_utf8_lossy(&s.data));
+            if found == expected {
+                Ok(())
+            } else {
+                Err(format!(
+                    "schema `{name}` declares `{}`; the reader decodes `{}`",
+                    found.join("; "),
+                    expected.join("; ")
+                ))
+            }
+        }
     }
 }
 
