@@ -115,6 +115,8 @@ impl McapLogWriter {
         })?;
         let err = |e| write_error(path, e);
         let mut writer = WriteOptions::new()
+            // lz4, not zstd: `run` reads an hour at 1 kHz in 0.40 s against 0.50 s, for a
+            // file of 231 MB against 185 MB.
             .compression(Some(Compression::Lz4))
             .compression_level(options.compression_level)
             // One thread: chunks are small, and the machine is shared with the pipeline.
