@@ -142,15 +142,7 @@ impl Retimer {
 mod tests {
     use super::*;
 
-    fn row(line: u64, time_s: f64) -> Row {
-        Row {
-            line,
-            time_s,
-            rate_dps: Some(1.0),
-            reference_deg: None,
-            temperature_c: None,
-        }
-    }
+    use crate::test_row as row;
 
     fn retimed(stamps: &[f64], gap_step_s: f64) -> (Vec<f64>, Retimer) {
         let mut r = Retimer::new(gap_step_s);

@@ -339,17 +339,18 @@ impl CsvRows {
             }
         }
         let find = |name: &str| names.iter().position(|n| n == name);
-        let required = |name: &str| {
+        // A missing time or rate column comes with the flags that read one that looks meant.
+        let required = |name: &str, role: Option<Role>| {
             find(name).ok_or_else(|| LogError::MissingColumn {
                 path: path.to_path_buf(),
                 line: header_line,
                 column: excerpt(name.as_bytes()),
                 available: column_list(&names),
-                hint: String::new(),
+                hint: role.map_or(String::new(), |role| hint(&names, role)),
             })
         };
-        let time = required(&columns.time_column).map_err(|e| with_hint(e, &names, Role::Time))?;
-        let rate = required(&columns.rate_column).map_err(|e| with_hint(e, &names, Role::Rate))?;
+        let time = required(&columns.time_column, Some(Role::Time))?;
+        let rate = required(&columns.rate_column, Some(Role::Rate))?;
         let columns = Columns {
             path: path.to_path_buf(),
             names: columns.clone(),
@@ -357,11 +358,11 @@ impl CsvRows {
             time,
             rate,
             reference: match &columns.reference_column {
-                Some(name) => Some(required(name)?),
+                Some(name) => Some(required(name, None)?),
                 None => find(DEFAULT_REFERENCE_COLUMN),
             },
             temperature: match &columns.temperature_column {
-                Some(name) => Some(required(name)?),
+                Some(name) => Some(required(name, None)?),
                 None => find(DEFAULT_TEMPERATURE_COLUMN),
             },
             time_scale: columns.time_unit.to_seconds(),
@@ -468,21 +469,11 @@ enum Role {
     Rate,
 }
 
-/// `error` (a missing time or rate column) with a hint naming the option that would read
-/// the header's column that looks meant: the first whose name starts with `time`
-/// (`timestamp`, `time_ms`, …) or is `t`, or starts with `rate`, `gyro` or `omega`; with
-/// the unit its suffix names (`_ms`, `_us`, `_ns`; `_rads`, `_rad_s`, `_radps`).
-fn with_hint(error: LogError, names: &[String], role: Role) -> LogError {
-    let LogError::MissingColumn {
-        path,
-        line,
-        column,
-        available,
-        ..
-    } = error
-    else {
-        return error;
-    };
+/// The hint for a missing time or rate column: `; to read …, give …` naming the option
+/// that reads the header's column that looks meant, the first whose name starts with `time`
+/// (`timestamp`, `time_ms`, …) or is `t`, or starts with `rate`, `gyro` or `omega`, with the
+/// unit its suffix names (`_ms`, `_us`, `_ns`; `_rads`, `_rad_s`, `_radps`); empty if none.
+fn hint(names: &[String], role: Role) -> String {
     let lower: Vec<String> = names
         .iter()
         .map(|n| n.trim().to_ascii_lowercase())
@@ -491,7 +482,7 @@ fn with_hint(error: LogError, names: &[String], role: Role) -> LogError {
         Role::Time => n.starts_with("time") || n == "t",
         Role::Rate => ["rate", "gyro", "omega"].iter().any(|p| n.starts_with(p)),
     });
-    let hint = found.map_or(String::new(), |i| {
+    found.map_or(String::new(), |i| {
         let name = &lower[i];
         let unit = match role {
             Role::Time => [("_ms", "ms"), ("_us", "us"), ("_ns", "ns")]
@@ -512,14 +503,7 @@ fn with_hint(error: LogError, names: &[String], role: Role) -> LogError {
             excerpt(names[i].as_bytes()),
             unit.unwrap_or_default()
         )
-    });
-    LogError::MissingColumn {
-        path,
-        line,
-        column,
-        available,
-        hint,
-    }
+    })
 }
 
 fn column_list(names: &[String]) -> String {

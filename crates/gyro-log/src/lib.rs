@@ -230,6 +230,18 @@ pub struct Row {
     pub temperature_c: Option<f64>,
 }
 
+/// A row at `time_s` turning 1 deg/s, nothing else (unit tests of the row stages).
+#[cfg(test)]
+pub(crate) fn test_row(line: u64, time_s: f64) -> Row {
+    Row {
+        line,
+        time_s,
+        rate_dps: Some(1.0),
+        reference_deg: None,
+        temperature_c: None,
+    }
+}
+
 /// A log read into memory.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Log {

@@ -17,7 +17,10 @@
 
 use crate::Row;
 
-/// Spans (s) of the counters unwrapped: 2^16 µs, 2^32 ns, 2^16 ms, 2^32 µs, 2^32 ms.
+/// The counters unwrapped: (bits, tick), shortest span first.
+pub const COUNTERS: [(u32, &str); 5] = [(16, "µs"), (32, "ns"), (16, "ms"), (32, "µs"), (32, "ms")];
+
+/// Their spans (s): 2^bits ticks.
 pub const SPANS_S: [f64; 5] = [
     65_536e-6,
     4_294_967_296e-9,
@@ -112,30 +115,20 @@ impl Unwrapper {
 
 /// What a counter's span is, in words: `a 32-bit count of µs (4294.967296 s)`.
 pub fn describe_span(span_s: f64) -> String {
-    let (bits, unit) = match SPANS_S.iter().position(|&s| s == span_s) {
-        Some(0) => ("16", "µs"),
-        Some(1) => ("32", "ns"),
-        Some(2) => ("16", "ms"),
-        Some(3) => ("32", "µs"),
-        Some(4) => ("32", "ms"),
-        _ => return format!("a counter of {span_s} s"),
-    };
-    format!("a {bits}-bit count of {unit} ({span_s} s)")
+    match SPANS_S.iter().position(|&s| s == span_s) {
+        Some(i) => {
+            let (bits, tick) = COUNTERS[i];
+            format!("a {bits}-bit count of {tick} ({span_s} s)")
+        }
+        None => format!("a counter of {span_s} s"),
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn row(line: u64, time_s: f64) -> Row {
-        Row {
-            line,
-            time_s,
-            rate_dps: Some(1.0),
-            reference_deg: None,
-            temperature_c: None,
-        }
-    }
+    use crate::test_row as row;
 
     /// Stamps of a counter of `span_s` that starts at `start_s`, every `step_s`.
     fn counter(start_s: f64, step_s: f64, n: usize, span_s: f64) -> Vec<f64> {
@@ -213,6 +206,18 @@ mod tests {
         stamps.extend([30.0, 30.01]);
         let (_, u) = unwrap_all(&stamps);
         assert_eq!(u.wraps, 1);
+    }
+
+    #[test]
+    fn the_spans_are_the_counters_ticks() {
+        for ((bits, tick), span) in COUNTERS.iter().zip(SPANS_S) {
+            let tick_s = match *tick {
+                "ns" => 1e-9,
+                "µs" => 1e-6,
+                _ => 1e-3,
+            };
+            assert!((span - 2f64.powi(*bits as i32) * tick_s).abs() < 1e-12 * span);
+        }
     }
 
     #[test]

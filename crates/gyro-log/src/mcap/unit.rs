@@ -1,6 +1,6 @@
 //! Reading the data section unit by unit ([`Unit`]: a chunk or a loose message), in the
 //! order the layout gives. A chunk compressed with lz4 or zstd (or not compressed) is read whole,
-//! decompressed in one call straight into the batch handed to the decoding thread, its
+//! decompressed in one call straight into the batch the records are given from, its
 //! CRC checked (over the decompressed records, before any of them is given), and its
 //! records given in place, without a copy. Any other unit (a loose message, a chunk in
 //! another compression) goes through one `mcap` linear reader, fed the units' bytes one
@@ -160,39 +160,43 @@ impl Units {
         }
         let start = batch.data.len();
         let size = uncompressed_size as usize;
-        if codec == Codec::Lz4 {
-            batch.data.resize(start + size, 0);
-            let decoded = lz4::decompress_frame(compressed, &mut batch.data[start..]);
-            if let Err(what) = decoded {
-                batch.data.truncate(start);
-                return Err(damaged(format!(
-                    "the chunk does not decompress (lz4: {what})"
-                )));
+        match codec {
+            Codec::Lz4 => {
+                batch.data.resize(start + size, 0);
+                let decoded = lz4::decompress_frame(compressed, &mut batch.data[start..]);
+                if let Err(what) = decoded {
+                    batch.data.truncate(start);
+                    return Err(damaged(format!(
+                        "the chunk does not decompress (lz4: {what})"
+                    )));
+                }
             }
-        } else if codec == Codec::Zstd {
-            batch.data.reserve(size);
-            let decompressor = match &mut self.zstd {
-                Some(d) => d,
-                empty => empty.insert(zstd::bulk::Decompressor::new().map_err(UnitError::Io)?),
-            };
-            let mut out = io::Cursor::new(&mut batch.data);
-            out.set_position(start as u64);
-            let wrote = decompressor
-                .decompress_to_buffer(compressed, &mut out)
-                .map_err(|e| damaged(format!("the chunk does not decompress (zstd: {e})")))?;
-            if wrote != size {
-                batch.data.truncate(start);
-                return Err(damaged(format!(
-                    "the chunk decompresses to {wrote} bytes, its header says {size}"
-                )));
+            Codec::Zstd => {
+                batch.data.reserve(size);
+                let decompressor = match &mut self.zstd {
+                    Some(d) => d,
+                    empty => empty.insert(zstd::bulk::Decompressor::new().map_err(UnitError::Io)?),
+                };
+                let mut out = io::Cursor::new(&mut batch.data);
+                out.set_position(start as u64);
+                let wrote = decompressor
+                    .decompress_to_buffer(compressed, &mut out)
+                    .map_err(|e| damaged(format!("the chunk does not decompress (zstd: {e})")))?;
+                if wrote != size {
+                    batch.data.truncate(start);
+                    return Err(damaged(format!(
+                        "the chunk decompresses to {wrote} bytes, its header says {size}"
+                    )));
+                }
             }
-        } else {
-            if compressed_size != uncompressed_size {
-                return Err(damaged(format!(
+            Codec::None => {
+                if compressed_size != uncompressed_size {
+                    return Err(damaged(format!(
                     "an uncompressed chunk of {compressed_size} bytes whose header says {uncompressed_size}"
                 )));
+                }
+                batch.data.extend_from_slice(compressed);
             }
-            batch.data.extend_from_slice(compressed);
         }
         let records = &batch.data[start..];
         if crc != 0 {
@@ -281,7 +285,7 @@ impl Units {
 }
 
 /// How a chunk's records are compressed (the chunk record's `compression`).
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy)]
 enum Codec {
     None,
     Zstd,
@@ -321,9 +325,7 @@ struct Batch {
 /// and the pipeline keep the other core (a third thread that decompressed ahead made
 /// `run` no faster on two cores, and held more chunks).
 pub(super) struct UnitEvents {
-    units: Box<Units>,
-    list: Arc<[Unit]>,
-    file_len: u64,
+    units: Units,
     current: Batch,
     /// Next item of `current` to give.
     position: usize,
@@ -335,9 +337,7 @@ pub(super) struct UnitEvents {
 impl UnitEvents {
     pub fn new(units: Units) -> Self {
         Self {
-            list: units.units(),
-            file_len: units.file_len(),
-            units: Box::new(units),
+            units,
             current: Batch::default(),
             position: 0,
             done: false,
@@ -347,7 +347,7 @@ impl UnitEvents {
 
     /// Length of the file (bytes).
     pub fn file_len(&self) -> u64 {
-        self.file_len
+        self.units.file_len()
     }
 
     /// [`Units::current_offset`] when the last event was given.
@@ -357,7 +357,7 @@ impl UnitEvents {
 
     /// The units, in reading order.
     pub fn units(&self) -> Arc<[Unit]> {
-        Arc::clone(&self.list)
+        self.units.units()
     }
 
     /// The next record of the current unit, the end of a unit, or why reading stopped;
