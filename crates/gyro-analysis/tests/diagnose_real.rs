@@ -148,6 +148,15 @@ fn latency_is_named_on_real_yaw_and_its_correction_does_not_hurt() {
     let (t, h) = (e.training.as_ref().unwrap(), e.holdout.as_ref().unwrap());
     assert!((4.0..9.0).contains(&t.arw_deg_per_rt_h), "{}", t.describe());
     assert!(t.ratio_to_model > 10.0, "{}", t.describe());
+    assert_eq!(t.compared_with, "prior model");
+    // These runs never rest: the baseline's white noise is the one measured on their
+    // moving residual, not the CRM100 prior's, and its note says so; the wander stays
+    // the prior's, checked against what the residual allows.
+    let sensor = &d.model.sensor;
+    assert_eq!(sensor.arw_deg_per_rt_h, t.arw_deg_per_rt_h);
+    let notes = d.model.notes.join("\n");
+    assert!(notes.contains("fitted to the moving residual"), "{notes}");
+    assert!(notes.contains("its wander"), "{notes}");
     assert!(
         h.arw_deg_per_rt_h > 1.5 * t.arw_deg_per_rt_h,
         "{} / {}",

@@ -251,10 +251,10 @@ fn nothing_significant_without_an_effect() {
         table.contains("temperature_bias"),
         "every effect is listed: {table}"
     );
-    // The effective noise on moving data is said beside the model's.
+    // The effective noise on moving data is said beside the sensor's own, from the rests.
     assert!(
         table.contains("effective noise on moving data: angle random walk at most")
-            && table.contains("x the model's"),
+            && table.contains("x the rests'"),
         "{table}"
     );
 }

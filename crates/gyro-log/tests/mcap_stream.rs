@@ -78,6 +78,36 @@ fn streaming_equals_whole_file_reading_on_the_fixtures() {
     assert_stream_equals_whole(&ros, &whole, &LogOptions::default());
 }
 
+/// A finished file of CDR samples says in its summary whether it has a temperature (its
+/// rows are not read ahead for it): streamed, the columns are those of the file read
+/// whole, with a temperature and without one.
+#[test]
+fn the_summary_decides_the_columns_of_a_finished_file() {
+    let dir = temp_dir("stream-columns");
+    for with_temperature in [true, false] {
+        let mut log = bench();
+        if !with_temperature {
+            log.has_temperature = false;
+            log.rows.iter_mut().for_each(|r| r.temperature_c = None);
+        }
+        let path = dir.join(format!("t{with_temperature}.mcap"));
+        gyro_log::write_mcap(&path, &log).unwrap();
+        let whole = gyro_log::read_mcap(&path, &McapOptions::default())
+            .unwrap()
+            .log;
+        assert_eq!(whole.has_temperature, with_temperature);
+        assert_stream_equals_whole(&path, &whole, &LogOptions::default());
+        let loaded = gyro_log::load(
+            &path,
+            &LogOptions::default(),
+            &GridOptions::default(),
+            &mut |_| {},
+        )
+        .unwrap();
+        assert_eq!(loaded.has_temperature, with_temperature);
+    }
+}
+
 #[test]
 fn a_truncated_file_warns_with_the_byte_offset_and_keeps_the_rows_before() {
     let dir = temp_dir("stream-cut");

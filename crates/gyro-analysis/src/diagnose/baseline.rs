@@ -1,6 +1,7 @@
 //! Stage 1, baseline: the nominal model, and every run re-simulated with it as an
 //! ensemble scored against the run; the floor of the gap between simulated ensembles.
 
+use super::effective::{measure, MeasuredNoise};
 use super::ensemble::{ensembles, Member, RealRun};
 use super::score::{self, gap, score, RunScore};
 use super::{fit, Options, Progress};
@@ -78,6 +79,12 @@ pub(crate) struct Baseline {
     pub(crate) notes: Vec<String>,
     /// The static first-difference variance the white noise was matched to (if fitted).
     pub(crate) white_target: Option<f64>,
+    /// The effective noise of the training runs' moving residual, compared with the
+    /// sensor's own white noise (the rests', else the prior's or the given model's).
+    pub(crate) moving_noise: Option<MeasuredNoise>,
+    /// The white noise the effective noise is compared with (deg/√h) and where it came
+    /// from.
+    pub(crate) own_noise: (f64, &'static str),
     /// Members of each candidate's ensemble (the baseline's first seeds).
     pub(crate) candidate_members: usize,
     /// Training runs against the nominal model.
@@ -95,6 +102,7 @@ pub(crate) struct Baseline {
 /// Stage 1: the nominal model (fitted on the training runs, or the given one) and the
 /// baseline ensembles of every run.
 pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) -> Baseline {
+    let moving = measure(&runs.train, "training");
     let (nominal, notes, white_target) = if options.fixed_model {
         let mut m = options.prior;
         if let Some(first) = runs.train.first() {
@@ -106,7 +114,8 @@ pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) 
             None,
         )
     } else {
-        let (mut nominal, mut notes, target) = fit::nominal_model(&runs.train, &options.prior);
+        let (mut nominal, mut notes, target) =
+            fit::nominal_model(&runs.train, &options.prior, moving.as_ref());
         // The prior's range is the CRM100's: any run, trained on or held out, that reads
         // beyond it shows it is not this sensor's (it is not fitted, only refused).
         let largest = crate::model::largest_plausible_abs_rate(
@@ -122,6 +131,12 @@ pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) 
         }
         (nominal, notes, target)
     };
+    let own_noise = match (options.fixed_model, white_target) {
+        (true, _) => (nominal.arw_deg_per_rt_h, "given model"),
+        (false, Some(_)) => (nominal.arw_deg_per_rt_h, "rests"),
+        (false, None) => (options.prior.arw_deg_per_rt_h, "prior model"),
+    };
+    let moving_noise = moving.map(|m| m.compared_to(own_noise.0, own_noise.1));
     let m = options.members.max(4);
     let mc = options.candidate_members.clamp(2, m);
     progress.stage(
@@ -159,6 +174,8 @@ pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) 
         nominal,
         notes,
         white_target,
+        moving_noise,
+        own_noise,
         candidate_members: mc,
         train_gap: gap(&train.scores),
         holdout_gap: gap(&holdout.scores),

@@ -59,9 +59,14 @@ pub struct MeasuredNoise {
     pub rate_random_walk_resolved: bool,
     /// Bias instability B (deg/s), 0 when no flat part is resolved.
     pub bias_instability_dps: f64,
-    /// The sensor model's own angle random walk (deg/√h), for the ratio.
+    /// The angle random walk N is compared with (deg/√h): the sensor's own, from the
+    /// training runs' rests when they have 2 s of them, else the prior model's (or the
+    /// `--model` given).
     pub model_arw_deg_per_rt_h: f64,
-    /// `arw_deg_per_rt_h / model_arw_deg_per_rt_h`: how many times the model's white
+    /// Where `model_arw_deg_per_rt_h` came from: `"rests"`, `"prior model"` or
+    /// `"given model"`.
+    pub compared_with: &'static str,
+    /// `arw_deg_per_rt_h / model_arw_deg_per_rt_h`: how many times the sensor's own white
     /// noise a filter must assume in this motion.
     pub ratio_to_model: f64,
     /// The whole characterisation (Allan deviation and fit), for the filter YAML.
@@ -79,19 +84,10 @@ pub struct EffectiveNoise {
     pub holdout: Option<MeasuredNoise>,
 }
 
-impl EffectiveNoise {
-    /// Measure both sets against the model's angle random walk `model_arw_deg_per_rt_h`.
-    pub fn measure(train: &[&RealRun], holdout: &[&RealRun], model_arw_deg_per_rt_h: f64) -> Self {
-        Self {
-            training: measure(train, "training", model_arw_deg_per_rt_h),
-            holdout: measure(holdout, "held-out", model_arw_deg_per_rt_h),
-        }
-    }
-}
-
 /// The effective noise of `runs` (those at the first run's sample rate), or `None` when
-/// their residual has no stretch of [`MIN_STRETCH_S`] or cannot be characterised.
-pub fn measure(runs: &[&RealRun], label: &'static str, model_arw: f64) -> Option<MeasuredNoise> {
+/// their residual has no stretch of [`MIN_STRETCH_S`] or cannot be characterised. Not yet
+/// compared with anything ([`MeasuredNoise::compared_to`]).
+pub fn measure(runs: &[&RealRun], label: &'static str) -> Option<MeasuredNoise> {
     let fs = runs.first()?.sample_rate_hz;
     let min_len = (MIN_STRETCH_S * fs).ceil() as usize;
     let same_rate: Vec<&&RealRun> = runs.iter().filter(|r| r.sample_rate_hz == fs).collect();
@@ -129,24 +125,48 @@ pub fn measure(runs: &[&RealRun], label: &'static str, model_arw: f64) -> Option
         rate_random_walk_dps_per_rt_s: k,
         rate_random_walk_resolved: resolved,
         bias_instability_dps: c.fit.bias_instability_dps.value,
-        model_arw_deg_per_rt_h: model_arw,
-        ratio_to_model: if model_arw > 0.0 {
-            arw / model_arw
-        } else {
-            f64::NAN
-        },
+        model_arw_deg_per_rt_h: f64::NAN,
+        compared_with: "nothing",
+        ratio_to_model: f64::NAN,
         characterization: c,
     })
 }
 
 impl MeasuredNoise {
-    /// One line: N with its ratio to the model's, K and B where resolved.
+    /// The same measurement compared with the sensor's own angle random walk
+    /// `model_arw_deg_per_rt_h` (deg/√h), which came from `compared_with`.
+    pub fn compared_to(self, model_arw_deg_per_rt_h: f64, compared_with: &'static str) -> Self {
+        let ratio = if model_arw_deg_per_rt_h > 0.0 {
+            self.arw_deg_per_rt_h / model_arw_deg_per_rt_h
+        } else {
+            f64::NAN
+        };
+        Self {
+            model_arw_deg_per_rt_h,
+            compared_with,
+            ratio_to_model: ratio,
+            ..self
+        }
+    }
+
+    /// Whose white noise N is compared with, as the text says it: "the rests'", "the prior
+    /// model's", "the given model's".
+    pub fn whose(&self) -> String {
+        if self.compared_with.ends_with('s') {
+            format!("the {}'", self.compared_with)
+        } else {
+            format!("the {}'s", self.compared_with)
+        }
+    }
+
+    /// One line: N with its ratio to the sensor's own, K and B where resolved.
     pub fn describe(&self) -> String {
         let mut s = format!(
-            "effective angle random walk on the {} runs N = {:.3} deg/sqrt(h) ({:.0}x the model's {:.3})",
+            "effective angle random walk on the {} runs N = {:.3} deg/sqrt(h) ({:.0}x {} {:.3})",
             self.runs,
             self.arw_deg_per_rt_h,
             self.ratio_to_model,
+            self.whose(),
             self.model_arw_deg_per_rt_h
         );
         s.push_str(&format!(
@@ -215,7 +235,9 @@ mod tests {
         ] {
             let runs = moving_runs(6.0, &effects);
             let refs: Vec<&RealRun> = runs.iter().collect();
-            let m = measure(&refs, "training", 0.5).unwrap();
+            let m = measure(&refs, "training")
+                .unwrap()
+                .compared_to(0.5, "prior model");
             // The −½ line under the upper bounds (68%) of a dozen τ up to 10 s: on 600 s it
             // is near the truth (on 300 s the scatter of the 10 s point pulls it 9% under,
             // on 1200 s it is 1% under).
@@ -231,12 +253,32 @@ mod tests {
         }
     }
 
+    /// Runs that never rest give the nominal model the white noise of their moving
+    /// residual, not the prior's, and its note says so; without the measurement it is the
+    /// prior's.
+    #[test]
+    fn runs_without_rest_give_the_baseline_their_moving_noise() {
+        let runs = moving_runs(6.0, &[]);
+        let refs: Vec<&RealRun> = runs.iter().collect();
+        let m = measure(&refs, "training").unwrap();
+        let prior = SensorModel::default();
+        let (model, notes, static_target) =
+            super::super::fit::nominal_model(&refs, &prior, Some(&m));
+        assert!(static_target.is_none(), "these runs do not rest");
+        assert_eq!(model.arw_deg_per_rt_h, m.arw_deg_per_rt_h);
+        assert!((0.9..1.2).contains(&(model.arw_deg_per_rt_h / 6.0)));
+        let text = notes.join("\n");
+        assert!(text.contains("fitted to the moving residual"), "{text}");
+        assert!(text.contains("; its wander "), "{text}");
+        let (model, notes, _) = super::super::fit::nominal_model(&refs, &prior, None);
+        assert_eq!(model.arw_deg_per_rt_h, prior.arw_deg_per_rt_h);
+        assert!(notes.join("\n").contains("from the prior model"));
+    }
+
     /// No residual stretch long enough: nothing measured, rather than a number from
     /// nothing.
     #[test]
     fn no_runs_measure_nothing() {
-        assert!(measure(&[], "training", 0.28).is_none());
-        let e = EffectiveNoise::measure(&[], &[], 0.28);
-        assert!(e.training.is_none() && e.holdout.is_none());
+        assert!(measure(&[], "training").is_none());
     }
 }

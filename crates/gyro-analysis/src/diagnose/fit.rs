@@ -145,9 +145,18 @@ pub struct Untestable {
 
 /// The nominal model for these training runs, notes on where each value came from, and
 /// the static first-difference variance the white noise was matched to (if measured).
+///
+/// The white noise comes from the runs' rests when they hold 2 s of them, else from
+/// `moving`, the effective noise of their moving residual ([`super::effective`]: the
+/// largest white noise its Allan deviation allows from 1 to 10 s), else from the prior.
+/// The bias wander and the output step stay the prior's: a wander or a step beyond them
+/// is what the vocabulary's `bias_instability`, `rate_random_walk` and `quantization`
+/// name, and a baseline fitted to them would absorb the effect it should reveal. The notes
+/// say whether the prior's wander is within what the residual allows.
 pub fn nominal_model(
     train: &[&RealRun],
     prior: &SensorModel,
+    moving: Option<&super::effective::MeasuredNoise>,
 ) -> (SensorModel, Vec<String>, Option<f64>) {
     let mut model = *prior;
     let mut notes = Vec::new();
@@ -185,16 +194,35 @@ pub fn nominal_model(
             "angle random walk {:.4} deg/sqrt(h): matched to the first differences of {count} static samples (output rounding included)",
             model.arw_deg_per_rt_h
         ));
+    } else if let Some(m) = moving.filter(|m| m.arw_deg_per_rt_h > 0.0) {
+        model.arw_deg_per_rt_h = m.arw_deg_per_rt_h;
+        notes.push(format!(
+            "angle random walk {:.4} deg/sqrt(h): fewer than 2 s of static samples, so fitted to the moving residual of the training runs (the largest white noise its Allan deviation allows from 1 to 10 s; it holds what the reference does not resolve as well as the sensor's own noise; the prior's is {:.4})",
+            model.arw_deg_per_rt_h, prior.arw_deg_per_rt_h
+        ));
     } else {
         notes.push(format!(
-            "angle random walk {:.4} deg/sqrt(h) from the prior model: fewer than 2 s of static samples",
+            "angle random walk {:.4} deg/sqrt(h) from the prior model: fewer than 2 s of static samples and no moving residual to measure",
             model.arw_deg_per_rt_h
         ));
     }
-    notes.push(format!(
+    let mut wander = format!(
         "Gauss-Markov bias sigma {} deg/s, T {} s, output step {:.5} deg/s, range {} deg/s: from the prior model",
         model.gm_sigma_dps, model.gm_tau_s, model.lsb_dps, model.range_dps
-    ));
+    );
+    if let Some(m) = moving {
+        let k_prior =
+            crate::noise::export::gauss_markov_random_walk(model.gm_sigma_dps, model.gm_tau_s);
+        let k = m.rate_random_walk_dps_per_rt_s;
+        let verdict = match (m.rate_random_walk_resolved, k_prior <= k) {
+            (true, _) => format!("the training residual's fitted wander is K = {k:.3e} deg/s/sqrt(s), the prior's {k_prior:.3e} (a larger one is the vocabulary's to name)"),
+            (false, true) => format!("within the bound the training residual allows (K {k_prior:.3e} <= {k:.3e} deg/s/sqrt(s))"),
+            (false, false) => format!("beyond the bound the training residual allows (K {k_prior:.3e} > {k:.3e} deg/s/sqrt(s)): the prior's wander is larger than these runs show"),
+        };
+        wander.push_str("; its wander ");
+        wander.push_str(&verdict);
+    }
+    notes.push(wander);
     (model, notes, target)
 }
 

@@ -214,11 +214,11 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         compensation: f.compensation,
         reference_warnings: sense_warnings(f.runs),
         warnings: lag_warnings(f.runs),
-        effective_noise: super::effective::EffectiveNoise::measure(
-            &f.runs.train,
-            &f.runs.holdout,
-            f.baseline.nominal.arw_deg_per_rt_h,
-        ),
+        effective_noise: super::effective::EffectiveNoise {
+            training: f.baseline.moving_noise.clone(),
+            holdout: super::effective::measure(&f.runs.holdout, "held-out")
+                .map(|m| m.compared_to(f.baseline.own_noise.0, f.baseline.own_noise.1)),
+        },
         motion_lines: [
             super::line::motion_line(&f.runs.train, "training"),
             super::line::motion_line(&f.runs.holdout, "held-out"),

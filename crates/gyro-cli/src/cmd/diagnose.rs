@@ -312,7 +312,7 @@ fn write_noise_yaml(out: &Path, args: &Args, result: &Diagnosis) -> Result<()> {
             let mut notes = vec![format!(
                 "{} (the diagnosis's sensor model has {:.4} deg/sqrt(h))",
                 t.describe(),
-                t.model_arw_deg_per_rt_h
+                result.model.sensor.arw_deg_per_rt_h
             )];
             if let Some(h) = &result.effective_noise.holdout {
                 notes.push(format!(

@@ -309,7 +309,26 @@ impl McapRows {
     /// back anyway) or the file ends, so that whether the log has a temperature and a
     /// reference is decided by them before the first row is placed. An error met is given
     /// by the iterator, after the rows before it.
+    ///
+    /// A finished file whose rate channels are all `gyro_msgs/msg/Sample` in CDR needs no
+    /// read-ahead: its summary defines every channel, and each says in its metadata
+    /// whether it has a temperature.
     pub fn prime(&mut self) {
+        if self.finished {
+            let rates: Vec<&Kind> = self
+                .state
+                .channels
+                .values()
+                .map(|c| &c.kind)
+                .filter(|k| !matches!(k, Kind::Ignored | Kind::Reference | Kind::ReferenceCdr))
+                .collect();
+            if !rates.is_empty() && rates.iter().all(|k| matches!(k, Kind::GyroCdr { .. })) {
+                self.state.has_temperature = rates
+                    .iter()
+                    .any(|k| matches!(k, Kind::GyroCdr { temperature: true }));
+                return;
+            }
+        }
         while self.primed.len() <= RATE_WINDOW_STEPS {
             match self.next_row() {
                 Some(row) => self.primed.push_back(row),

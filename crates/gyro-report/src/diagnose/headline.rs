@@ -347,9 +347,10 @@ fn effective_noise_line(e: &gyro_analysis::diagnose::effective::EffectiveNoise) 
         )
     });
     Some(format!(
-        "effective noise on moving data: angle random walk at most {} deg/sqrt(h) on the training runs ({:.0}x the model's {}; read from 1 to 10 s in what the deterministic terms leave of gyro minus reference){held_out}: what a filter must assume on this motion (--noise-yaml writes it)",
+        "effective noise on moving data: angle random walk at most {} deg/sqrt(h) on the training runs ({:.0}x {} {}; read from 1 to 10 s in what the deterministic terms leave of gyro minus reference){held_out}: what a filter must assume on this motion (--noise-yaml writes it)",
         sig3(t.arw_deg_per_rt_h),
         t.ratio_to_model,
+        t.whose(),
         sig3(t.model_arw_deg_per_rt_h)
     ))
 }
