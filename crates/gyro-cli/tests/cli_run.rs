@@ -872,4 +872,21 @@ fn a_micros_counter_that_wraps_is_unwrapped_and_said() {
         table.contains("1 wraps of the time stamps' counter unwrapped"),
         "{table}"
     );
+    // Converted to MCAP, which orders messages by time, the stamps are written unwrapped
+    // (and said): the MCAP log gives the same movements.
+    let mcap = dir.join("micros.mcap");
+    let mcap = mcap.to_str().unwrap();
+    let out = gyro(&["convert", &wrapped, mcap, "--time-unit", "us"]);
+    let note = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(out.status.success(), "{note}");
+    assert!(
+        note.contains(
+            "time stamps wrap: a 32-bit count of µs (4294.967296 s), 1 time(s), the first at line 25005: written unwrapped"
+        ),
+        "{note}"
+    );
+    let from_mcap = json_of(&gyro(&["run", mcap, "--format", "json"]));
+    assert_eq!(from_mcap["input"]["counter_wraps"].as_u64(), Some(0));
+    assert_eq!(from_mcap["input"]["backward_steps"].as_u64(), Some(0));
+    assert_eq!(movements(&from_mcap), movements(&expected));
 }

@@ -189,3 +189,36 @@ fn killed_writer_loses_at_most_the_open_chunk() {
         "{stderr}"
     );
 }
+
+/// A log whose time goes back (two recordings concatenated) is refused by `convert` to
+/// MCAP as `run` refuses it, naming the line, and nothing is written: MCAP orders messages
+/// by time, and would give the rows back interleaved, a log that reads.
+#[test]
+fn convert_refuses_time_that_goes_back() {
+    let dir = temp_dir("convert_back");
+    let csv = dir.join("back.csv");
+    let mut text = String::from("time_s,rate_dps,reference_deg\n");
+    for k in 0..400 {
+        let t = if k < 200 {
+            k as f64 * 0.01
+        } else {
+            (k - 200) as f64 * 0.01
+        };
+        text.push_str(&format!("{t:.2},1.0,{:.2}\n", 0.01 * k as f64));
+    }
+    std::fs::write(&csv, text).unwrap();
+    let csv = csv.to_str().unwrap();
+    let mcap = dir.join("back.mcap");
+    for out in [
+        gyro(&["run", csv]),
+        gyro(&["convert", csv, mcap.to_str().unwrap()]),
+    ] {
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("back.csv:202: time goes back by 1.990000 s"),
+            "{err}"
+        );
+    }
+    assert!(!mcap.exists());
+}

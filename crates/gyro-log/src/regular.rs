@@ -1077,19 +1077,7 @@ mod tests {
         /// The whole-log implementation `place` replaced, kept verbatim as the oracle.
         pub fn regularize_whole(log: &Log, options: &GridOptions) -> Result<RegularLog, LogError> {
             // The stamps unwrapped first, as in the streaming placement.
-            let mut unwrapper = crate::wraps::Unwrapper::default();
-            let unwrapped = Log {
-                rows: log
-                    .rows
-                    .iter()
-                    .map(|&r| {
-                        let mut r = r;
-                        unwrapper.unwrap(&mut r);
-                        r
-                    })
-                    .collect(),
-                ..log.clone()
-            };
+            let (unwrapped, unwrapper) = crate::wraps::unwrapped(log);
             let mut whole = placed_whole(&unwrapped, options)?;
             super::super::note_wraps(&mut whole.quality, &unwrapper);
             Ok(whole)

@@ -113,6 +113,40 @@ impl Unwrapper {
     }
 }
 
+/// `log` with its stamps unwrapped, and what the unwrapping did (`wraps`, the span, the
+/// first line): what placement reads, for writers that must keep the rows in time order
+/// (`gyro-cli convert`: MCAP orders messages by their time).
+pub fn unwrapped(log: &crate::Log) -> (crate::Log, Unwrapper) {
+    let mut unwrapper = Unwrapper::default();
+    let rows = log
+        .rows
+        .iter()
+        .map(|&row| {
+            let mut row = row;
+            unwrapper.unwrap(&mut row);
+            row
+        })
+        .collect();
+    (
+        crate::Log {
+            rows,
+            ..log.clone()
+        },
+        unwrapper,
+    )
+}
+
+/// What `unwrapper` did, in words, or `None` if it unwrapped nothing: "time stamps wrap: a
+/// 16-bit count of ms (65.536 s), 3 times, the first at line 905".
+pub fn describe(unwrapper: &Unwrapper) -> Option<String> {
+    let (span_s, line) = (unwrapper.span_s()?, unwrapper.first_line?);
+    Some(format!(
+        "time stamps wrap: {}, {} time(s), the first at line {line}",
+        describe_span(span_s),
+        unwrapper.wraps
+    ))
+}
+
 /// What a counter's span is, in words: `a 32-bit count of µs (4294.967296 s)`.
 pub fn describe_span(span_s: f64) -> String {
     match SPANS_S.iter().position(|&s| s == span_s) {

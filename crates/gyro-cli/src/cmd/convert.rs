@@ -24,6 +24,16 @@ pub fn run(args: &Args) -> Result<()> {
     args.force
         .check([args.output.as_path()], [args.input.as_path()])?;
     let log = super::read(&args.input, &args.input_options)?;
+    // Stamps from a wrapping tick counter are written unwrapped, as every command places
+    // them: an MCAP file orders its messages by time, and would put the rows after a wrap
+    // before the ones ahead of it.
+    let (log, unwrapper) = log::wraps::unwrapped(&log);
+    if let Some(what) = log::wraps::describe(&unwrapper) {
+        super::warn(&format!(
+            "{}: {what}: written unwrapped",
+            args.input.display()
+        ));
+    }
     log::write_log(&args.output, &log, args.to)?;
     let yes_no = |b: bool| if b { "yes" } else { "no" };
     say!(

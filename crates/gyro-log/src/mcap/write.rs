@@ -408,7 +408,28 @@ fn write_error(path: &Path, e: McapError) -> LogError {
 
 /// Write `log` as an MCAP file (see the module docs for the layout): its metadata, then
 /// each row as a `/gyro` and (if the log has a reference) a `/reference` message.
+///
+/// A log whose time goes back by more than placement tolerates (the default
+/// [`crate::GridOptions::max_gap_s`]: a concatenated or corrupt log, which `run` refuses as
+/// it is) is refused, [`LogError::TimeBackwards`] naming its line, with nothing written:
+/// MCAP orders messages by time, so its rows would come back in another order, a log that
+/// reads. Stamps from a wrapping counter are to be unwrapped first ([`crate::wraps`]).
 pub fn write_mcap(path: &Path, log: &Log) -> Result<(), LogError> {
+    let max_back_s = crate::GridOptions::default().max_gap_s;
+    for pair in log.rows.windows(2) {
+        let (previous, row) = (&pair[0], &pair[1]);
+        let back_s = previous.time_s - row.time_s;
+        if back_s > max_back_s {
+            return Err(LogError::TimeBackwards {
+                path: log.path.clone(),
+                line: row.line,
+                previous_line: previous.line,
+                previous_s: previous.time_s,
+                time_s: row.time_s,
+                back_s,
+            });
+        }
+    }
     let mut writer = McapLogWriter::create_with(
         path,
         McapWriteOptions {
