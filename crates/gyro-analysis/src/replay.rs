@@ -278,14 +278,34 @@ pub enum ReplayFileError {
     #[error(transparent)]
     Log(#[from] LogError),
     /// The pipeline cannot be configured for the log's sample rate.
-    #[error("{path}: cannot configure the pipeline for this log")]
+    #[error(
+        "{path}: cannot configure the pipeline for this log{}",
+        rate_hint(*sample_rate_hz, *output_rate_hz)
+    )]
     Config {
         /// The log.
         path: PathBuf,
         /// Why.
         #[source]
         cause: gyro_core::Error,
+        /// The log's sample rate as placed (Hz).
+        sample_rate_hz: f64,
+        /// The configuration's output rate (Hz).
+        output_rate_hz: f32,
     },
+}
+
+/// Why a sample rate cannot be decimated to the output rate, when that is the reason: a
+/// rate below it is most often stamps in ms read as seconds.
+fn rate_hint(sample_rate_hz: f64, output_rate_hz: f32) -> String {
+    if sample_rate_hz < f64::from(output_rate_hz) {
+        format!(
+            " (its stamps give {} Hz, below the output rate of {output_rate_hz} Hz: time stamps in ms read as seconds? --time-unit ms; else a model file's config.output_rate_hz at most the sample rate)",
+            (sample_rate_hz * 1e3).round() / 1e3
+        )
+    } else {
+        String::new()
+    }
 }
 
 /// Read, place on the grid and replay a log: what [`gyro_log::load`] and [`replay_with`]
@@ -329,14 +349,17 @@ pub fn replay_file_into(
     warn: &mut dyn FnMut(&str),
     series: &mut dyn SeriesSink,
 ) -> Result<RunReport, ReplayFileError> {
-    let config_error = |cause| ReplayFileError::Config {
+    let config_error = |cause, sample_rate_hz| ReplayFileError::Config {
         path: path.to_path_buf(),
         cause,
+        sample_rate_hz,
+        output_rate_hz: config.output_rate_hz,
     };
     let delay = replay_options.reference_delay_s;
     if delay.is_finite() && delay != 0.0 {
         let regular = gyro_log::load(path, options, grid, warn)?;
-        let mut report = replay_with(&regular, config, replay_options).map_err(config_error)?;
+        let mut report = replay_with(&regular, config, replay_options)
+            .map_err(|cause| config_error(cause, regular.sample_rate_hz))?;
         series.start(report.output_rate_hz);
         for point in std::mem::take(&mut report.series) {
             series.point(&point);
@@ -351,9 +374,10 @@ pub fn replay_file_into(
         series,
     };
     let quality = gyro_log::stream(path, options, grid, &mut sink, warn)?;
+    let sample_rate_hz = quality.sample_rate_hz;
     match sink.replayer {
         Some(Ok(replayer)) => Ok(replayer.finish(quality)),
-        Some(Err(cause)) => Err(config_error(cause)),
+        Some(Err(cause)) => Err(config_error(cause, sample_rate_hz)),
         // `place` succeeded, so it gave the rate: not reached.
         None => Replayer::new(
             quality.sample_rate_hz,
@@ -365,7 +389,7 @@ pub fn replay_file_into(
             sink.series.start(replayer.output_rate_hz);
             replayer.finish(quality)
         })
-        .map_err(config_error),
+        .map_err(|cause| config_error(cause, sample_rate_hz)),
     }
 }
 

@@ -23,10 +23,13 @@ fn materialised(
     let raw = log::read_log(path, &LogOptions::default()).map_err(|e| e.to_string())?;
     let regular = log::regularize(&raw, grid).map_err(|e| e.to_string())?;
     replay::replay_with(&regular, config, options).map_err(|cause| {
-        format!(
-            "{}: cannot configure the pipeline for this log: {cause}",
-            path.display()
-        )
+        let e = ReplayFileError::Config {
+            path: path.to_path_buf(),
+            cause,
+            sample_rate_hz: regular.sample_rate_hz,
+            output_rate_hz: config.output_rate_hz,
+        };
+        format!("{:#}", anyhow::Error::new(e))
     })
 }
 
@@ -386,7 +389,7 @@ fn streaming_equals_materialising_on_fixtures_and_generated_logs() {
         ("ragged.csv", "ragged.csv:3: row has 1 fields"),
         (
             "rate3.csv",
-            "rate3.csv: cannot configure the pipeline for this log: ",
+            "rate3.csv: cannot configure the pipeline for this log (its stamps give 3 Hz, below the output rate of 50 Hz: time stamps in ms read as seconds? --time-unit ms",
         ),
         ("rate3_gap.csv", "rate3_gap.csv:103: gap of 7.000 s"),
     ] {

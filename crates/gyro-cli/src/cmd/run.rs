@@ -183,12 +183,7 @@ pub fn run(args: &Args) -> Result<()> {
     )
     .map_err(|e| match e {
         replay::ReplayFileError::Log(e) => anyhow::Error::new(e),
-        replay::ReplayFileError::Config { path, cause } => {
-            anyhow::Error::new(cause).context(format!(
-                "{}: cannot configure the pipeline for this log",
-                path.display()
-            ))
-        }
+        e @ replay::ReplayFileError::Config { .. } => anyhow::Error::new(e),
     })?;
     result.series = kept;
     let file = args.log.display().to_string();
