@@ -269,7 +269,7 @@ mod tests {
         assert!((0.9..1.2).contains(&(model.arw_deg_per_rt_h / 6.0)));
         let text = notes.join("\n");
         assert!(text.contains("fitted to the moving residual"), "{text}");
-        assert!(text.contains("; its wander "), "{text}");
+        assert!(text.contains("; its wander: K "), "{text}");
         let (model, notes, _) = super::super::fit::nominal_model(&refs, &prior, None);
         assert_eq!(model.arw_deg_per_rt_h, prior.arw_deg_per_rt_h);
         assert!(notes.join("\n").contains("from the prior model"));

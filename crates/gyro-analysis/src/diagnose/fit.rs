@@ -215,11 +215,11 @@ pub fn nominal_model(
             crate::noise::export::gauss_markov_random_walk(model.gm_sigma_dps, model.gm_tau_s);
         let k = m.rate_random_walk_dps_per_rt_s;
         let verdict = match (m.rate_random_walk_resolved, k_prior <= k) {
-            (true, _) => format!("the training residual's fitted wander is K = {k:.3e} deg/s/sqrt(s), the prior's {k_prior:.3e} (a larger one is the vocabulary's to name)"),
-            (false, true) => format!("within the bound the training residual allows (K {k_prior:.3e} <= {k:.3e} deg/s/sqrt(s))"),
-            (false, false) => format!("beyond the bound the training residual allows (K {k_prior:.3e} > {k:.3e} deg/s/sqrt(s)): the prior's wander is larger than these runs show"),
+            (true, _) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, against {k:.3e} fitted to the training residual (a larger wander is the vocabulary's to name)"),
+            (false, true) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, within the bound the training residual allows ({k:.3e})"),
+            (false, false) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, beyond the bound the training residual allows ({k:.3e}): the prior's wander is larger than these runs show"),
         };
-        wander.push_str("; its wander ");
+        wander.push_str("; its wander: ");
         wander.push_str(&verdict);
     }
     notes.push(wander);
