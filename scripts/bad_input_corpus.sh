@@ -63,6 +63,7 @@ data 50 >in/no_header.csv
 { echo "$hdr"; data 3000 | awk -F, -v OFS=, '{$2="1e300"; print}'; } >in/rates_1e300.csv
 { echo "$hdr"; data 1; } >in/one_row.csv
 { echo "$hdr"; data 3000 | awk -F, -v OFS=, '{$1=$1*1e6+1.7e15; print}'; } >in/epoch_us_as_s.csv
+{ echo "$hdr"; data 3000 | awk -F, -v OFS=, '{$1=$1*1000; print}'; } >in/ms_as_s.csv
 { echo '# sample_rate_hz: -1000'; echo "$hdr"; data 3000; } >in/meta_rate_negative.csv
 { echo '# sample_rate_hz: 0'; echo "$hdr"; data 3000; } >in/meta_rate_zero.csv
 { echo '# sample_rate_hz: NaN'; echo "$hdr"; data 3000; } >in/meta_rate_nan.csv
@@ -142,9 +143,10 @@ done
 for f in empty nan_time utf16 no_reference epoch_us_as_s; do
     c "simulate --motion-from $f.csv" refuse "$f.csv" "\$G simulate --motion-from in/$f.csv -o out/s.csv"
 done
-for f in empty not_a_number utf16 nul_bytes; do
+for f in empty not_a_number utf16 nul_bytes time_backwards; do
     c "convert $f.csv" refuse "$f.csv" "\$G convert in/$f.csv out/c.mcap"
 done
+c "run ms_as_s.csv (stamps in ms read as s)" refuse "--time-unit ms" "\$G run in/ms_as_s.csv"
 for f in empty utf16 not_a_number; do
     c "emulate --log $f.csv" refuse "$f.csv" "\$G emulate --log in/$f.csv --port out/nowhere"
 done
