@@ -398,6 +398,19 @@ impl Known {
 }
 
 /// Effects fitted from the joint regression, which [`Joint`] refits given the others.
+/// The 95% interval of a regression fit holds the effect's absence: a zero coefficient
+/// (delay, ppm, scale, …), or for a bandwidth no upper bound (a delay interval reaching
+/// zero maps to an unbounded cutoff).
+pub(crate) fn interval_holds_absence(fit: &Fit) -> bool {
+    let [(lo, hi)] = fit.ci95.as_slice() else {
+        return false;
+    };
+    match fit.effect {
+        Effect::Bandwidth { .. } => hi.is_none(),
+        _ => lo.is_none_or(|l| l <= 0.0) && hi.is_none_or(|h| h >= 0.0),
+    }
+}
+
 fn conditional(effect: &Effect) -> bool {
     matches!(effect.info().fit, FitProcedure::Regression { .. })
 }
@@ -1136,6 +1149,28 @@ fn wander_overshoot(per_tau: &[(f64, f64, f64)], gain: f64) -> Option<(f64, f64)
 #[cfg(test)]
 mod wander_shape_tests {
     use super::*;
+
+    /// An interval holds an effect's absence when it reaches a zero coefficient, or for a
+    /// bandwidth, an unbounded cutoff.
+    #[test]
+    fn intervals_that_hold_absence() {
+        let fit = |effect, lo: Option<f64>, hi: Option<f64>| Fit {
+            effect,
+            ci95: vec![(lo, hi)],
+            z: 5.0,
+            passes: true,
+            test: String::new(),
+            direct: false,
+        };
+        let latency = Effect::Latency { delay_s: -0.0003 };
+        assert!(interval_holds_absence(&fit(latency, Some(-0.0025), Some(0.0018))));
+        assert!(!interval_holds_absence(&fit(latency, Some(0.0106), Some(0.0125))));
+        assert!(!interval_holds_absence(&fit(latency, Some(-0.012), Some(-0.010))));
+        assert!(interval_holds_absence(&fit(latency, None, Some(0.01))));
+        let bandwidth = Effect::Bandwidth { cutoff_hz: 30.0 };
+        assert!(interval_holds_absence(&fit(bandwidth, Some(20.0), None)));
+        assert!(!interval_holds_absence(&fit(bandwidth, Some(20.0), Some(40.0))));
+    }
 
     #[test]
     fn a_wander_matching_the_runs_at_every_tau_passes() {
