@@ -398,17 +398,24 @@ impl Known {
 }
 
 /// Effects fitted from the joint regression, which [`Joint`] refits given the others.
+/// A delay shorter than this share of a sample period moves no sample by more than that
+/// share of its step: below what the log's timing resolves as an effect of its own.
+pub const NEGLIGIBLE_DELAY_SAMPLES: f64 = 0.1;
+
 /// The 95% interval of a regression fit holds the effect's absence: a zero coefficient
-/// (delay, ppm, scale, …), or for a bandwidth no upper bound (a delay interval reaching
-/// zero maps to an unbounded cutoff).
-pub(crate) fn interval_holds_absence(fit: &Fit) -> bool {
+/// (ppm, scale, …); for a latency, a delay under [`NEGLIGIBLE_DELAY_SAMPLES`] of a sample
+/// period at `sample_rate_hz`; for a bandwidth, a cutoff at the Nyquist frequency or none
+/// (the fit's stand-in for no limit: a delay interval reaching zero maps to it).
+pub(crate) fn interval_holds_absence(fit: &Fit, sample_rate_hz: f64) -> bool {
     let [(lo, hi)] = fit.ci95.as_slice() else {
         return false;
     };
-    match fit.effect {
-        Effect::Bandwidth { .. } => hi.is_none(),
-        _ => lo.is_none_or(|l| l <= 0.0) && hi.is_none_or(|h| h >= 0.0),
-    }
+    let absent = match fit.effect {
+        Effect::Bandwidth { .. } => return hi.is_none_or(|h| h >= 0.5 * sample_rate_hz),
+        Effect::Latency { .. } if sample_rate_hz > 0.0 => NEGLIGIBLE_DELAY_SAMPLES / sample_rate_hz,
+        _ => 0.0,
+    };
+    lo.is_none_or(|l| l <= absent) && hi.is_none_or(|h| h >= -absent)
 }
 
 fn conditional(effect: &Effect) -> bool {
@@ -1162,14 +1169,21 @@ mod wander_shape_tests {
             test: String::new(),
             direct: false,
         };
+        let holds = |effect, lo, hi, fs| interval_holds_absence(&fit(effect, lo, hi), fs);
         let latency = Effect::Latency { delay_s: -0.0003 };
-        assert!(interval_holds_absence(&fit(latency, Some(-0.0025), Some(0.0018))));
-        assert!(!interval_holds_absence(&fit(latency, Some(0.0106), Some(0.0125))));
-        assert!(!interval_holds_absence(&fit(latency, Some(-0.012), Some(-0.010))));
-        assert!(interval_holds_absence(&fit(latency, None, Some(0.01))));
+        assert!(holds(latency, Some(-0.0025), Some(0.0018), 100.0));
+        assert!(!holds(latency, Some(0.0106), Some(0.0125), 100.0));
+        assert!(!holds(latency, Some(-0.012), Some(-0.010), 100.0));
+        assert!(holds(latency, None, Some(0.01), 100.0));
+        // 33 µs [6, 60] at 1 kHz: under a tenth of a sample (0.1 ms); at 100 µs, not.
+        assert!(holds(latency, Some(6e-6), Some(6e-5), 1000.0));
+        assert!(!holds(latency, Some(1.1e-4), Some(2e-4), 1000.0));
+        let scale = Effect::ScaleFactor { k: 1e-5 };
+        assert!(!holds(scale, Some(6e-6), Some(6e-5), 1000.0));
         let bandwidth = Effect::Bandwidth { cutoff_hz: 30.0 };
-        assert!(interval_holds_absence(&fit(bandwidth, Some(20.0), None)));
-        assert!(!interval_holds_absence(&fit(bandwidth, Some(20.0), Some(40.0))));
+        assert!(holds(bandwidth, Some(20.0), None, 100.0));
+        assert!(!holds(bandwidth, Some(20.0), Some(40.0), 100.0));
+        assert!(holds(bandwidth, Some(500.0), Some(500.0), 1000.0));
     }
 
     #[test]
