@@ -495,6 +495,25 @@ pub fn place<S: SlotSink + ?Sized>(
     Ok(quality)
 }
 
+/// The error for `row` stamped more than `max_back_s` before `previous` (a concatenated or
+/// corrupt log), if it is.
+pub(crate) fn time_backwards(
+    path: &Path,
+    previous: &Row,
+    row: &Row,
+    max_back_s: f64,
+) -> Option<LogError> {
+    let back_s = previous.time_s - row.time_s;
+    (back_s > max_back_s).then(|| LogError::TimeBackwards {
+        path: path.to_path_buf(),
+        line: row.line,
+        previous_line: previous.line,
+        previous_s: previous.time_s,
+        time_s: row.time_s,
+        back_s,
+    })
+}
+
 /// What `unwrapper` did, in the quality report: the count, the span, the first line.
 fn note_wraps(quality: &mut Quality, unwrapper: &Unwrapper) {
     quality.counter_wraps = unwrapper.wraps;
@@ -666,15 +685,8 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
             let dt = row.time_s - prev.time_s;
             self.quality.longest_step_s = self.quality.longest_step_s.max(dt);
             if dt < 0.0 {
-                if -dt > self.max_gap_s {
-                    self.row_error = Some(LogError::TimeBackwards {
-                        path: self.path.to_path_buf(),
-                        line: row.line,
-                        previous_line: prev.line,
-                        previous_s: prev.time_s,
-                        time_s: row.time_s,
-                        back_s: -dt,
-                    });
+                if let Some(e) = time_backwards(self.path, &prev, row, self.max_gap_s) {
+                    self.row_error = Some(e);
                     return;
                 }
                 self.quality.backward_steps += 1;

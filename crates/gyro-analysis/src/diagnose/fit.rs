@@ -397,27 +397,32 @@ impl Known {
     }
 }
 
-/// Effects fitted from the joint regression, which [`Joint`] refits given the others.
 /// A delay shorter than this share of a sample period moves no sample by more than that
 /// share of its step: below what the log's timing resolves as an effect of its own.
 pub const NEGLIGIBLE_DELAY_SAMPLES: f64 = 0.1;
 
 /// The 95% interval of a regression fit holds the effect's absence: a zero coefficient
 /// (ppm, scale, …); for a latency, a delay under [`NEGLIGIBLE_DELAY_SAMPLES`] of a sample
-/// period at `sample_rate_hz`; for a bandwidth, a cutoff at the Nyquist frequency or none
-/// (the fit's stand-in for no limit: a delay interval reaching zero maps to it).
-pub(crate) fn interval_holds_absence(fit: &Fit, sample_rate_hz: f64) -> bool {
+/// period of `model`; for a bandwidth, a cutoff the effect table counts as neutral (at the
+/// Nyquist frequency, the fit's stand-in for no limit) or none (a delay interval reaching
+/// zero maps to it).
+pub(crate) fn interval_holds_absence(fit: &Fit, model: &SensorModel) -> bool {
     let [(lo, hi)] = fit.ci95.as_slice() else {
         return false;
     };
     let absent = match fit.effect {
-        Effect::Bandwidth { .. } => return hi.is_none_or(|h| h >= 0.5 * sample_rate_hz),
-        Effect::Latency { .. } if sample_rate_hz > 0.0 => NEGLIGIBLE_DELAY_SAMPLES / sample_rate_hz,
+        Effect::Bandwidth { .. } => {
+            return hi.is_none_or(|cutoff_hz| Effect::Bandwidth { cutoff_hz }.is_neutral(model))
+        }
+        Effect::Latency { .. } if model.sample_rate_hz > 0.0 => {
+            NEGLIGIBLE_DELAY_SAMPLES / model.sample_rate_hz
+        }
         _ => 0.0,
     };
     lo.is_none_or(|l| l <= absent) && hi.is_none_or(|h| h >= -absent)
 }
 
+/// Effects fitted from the joint regression, which [`Joint`] refits given the others.
 fn conditional(effect: &Effect) -> bool {
     matches!(effect.info().fit, FitProcedure::Regression { .. })
 }
@@ -1157,8 +1162,8 @@ fn wander_overshoot(per_tau: &[(f64, f64, f64)], gain: f64) -> Option<(f64, f64)
 mod wander_shape_tests {
     use super::*;
 
-    /// An interval holds an effect's absence when it reaches a zero coefficient, or for a
-    /// bandwidth, an unbounded cutoff.
+    /// An interval holds an effect's absence when it reaches a zero coefficient, a delay
+    /// under a tenth of a sample, or for a bandwidth, a neutral or unbounded cutoff.
     #[test]
     fn intervals_that_hold_absence() {
         let fit = |effect, lo: Option<f64>, hi: Option<f64>| Fit {
@@ -1169,7 +1174,13 @@ mod wander_shape_tests {
             test: String::new(),
             direct: false,
         };
-        let holds = |effect, lo, hi, fs| interval_holds_absence(&fit(effect, lo, hi), fs);
+        let holds = |effect, lo, hi, fs| {
+            let model = SensorModel {
+                sample_rate_hz: fs,
+                ..SensorModel::default()
+            };
+            interval_holds_absence(&fit(effect, lo, hi), &model)
+        };
         let latency = Effect::Latency { delay_s: -0.0003 };
         assert!(holds(latency, Some(-0.0025), Some(0.0018), 100.0));
         assert!(!holds(latency, Some(0.0106), Some(0.0125), 100.0));

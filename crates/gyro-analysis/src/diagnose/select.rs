@@ -522,7 +522,7 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
             .find(|(_, refit)| {
                 refit
                     .as_ref()
-                    .is_some_and(|f| fit::interval_holds_absence(f, scorer.sample_rate_hz()))
+                    .is_some_and(|f| fit::interval_holds_absence(f, scorer.nominal()))
             })
             .map(|(&i, _)| i);
         if let Some(i) = absent {

@@ -416,19 +416,12 @@ fn write_error(path: &Path, e: McapError) -> LogError {
 /// reads. Stamps from a wrapping counter are to be unwrapped first ([`crate::wraps`]).
 pub fn write_mcap(path: &Path, log: &Log) -> Result<(), LogError> {
     let max_back_s = crate::GridOptions::default().max_gap_s;
-    for pair in log.rows.windows(2) {
-        let (previous, row) = (&pair[0], &pair[1]);
-        let back_s = previous.time_s - row.time_s;
-        if back_s > max_back_s {
-            return Err(LogError::TimeBackwards {
-                path: log.path.clone(),
-                line: row.line,
-                previous_line: previous.line,
-                previous_s: previous.time_s,
-                time_s: row.time_s,
-                back_s,
-            });
-        }
+    if let Some(e) = log
+        .rows
+        .windows(2)
+        .find_map(|pair| crate::regular::time_backwards(&log.path, &pair[0], &pair[1], max_back_s))
+    {
+        return Err(e);
     }
     let mut writer = McapLogWriter::create_with(
         path,
