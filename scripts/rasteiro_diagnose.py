@@ -10,7 +10,8 @@ Per sensor axis (the board's x, y and z files):
 For each diagnosis it prints what the turns show rest to rest (`turns` in the JSON: the
 gyro-reference lag searched wide, the turns' scale with its 95% interval, whether it is
 named and written, the held-out turns' own scale and RMS error without and with it, and
-the movements the reference does not follow). Then the held-out turns' median |error|
+the movements the reference does not follow) and the whiteness check of the training
+rests (`model.rest_noise`: the white noise from first differences and from 0.05 s blocks). Then the held-out turns' median |error|
 (90th percentile) rest to rest against the robot's pose, per group: the plain per-rest
 estimator, the same with a least-squares scale of its own turn errors on the same training
 recordings (the plainest alternative with the same information), `gyro-cli run` with the
@@ -70,6 +71,13 @@ def describe(label, d, written):
     if u:
         g = [abs(x["gyro_deg"]) for x in u]
         parts.append(f"{len(u)} untracked ({min(g):.1f}-{max(g):.1f} deg)")
+    rest = (d.get("model") or {}).get("rest_noise")
+    if rest:
+        parts.append(
+            f"rest noise {rest['first_difference_arw_deg_per_rt_h']:.2f} -> "
+            f"{rest['block_arw_deg_per_rt_h']:.2f} deg/sqrt(h) at {rest['tau_s']:.2f} s"
+            f" (z {rest['z']:.0f}{', coloured' if rest['coloured'] else ''})"
+        )
     named = [e["id"] for e in d["effects"] if e["significant"]]
     parts.append(f"vocabulary: {', '.join(named) or 'none'}; {len(d.get('unexplained') or [])} unexplained")
     parts.append(f"model file {'written' if written else 'not written'}")

@@ -77,8 +77,10 @@ pub(crate) struct Baseline {
     pub(crate) nominal: SensorModel,
     /// Where its values came from.
     pub(crate) notes: Vec<String>,
-    /// The static first-difference variance the white noise was matched to (if fitted).
-    pub(crate) white_target: Option<f64>,
+    /// The static statistic the white noise was matched to (if fitted at rest).
+    pub(crate) white_target: Option<fit::WhiteTarget>,
+    /// The whiteness check of the training runs' rests.
+    pub(crate) whiteness: Option<fit::RestWhiteness>,
     /// The effective noise of the training runs' moving residual, compared with the
     /// sensor's own white noise (the rests', else the prior's or the given model's).
     pub(crate) moving_noise: Option<MeasuredNoise>,
@@ -103,7 +105,7 @@ pub(crate) struct Baseline {
 /// baseline ensembles of every run.
 pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) -> Baseline {
     let moving = measure(&runs.train, "training");
-    let (nominal, notes, white_target) = if options.fixed_model {
+    let (nominal, notes, white_target, whiteness) = if options.fixed_model {
         let mut m = options.prior;
         if let Some(first) = runs.train.first() {
             m.sample_rate_hz = first.sample_rate_hz;
@@ -112,10 +114,15 @@ pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) 
             m,
             vec!["the --model sensor model as given".to_string()],
             None,
+            None,
         )
     } else {
-        let (mut nominal, mut notes, target) =
-            fit::nominal_model(&runs.train, &options.prior, moving.as_ref());
+        let fit::Nominal {
+            model: mut nominal,
+            mut notes,
+            white_target,
+            whiteness,
+        } = fit::nominal_model(&runs.train, &options.prior, moving.as_ref());
         // The prior's range is the CRM100's: any run, trained on or held out, that reads
         // beyond it shows it is not this sensor's (it is not fitted, only refused).
         let largest = crate::model::largest_plausible_abs_rate(
@@ -129,7 +136,7 @@ pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) 
             nominal.range_dps = f64::from(gyro_core::Config::default().max_abs_rate_dps);
             notes.push(note);
         }
-        (nominal, notes, target)
+        (nominal, notes, white_target, whiteness)
     };
     let own_noise = match (options.fixed_model, white_target) {
         (true, _) => (nominal.arw_deg_per_rt_h, "given model"),
@@ -174,6 +181,7 @@ pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) 
         nominal,
         notes,
         white_target,
+        whiteness,
         moving_noise,
         own_noise,
         candidate_members: mc,

@@ -198,6 +198,9 @@ pub struct ModelSummary {
     pub sensor: SensorModel,
     /// Provenance of its values.
     pub notes: Vec<String>,
+    /// Whether the training runs' rest noise is white (the first differences against
+    /// the Allan variance at a short τ); absent without enough rest or with `--model`.
+    pub rest_noise: Option<super::fit::RestWhiteness>,
     /// The selected effects with their parameters.
     pub effects: Vec<Effect>,
 }

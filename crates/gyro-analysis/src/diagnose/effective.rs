@@ -262,15 +262,21 @@ mod tests {
         let refs: Vec<&RealRun> = runs.iter().collect();
         let m = measure(&refs, "training").unwrap();
         let prior = SensorModel::default();
-        let (model, notes, static_target) =
-            super::super::fit::nominal_model(&refs, &prior, Some(&m));
-        assert!(static_target.is_none(), "these runs do not rest");
+        let super::super::fit::Nominal {
+            model,
+            notes,
+            white_target,
+            whiteness,
+        } = super::super::fit::nominal_model(&refs, &prior, Some(&m));
+        assert!(white_target.is_none(), "these runs do not rest");
+        assert!(whiteness.is_none(), "these runs do not rest");
         assert_eq!(model.arw_deg_per_rt_h, m.arw_deg_per_rt_h);
         assert!((0.9..1.2).contains(&(model.arw_deg_per_rt_h / 6.0)));
         let text = notes.join("\n");
         assert!(text.contains("fitted to the moving residual"), "{text}");
         assert!(text.contains("; its wander: K "), "{text}");
-        let (model, notes, _) = super::super::fit::nominal_model(&refs, &prior, None);
+        let super::super::fit::Nominal { model, notes, .. } =
+            super::super::fit::nominal_model(&refs, &prior, None);
         assert_eq!(model.arw_deg_per_rt_h, prior.arw_deg_per_rt_h);
         assert!(notes.join("\n").contains("from the prior model"));
     }

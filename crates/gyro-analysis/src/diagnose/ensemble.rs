@@ -389,6 +389,7 @@ pub fn simulate_member(
                 plateau_samples: 0,
                 temperature_varies: false,
                 static_diff_var: (f64::NAN, 0),
+                static_block_var: (f64::NAN, 0),
                 bias_dps: f64::NAN,
                 incoherent_psd: Vec::new(),
                 reference_psd: Vec::new(),

@@ -104,6 +104,17 @@ pub const CUBIC_SCALE_DPS: f64 = 100.0;
 pub const LINE_SEGMENT_S: f64 = 2.0;
 /// Averaging times of the wander feature (s).
 pub const WANDER_TAUS_S: [f64; 3] = [1.0, 4.0, 16.0];
+/// Averaging time of the whiteness check on static samples (s). The Allan variance of the
+/// rests at this τ, beside their first differences, tells white rest noise from noise a
+/// low-pass inside the band has coloured (a MEMS gyro's digital low-pass): the first
+/// differences read the top of the band, the angle integrates the bottom of it.
+pub const WHITE_CHECK_TAU_S: f64 = 0.05;
+
+/// Samples per block of the whiteness check at `fs` Hz ([`WHITE_CHECK_TAU_S`], at least 2).
+pub fn white_check_block(fs: f64) -> usize {
+    ((WHITE_CHECK_TAU_S * fs).round() as usize).max(2)
+}
+
 /// A run's temperature "varies" when its range exceeds this (°C).
 pub const MIN_TEMPERATURE_RANGE_C: f64 = 0.5;
 
@@ -124,9 +135,14 @@ pub struct Features {
     pub plateau_samples: usize,
     /// The temperature varied enough for the temperature regressors.
     pub temperature_varies: bool,
-    /// Mean of the smoothed-gyro residual's first differences squared / 2 on static
-    /// samples ((deg/s)²) and how many differences (white-noise level).
+    /// Mean of the gyro's first differences squared / 2 at rest
+    /// ([`super::stats::Residuals::is_rest`]; (deg/s)²) and how many differences
+    /// (white-noise level).
     pub static_diff_var: (f64, usize),
+    /// Allan variance of the gyro at rest ([`super::stats::Residuals::is_rest`]) at
+    /// [`white_check_block`] samples ((deg/s)²: half the mean squared difference of
+    /// consecutive block means inside one rest) and how many differences.
+    pub static_block_var: (f64, usize),
     /// The run's bias (deg/s): the regression intercept (the bias at zero rate and the
     /// starting temperature) when at least 2 s of static samples pin it; on continuous
     /// motion the intercept trades with the |rate| and rate³ terms (at a near-constant
@@ -431,10 +447,10 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
         coef[k] = low_coef[k];
     }
 
-    // White-noise level from static samples: first differences of the raw residual.
+    // White-noise level at rest: first differences of the raw gyro.
     let (mut sum, mut count) = (0.0, 0usize);
     for i in 1..n {
-        if r.is_static[i] && r.is_static[i - 1] {
+        if r.is_rest[i] && r.is_rest[i - 1] {
             let d = r.rate_dps[i] - r.rate_dps[i - 1];
             if d.is_finite() {
                 sum += d * d;
@@ -447,6 +463,9 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
     } else {
         (f64::NAN, 0)
     };
+    // Of the raw gyro, as the first differences (the reference's own noise stays out).
+    let static_block_var =
+        static_allan_variance(&r.rate_dps, |i| r.is_rest[i], white_check_block(fs));
 
     let features = Features {
         coef,
@@ -456,12 +475,40 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
         plateau_samples,
         temperature_varies,
         static_diff_var,
+        static_block_var,
         bias_dps: run_bias(r, full_band_intercept),
         incoherent_psd: Vec::new(),
         reference_psd: Vec::new(),
         cross_psd: Vec::new(),
     };
     (features, residual)
+}
+
+/// Allan variance at `block` samples of the finite samples of `x` where `ok`: half the
+/// mean squared difference of consecutive non-overlapping block means within each stretch,
+/// and how many differences (NaN and 0 when none).
+pub(crate) fn static_allan_variance(
+    x: &[f64],
+    ok: impl Fn(usize) -> bool,
+    block: usize,
+) -> (f64, usize) {
+    let block = block.max(1);
+    let (mut sum, mut count) = (0.0, 0usize);
+    for run in stretches(x.len(), |i| ok(i) && x[i].is_finite()) {
+        let means: Vec<f64> = x[run]
+            .chunks_exact(block)
+            .map(|c| c.iter().sum::<f64>() / block as f64)
+            .collect();
+        for pair in means.windows(2) {
+            sum += (pair[1] - pair[0]).powi(2);
+            count += 1;
+        }
+    }
+    if count > 0 {
+        (sum / count as f64 / 2.0, count)
+    } else {
+        (f64::NAN, 0)
+    }
 }
 
 /// Least-squares coefficients of the rows `row(i)`, `i < n`, on the regression columns

@@ -143,12 +143,73 @@ pub struct Untestable {
     pub reason: String,
 }
 
+/// A static noise statistic the white noise is matched to: the Allan variance at
+/// `block` samples ((deg/s)²; at one sample, half the mean squared first difference).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct WhiteTarget {
+    /// The measured Allan variance ((deg/s)²).
+    pub avar_dps2: f64,
+    /// Its averaging time in samples.
+    pub block: usize,
+}
+
+/// |z| beyond which the rests' noise is not white: the Allan variance at
+/// [`super::features::WHITE_CHECK_TAU_S`] against the first differences', both read as a
+/// white noise through the nominal model (as [`Z_CRITICAL`]).
+pub const WHITE_CHECK_Z: f64 = 4.0;
+/// Smallest relative difference of the two white variances that counts as colour: under
+/// it the first differences stand, however many rests measure it.
+pub const WHITE_CHECK_MIN: f64 = 0.1;
+/// Fewest block differences over the training runs for the whiteness check.
+pub const MIN_WHITE_CHECK_DIFFS: usize = 20;
+
+/// The whiteness check of the training runs' rests: the white noise their first
+/// differences give and the one their Allan variance at a short τ gives, each matched
+/// through the nominal model (its wander and output step included).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct RestWhiteness {
+    /// Averaging time of the check (s).
+    pub tau_s: f64,
+    /// Angle random walk from the first differences (deg/√h).
+    pub first_difference_arw_deg_per_rt_h: f64,
+    /// Angle random walk from the Allan variance at `tau_s` (deg/√h).
+    pub block_arw_deg_per_rt_h: f64,
+    /// Block differences the check rests on.
+    pub block_differences: usize,
+    /// (block / first-difference white variance − 1) over its standard error √(3/n)
+    /// (consecutive block differences share a block: a white noise's non-overlapping
+    /// Allan variance from n differences has a relative variance of about 3/n).
+    pub z: f64,
+    /// |z| ≥ [`WHITE_CHECK_Z`] and the variances differ by at least [`WHITE_CHECK_MIN`]
+    /// of the first differences': the rests' noise is coloured, and the baseline's white
+    /// noise is the block's (the band the angle integrates), not the first differences'.
+    pub coloured: bool,
+}
+
+/// The nominal model fitted on some training runs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Nominal {
+    /// The model.
+    pub model: SensorModel,
+    /// Where each value came from.
+    pub notes: Vec<String>,
+    /// The static statistic the white noise was matched to (if measured at rest).
+    pub white_target: Option<WhiteTarget>,
+    /// The whiteness check of the rests (when they hold enough blocks).
+    pub whiteness: Option<RestWhiteness>,
+}
+
 /// The nominal model for these training runs, notes on where each value came from, and
-/// the static first-difference variance the white noise was matched to (if measured).
+/// the static statistic the white noise was matched to (if measured).
 ///
 /// The white noise comes from the runs' rests when they hold 2 s of them, else from
 /// `moving`, the effective noise of their moving residual ([`super::effective`]: the
 /// largest white noise its Allan deviation allows from 1 to 10 s), else from the prior.
+/// At rest it is matched to the first differences, unless the rests' Allan variance at
+/// [`super::features::WHITE_CHECK_TAU_S`] reads a white noise that differs beyond
+/// [`WHITE_CHECK_Z`]: a low-pass inside the band (a MEMS gyro's digital filter) leaves
+/// the first differences short of the low band that the angle integrates, and the
+/// block's statistic is used instead ([`RestWhiteness`]).
 /// The bias wander and the output step stay the prior's: a wander or a step beyond them
 /// is what the vocabulary's `bias_instability`, `rate_random_walk` and `quantization`
 /// name, and a baseline fitted to them would absorb the effect it should reveal. The notes
@@ -157,7 +218,7 @@ pub fn nominal_model(
     train: &[&RealRun],
     prior: &SensorModel,
     moving: Option<&super::effective::MeasuredNoise>,
-) -> (SensorModel, Vec<String>, Option<f64>) {
+) -> Nominal {
     let mut model = *prior;
     let mut notes = Vec::new();
     if let Some(run) = train.first() {
@@ -175,25 +236,78 @@ pub fn nominal_model(
             model.bias_dps
         ));
     }
-    let (sum, count) = train.iter().fold((0.0, 0usize), |(s, c), r| {
-        let (v, n) = r.features.static_diff_var;
-        if n > 0 && v.is_finite() {
-            (s + v * n as f64, c + n)
-        } else {
-            (s, c)
-        }
-    });
+    let pooled = |pick: fn(&RealRun) -> (f64, usize)| {
+        let (sum, count) = train.iter().fold((0.0, 0usize), |(s, c), r| {
+            let (v, n) = pick(r);
+            if n > 0 && v.is_finite() {
+                (s + v * n as f64, c + n)
+            } else {
+                (s, c)
+            }
+        });
+        (sum / count.max(1) as f64, count)
+    };
+    let (diff_var, count) = pooled(|r| r.features.static_diff_var);
+    let (block_var, block_count) = pooled(|r| r.features.static_block_var);
     let needed = (2.0 * model.sample_rate_hz) as usize;
     let mut target = None;
+    let mut whiteness = None;
+    let arw_of = |sigma: f64, model: &SensorModel| sigma * 60.0 / model.sample_rate_hz.sqrt();
     if count >= needed.max(20) {
-        let v = sum / count as f64;
-        let sigma = solve_white_sigma(v, &model, &[model.lsb_dps]);
-        model.arw_deg_per_rt_h = sigma * 60.0 / model.sample_rate_hz.sqrt();
-        target = Some(v);
-        notes.push(format!(
-            "angle random walk {:.4} deg/sqrt(h): matched to the first differences of {count} static samples (output rounding included)",
-            model.arw_deg_per_rt_h
-        ));
+        let diff_target = WhiteTarget {
+            avar_dps2: diff_var,
+            block: 1,
+        };
+        let diff_sigma = solve_white_sigma(diff_target, &model, &[model.lsb_dps]);
+        let mut chosen = (diff_target, diff_sigma);
+        let block = super::features::white_check_block(model.sample_rate_hz);
+        if block_count >= MIN_WHITE_CHECK_DIFFS && diff_sigma > 0.0 {
+            let block_target = WhiteTarget {
+                avar_dps2: block_var,
+                block,
+            };
+            let block_sigma = solve_white_sigma(block_target, &model, &[model.lsb_dps]);
+            let ratio = (block_sigma / diff_sigma).powi(2);
+            let z = (ratio - 1.0) / (3.0 / block_count as f64).sqrt();
+            let coloured = z.abs() >= WHITE_CHECK_Z && (ratio - 1.0).abs() >= WHITE_CHECK_MIN;
+            if coloured {
+                chosen = (block_target, block_sigma);
+            }
+            whiteness = Some(RestWhiteness {
+                tau_s: block as f64 / model.sample_rate_hz,
+                first_difference_arw_deg_per_rt_h: arw_of(diff_sigma, &model),
+                block_arw_deg_per_rt_h: arw_of(block_sigma, &model),
+                block_differences: block_count,
+                z,
+                coloured,
+            });
+        }
+        model.arw_deg_per_rt_h = arw_of(chosen.1, &model);
+        target = Some(chosen.0);
+        notes.push(match &whiteness {
+            Some(w) if w.coloured => format!(
+                "angle random walk {:.4} deg/sqrt(h): matched to the Allan variance at {:.3} s of the gyro at rest ({} block differences), not to its first differences ({:.4} deg/sqrt(h)): the rest noise is not white ({:.2}x the first differences' white variance, z {:.1}; {}); the angle integrates the low band, and the simulated noise stays white, so its high band is not the sensor's",
+                model.arw_deg_per_rt_h,
+                w.tau_s,
+                w.block_differences,
+                w.first_difference_arw_deg_per_rt_h,
+                (w.block_arw_deg_per_rt_h / w.first_difference_arw_deg_per_rt_h).powi(2),
+                w.z,
+                if w.z > 0.0 {
+                    "more in the low band than at the top: a low-pass inside the band, such as the sensor's own digital filter, or motion at rest that the reference does not resolve"
+                } else {
+                    "the top of the band holds noise the low band does not, such as a vibration at rest"
+                },
+            ),
+            Some(w) => format!(
+                "angle random walk {:.4} deg/sqrt(h): matched to the first differences of {count} static samples (output rounding included); the rest noise is white at {:.3} s ({:.4} deg/sqrt(h) from the Allan variance there, z {:.1})",
+                model.arw_deg_per_rt_h, w.tau_s, w.block_arw_deg_per_rt_h, w.z
+            ),
+            None => format!(
+                "angle random walk {:.4} deg/sqrt(h): matched to the first differences of {count} static samples (output rounding included)",
+                model.arw_deg_per_rt_h
+            ),
+        });
     } else if let Some(m) = moving.filter(|m| m.arw_deg_per_rt_h > 0.0) {
         model.arw_deg_per_rt_h = m.arw_deg_per_rt_h;
         notes.push(format!(
@@ -223,20 +337,27 @@ pub fn nominal_model(
         wander.push_str(&verdict);
     }
     notes.push(wander);
-    (model, notes, target)
+    Nominal {
+        model,
+        notes,
+        white_target: target,
+        whiteness,
+    }
 }
 
 /// The white-noise σ (deg/s per sample) whose simulated static output — bias, the
-/// Gauss-Markov wander, white noise, rounded to each of `lsbs` in turn — has half the
-/// mean squared first difference `target`. Rounding a signal that barely moves is not
-/// the textbook lsb²/12, so the match is by simulation (40 000 samples, fixed seed,
-/// bisection).
-pub fn solve_white_sigma(target: f64, model: &SensorModel, lsbs: &[f64]) -> f64 {
+/// Gauss-Markov wander, white noise, rounded to each of `lsbs` in turn — has the Allan
+/// variance `target` at its block length (at one sample: half the mean squared first
+/// difference). Rounding a signal that barely moves is not the textbook lsb²/12, so the
+/// match is by simulation (40 000 samples, or 40 000 blocks, fixed seed, bisection).
+pub fn solve_white_sigma(target: WhiteTarget, model: &SensorModel, lsbs: &[f64]) -> f64 {
     use rand::SeedableRng;
     use rand_distr::{Distribution, StandardNormal};
-    const N: usize = 40_000;
+    let block = target.block.max(1);
+    let n = 40_000 * block;
+    let target = target.avar_dps2;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x000A_11A4);
-    let white: Vec<f64> = (0..N).map(|_| StandardNormal.sample(&mut rng)).collect();
+    let white: Vec<f64> = (0..n).map(|_| StandardNormal.sample(&mut rng)).collect();
     let dt = 1.0 / model.sample_rate_hz;
     let phi = (-dt / model.gm_tau_s).exp();
     let drive = model.gm_sigma_dps * (1.0 - phi * phi).sqrt();
@@ -244,38 +365,48 @@ pub fn solve_white_sigma(target: f64, model: &SensorModel, lsbs: &[f64]) -> f64 
         let x: f64 = StandardNormal.sample(&mut rng);
         x
     };
-    let wander: Vec<f64> = (0..N)
+    let wander: Vec<f64> = (0..n)
         .map(|_| {
             let x: f64 = StandardNormal.sample(&mut rng);
             g = phi * g + drive * x;
             g
         })
         .collect();
-    let diff_var = |sigma: f64| -> f64 {
+    let block_var = |sigma: f64| -> f64 {
         let mut prev = f64::NAN;
-        let (mut sum, mut n) = (0.0, 0usize);
-        for k in 0..N {
+        let (mut sum, mut count) = (0.0, 0usize);
+        let (mut acc, mut filled) = (0.0, 0usize);
+        for k in 0..n {
             let mut x = model.bias_dps + wander[k] + sigma * white[k];
             for &q in lsbs {
                 if q > 0.0 {
                     x = (x / q).round() * q;
                 }
             }
+            if block > 1 {
+                acc += x;
+                filled += 1;
+                if filled < block {
+                    continue;
+                }
+                x = acc / block as f64;
+                (acc, filled) = (0.0, 0);
+            }
             if prev.is_finite() {
                 sum += (x - prev) * (x - prev);
-                n += 1;
+                count += 1;
             }
             prev = x;
         }
-        sum / n.max(1) as f64 / 2.0
+        sum / count.max(1) as f64 / 2.0
     };
-    let (mut lo, mut hi) = (0.0, (2.0 * target).sqrt().max(1e-6) * 2.0);
-    if diff_var(lo) >= target {
+    let (mut lo, mut hi) = (0.0, (2.0 * target * block as f64).sqrt().max(1e-6) * 2.0);
+    if block_var(lo) >= target {
         return 0.0;
     }
     for _ in 0..40 {
         let mid = 0.5 * (lo + hi);
-        if diff_var(mid) < target {
+        if block_var(mid) < target {
             lo = mid;
         } else {
             hi = mid;
@@ -285,12 +416,12 @@ pub fn solve_white_sigma(target: f64, model: &SensorModel, lsbs: &[f64]) -> f64 
 }
 
 /// The model to simulate with `effects` added. With quantisation, the white noise is
-/// matched again to the measured static differences `white_target` (it was measured
+/// matched again to the measured static statistic `white_target` (it was measured
 /// with the rounding in it).
 pub fn model_with(
     nominal: &SensorModel,
     effects: &[Effect],
-    white_target: Option<f64>,
+    white_target: Option<WhiteTarget>,
 ) -> SensorModel {
     let mut model = *nominal;
     if let Some(target) = white_target {
@@ -1383,4 +1514,101 @@ fn line_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
             super::line::LINE_MIN_RATIO
         ),
     })
+}
+
+#[cfg(test)]
+mod whiteness_tests {
+    #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+    use super::*;
+    use gyro_log::{regularize, GridOptions};
+    use gyro_sim::{simulate, BenchProfile, Motion, SimOptions};
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    const FS: f64 = 200.0;
+    /// White noise per sample (deg/s): 0.1 · 60 / √200 = 0.42 deg/√h.
+    const SIGMA: f64 = 0.1;
+
+    /// Noise-free bench runs (rest, turn, rest) at [`FS`] plus white noise of [`SIGMA`]
+    /// per sample, through a one-pole low-pass at `cutoff_hz` (DC gain 1: the same noise
+    /// density in the low band) when given.
+    fn runs(cutoff_hz: Option<f64>) -> Vec<RealRun> {
+        let model = SensorModel {
+            sample_rate_hz: FS,
+            ..SensorModel::default().noise_free()
+        };
+        (0..3u64)
+            .map(|i| {
+                let motion = Motion::bench(&BenchProfile::default(), 7 + i);
+                let options = SimOptions {
+                    seed: i,
+                    ..SimOptions::default()
+                };
+                let log = simulate(&model, &[], &motion, &options);
+                let mut regular = regularize(&log, &GridOptions::default()).unwrap();
+                let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(100 + i);
+                let alpha = cutoff_hz.map(|f| 1.0 - (-std::f64::consts::TAU * f / FS).exp());
+                let mut y = 0.0;
+                for slot in &mut regular.slots {
+                    let w: f64 = StandardNormal.sample(&mut rng);
+                    y = match alpha {
+                        Some(a) => y + a * (SIGMA * w - y),
+                        None => SIGMA * w,
+                    };
+                    slot.rate_dps += y;
+                }
+                RealRun::prepare(format!("run {i}"), regular).unwrap()
+            })
+            .collect()
+    }
+
+    fn nominal(cutoff_hz: Option<f64>) -> Nominal {
+        let runs = runs(cutoff_hz);
+        let refs: Vec<&RealRun> = runs.iter().collect();
+        let prior = SensorModel {
+            lsb_dps: 0.0,
+            ..SensorModel::default()
+        };
+        nominal_model(&refs, &prior, None)
+    }
+
+    /// White rest noise passes the check, and the white noise is the first differences'
+    /// (within 5% of the truth).
+    #[test]
+    fn white_rest_noise_keeps_the_first_differences() {
+        let truth = SIGMA * 60.0 / FS.sqrt();
+        let n = nominal(None);
+        let w = n.whiteness.unwrap();
+        assert!(!w.coloured, "{w:?}");
+        assert!(w.z.abs() < WHITE_CHECK_Z, "{w:?}");
+        assert_eq!(n.white_target.unwrap().block, 1);
+        assert!(
+            (n.model.arw_deg_per_rt_h / truth - 1.0).abs() < 0.05,
+            "{w:?}"
+        );
+        assert!(n
+            .notes
+            .iter()
+            .any(|s| s.contains("the rest noise is white")));
+    }
+
+    /// Rest noise through a 20 Hz low-pass: the first differences read far less than
+    /// the low band's density, the check says so, and the white noise comes from the
+    /// 0.05 s blocks, near the truth the angle integrates (the blocks weigh the band
+    /// around 10 Hz most, so a cutoff at 20 Hz still takes a little from them).
+    #[test]
+    fn low_passed_rest_noise_is_read_in_the_low_band() {
+        let truth = SIGMA * 60.0 / FS.sqrt();
+        let n = nominal(Some(20.0));
+        let w = n.whiteness.unwrap();
+        assert!(w.coloured && w.z > WHITE_CHECK_Z, "{w:?}");
+        assert!(w.first_difference_arw_deg_per_rt_h < 0.6 * truth, "{w:?}");
+        assert_eq!(n.white_target.unwrap().block, 10);
+        let ratio = n.model.arw_deg_per_rt_h / truth;
+        assert!((0.8..1.1).contains(&ratio), "{ratio} {w:?}");
+        assert!(n
+            .notes
+            .iter()
+            .any(|s| s.contains("the rest noise is not white")));
+    }
 }

@@ -11,7 +11,9 @@
 //! - **Residual rate**: gyro rate − reference rate (deg/s); the gyro rate is not smoothed.
 //! - **Segments**: `static` = runs of consecutive samples with |reference rate| <
 //!   [`STATIC_RATE_DPS`] lasting at least [`STATIC_MIN_S`]; `dynamic` = every other
-//!   sample that has a residual.
+//!   sample that has a residual. The white-noise features use the static samples at
+//!   rest for the gyro too ([`Residuals::is_rest`]): a board tilted on a robot sees part
+//!   of the other axes' turns while this axis's reference rests.
 //! - **Strata** of `dynamic`: by |reference rate| ([`RATE_BINS_DPS`], segment
 //!   `dynamic/rate_<lo>_<hi>`, the last `dynamic/rate_300_inf`; a bin without samples
 //!   gives no statistic), by sign (`dynamic/positive`, `dynamic/negative`). Of both
@@ -64,6 +66,12 @@ pub const SMOOTH_WINDOW_S: f64 = 0.02;
 pub const STATIC_RATE_DPS: f64 = 1.0;
 /// Shortest still run counted as static (s).
 pub const STATIC_MIN_S: f64 = 0.5;
+/// Averaging window of the gyro's stillness check (s).
+pub const GYRO_STILL_WINDOW_S: f64 = 0.05;
+/// Left out at each end of a rest for the white-noise features (s): the reference rate is
+/// under [`STATIC_RATE_DPS`] on the first and last ramps of the turns around it, whose
+/// steps would count as noise.
+pub const REST_EDGE_S: f64 = 0.1;
 /// Bins of |reference rate| of the dynamic samples (deg/s): `[lo, hi)`.
 pub const RATE_BINS_DPS: [(f64, f64); 4] = [
     (0.0, 30.0),
@@ -137,6 +145,11 @@ pub struct Residuals {
     pub temperature_c: Vec<f64>,
     /// Whether the sample belongs to the static segment.
     pub is_static: Vec<bool>,
+    /// Whether the sample is at rest for the gyro too: static, and the residual's mean
+    /// over [`GYRO_STILL_WINDOW_S`] within [`STATIC_RATE_DPS`] of its median over the
+    /// reference's rest, for at least [`STATIC_MIN_S`] once [`REST_EDGE_S`] is left out
+    /// at each end (the white-noise statistics).
+    pub is_rest: Vec<bool>,
     /// Gyro rate in the low band (deg/s; [`super::low_band`]), NaN where the reference
     /// rate is undefined or the rate is too low for a low band.
     pub low_rate_dps: Vec<f64>,
@@ -226,9 +239,19 @@ pub fn residuals_of(
         .collect();
     let min_len = ((STATIC_MIN_S * fs).ceil() as usize).max(1);
     let mut is_static = vec![false; n];
+    let mut is_rest = vec![false; n];
     for run in runs(&still) {
-        if run.len() >= min_len {
-            is_static[run].iter_mut().for_each(|s| *s = true);
+        if run.len() < min_len {
+            continue;
+        }
+        is_static[run.clone()].iter_mut().for_each(|s| *s = true);
+        let gyro_still = gyro_still(&residual_dps[run.clone()], fs);
+        let edge = (REST_EDGE_S * fs).round() as usize;
+        for part in runs(&gyro_still) {
+            if part.len() >= min_len + 2 * edge {
+                let part = run.start + part.start + edge..run.start + part.end - edge;
+                is_rest[part].iter_mut().for_each(|s| *s = true);
+            }
         }
     }
     let (low_rate_dps, low_reference_rate_dps) = match super::low_band::cutoff_hz(fs) {
@@ -250,12 +273,43 @@ pub fn residuals_of(
         residual_dps,
         temperature_c,
         is_static,
+        is_rest,
         low_rate_dps,
         low_reference_rate_dps,
     })
 }
 
 /// Maximal runs of consecutive `true`.
+/// Per sample of a still reference's run, given the residual there (the gyro less the
+/// reference rate, so that the reference's own slow edges of a turn are not counted): its
+/// mean over [`GYRO_STILL_WINDOW_S`] (centred, inside the run, finite samples only) is
+/// within [`STATIC_RATE_DPS`] of its median over the run. A sample whose window holds no
+/// finite value shows no motion and counts as still.
+fn gyro_still(rate_dps: &[f64], fs: f64) -> Vec<bool> {
+    let mut finite: Vec<f64> = rate_dps.iter().copied().filter(|v| v.is_finite()).collect();
+    if finite.is_empty() {
+        return vec![true; rate_dps.len()];
+    }
+    finite.sort_by(f64::total_cmp);
+    let median = finite[finite.len() / 2];
+    let half = ((GYRO_STILL_WINDOW_S * fs / 2.0).round() as usize).max(1);
+    // Prefix sums of the finite values and of their count.
+    let mut sum = vec![0.0; rate_dps.len() + 1];
+    let mut count = vec![0usize; rate_dps.len() + 1];
+    for (i, v) in rate_dps.iter().enumerate() {
+        let ok = v.is_finite();
+        sum[i + 1] = sum[i] + if ok { v - median } else { 0.0 };
+        count[i + 1] = count[i] + usize::from(ok);
+    }
+    (0..rate_dps.len())
+        .map(|i| {
+            let (lo, hi) = (i.saturating_sub(half), (i + half + 1).min(rate_dps.len()));
+            let k = count[hi] - count[lo];
+            k == 0 || ((sum[hi] - sum[lo]) / k as f64).abs() < STATIC_RATE_DPS
+        })
+        .collect()
+}
+
 fn runs(mask: &[bool]) -> Vec<std::ops::Range<usize>> {
     stretches(mask.len(), |i| mask[i])
 }
@@ -868,6 +922,36 @@ mod tests {
             .find(|s| s.segment == segment && s.statistic == statistic)
             .map(|s| s.value)
             .unwrap_or_else(|| panic!("missing {segment} {statistic}"))
+    }
+
+    /// A reference at rest for 6 s while the gyro sees a 5 °/s turn for 1 s in the
+    /// middle (a tilted board on a robot turning another axis): the turn is not a rest
+    /// for the white-noise features, the rests on each side are; a lost gyro sample at
+    /// rest does not split a rest.
+    #[test]
+    fn a_turn_the_reference_does_not_see_is_not_rest() {
+        let fs = 100.0;
+        let n = 600;
+        let mut rate: Vec<f64> = (0..n)
+            .map(|i| 0.3 + if (250..350).contains(&i) { 5.0 } else { 0.0 })
+            .collect();
+        rate[100] = f64::NAN;
+        let time_s = (0..n).map(|i| i as f64 / fs).collect();
+        let r = residuals_of(fs, time_s, rate, &vec![10.0; n], vec![f64::NAN; n]).unwrap();
+        let h = smooth_half_width(fs);
+        // The 70 ms mean (±3 samples) leaves the rest 2 samples into the turn's window;
+        // 10 samples (0.1 s) are left out at each end of a rest.
+        let rest = |range: std::ops::Range<usize>| r.is_rest[range].iter().all(|s| *s);
+        assert!(rest(h + 10..238) && rest(362..n - h - 10));
+        assert!(r.is_rest[238..362].iter().all(|s| !*s));
+        assert!(!r.is_rest[h + 9] && !r.is_rest[n - h - 10]);
+        // The static segment is the reference's rest.
+        assert!(r.is_static[h..n - h].iter().all(|s| *s));
+        // Without the turn, the whole reference rest is static, as before.
+        let rate = vec![0.3; n];
+        let time_s = (0..n).map(|i| i as f64 / fs).collect();
+        let r = residuals_of(fs, time_s, rate, &vec![10.0; n], vec![f64::NAN; n]).unwrap();
+        assert!(r.is_rest[h + 10..n - h - 10].iter().all(|s| *s));
     }
 
     #[test]

@@ -208,6 +208,7 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         model: ModelSummary {
             sensor: f.baseline.nominal,
             notes: f.baseline.notes,
+            rest_noise: f.baseline.whiteness.clone(),
             effects: f.selected_effects,
         },
         runs,

@@ -1312,6 +1312,7 @@ mod tests {
             model: ModelSummary {
                 sensor: SensorModel::default(),
                 notes: vec!["bias <from> the prior".into()],
+                rest_noise: None,
                 effects: vec![Effect::ClockError { ppm: 500.0 }],
             },
             runs: vec![run("a.csv", "train", 3.0), run("b.csv", "holdout", -12.0)],
