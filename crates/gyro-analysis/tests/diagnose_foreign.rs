@@ -156,6 +156,13 @@ fn a_low_passed_gyro_with_rests_gets_its_low_band_noise_and_its_lag() {
     assert_eq!(d.model.sensor.arw_deg_per_rt_h, w.block_arw_deg_per_rt_h);
     let notes = d.model.notes.join("\n");
     assert!(notes.contains("the rest noise is not white"), "{notes}");
+    assert!(
+        d.warnings
+            .iter()
+            .any(|w| w.contains("rests' noise is not white")),
+        "{:?}",
+        d.warnings
+    );
 
     let named = &d.verdict.unmodelled;
     assert_eq!(named.len(), 1, "{:?}", d.verdict);

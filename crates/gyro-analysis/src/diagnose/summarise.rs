@@ -214,7 +214,10 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         runs,
         compensation: f.compensation,
         reference_warnings: sense_warnings(f.runs),
-        warnings: lag_warnings(f.runs),
+        warnings: lag_warnings(f.runs)
+            .into_iter()
+            .chain(f.baseline.whiteness.as_ref().and_then(colour_warning))
+            .collect(),
         effective_noise: super::effective::EffectiveNoise {
             training: f.baseline.moving_noise.clone(),
             holdout: super::effective::measure(&f.runs.holdout, "held-out")
@@ -288,6 +291,17 @@ fn sense_warnings(runs: &Runs) -> Vec<String> {
 /// A warning when the gyro–reference lag of some runs lies beyond the cross-correlation's
 /// search: their `xcorr_peak_lag_s` is cut at its edge, and the latency's fit and
 /// posterior check read a cut value.
+/// The warning a coloured rest noise gives: the nominal model's white noise cannot be the
+/// rests' at every frequency.
+fn colour_warning(w: &super::fit::RestWhiteness) -> Option<String> {
+    w.coloured.then(|| {
+        format!(
+            "the training rests' noise is not white: their first differences read {:.3} deg/sqrt(h), their {:.2} s blocks {:.3} (z {:.0}); the baseline takes the blocks' figure, and its simulated noise, white, does not reproduce the rests' high band (the static statistics that show it are left unexplained)",
+            w.first_difference_arw_deg_per_rt_h, w.tau_s, w.block_arw_deg_per_rt_h, w.z
+        )
+    })
+}
+
 fn lag_warnings(runs: &Runs) -> Vec<String> {
     let all: Vec<&RealRun> = runs.train.iter().chain(&runs.holdout).copied().collect();
     // The runs cut at the edge, with the edge.
