@@ -106,6 +106,14 @@ pub fn table(label: &str, c: &Characterization) -> String {
             .map_or_else(|| "-".to_string(), |t| format!("{t:.4} s")),
         gm.delta_cost
     );
+    if let Some((_, t)) = gyro_analysis::noise::export::bandwidth_term(c) {
+        let _ = writeln!(
+            s,
+            "    T under {} s: white noise through the sensor's own low-pass (1/(2πT) = {:.1} Hz), not a bias wander; --noise-yaml reads N from τ 1–10 s and leaves the term out of K",
+            gyro_analysis::noise::export::BANDWIDTH_GM_MAX_S,
+            1.0 / (std::f64::consts::TAU * t)
+        );
+    }
     let _ = writeln!(
         s,
         "  floor: min adev {:.4e} deg/s at τ {:.4} s -> B = min/0.664 = {:.4e} deg/s{}",

@@ -36,7 +36,11 @@
 //!   together with the random walk equivalent of a fitted Gauss-Markov bias (below); both
 //!   from [`super::fit`] (IEEE Std 952), nothing refitted. A term the fit dropped is
 //!   replaced by its upper bound: the −½ (+½) line that stays under the Allan deviation's
-//!   upper confidence bound at every τ.
+//!   upper confidence bound at every τ. A fitted Gauss-Markov term of correlation time
+//!   under [`BANDWIDTH_GM_MAX_S`] is the sensor's low-pass on its white noise (a MEMS
+//!   gyro's digital filter makes the Allan deviation rise, then fall as white noise): N is
+//!   then read from τ = 1 s to 10 s as on moving data ([`white_bound`]), and the term is
+//!   not counted in K.
 //! - [`NoiseParams::from_residual`] (`gyro-cli diagnose`, measured on moving data): the
 //!   Allan deviation of what the deterministic terms leave of gyro minus reference
 //!   (`diagnose::effective`); N the largest white noise its Allan deviation allows from
@@ -191,7 +195,20 @@ impl NoiseParams {
     pub fn from_allan(c: &Characterization, source: String) -> Result<Self, ExportError> {
         let fit = &c.fit;
         let mut notes = Vec::new();
-        let n_dps = if fit.arw_dps_per_rt_hz.significant {
+        let low_pass = bandwidth_term(c);
+        let n_dps = if let (Some((sigma, t)), Some(bound)) = (low_pass, white_bound(c)) {
+            notes.push(format!(
+                "gyroscope_noise_density: the fitted Gauss-Markov term (sigma {} deg/s, T {:.4} s, under {} s) is white noise through the sensor's own low-pass (fitted as first order: 1/(2 pi T) = {:.1} Hz), white at every tau from 1 s, so N is the -1/2 line under the Allan deviation's upper bound from 1 to 10 s, {} deg/s/sqrt(Hz) ({:.4} deg/sqrt(h)); the fitted N ({:.4} deg/sqrt(h)) is not used: the low-pass took the top of the band from it",
+                sci(sigma),
+                t,
+                BANDWIDTH_GM_MAX_S,
+                1.0 / (std::f64::consts::TAU * t),
+                sci(bound),
+                bound * 60.0,
+                fit.arw_deg_per_rt_h
+            ));
+            bound
+        } else if fit.arw_dps_per_rt_hz.significant {
             notes.push(format!(
                 "gyroscope_noise_density: the fitted angle random walk N = {:.4} deg/sqrt(h) = {} deg/s/sqrt(Hz) (the -1/2 line of the Allan deviation at tau = 1 s)",
                 fit.arw_deg_per_rt_h,
@@ -206,7 +223,12 @@ impl NoiseParams {
             ));
             bound
         };
-        let (k_dps, _) = random_walk(c, 0.0, &mut notes);
+        let min_gm_tau_s = if low_pass.is_some() {
+            BANDWIDTH_GM_MAX_S
+        } else {
+            0.0
+        };
+        let (k_dps, _) = random_walk(c, min_gm_tau_s, &mut notes);
         if fit.bias_instability_dps.significant {
             notes.push(format!(
                 "not included: the bias instability B = {} deg/s (a flat Allan floor of {} deg/s, not a random walk)",
@@ -256,6 +278,22 @@ impl NoiseParams {
         ));
         let (k_dps, _) = random_walk(c, RANDOM_WALK_TAU_S, &mut notes);
         Self::of_dps(n_dps, k_dps, c.sample_rate_hz, source, notes)
+    }
+}
+
+/// A fitted Gauss-Markov term whose correlation time is under this (s) is the sensor's own
+/// low-pass on its white noise (a MEMS gyro's digital filter), not a bias wander: at every
+/// τ from 1 s, where N is read, it is white (its Allan variance 2σ²T/τ), and read as a
+/// random walk at 3 s it would count white noise as K.
+pub const BANDWIDTH_GM_MAX_S: f64 = 0.1;
+
+/// The fitted Gauss-Markov term of `c` as (σ, T) when it is a low-pass on the white noise
+/// ([`BANDWIDTH_GM_MAX_S`]).
+pub fn bandwidth_term(c: &Characterization) -> Option<(f64, f64)> {
+    let gm = &c.fit.gauss_markov;
+    match (gm.significant, gm.corr_time_s) {
+        (true, Some(t)) if t < BANDWIDTH_GM_MAX_S => Some((gm.sigma_dps, t)),
+        _ => None,
     }
 }
 
@@ -655,6 +693,46 @@ mod tests {
         // Nothing computed in the range.
         c.allan.points.retain(|p| p.tau_s < 1.0);
         assert_eq!(white_bound(&c), None);
+    }
+
+    /// Static white noise of 3.0 deg/√h through a one-pole low-pass at 10 Hz (a MEMS
+    /// gyro's digital filter) on 100 Hz samples: the Allan fit takes the filter for a
+    /// short Gauss-Markov term, and the export reads N from 1 to 10 s instead of the
+    /// fitted N (within 10% of 3.0 deg/√h), and does not count the term as a random walk
+    /// (K stays the upper bound, far under the term read at 3 s).
+    #[test]
+    fn a_low_pass_on_the_noise_is_not_read_as_a_bias_wander() {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        let fs = 100.0;
+        let sigma = 3.0 / 60.0 * f64::sqrt(fs);
+        let alpha = 1.0 - (-std::f64::consts::TAU * 10.0 / fs).exp();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut y = 0.0;
+        let x: Vec<f64> = (0..120_000)
+            .map(|_| {
+                let w: f64 = StandardNormal.sample(&mut rng);
+                y += alpha * (sigma * w - y);
+                y
+            })
+            .collect();
+        let c = crate::noise::characterize(&[&x], fs, &crate::noise::NoiseOptions::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let (gm_sigma, t) = bandwidth_term(&c).unwrap_or_else(|| panic!("{:?}", c.fit));
+        let p = NoiseParams::from_allan(&c, "test".into()).unwrap_or_else(|e| panic!("{e}"));
+        let n_deg_per_rt_h = p.noise_density_rad_s_rt_hz / noise_density_from_arw(1.0);
+        assert!(
+            (2.7..3.3).contains(&n_deg_per_rt_h),
+            "{n_deg_per_rt_h} {:?}",
+            c.fit
+        );
+        let k_gm = gauss_markov_random_walk(gm_sigma, t);
+        let k = p.random_walk_rad_s2_rt_hz / random_walk_from_dps_per_rt_s(1.0);
+        assert!(k < 0.1 * k_gm, "{k} against {k_gm}");
+        assert!(p
+            .notes
+            .iter()
+            .any(|n| n.contains("the sensor's own low-pass")));
     }
 
     #[test]
