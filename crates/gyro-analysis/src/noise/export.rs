@@ -733,6 +733,13 @@ mod tests {
             .notes
             .iter()
             .any(|n| n.contains("the sensor's own low-pass")));
+        // The model file's sensor: the same white noise, no bias wander.
+        let model = c.sensor_model();
+        assert!(
+            (model.arw_deg_per_rt_h - n_deg_per_rt_h).abs() < 1e-9,
+            "{model:?}"
+        );
+        assert_eq!(model.gm_sigma_dps, 0.0);
     }
 
     #[test]

@@ -269,15 +269,25 @@ impl Characterization {
     /// The simulator's sensor model from this characterisation: rate, bias (the mean
     /// rate), ARW (fitted N), Gauss-Markov σ and T (σ = 0 if the term is not significant;
     /// T then stays the default), output step (if the data lies on a grid, else 0); the
-    /// range stays the default. Terms the model lacks are in `suggested_effects`.
+    /// range stays the default. Terms the model lacks are in `suggested_effects`. A
+    /// Gauss-Markov term that is the sensor's low-pass on its white noise
+    /// ([`export::bandwidth_term`]) is not a bias wander: the ARW is then the white noise
+    /// read from τ 1–10 s ([`export::white_bound`]) and σ = 0.
     pub fn sensor_model(&self) -> SensorModel {
         let default = SensorModel::default();
         let gm = &self.fit.gauss_markov;
+        let low_pass_arw = export::bandwidth_term(self)
+            .and_then(|_| export::white_bound(self))
+            .map(|n_dps_per_rt_hz| 60.0 * n_dps_per_rt_hz);
         SensorModel {
             sample_rate_hz: self.sample_rate_hz,
             bias_dps: self.mean_rate_dps,
-            arw_deg_per_rt_h: self.fit.arw_deg_per_rt_h,
-            gm_sigma_dps: if gm.significant { gm.sigma_dps } else { 0.0 },
+            arw_deg_per_rt_h: low_pass_arw.unwrap_or(self.fit.arw_deg_per_rt_h),
+            gm_sigma_dps: if gm.significant && low_pass_arw.is_none() {
+                gm.sigma_dps
+            } else {
+                0.0
+            },
             gm_tau_s: gm.corr_time_s.unwrap_or(default.gm_tau_s),
             lsb_dps: self.rate_step_dps.unwrap_or(0.0),
             range_dps: default.range_dps,
