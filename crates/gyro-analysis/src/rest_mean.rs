@@ -188,6 +188,28 @@ pub struct SimulatedRun {
     pub log: gyro_log::RegularLog,
 }
 
+impl SimulatedRun {
+    /// Each true rotation (its angle, deg) with the movement of `report` that holds its
+    /// middle, if any: how the pipeline's own movement events are scored against the truth.
+    pub fn movements<'a>(
+        &self,
+        report: &'a crate::replay::RunReport,
+    ) -> Vec<(f64, Option<&'a crate::replay::MovementResult>)> {
+        self.motion
+            .rotations()
+            .iter()
+            .map(|r| {
+                let middle_s = r.start_s + 0.5 * r.duration_s;
+                let found = report
+                    .movements
+                    .iter()
+                    .find(|m| m.start_time_s <= middle_s && middle_s <= m.end_time_s);
+                (r.angle_deg, found)
+            })
+            .collect()
+    }
+}
+
 /// Simulate `sensor` with `effects` on the default bench motion of `seed`.
 pub fn simulate_bench_run(
     sensor: &gyro_sim::SensorModel,
