@@ -337,7 +337,9 @@ pub fn simulate_series(
                 .collect()
         })
         .unwrap_or_default();
-    // Two equal first-order stages, -3 dB at the cutoff overall.
+    // Two equal first-order stages, -3 dB at the cutoff overall, on the rate and on the
+    // white noise (the sensor's low-pass filters its sensing element's noise as an
+    // MEMS gyro's digital low-pass does; the bias terms are slow and pass it unchanged).
     let bandwidth_alpha = terms.bandwidth_hz.map(|cutoff_hz| {
         let pole_hz = cutoff_hz / (2f64.sqrt() - 1.0).sqrt();
         1.0 - (-2.0 * std::f64::consts::PI * pole_hz * dt).exp()
@@ -364,6 +366,7 @@ pub fn simulate_series(
     let vibration = terms.vibration;
     let mut walk = 0.0;
     let mut stages = [motion.rate_dps(-delay_s); 2];
+    let mut noise_stages = [0.0_f64; 2];
     let mut dropout_left = false;
     let temperature_c_is_recorded = temperature_c.is_some();
 
@@ -418,13 +421,19 @@ pub fn simulate_series(
             walk += walk_k * dt.sqrt() * w;
         }
         let white: f64 = StandardNormal.sample(&mut white_rng);
+        let mut white_dps = white_sigma * white;
+        if let Some(alpha) = bandwidth_alpha {
+            noise_stages[0] += alpha * (white_dps - noise_stages[0]);
+            noise_stages[1] += alpha * (noise_stages[0] - noise_stages[1]);
+            white_dps = noise_stages[1];
+        }
         measured += model.bias_dps
             + turn_on
             + gm.step(&mut gm_rng)
             + temp_bias * delta_c
             + flicker_dps
             + walk
-            + white_sigma * white;
+            + white_dps;
         for lsb in [model.lsb_dps, extra_lsb] {
             if lsb > 0.0 {
                 measured = (measured / lsb).round() * lsb;
@@ -493,5 +502,43 @@ mod tests {
                 "{effect:?}: the reference stops moving ({step} deg)"
             );
         }
+    }
+
+    /// The sensor's bandwidth filters its white noise as it filters the rate: at rest the
+    /// first differences (the top of the band) shrink, while the noise the angle
+    /// integrates (0.5 s block means) keeps its density.
+    #[test]
+    fn the_bandwidth_filters_the_white_noise() {
+        let motion = Motion::from_rotations(Vec::new(), 120.0);
+        let model = SensorModel {
+            gm_sigma_dps: 0.0,
+            lsb_dps: 0.0,
+            ..SensorModel::default()
+        };
+        let rest = |effects: &[Effect]| {
+            let s = simulate_series(&model, effects, &motion, &SimOptions::default(), None);
+            let differences = s.rate_dps.windows(2).map(|w| (w[1] - w[0]).powi(2));
+            let difference_variance = differences.sum::<f64>() / (s.rate_dps.len() - 1) as f64;
+            let blocks: Vec<f64> = s
+                .rate_dps
+                .chunks_exact(500)
+                .map(|b| b.iter().sum::<f64>() / 500.0)
+                .collect();
+            let block_variance = blocks
+                .windows(2)
+                .map(|w| (w[1] - w[0]).powi(2))
+                .sum::<f64>()
+                / (2.0 * (blocks.len() - 1) as f64);
+            (difference_variance, block_variance)
+        };
+        let (white_differences, white_blocks) = rest(&[]);
+        let (filtered_differences, filtered_blocks) =
+            rest(&[Effect::Bandwidth { cutoff_hz: 15.0 }]);
+        assert!(
+            filtered_differences < 0.01 * white_differences,
+            "{filtered_differences} vs {white_differences}"
+        );
+        let ratio = filtered_blocks / white_blocks;
+        assert!((0.8..1.25).contains(&ratio), "block variance ratio {ratio}");
     }
 }
