@@ -14,6 +14,7 @@
 //! ```
 
 mod effects;
+mod low_pass;
 mod motion;
 mod sensor;
 
@@ -22,6 +23,7 @@ pub use effects::{
     EffectInfo, FitProcedure, ParamRange, ParamSpec, Reading, Regressor, WanderShape, EFFECTS,
     LOW_PASS_POLE_RATIO,
 };
+pub use low_pass::TwoPoleLowPass;
 pub use motion::{BenchProfile, Motion, Rotation};
 pub use sensor::{
     check_size, sample_count, simulate, simulate_series, InvalidSensorModel, SensorModel,

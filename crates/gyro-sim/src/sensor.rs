@@ -337,13 +337,16 @@ pub fn simulate_series(
                 .collect()
         })
         .unwrap_or_default();
-    // Two equal first-order stages, -3 dB at the cutoff overall, on the rate and on the
-    // white noise (the sensor's low-pass filters its sensing element's noise as an
-    // MEMS gyro's digital low-pass does; the bias terms are slow and pass it unchanged).
-    let bandwidth_alpha = terms.bandwidth_hz.map(|cutoff_hz| {
-        let pole_hz = cutoff_hz / (2f64.sqrt() - 1.0).sqrt();
-        1.0 - (-2.0 * std::f64::consts::PI * pole_hz * dt).exp()
-    });
+    // The sensor's low-pass on the rate and on the white noise (it filters its sensing
+    // element's noise as an MEMS gyro's digital low-pass does; the bias terms are slow
+    // and pass it unchanged).
+    let low_pass = |initial: f64| {
+        terms
+            .bandwidth_hz
+            .map(|cutoff_hz| crate::TwoPoleLowPass::new(cutoff_hz, fs, initial))
+    };
+    let (mut rate_low_pass, mut noise_low_pass) =
+        (low_pass(motion.rate_dps(-terms.delay_s)), low_pass(0.0));
     let (scale_k, asym_k, k3, k2) = (
         terms.scale_k,
         terms.asymmetry_k,
@@ -365,8 +368,6 @@ pub fn simulate_series(
     let count_clock = 1.0 + terms.count_clock_ppm * 1e-6;
     let vibration = terms.vibration;
     let mut walk = 0.0;
-    let mut stages = [motion.rate_dps(-delay_s); 2];
-    let mut noise_stages = [0.0_f64; 2];
     let mut dropout_left = false;
     let temperature_c_is_recorded = temperature_c.is_some();
 
@@ -404,10 +405,8 @@ pub fn simulate_series(
 
         let gyro_s = true_s / count_clock;
         let mut rate = motion.rate_dps(gyro_s - delay_s);
-        if let Some(alpha) = bandwidth_alpha {
-            stages[0] += alpha * (rate - stages[0]);
-            stages[1] += alpha * (stages[0] - stages[1]);
-            rate = stages[1];
+        if let Some(filter) = rate_low_pass.as_mut() {
+            rate = filter.step(rate);
         }
         let scale = 1.0 + scale_k + asym_k * rate.signum() + temp_scale * delta_c;
         let mut measured = rate * scale + k3 * rate * rate * rate + k2 * rate * rate;
@@ -422,10 +421,8 @@ pub fn simulate_series(
         }
         let white: f64 = StandardNormal.sample(&mut white_rng);
         let mut white_dps = white_sigma * white;
-        if let Some(alpha) = bandwidth_alpha {
-            noise_stages[0] += alpha * (white_dps - noise_stages[0]);
-            noise_stages[1] += alpha * (noise_stages[0] - noise_stages[1]);
-            white_dps = noise_stages[1];
+        if let Some(filter) = noise_low_pass.as_mut() {
+            white_dps = filter.step(white_dps);
         }
         measured += model.bias_dps
             + turn_on

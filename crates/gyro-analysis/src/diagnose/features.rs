@@ -264,6 +264,14 @@ fn line_spectra(r: &Residuals) -> Spectra {
     (incoherent, reference, cross)
 }
 
+/// Smallest range of the reference's |rate| over a run's plateau samples, as a share of
+/// the plateau's level, for them to be a clip: a clip at 120 °/s of turns peaking at
+/// 200 °/s has the reference range over 80 °/s while the output holds; the peak of a
+/// smooth turn held on one output code (a low-passed gyro whose noise no longer dithers
+/// its output step: 15 Hz on a CRM100's 1/24 °/s) has it range over 0.07–0.27 °/s at
+/// 106–164 °/s, as the reference turns too.
+pub const PLATEAU_REFERENCE_SHARE: f64 = 0.01;
+
 /// The features of `r` without the line spectra (empty); `plateau_tol_dps` is the
 /// tolerance of the clip plateau (e.g. an output step).
 pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
@@ -283,7 +291,10 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
     let fs = r.sample_rate_hz;
     let h = smooth_half_width(fs);
 
-    // Plateau: samples at the largest |rate| while the reference is beyond it.
+    // Plateau: samples at the largest |rate| while the reference is beyond it, and moves
+    // on: a clip holds the output while the reference's rate rises past it and falls
+    // back, but the rounded peak of a smooth turn (a low-passed gyro whose noise no
+    // longer dithers its output step) sits where the reference turns too.
     let max_abs = r
         .rate_dps
         .iter()
@@ -291,9 +302,17 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
         .fold(0.0f64, |m, v| m.max(v.abs()));
     let tol = plateau_tol_dps.max(1e-9);
     let on_plateau = |i: usize| r.rate_dps[i].abs() >= max_abs - tol;
-    let plateau_samples = (0..n)
+    let beyond: Vec<f64> = (0..n)
         .filter(|&i| on_plateau(i) && r.reference_rate_dps[i].abs() > max_abs + tol)
-        .count();
+        .map(|i| r.reference_rate_dps[i].abs())
+        .collect();
+    let reference_span = beyond.iter().fold(f64::NEG_INFINITY, |m, &v| m.max(v))
+        - beyond.iter().fold(f64::INFINITY, |m, &v| m.min(v));
+    let plateau_samples = if reference_span >= PLATEAU_REFERENCE_SHARE * max_abs {
+        beyond.len()
+    } else {
+        0
+    };
     let clipped = plateau_samples >= 3;
 
     // Smoothed gyro: trapezoid mean over [i − h, i + h], like the reference rate.
@@ -753,6 +772,32 @@ mod tests {
                 REGRESSORS[index]
             );
         }
+    }
+
+    /// A low-passed gyro whose noise no longer dithers its output step holds each turn's
+    /// peak on one code for a few samples while the reference, unfiltered, peaks a little
+    /// higher: not a clip (the reference turns there too), on every run.
+    #[test]
+    fn a_rounded_smooth_peak_is_not_a_clip_plateau() {
+        let model = SensorModel::default();
+        let mut held = 0;
+        for seed in 1..=5 {
+            let motion = Motion::bench(&BenchProfile::default(), seed);
+            let options = SimOptions {
+                seed,
+                ..SimOptions::default()
+            };
+            let effects = [Effect::Bandwidth { cutoff_hz: 15.0 }];
+            let s = simulate_series(&model, &effects, &motion, &options, None);
+            let fs = s.sample_rate_hz;
+            let time: Vec<f64> = (0..s.rate_dps.len()).map(|k| k as f64 / fs).collect();
+            let peak_dps = s.rate_dps.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            held += s.rate_dps.iter().filter(|v| v.abs() == peak_dps).count();
+            let r = residuals_of(fs, time, s.rate_dps, &s.reference_deg, s.temperature_c).unwrap();
+            assert_eq!(features(&r, 1e-9).plateau_samples, 0, "seed {seed}");
+        }
+        // The peaks are held: the case the rule is for.
+        assert!(held > 10, "{held}");
     }
 
     #[test]

@@ -258,7 +258,7 @@ pub fn nominal_model(
             avar_dps2: diff_var,
             block: 1,
         };
-        let diff_sigma = solve_white_sigma(diff_target, &model, &[model.lsb_dps]);
+        let diff_sigma = solve_white_sigma(diff_target, &model, &[model.lsb_dps], None);
         let mut chosen = (diff_target, diff_sigma);
         let block = super::features::white_check_block(model.sample_rate_hz);
         if block_count >= MIN_WHITE_CHECK_DIFFS && diff_sigma > 0.0 {
@@ -266,7 +266,7 @@ pub fn nominal_model(
                 avar_dps2: block_var,
                 block,
             };
-            let block_sigma = solve_white_sigma(block_target, &model, &[model.lsb_dps]);
+            let block_sigma = solve_white_sigma(block_target, &model, &[model.lsb_dps], None);
             let ratio = (block_sigma / diff_sigma).powi(2);
             let z = (ratio - 1.0) / (3.0 / block_count as f64).sqrt();
             let coloured = z.abs() >= WHITE_CHECK_Z && (ratio - 1.0).abs() >= WHITE_CHECK_MIN;
@@ -346,18 +346,30 @@ pub fn nominal_model(
 }
 
 /// The white-noise σ (deg/s per sample) whose simulated static output — bias, the
-/// Gauss-Markov wander, white noise, rounded to each of `lsbs` in turn — has the Allan
-/// variance `target` at its block length (at one sample: half the mean squared first
-/// difference). Rounding a signal that barely moves is not the textbook lsb²/12, so the
-/// match is by simulation (40 000 samples, or 40 000 blocks, fixed seed, bisection).
-pub fn solve_white_sigma(target: WhiteTarget, model: &SensorModel, lsbs: &[f64]) -> f64 {
+/// Gauss-Markov wander, white noise (through the sensor's low-pass of `cutoff_hz`, when
+/// given, as the simulator's `bandwidth` filters it), rounded to each of `lsbs` in turn —
+/// has the Allan variance `target` at its block length (at one sample: half the mean
+/// squared first difference). Rounding a signal that barely moves is not the textbook
+/// lsb²/12, so the match is by simulation (40 000 samples, or 40 000 blocks, fixed seed,
+/// bisection).
+pub fn solve_white_sigma(
+    target: WhiteTarget,
+    model: &SensorModel,
+    lsbs: &[f64],
+    cutoff_hz: Option<f64>,
+) -> f64 {
     use rand::SeedableRng;
     use rand_distr::{Distribution, StandardNormal};
     let block = target.block.max(1);
     let n = 40_000 * block;
     let target = target.avar_dps2;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x000A_11A4);
-    let white: Vec<f64> = (0..n).map(|_| StandardNormal.sample(&mut rng)).collect();
+    let mut white: Vec<f64> = (0..n).map(|_| StandardNormal.sample(&mut rng)).collect();
+    // The filter is linear: filtering the unit noise once scales with σ.
+    if let Some(cutoff_hz) = cutoff_hz {
+        let mut filter = gyro_sim::TwoPoleLowPass::new(cutoff_hz, model.sample_rate_hz, 0.0);
+        white.iter_mut().for_each(|w| *w = filter.step(*w));
+    }
     let dt = 1.0 / model.sample_rate_hz;
     let phi = (-dt / model.gm_tau_s).exp();
     let drive = model.gm_sigma_dps * (1.0 - phi * phi).sqrt();
@@ -415,23 +427,39 @@ pub fn solve_white_sigma(target: WhiteTarget, model: &SensorModel, lsbs: &[f64])
     0.5 * (lo + hi)
 }
 
-/// The model to simulate with `effects` added. With quantisation, the white noise is
-/// matched again to the measured static statistic `white_target` (it was measured
-/// with the rounding in it).
+/// The model to simulate with `effects` added. The white noise is matched again to the
+/// measured static statistic `white_target` where an effect changes what it measured:
+/// with quantisation (it was measured with the rounding in it), and with a `bandwidth`
+/// when the statistic is the rests' block Allan variance (the low band the angle
+/// integrates, which the sensor's low-pass must keep: a cutoff near the block's
+/// frequency still lowers it). First differences stay as they are under a bandwidth:
+/// they are the top of the band, which a low-pass shapes, and their mismatch is the
+/// evidence against it.
 pub fn model_with(
     nominal: &SensorModel,
     effects: &[Effect],
     white_target: Option<WhiteTarget>,
 ) -> SensorModel {
     let mut model = *nominal;
-    if let Some(target) = white_target {
-        // An effect read from the output grid is an extra rounding of the output.
-        for e in effects.iter().filter(|e| !e.is_neutral(nominal)) {
-            if let (FitProcedure::OutputGrid, [lsb_dps]) = (e.info().fit, e.params().as_slice()) {
-                let sigma = solve_white_sigma(target, nominal, &[nominal.lsb_dps, *lsb_dps]);
-                model.arw_deg_per_rt_h = sigma * 60.0 / model.sample_rate_hz.sqrt();
-            }
-        }
+    let Some(target) = white_target else {
+        return model;
+    };
+    let active = || effects.iter().filter(|e| !e.is_neutral(nominal));
+    // An effect read from the output grid is an extra rounding of the output.
+    let extra_lsb = active().find_map(|e| match (e.info().fit, e.params().as_slice()) {
+        (FitProcedure::OutputGrid, [lsb_dps]) => Some(*lsb_dps),
+        _ => None,
+    });
+    let cutoff_hz = active()
+        .find_map(|e| match e {
+            Effect::Bandwidth { cutoff_hz } => Some(*cutoff_hz),
+            _ => None,
+        })
+        .filter(|_| target.block > 1);
+    if extra_lsb.is_some() || cutoff_hz.is_some() {
+        let lsbs = [nominal.lsb_dps, extra_lsb.unwrap_or(0.0)];
+        let sigma = solve_white_sigma(target, nominal, &lsbs, cutoff_hz);
+        model.arw_deg_per_rt_h = sigma * 60.0 / model.sample_rate_hz.sqrt();
     }
     model
 }

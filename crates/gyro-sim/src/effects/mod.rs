@@ -185,8 +185,8 @@ effect_enum! {
 }
 
 /// A two-pole (critically damped) low-pass of cutoff f_c has its poles at this multiple
-/// of f_c; it delays slow motion by 2/(2π · ratio · f_c).
-pub const LOW_PASS_POLE_RATIO: f64 = 1.5538;
+/// of f_c, `1/√(√2 − 1)`; it delays slow motion by 2/(2π · ratio · f_c).
+pub const LOW_PASS_POLE_RATIO: f64 = 1.553_773_974_030_037_1;
 
 /// The `bias_instability` effect of standard deviation `sigma_dps` as the sum of its six
 /// first-order Gauss-Markov processes: `(σ_i, τ_i)` with τ_i = 10^(0.6 i) s, i = 0..5
