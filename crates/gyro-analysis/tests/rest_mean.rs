@@ -29,15 +29,18 @@ fn per_movement(effects: &[&str], runs: u64) -> (f64, f64) {
     (median(pipeline), median(oracle))
 }
 
+/// The bench scenarios: the effects of each.
+const SCENARIOS: [&[&str]; 5] = [
+    &[],
+    &["turn_on_bias:sigma_dps=0.3"],
+    &["bias_instability:sigma_dps=0.05"],
+    &["quantization:lsb_dps=0.2"],
+    &["rate_random_walk:k_dps_per_rt_s=0.005"],
+];
+
 #[test]
 fn the_default_pipeline_is_not_worse_than_the_rest_mean_per_movement() {
-    for effects in [
-        &[][..],
-        &["turn_on_bias:sigma_dps=0.3"][..],
-        &["bias_instability:sigma_dps=0.05"][..],
-        &["quantization:lsb_dps=0.2"][..],
-        &["rate_random_walk:k_dps_per_rt_s=0.005"][..],
-    ] {
+    for effects in SCENARIOS {
         let (pipeline, oracle) = per_movement(effects, 5);
         assert!(
             pipeline <= oracle,
@@ -52,13 +55,7 @@ fn the_default_pipeline_is_not_worse_than_the_rest_mean_per_movement() {
 #[test]
 fn a_movements_std_covers_its_true_angle_as_a_95_percent_interval() {
     let (mut covered, mut total) = (0_usize, 0_usize);
-    for effects in [
-        &[][..],
-        &["turn_on_bias:sigma_dps=0.3"][..],
-        &["bias_instability:sigma_dps=0.05"][..],
-        &["quantization:lsb_dps=0.2"][..],
-        &["rate_random_walk:k_dps_per_rt_s=0.005"][..],
-    ] {
+    for effects in SCENARIOS {
         let effects: Vec<Effect> = effects.iter().map(|s| Effect::parse(s).unwrap()).collect();
         for seed in 1..=8 {
             let run = simulate_bench_run(&SensorModel::default(), &effects, seed).unwrap();
