@@ -302,14 +302,15 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
         .fold(0.0f64, |m, v| m.max(v.abs()));
     let tol = plateau_tol_dps.max(1e-9);
     let on_plateau = |i: usize| r.rate_dps[i].abs() >= max_abs - tol;
-    let beyond: Vec<f64> = (0..n)
+    // One pass, no allocation: this runs for every ensemble member.
+    let (count, lowest, highest) = (0..n)
         .filter(|&i| on_plateau(i) && r.reference_rate_dps[i].abs() > max_abs + tol)
         .map(|i| r.reference_rate_dps[i].abs())
-        .collect();
-    let reference_span = beyond.iter().fold(f64::NEG_INFINITY, |m, &v| m.max(v))
-        - beyond.iter().fold(f64::INFINITY, |m, &v| m.min(v));
-    let plateau_samples = if reference_span >= PLATEAU_REFERENCE_SHARE * max_abs {
-        beyond.len()
+        .fold((0, f64::INFINITY, f64::NEG_INFINITY), |(c, lo, hi), v| {
+            (c + 1, lo.min(v), hi.max(v))
+        });
+    let plateau_samples = if highest - lowest >= PLATEAU_REFERENCE_SHARE * max_abs {
+        count
     } else {
         0
     };
