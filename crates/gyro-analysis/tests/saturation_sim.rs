@@ -3,8 +3,10 @@
 //!
 //! Two ways to clip: a sensor whose range is ±75 deg/s, with the range known to the
 //! pipeline (the model file's `sensor.range_dps`); and a ±300 deg/s sensor that clips at
-//! 75 deg/s (effect `saturation`), where only the clip plateau tells. `cargo test -p
-//! gyro-analysis --test saturation_sim -- --nocapture` prints the counts.
+//! 75 deg/s (effect `saturation`), where only the clip plateau tells. The same with the
+//! gyro's own low-pass (effect `bandwidth`, 15 and 5 Hz), whose output repeats a reading
+//! at smooth peaks and steady turns without any clip. `cargo test -p gyro-analysis --test
+//! saturation_sim -- --nocapture` prints the counts.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use gyro_analysis::replay::{replay, MovementResult};
@@ -65,6 +67,7 @@ fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
     };
     let (mut movements_seen, mut clipped_seen) = (0, 0);
     let (mut by_range, mut by_plateau, mut plateau_missed) = (0, 0, 0);
+    let mut low_passed_seen = 0;
     let mut missed_lost_deg = 0.0_f64;
     for seed in SEEDS {
         let motion = Motion::bench(&BenchProfile::default(), seed);
@@ -98,29 +101,49 @@ fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
             by_range += usize::from(m.saturated);
         }
 
-        // A ±300 deg/s sensor clipping at 75 deg/s, range 300 (the model's) or unknown:
-        // the plateau flags every movement whose true peak passes the clip by 1 deg/s;
-        // one that barely touches it may go unflagged, losing almost nothing.
-        let effect = [Effect::Saturation {
+        // A low-passed gyro repeats readings at smooth peaks and steady turns: no clip,
+        // nothing flagged.
+        for cutoff_hz in [15.0, 5.0] {
+            let effect = [Effect::Bandwidth { cutoff_hz }];
+            let log = simulate(&SensorModel::default(), &effect, &motion, &options(seed));
+            for range_dps in [None, Some(300.0)] {
+                let found = movements(&log, range_dps);
+                assert_eq!(found.len(), motion.rotations().len(), "seed {seed}");
+                low_passed_seen += found.len();
+                assert!(
+                    found.iter().all(|m| !m.saturated),
+                    "seed {seed}, {cutoff_hz} Hz"
+                );
+            }
+        }
+
+        // A ±300 deg/s sensor clipping at 75 deg/s, range 300 (the model's) or unknown,
+        // with and without a 15 Hz low-pass before the clip: the plateau flags every
+        // movement whose true peak passes the clip by 1 deg/s; one that barely touches it
+        // may go unflagged, losing little.
+        let clip = Effect::Saturation {
             limit_dps: CLIP_DPS,
-        }];
-        let log = simulate(&SensorModel::default(), &effect, &motion, &options(seed));
-        let truth = truths(&motion, &log, CLIP_DPS);
-        for range_dps in [None, Some(300.0)] {
-            let found = movements(&log, range_dps);
-            assert_eq!(found.len(), truth.len(), "seed {seed}");
-            for (t, m) in truth.iter().zip(&found) {
-                if t.peak_dps > CLIP_DPS + 1.0 {
-                    assert!(m.saturated, "seed {seed}: peak {} {m:?}", t.peak_dps);
-                }
-                if !t.clipped {
-                    assert!(!m.saturated, "seed {seed}: not clipped {m:?}");
-                }
-                if range_dps.is_none() {
-                    by_plateau += usize::from(m.saturated);
-                    if t.clipped && !m.saturated {
-                        plateau_missed += 1;
-                        missed_lost_deg = missed_lost_deg.max(t.lost_deg);
+        };
+        let low_pass = Effect::Bandwidth { cutoff_hz: 15.0 };
+        for effects in [vec![clip], vec![clip, low_pass]] {
+            let log = simulate(&SensorModel::default(), &effects, &motion, &options(seed));
+            let truth = truths(&motion, &log, CLIP_DPS);
+            for range_dps in [None, Some(300.0)] {
+                let found = movements(&log, range_dps);
+                assert_eq!(found.len(), truth.len(), "seed {seed}");
+                for (t, m) in truth.iter().zip(&found) {
+                    if t.peak_dps > CLIP_DPS + 1.0 {
+                        assert!(m.saturated, "seed {seed}: peak {} {m:?}", t.peak_dps);
+                    }
+                    if !t.clipped {
+                        assert!(!m.saturated, "seed {seed}: not clipped {m:?}");
+                    }
+                    if range_dps.is_none() {
+                        by_plateau += usize::from(m.saturated);
+                        if t.clipped && !m.saturated {
+                            plateau_missed += 1;
+                            missed_lost_deg = missed_lost_deg.max(t.lost_deg);
+                        }
                     }
                 }
             }
@@ -128,10 +151,14 @@ fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
     }
     println!(
         "{} runs, {movements_seen} movements, {clipped_seen} with a clipped reading; \
-         range known: {by_range} flagged; plateau only: {by_plateau} flagged, \
-         {plateau_missed} clipped but not flagged (at most {missed_lost_deg:.4} deg lost)",
+         range known: {by_range} flagged; plateau only (with and without low-pass): \
+         {by_plateau} flagged, {plateau_missed} clipped but not flagged (at most \
+         {missed_lost_deg:.4} deg lost); low-passed without clip: {low_passed_seen} \
+         movements, none flagged",
         SEEDS.count()
     );
     assert!(clipped_seen >= 40, "{clipped_seen}");
-    assert!(missed_lost_deg < 0.05, "{missed_lost_deg}");
+    // A clip passed by less than 1 deg/s on a slow turn stands little beyond the filtered
+    // rate and lasts less than the long plateau: it may go unflagged, losing under 0.1°.
+    assert!(missed_lost_deg < 0.1, "{missed_lost_deg}");
 }

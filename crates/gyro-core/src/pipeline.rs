@@ -86,6 +86,24 @@ pub const CLIP_PLATEAU_SAMPLES: u8 = 16;
 /// rest on a quantised output (the same reading again and again) is never one.
 pub const CLIP_PLATEAU_MIN_DPS: f32 = 30.0;
 
+/// How far (deg/s) a clip plateau's level must stand beyond the pipeline's filtered rate
+/// of the block before, toward the plateau's sign, for the plateau to count before it
+/// lasts [`CLIP_PLATEAU_LONG_SAMPLES`] readings: a clip cuts off a rate still on its way
+/// up, which the filter, some 30 ms behind, has not caught; a gyro whose own low-pass
+/// leaves its output steadier than its step (a smooth peak, a steady turn) repeats a
+/// reading at the rate the filter already has. Measured on simulated 1 kHz bench runs
+/// (CRM100 step 1/24 deg/s, 5 and 15 Hz low-pass): such repeats stood at most 0.56 deg/s
+/// beyond the filtered rate; clips at 120 deg/s at least 2.2 deg/s.
+pub const CLIP_PLATEAU_LEAD_DPS: f32 = 1.0;
+
+/// Identical readings (at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`]) that make a clip plateau
+/// whatever the filtered rate. A clip reached on a slowly rising rate stands less than
+/// [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate (on the runs above, 75 deg/s clips
+/// of bench turns peaking up to 81 deg/s, losing up to 1.6°, stood 0.15–0.8 deg/s beyond
+/// it), but it lasts: those that passed the clip by 1 deg/s lasted at least 142 readings
+/// at 1 kHz, while the low-passed repeats lasted at most 76.
+pub const CLIP_PLATEAU_LONG_SAMPLES: u8 = 128;
+
 impl Default for Config {
     /// 1 kHz in, 50 Hz out, 2nd-order Butterworth at 12.5 Hz, Kalman compensation.
     ///
@@ -176,8 +194,9 @@ pub struct Movement {
     pub raw_angle_deg: f32,
     /// A reading during the movement (its confirming run included) reached the sensor's
     /// range ([`Config::range_dps`], within [`RANGE_MARGIN`]) or sat on a clip plateau
-    /// ([`CLIP_PLATEAU_SAMPLES`] identical readings at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`]):
-    /// the angle is then a lower bound of the turn. Reaching the range does not count once
+    /// ([`CLIP_PLATEAU_SAMPLES`] identical readings at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`],
+    /// standing [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate, or
+    /// [`CLIP_PLATEAU_LONG_SAMPLES`] of them): the angle is then a lower bound of the turn. Reaching the range does not count once
     /// a reading has gone beyond it by more than [`RANGE_MARGIN`] (since the start, up to
     /// the movement's end): a sensor reads at most its range, so that range is not this
     /// sensor's ([`Pipeline::range_contradicted`]); a clip plateau still counts.
@@ -320,6 +339,10 @@ const CLIP_PLATEAU: u8 = 2;
 /// Clip watch flag: a reading went beyond the range by more than [`RANGE_MARGIN`] (kept
 /// for the whole run: the range is not this sensor's).
 const CLIP_BEYOND: u8 = 4;
+/// Clip watch flag, never kept: a reading is the [`CLIP_PLATEAU_SAMPLES`]-th or later of
+/// identical readings at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`], which [`Pipeline::plateau`]
+/// turns into [`CLIP_PLATEAU`] or drops.
+const CLIP_REPEATS: u8 = 8;
 /// The flags of one stretch of readings that go to the movement in progress.
 const CLIP_PENDING: u8 = CLIP_RANGE | CLIP_PLATEAU;
 /// |reading| beyond which the range is contradicted, as a multiple of the level at which
@@ -377,9 +400,10 @@ fn range_flags(levels: ClipLevels, magnitude: f32) -> u8 {
 }
 
 /// One reading through the clip watch: `last` and `run` (the last reading and how many
-/// times in a row it came, up to the plateau) move on; its flags: whether it reaches the
-/// range or goes beyond it ([`range_flags`]), or completes a clip plateau (see
-/// [`Movement::saturated`]). Judged on the reading, before correction.
+/// times in a row it came, up to [`CLIP_PLATEAU_LONG_SAMPLES`]) move on; its flags:
+/// whether it reaches the range or goes beyond it ([`range_flags`]), or is one of enough
+/// identical readings to make a clip plateau ([`CLIP_REPEATS`], for
+/// [`Pipeline::plateau`]). Judged on the reading, before correction.
 #[inline(always)]
 fn clip_seen(levels: ClipLevels, last: &mut f32, run: &mut u8, reading_dps: f32) -> u8 {
     // Without branches: whether a reading repeats is a coin toss on a quantised sensor.
@@ -388,7 +412,7 @@ fn clip_seen(levels: ClipLevels, last: &mut f32, run: &mut u8, reading_dps: f32)
     *last = reading_dps;
     let magnitude = libm::fabsf(reading_dps);
     range_flags(levels, magnitude)
-        | (u8::from((*run >= CLIP_PLATEAU_SAMPLES) & (magnitude >= CLIP_PLATEAU_MIN_DPS)) << 1)
+        | (u8::from((*run >= CLIP_PLATEAU_SAMPLES) & (magnitude >= CLIP_PLATEAU_MIN_DPS)) << 3)
 }
 
 /// Where the clip watch ends over readings none of which repeats the one before it (the
@@ -759,7 +783,12 @@ impl Pipeline {
                 self.corrector.observe_temperature(temperatures_c[i]);
             }
             let rate = if self.plausible(reading) {
-                clipped |= clip_seen(levels, &mut clip_last, &mut clip_run, reading);
+                let seen = clip_seen(levels, &mut clip_last, &mut clip_run, reading);
+                clipped |= if seen & CLIP_REPEATS == 0 {
+                    seen
+                } else {
+                    seen & !CLIP_REPEATS | self.plateau::<TEMPERATURE>(reading, clip_run)
+                };
                 self.corrected::<TEMPERATURE>(reading)
             } else {
                 // Replaced by the last rate the decimator took (0 before the first).
@@ -858,7 +887,9 @@ impl Pipeline {
 
     /// The plausibility test and the clip watch over whole blocks of `factor` samples in
     /// order: each block's clip flags ([`clip_seen`]), or `None` (and nothing changed) if a
-    /// sample is implausible.
+    /// sample is implausible or may complete a clip plateau: whether it does depends on the
+    /// filtered rate of the block before its own ([`Self::plateau`]), which blocks side by
+    /// side do not have yet, so those blocks go one after the other (`segment`).
     ///
     /// Blocks that stay below both the clip plateau's level and the range, as rests do,
     /// need no watch sample by sample: their test reads all samples at once, and the watch
@@ -904,6 +935,9 @@ impl Pipeline {
                     .iter()
                     .fold(0, |seen, &x| seen | range_flags(levels, libm::fabsf(x)));
             }
+            if distinct.first_clipped & CLIP_REPEATS != 0 {
+                return None;
+            }
             clipped[0] |= distinct.first_clipped;
             (self.clip_last_dps, self.clip_run) = (distinct.last_dps, distinct.run);
         } else {
@@ -914,9 +948,28 @@ impl Pipeline {
                     *clipped |= clip_seen(levels, &mut clip_last, &mut clip_run, reading);
                 }
             }
+            if clipped.iter().any(|&seen| seen & CLIP_REPEATS != 0) {
+                return None;
+            }
             (self.clip_last_dps, self.clip_run) = (clip_last, clip_run);
         }
         Some(clipped)
+    }
+
+    /// Whether a reading `reading_dps`, the `run`-th identical one in a row ([`CLIP_REPEATS`]),
+    /// completes a clip plateau: [`CLIP_PLATEAU`] if its corrected level stands at least
+    /// [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate of the last output step, toward its
+    /// sign, or if the run has lasted [`CLIP_PLATEAU_LONG_SAMPLES`] readings; else 0.
+    #[cold]
+    #[inline(never)]
+    fn plateau<const TEMPERATURE: bool>(&self, reading_dps: f32, run: u8) -> u8 {
+        let level_dps = self.corrected::<TEMPERATURE>(reading_dps);
+        let lead_dps = libm::copysignf(1.0, level_dps) * (level_dps - self.previous.0);
+        if lead_dps >= CLIP_PLATEAU_LEAD_DPS || run >= CLIP_PLATEAU_LONG_SAMPLES {
+            CLIP_PLATEAU
+        } else {
+            0
+        }
     }
 
     /// Plausible: finite and within `max_abs_rate_dps`.

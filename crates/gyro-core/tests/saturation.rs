@@ -292,3 +292,67 @@ fn bench_runs_flag_clipped_movements_only() {
     assert!(clipped_movements >= 40, "{clipped_movements}");
     assert!(flagged >= clipped_movements);
 }
+
+/// Readings at 1 kHz that rest 2 s, rise from 0 at `slope_dps_per_s` to `peak_dps`, fall
+/// back at the same slope and rest 2 s, quantised to the CRM100 step without noise (a gyro
+/// whose own low-pass leaves its noise under the step), clipped at ±`clip_dps`.
+fn triangle(slope_dps_per_s: f64, peak_dps: f64, clip_dps: f64) -> Vec<f32> {
+    let rise_s = peak_dps / slope_dps_per_s;
+    let n = ((4.0 + 2.0 * rise_s) * FS_HZ).round() as usize;
+    (0..n)
+        .map(|i| {
+            let t = i as f64 / FS_HZ - 2.0;
+            let rate = (peak_dps - slope_dps_per_s * (t - rise_s).abs()).max(0.0);
+            ((rate / LSB_DPS).round() * LSB_DPS).min(clip_dps) as f32
+        })
+        .collect()
+}
+
+/// A run of identical readings counts as a clip plateau when it stands beyond the filtered
+/// rate (a steep rise cut off) or lasts (a slow rise cut off), not when the output is
+/// merely steady: readings that hold one value at a smooth peak or a steady turn sit at
+/// the rate the filter already has.
+#[test]
+fn a_steady_reading_is_a_clip_plateau_only_beyond_the_filtered_rate_or_long() {
+    let unknown = with_range(None);
+    // A turn that eases into a steady 60 deg/s over 1 s (raised cosine), holds it for
+    // 100 samples (under the long run) and eases out: one reading at the top for longer
+    // than the plateau, at the rate the filter already has.
+    let ease = |t: f64| 30.0 * (1.0 - (std::f64::consts::PI * t.clamp(0.0, 1.0)).cos());
+    let hold_s = 0.1;
+    assert!(hold_s * FS_HZ < f64::from(gyro_core::CLIP_PLATEAU_LONG_SAMPLES));
+    let steady: Vec<f32> = (0..6100)
+        .map(|i| {
+            let t = i as f64 / FS_HZ - 2.0;
+            let rate = ease(t).min(ease(2.0 + hold_s - t));
+            ((rate / LSB_DPS).round() * LSB_DPS) as f32
+        })
+        .collect();
+    let top = steady.iter().filter(|&&r| r == 60.0).count();
+    assert!((100..128).contains(&top), "{top}");
+    assert_eq!(flags(&unknown, &steady), [false]);
+
+    // A steep turn (1000 deg/s per s, peak 70) cut off at 60 deg/s: 20 identical readings,
+    // reached from far below the filtered rate.
+    let steep = triangle(1000.0, 70.0, 60.0);
+    let run = steep.iter().filter(|&&r| r == 60.0).count();
+    assert!((16..40).contains(&run), "{run}");
+    assert_eq!(flags(&unknown, &steep), [true]);
+
+    // A slow turn (20 deg/s per s, peak 70) cut off at 60 deg/s: the filtered rate keeps
+    // up with the rise (under 1 deg/s behind), but the clip lasts a second.
+    let slow = triangle(20.0, 70.0, 60.0);
+    assert_eq!(flags(&unknown, &slow), [true]);
+    // The same slow turn cut off for fewer readings than the long run, at 69.9 deg/s:
+    // not told from a steady peak (it loses 0.0004°).
+    let barely = triangle(20.0, 70.0, 69.9);
+    let run = barely
+        .iter()
+        .filter(|&&r| r == barely[0].max(69.875))
+        .count();
+    assert!(
+        run < usize::from(gyro_core::CLIP_PLATEAU_LONG_SAMPLES),
+        "{run}"
+    );
+    assert_eq!(flags(&unknown, &barely), [false]);
+}
