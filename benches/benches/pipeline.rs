@@ -7,9 +7,7 @@
 //! the same input, so that the ratio of the two is measured in one run:
 //! - `plain_loop`: average-decimate 20:1 (a plain f32 sum), one biquad section in direct
 //!   form (the pipeline's Butterworth design, rounded to f32), a threshold detector
-//!   (|rate| above `enter_dps`), trapezoid integration while moving;
-//! - `plain_loop_kahan`: the same with the decimator's sum compensated (Kahan) as the
-//!   pipeline's is, which is what its bit-exact outputs are built on.
+//!   (|rate| above `enter_dps`), trapezoid integration while moving.
 //!
 //! The pipeline runs each compensation mode sample by sample (`Pipeline::push`: `none`,
 //! `paper`, `kalman`) and through `Pipeline::push_block`, the whole input in one call
@@ -20,7 +18,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use gyro_benches::bench_signal_dps;
-use gyro_core::{Compensation, Config, KahanSum, Pipeline};
+use gyro_core::{Compensation, Config, Pipeline};
 use std::hint::black_box;
 
 /// The floor's settings, from the default pipeline configuration.
@@ -51,26 +49,16 @@ impl Plain {
     }
 
     /// Decimate, filter, detect, integrate: the angle turned while moving (deg).
-    /// `KAHAN` compensates the decimator's sum.
-    fn run<const KAHAN: bool>(&self, signal: &[f32]) -> f32 {
+    fn run(&self, signal: &[f32]) -> f32 {
         let [b0, b1, b2, a1, a2] = self.biquad;
         let (mut x1, mut x2, mut y1, mut y2) = (0.0_f32, 0.0_f32, 0.0_f32, 0.0_f32);
         let mut angle_deg = 0.0_f32;
         let scale = 1.0 / self.factor as f32;
         for block in signal.chunks_exact(self.factor) {
-            let sum = if KAHAN {
-                let mut sum = KahanSum::ZERO;
-                for &x in block {
-                    sum.add(x);
-                }
-                sum.value()
-            } else {
-                let mut sum = 0.0_f32;
-                for &x in block {
-                    sum += x;
-                }
-                sum
-            };
+            let mut sum = 0.0_f32;
+            for &x in block {
+                sum += x;
+            }
             let x = sum * scale;
             let y = b0 * x + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2;
             if y.abs() > self.enter_dps {
@@ -90,10 +78,7 @@ fn pipeline_per_sample(c: &mut Criterion) {
     group.throughput(Throughput::Elements(N as u64));
     let plain = Plain::new(&Config::default());
     group.bench_with_input("plain_loop", &signal, |b, signal| {
-        b.iter(|| plain.run::<false>(black_box(signal)))
-    });
-    group.bench_with_input("plain_loop_kahan", &signal, |b, signal| {
-        b.iter(|| plain.run::<true>(black_box(signal)))
+        b.iter(|| plain.run(black_box(signal)))
     });
     for (name, compensation) in [
         ("none", Compensation::None),

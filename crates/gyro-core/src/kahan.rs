@@ -44,43 +44,6 @@ fn step(sum: f32, compensation: f32, x: f32) -> (f32, f32) {
     (t, (t - sum) - y)
 }
 
-/// `N` independent compensated sums side by side, lane `k` equal bit for bit to a
-/// [`KahanSum`] given lane `k`'s values in the same order.
-///
-/// Each sum is a chain of dependent additions; side by side (in lanes the compiler may put
-/// in one vector register), the chains overlap instead of waiting on each other.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct KahanLanes<const N: usize> {
-    sums: [f32; N],
-    compensations: [f32; N],
-}
-
-impl<const N: usize> KahanLanes<N> {
-    /// Zero in every lane.
-    pub const ZERO: Self = Self {
-        sums: [0.0; N],
-        compensations: [0.0; N],
-    };
-
-    /// Add `x[k]` to lane `k`.
-    #[inline(always)]
-    pub fn add(&mut self, x: [f32; N]) {
-        let lanes = self.sums.iter_mut().zip(&mut self.compensations);
-        for ((sum, compensation), x) in lanes.zip(x) {
-            (*sum, *compensation) = step(*sum, *compensation, x);
-        }
-    }
-
-    /// Lane `k` as a [`KahanSum`] (`k < N`).
-    #[inline]
-    pub fn lane(&self, k: usize) -> KahanSum {
-        KahanSum {
-            sum: self.sums[k],
-            compensation: self.compensations[k],
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -99,26 +62,5 @@ mod tests {
         assert!((k.value() - exact).abs() < 1e-3, "{}", k.value());
         // Plain f32 loses the addends entirely: the test would pass vacuously otherwise.
         assert!((plain - exact).abs() > 1.0);
-    }
-
-    #[test]
-    fn lanes_are_sums_bit_for_bit() {
-        let mut lanes = KahanLanes::<3>::ZERO;
-        let mut sums = [KahanSum::ZERO; 3];
-        for i in 0..1000 {
-            let x = [
-                1.0e4 / (i + 1) as f32,
-                -1.0e-4 * i as f32,
-                (i as f32 * 0.7).sin(),
-            ];
-            lanes.add(x);
-            for (sum, x) in sums.iter_mut().zip(x) {
-                sum.add(x);
-            }
-        }
-        for (k, sum) in sums.iter().enumerate() {
-            assert_eq!(lanes.lane(k).value().to_bits(), sum.value().to_bits());
-            assert_eq!(lanes.lane(k), *sum);
-        }
     }
 }

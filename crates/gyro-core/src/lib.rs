@@ -58,7 +58,7 @@ pub use decision::{decide, Direction, Tightening, Verdict};
 pub use error::Error;
 pub use gauss_markov::GaussMarkov;
 pub use integrator::Integrator;
-pub use kahan::{KahanLanes, KahanSum};
+pub use kahan::KahanSum;
 pub use kalman::{KalmanBias, KalmanConfig};
 pub use motion::{MotionConfig, MotionDetector, MotionState, Phase};
 pub use pipeline::{

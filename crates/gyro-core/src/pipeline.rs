@@ -7,7 +7,7 @@ use crate::decision::Tightening;
 use crate::error::{check_range, Error};
 use crate::gauss_markov::GaussMarkov;
 use crate::integrator::Integrator;
-use crate::kahan::{KahanLanes, KahanSum};
+use crate::kahan::KahanSum;
 use crate::kalman::{KalmanBias, KalmanConfig};
 use crate::motion::{MotionConfig, MotionDetector, MotionState, Phase};
 use crate::sos::{Sos, SosState};
@@ -328,8 +328,8 @@ impl RestBlocks {
 }
 
 /// How many whole blocks [`Pipeline::push_block`] sums side by side (half as many when
-/// fewer are at hand): 8 lanes, two 4-lane vector registers of sums and two of
-/// compensations, whose chains of additions overlap.
+/// fewer are at hand): 8 lanes, two 4-lane vector registers of sums, whose chains of
+/// additions overlap.
 const SIDE_BY_SIDE: usize = 8;
 
 /// Clip watch flag: a reading reached the range.
@@ -837,7 +837,7 @@ impl Pipeline {
         let sums = self.block_sums(&rows);
 
         for (k, row) in rows.into_iter().enumerate() {
-            let sum = sums.lane(k);
+            let sum = sums[k];
             let times_s = &times_s[k * factor..(k + 1) * factor];
             self.block_start_time_s = self.time_of(times_s, 0);
             self.last_time_s = self.time_of_last(times_s, self.block_start_time_s);
@@ -849,16 +849,16 @@ impl Pipeline {
         true
     }
 
-    /// The compensated sums of whole blocks (`rows`, of one length), side by side, each in
-    /// its samples' order. The samples are read 4 of a block at a time: one load and one
-    /// bounds check for 4 values, which shuffles then turn into 4 columns of the lanes,
-    /// rather than a load and a check for each value.
+    /// The sums of whole blocks (`rows`, of one length), side by side, each in its
+    /// samples' order (as [`Decimator`] sums them). The samples are read 4 of a block at a
+    /// time: one load and one bounds check for 4 values, which shuffles then turn into 4
+    /// columns of the lanes, rather than a load and a check for each value.
     #[inline(always)]
-    fn block_sums<const LANES: usize>(&self, rows: &[&[f32]; LANES]) -> KahanLanes<LANES> {
+    fn block_sums<const LANES: usize>(&self, rows: &[&[f32]; LANES]) -> [f32; LANES] {
         let factor = rows.first().map_or(0, |row| row.len());
         // Without temperature: a temperature that would change the rate keeps the blocks
         // out of here.
-        let mut sums = KahanLanes::<LANES>::ZERO;
+        let mut sums = [0.0_f32; LANES];
         let mut i = 0;
         while i + 4 <= factor {
             let quads: [[f32; 4]; LANES] = core::array::from_fn(|k| {
@@ -869,18 +869,17 @@ impl Pipeline {
             });
             // Column by column straight from the quads (an array of the columns first
             // measured slower).
-            #[allow(clippy::needless_range_loop)]
             for j in 0..4 {
-                sums.add(core::array::from_fn(|k| {
-                    self.corrected::<false>(quads[k][j])
-                }));
+                for (sum, quad) in sums.iter_mut().zip(&quads) {
+                    *sum += self.corrected::<false>(quad[j]);
+                }
             }
             i += 4;
         }
         for i in i..factor {
-            sums.add(core::array::from_fn(|k| {
-                self.corrected::<false>(rows[k].get(i).copied().unwrap_or_default())
-            }));
+            for (sum, row) in sums.iter_mut().zip(rows) {
+                *sum += self.corrected::<false>(row.get(i).copied().unwrap_or_default());
+            }
         }
         sums
     }
@@ -1301,7 +1300,7 @@ mod size_tests {
     use super::Pipeline;
 
     /// The firmware budget: the whole pipeline state in 512 bytes at most. It is exactly
-    /// 512, every byte a field: `Track` gave up 8 bytes of `Option` padding for the
+    /// 512, all but 4 bytes of padding a field: `Track` gave up 8 bytes of `Option` padding for the
     /// corrector, the saturation state (10 bytes) is paid for by `previous` without an
     /// `Option` tag and the sample rate kept as f32 instead of the period as f64, the
     /// last free byte says whether the correction is the identity, and the Kalman
