@@ -6,7 +6,7 @@
 //! 75 deg/s (effect `saturation`), where only the clip plateau tells. The same with the
 //! gyro's own low-pass (effect `bandwidth`, 15 and 5 Hz), whose output repeats a reading
 //! at smooth peaks and steady turns without any clip. `cargo test -p gyro-analysis --test
-//! saturation_sim -- --nocapture` prints the counts.
+//! saturation_sim -- --nocapture` prints the counts. The clip also at 100 Hz.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use gyro_analysis::replay::{replay, MovementResult};
@@ -125,8 +125,17 @@ fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
             limit_dps: CLIP_DPS,
         };
         let low_pass = Effect::Bandwidth { cutoff_hz: 15.0 };
-        for effects in [vec![clip], vec![clip, low_pass]] {
-            let log = simulate(&SensorModel::default(), &effects, &motion, &options(seed));
+        // And a 100 Hz sensor: 16 readings there last 160 ms, past the filter's lag.
+        let at_100_hz = SensorModel {
+            sample_rate_hz: 100.0,
+            ..SensorModel::default()
+        };
+        for (sensor, effects) in [
+            (SensorModel::default(), vec![clip]),
+            (SensorModel::default(), vec![clip, low_pass]),
+            (at_100_hz, vec![clip]),
+        ] {
+            let log = simulate(&sensor, &effects, &motion, &options(seed));
             let truth = truths(&motion, &log, CLIP_DPS);
             for range_dps in [None, Some(300.0)] {
                 let found = movements(&log, range_dps);

@@ -88,21 +88,23 @@ pub const CLIP_PLATEAU_MIN_DPS: f32 = 30.0;
 
 /// How far (deg/s) a clip plateau's level must stand beyond the pipeline's filtered rate
 /// of the block before, toward the plateau's sign, for the plateau to count before it
-/// lasts [`CLIP_PLATEAU_LONG_SAMPLES`] readings: a clip cuts off a rate still on its way
+/// lasts [`CLIP_PLATEAU_LONG_S`]: a clip cuts off a rate still on its way
 /// up, which the filter, some 30 ms behind, has not caught; a gyro whose own low-pass
 /// leaves its output steadier than its step (a smooth peak, a steady turn) repeats a
 /// reading at the rate the filter already has. Measured on simulated 1 kHz bench runs
-/// (CRM100 step 1/24 deg/s, 5 and 15 Hz low-pass): such repeats stood at most 0.56 deg/s
-/// beyond the filtered rate; clips at 120 deg/s at least 2.2 deg/s.
+/// (CRM100 step 1/24 deg/s, 5 and 15 Hz low-pass, 48 runs of 60 s each): such repeats
+/// stood at most 0.63 deg/s beyond the filtered rate; clips at 120 deg/s at least 2.2.
 pub const CLIP_PLATEAU_LEAD_DPS: f32 = 1.0;
 
-/// Identical readings (at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`]) that make a clip plateau
-/// whatever the filtered rate. A clip reached on a slowly rising rate stands less than
-/// [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate (on the runs above, 75 deg/s clips
-/// of bench turns peaking up to 81 deg/s, losing up to 1.6°, stood 0.15–0.8 deg/s beyond
-/// it), but it lasts: those that passed the clip by 1 deg/s lasted at least 142 readings
-/// at 1 kHz, while the low-passed repeats lasted at most 76.
-pub const CLIP_PLATEAU_LONG_SAMPLES: u8 = 128;
+/// How long (s) identical readings (at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`]) last to make a
+/// clip plateau whatever the filtered rate ([`Pipeline::clip_plateau_long_samples`]
+/// readings). A clip reached on a slowly rising rate stands less than
+/// [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate (on the 1 kHz runs above, 75 deg/s
+/// clips of bench turns peaking up to 81 deg/s, losing up to 1.6°, stood 0.15–0.8 deg/s
+/// beyond it), but it lasts: those that passed the clip by 1 deg/s lasted at least 142 ms,
+/// while the low-passed repeats lasted at most 76 ms. In time rather than readings: how
+/// long a smooth peak or a clip lasts is set by the motion, not by the sample rate.
+pub const CLIP_PLATEAU_LONG_S: f32 = 0.128;
 
 impl Default for Config {
     /// 1 kHz in, 50 Hz out, 2nd-order Butterworth at 12.5 Hz, Kalman compensation.
@@ -195,8 +197,8 @@ pub struct Movement {
     /// A reading during the movement (its confirming run included) reached the sensor's
     /// range ([`Config::range_dps`], within [`RANGE_MARGIN`]) or sat on a clip plateau
     /// ([`CLIP_PLATEAU_SAMPLES`] identical readings at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`],
-    /// standing [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate, or
-    /// [`CLIP_PLATEAU_LONG_SAMPLES`] of them): the angle is then a lower bound of the turn. Reaching the range does not count once
+    /// standing [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate, or lasting
+    /// [`CLIP_PLATEAU_LONG_S`]): the angle is then a lower bound of the turn. Reaching the range does not count once
     /// a reading has gone beyond it by more than [`RANGE_MARGIN`] (since the start, up to
     /// the movement's end): a sensor reads at most its range, so that range is not this
     /// sensor's ([`Pipeline::range_contradicted`]); a clip plateau still counts.
@@ -400,7 +402,7 @@ fn range_flags(levels: ClipLevels, magnitude: f32) -> u8 {
 }
 
 /// One reading through the clip watch: `last` and `run` (the last reading and how many
-/// times in a row it came, up to [`CLIP_PLATEAU_LONG_SAMPLES`]) move on; its flags:
+/// times in a row it came, up to 255) move on; its flags:
 /// whether it reaches the range or goes beyond it ([`range_flags`]), or is one of enough
 /// identical readings to make a clip plateau ([`CLIP_REPEATS`], for
 /// [`Pipeline::plateau`]). Judged on the reading, before correction.
@@ -958,17 +960,27 @@ impl Pipeline {
     /// Whether a reading `reading_dps`, the `run`-th identical one in a row ([`CLIP_REPEATS`]),
     /// completes a clip plateau: [`CLIP_PLATEAU`] if its corrected level stands at least
     /// [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate of the last output step, toward its
-    /// sign, or if the run has lasted [`CLIP_PLATEAU_LONG_SAMPLES`] readings; else 0.
+    /// sign, or if the run has lasted [`Self::clip_plateau_long_samples`] readings; else 0.
     #[cold]
     #[inline(never)]
     fn plateau<const TEMPERATURE: bool>(&self, reading_dps: f32, run: u8) -> u8 {
         let level_dps = self.corrected::<TEMPERATURE>(reading_dps);
         let lead_dps = libm::copysignf(1.0, level_dps) * (level_dps - self.previous.0);
-        if lead_dps >= CLIP_PLATEAU_LEAD_DPS || run >= CLIP_PLATEAU_LONG_SAMPLES {
+        if lead_dps >= CLIP_PLATEAU_LEAD_DPS || run >= self.clip_plateau_long_samples() {
             CLIP_PLATEAU
         } else {
             0
         }
+    }
+
+    /// Identical readings that make a clip plateau whatever the filtered rate:
+    /// [`CLIP_PLATEAU_LONG_S`] at the input rate (128 at 1 kHz), at least
+    /// [`CLIP_PLATEAU_SAMPLES`] (below 125 Hz every plateau counts, as 16 readings then
+    /// last longer) and at most 255, the run counter's limit (above 2 kHz a shorter time).
+    pub fn clip_plateau_long_samples(&self) -> u8 {
+        let input_rate_hz = f32::from(self.decimator.factor()) / self.output_period_s();
+        // `as` saturates at 255 (and takes NaN, which a validated rate never is, to 0).
+        (libm::roundf(CLIP_PLATEAU_LONG_S * input_rate_hz) as u8).max(CLIP_PLATEAU_SAMPLES)
     }
 
     /// Plausible: finite and within `max_abs_rate_dps`.

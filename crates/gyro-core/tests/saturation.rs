@@ -320,7 +320,7 @@ fn a_steady_reading_is_a_clip_plateau_only_beyond_the_filtered_rate_or_long() {
     // than the plateau, at the rate the filter already has.
     let ease = |t: f64| 30.0 * (1.0 - (std::f64::consts::PI * t.clamp(0.0, 1.0)).cos());
     let hold_s = 0.1;
-    assert!(hold_s * FS_HZ < f64::from(gyro_core::CLIP_PLATEAU_LONG_SAMPLES));
+    assert!(hold_s < f64::from(gyro_core::CLIP_PLATEAU_LONG_S));
     let steady: Vec<f32> = (0..6100)
         .map(|i| {
             let t = i as f64 / FS_HZ - 2.0;
@@ -351,8 +351,27 @@ fn a_steady_reading_is_a_clip_plateau_only_beyond_the_filtered_rate_or_long() {
         .filter(|&&r| r == barely[0].max(69.875))
         .count();
     assert!(
-        run < usize::from(gyro_core::CLIP_PLATEAU_LONG_SAMPLES),
+        (run as f64) < f64::from(gyro_core::CLIP_PLATEAU_LONG_S) * FS_HZ,
         "{run}"
     );
     assert_eq!(flags(&unknown, &barely), [false]);
+}
+
+/// The long plateau is a time: 128 readings at 1 kHz, every plateau (16 readings) below
+/// 125 Hz, and the run counter's 255 above 2 kHz.
+#[test]
+fn the_long_plateau_is_a_time() {
+    let long = |sample_rate_hz: f32| {
+        let config = Config {
+            sample_rate_hz,
+            ..Config::default()
+        };
+        Pipeline::try_new(&config)
+            .expect("config")
+            .clip_plateau_long_samples()
+    };
+    assert_eq!(long(1000.0), 128);
+    assert_eq!(long(500.0), 64);
+    assert_eq!(long(100.0), CLIP_PLATEAU_SAMPLES);
+    assert_eq!(long(8000.0), u8::MAX);
 }
