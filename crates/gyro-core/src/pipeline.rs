@@ -88,8 +88,8 @@ pub const CLIP_PLATEAU_MIN_DPS: f32 = 30.0;
 
 /// How far (deg/s) a clip plateau's level must stand beyond the pipeline's filtered rate
 /// of the block before, toward the plateau's sign, for the plateau to count before it
-/// lasts [`CLIP_PLATEAU_LONG_S`]: a clip cuts off a rate still on its way
-/// up, which the filter, some 30 ms behind, has not caught; a gyro whose own low-pass
+/// lasts [`CLIP_PLATEAU_LONG_S`]: a clip cuts off a rate still on its way up, which the
+/// filter, some 30 ms behind, has not caught; a gyro whose own low-pass
 /// leaves its output steadier than its step (a smooth peak, a steady turn) repeats a
 /// reading at the rate the filter already has. Measured on simulated 1 kHz bench runs
 /// (CRM100 step 1/24 deg/s, 5 and 15 Hz low-pass, 48 runs of 60 s each): such repeats
@@ -198,10 +198,11 @@ pub struct Movement {
     /// range ([`Config::range_dps`], within [`RANGE_MARGIN`]) or sat on a clip plateau
     /// ([`CLIP_PLATEAU_SAMPLES`] identical readings at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`],
     /// standing [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate, or lasting
-    /// [`CLIP_PLATEAU_LONG_S`]): the angle is then a lower bound of the turn. Reaching the range does not count once
-    /// a reading has gone beyond it by more than [`RANGE_MARGIN`] (since the start, up to
-    /// the movement's end): a sensor reads at most its range, so that range is not this
-    /// sensor's ([`Pipeline::range_contradicted`]); a clip plateau still counts.
+    /// [`CLIP_PLATEAU_LONG_S`]): the angle is then a lower bound of the turn. Reaching the
+    /// range does not count once a reading has gone beyond it by more than
+    /// [`RANGE_MARGIN`] (since the start, up to the movement's end): a sensor reads at most
+    /// its range, so that range is not this sensor's ([`Pipeline::range_contradicted`]); a
+    /// clip plateau still counts.
     pub saturated: bool,
     /// Standard deviation of `angle_deg` (deg), in Kalman mode: what the filter's bias
     /// uncertainty and rate noise make of this movement's angle (the input to a
@@ -785,13 +786,14 @@ impl Pipeline {
                 self.corrector.observe_temperature(temperatures_c[i]);
             }
             let rate = if self.plausible(reading) {
+                let rate = self.corrected::<TEMPERATURE>(reading);
                 let seen = clip_seen(levels, &mut clip_last, &mut clip_run, reading);
                 clipped |= if seen & CLIP_REPEATS == 0 {
                     seen
                 } else {
-                    seen & !CLIP_REPEATS | self.plateau::<TEMPERATURE>(reading, clip_run)
+                    seen & !CLIP_REPEATS | self.plateau(rate, clip_run)
                 };
-                self.corrected::<TEMPERATURE>(reading)
+                rate
             } else {
                 // Replaced by the last rate the decimator took (0 before the first).
                 self.reject();
@@ -930,14 +932,14 @@ impl Pipeline {
         } else if let Some(distinct) = distinct_run(rates_dps, self.clip_last_dps, self.clip_run) {
             // No reading repeats the one before it, but perhaps the first: a plateau can
             // only complete there, and the watch ends on a run of one (or the first's).
+            if distinct.first_clipped & CLIP_REPEATS != 0 {
+                return None;
+            }
             let levels = ClipLevels::at(self.clip_level_dps);
             for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
                 *clipped = block
                     .iter()
                     .fold(0, |seen, &x| seen | range_flags(levels, libm::fabsf(x)));
-            }
-            if distinct.first_clipped & CLIP_REPEATS != 0 {
-                return None;
             }
             clipped[0] |= distinct.first_clipped;
             (self.clip_last_dps, self.clip_run) = (distinct.last_dps, distinct.run);
@@ -957,14 +959,14 @@ impl Pipeline {
         Some(clipped)
     }
 
-    /// Whether a reading `reading_dps`, the `run`-th identical one in a row ([`CLIP_REPEATS`]),
-    /// completes a clip plateau: [`CLIP_PLATEAU`] if its corrected level stands at least
-    /// [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate of the last output step, toward its
-    /// sign, or if the run has lasted [`Self::clip_plateau_long_samples`] readings; else 0.
+    /// Whether a reading, the `run`-th identical one in a row ([`CLIP_REPEATS`]), whose
+    /// corrected rate is `level_dps`, completes a clip plateau: [`CLIP_PLATEAU`] if that
+    /// level stands at least [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate of the last
+    /// output step, toward its sign, or if the run has lasted
+    /// [`Self::clip_plateau_long_samples`] readings; else 0.
     #[cold]
     #[inline(never)]
-    fn plateau<const TEMPERATURE: bool>(&self, reading_dps: f32, run: u8) -> u8 {
-        let level_dps = self.corrected::<TEMPERATURE>(reading_dps);
+    fn plateau(&self, level_dps: f32, run: u8) -> u8 {
         let lead_dps = libm::copysignf(1.0, level_dps) * (level_dps - self.previous.0);
         if lead_dps >= CLIP_PLATEAU_LEAD_DPS || run >= self.clip_plateau_long_samples() {
             CLIP_PLATEAU
@@ -1312,8 +1314,8 @@ mod size_tests {
     use super::Pipeline;
 
     /// The firmware budget: the whole pipeline state in 512 bytes at most. It is exactly
-    /// 512, all but 4 bytes of padding a field: `Track` gave up 8 bytes of `Option` padding for the
-    /// corrector, the saturation state (10 bytes) is paid for by `previous` without an
+    /// 512, all but 4 bytes of padding a field: `Track` gave up 8 bytes of `Option`
+    /// padding for the corrector, the saturation state (10 bytes) is paid for by `previous` without an
     /// `Option` tag and the sample rate kept as f32 instead of the period as f64, the
     /// last free byte says whether the correction is the identity, and the Kalman
     /// filter's cached transition φ is paid for by the output period kept once (the
