@@ -6,7 +6,8 @@
 //! 75 deg/s (effect `saturation`), where only the clip plateau tells. The same with the
 //! gyro's own low-pass (effect `bandwidth`, 15 and 5 Hz), whose output repeats a reading
 //! at smooth peaks and steady turns without any clip. `cargo test -p gyro-analysis --test
-//! saturation_sim -- --nocapture` prints the counts. The clip also at 100 Hz.
+//! saturation_sim -- --nocapture` prints the counts. The clip also at 100 Hz and at 8 kHz,
+//! with and without the low-pass there.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use gyro_analysis::replay::{replay, MovementResult};
@@ -59,6 +60,14 @@ fn movements(log: &gyro_log::Log, range_dps: Option<f32>) -> Vec<MovementResult>
     replay(&regular, &config).unwrap().movements
 }
 
+/// A CRM100 read at 8 kHz.
+fn at_8_khz() -> SensorModel {
+    SensorModel {
+        sample_rate_hz: 8000.0,
+        ..SensorModel::default()
+    }
+}
+
 #[test]
 fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
     let options = |seed| SimOptions {
@@ -69,6 +78,8 @@ fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
     let (mut by_range, mut by_plateau, mut plateau_missed) = (0, 0, 0);
     let mut low_passed_seen = 0;
     let mut missed_lost_deg = 0.0_f64;
+    // The same for the noisy 8 kHz sensor.
+    let mut missed_noisy_lost_deg = 0.0_f64;
     for seed in SEEDS {
         let motion = Motion::bench(&BenchProfile::default(), seed);
         let clean = simulate(&SensorModel::default(), &[], &motion, &options(seed));
@@ -102,10 +113,14 @@ fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
         }
 
         // A low-passed gyro repeats readings at smooth peaks and steady turns: no clip,
-        // nothing flagged.
-        for cutoff_hz in [15.0, 5.0] {
+        // nothing flagged. Also at 8 kHz, where 16 readings last 2 ms.
+        for (sensor, cutoff_hz) in [
+            (SensorModel::default(), 15.0),
+            (SensorModel::default(), 5.0),
+            (at_8_khz(), 15.0),
+        ] {
             let effect = [Effect::Bandwidth { cutoff_hz }];
-            let log = simulate(&SensorModel::default(), &effect, &motion, &options(seed));
+            let log = simulate(&sensor, &effect, &motion, &options(seed));
             for range_dps in [None, Some(300.0)] {
                 let found = movements(&log, range_dps);
                 assert_eq!(found.len(), motion.rotations().len(), "seed {seed}");
@@ -120,7 +135,9 @@ fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
         // A ±300 deg/s sensor clipping at 75 deg/s, range 300 (the model's) or unknown,
         // with and without a 15 Hz low-pass before the clip: the plateau flags every
         // movement whose true peak passes the clip by 1 deg/s; one that barely touches it
-        // may go unflagged, losing little.
+        // may go unflagged, losing little. At 8 kHz without the low-pass each reading's
+        // noise (0.42 deg/s) breaks a clip barely passed into runs shorter than the 16 ms a
+        // plateau needs there: the margin is 1 deg/s plus 3 σ of that noise.
         let clip = Effect::Saturation {
             limit_dps: CLIP_DPS,
         };
@@ -130,10 +147,13 @@ fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
             sample_rate_hz: 100.0,
             ..SensorModel::default()
         };
-        for (sensor, effects) in [
-            (SensorModel::default(), vec![clip]),
-            (SensorModel::default(), vec![clip, low_pass]),
-            (at_100_hz, vec![clip]),
+        let noisy_8k_margin_dps = 1.0 + 3.0 * at_8_khz().white_sigma_dps();
+        for (sensor, effects, margin_dps) in [
+            (SensorModel::default(), vec![clip], 1.0),
+            (SensorModel::default(), vec![clip, low_pass], 1.0),
+            (at_100_hz, vec![clip], 1.0),
+            (at_8_khz(), vec![clip], noisy_8k_margin_dps),
+            (at_8_khz(), vec![clip, low_pass], 1.0),
         ] {
             let log = simulate(&sensor, &effects, &motion, &options(seed));
             let truth = truths(&motion, &log, CLIP_DPS);
@@ -141,7 +161,7 @@ fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
                 let found = movements(&log, range_dps);
                 assert_eq!(found.len(), truth.len(), "seed {seed}");
                 for (t, m) in truth.iter().zip(&found) {
-                    if t.peak_dps > CLIP_DPS + 1.0 {
+                    if t.peak_dps > CLIP_DPS + margin_dps {
                         assert!(m.saturated, "seed {seed}: peak {} {m:?}", t.peak_dps);
                     }
                     if !t.clipped {
@@ -151,7 +171,12 @@ fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
                         by_plateau += usize::from(m.saturated);
                         if t.clipped && !m.saturated {
                             plateau_missed += 1;
-                            missed_lost_deg = missed_lost_deg.max(t.lost_deg);
+                            let lost = if margin_dps > 1.0 {
+                                &mut missed_noisy_lost_deg
+                            } else {
+                                &mut missed_lost_deg
+                            };
+                            *lost = lost.max(t.lost_deg);
                         }
                     }
                 }
@@ -162,12 +187,15 @@ fn clipped_movements_are_flagged_and_unclipped_runs_are_not() {
         "{} runs, {movements_seen} movements, {clipped_seen} with a clipped reading; \
          range known: {by_range} flagged; plateau only (with and without low-pass): \
          {by_plateau} flagged, {plateau_missed} clipped but not flagged (at most \
-         {missed_lost_deg:.4} deg lost); low-passed without clip: {low_passed_seen} \
-         movements, none flagged",
+         {missed_lost_deg:.4} deg lost; {missed_noisy_lost_deg:.4} by the noisy 8 kHz \
+         sensor); low-passed without clip: {low_passed_seen} movements, none flagged",
         SEEDS.count()
     );
     assert!(clipped_seen >= 40, "{clipped_seen}");
     // A clip passed by less than 1 deg/s on a slow turn stands little beyond the filtered
     // rate and lasts less than the long plateau: it may go unflagged, losing under 0.1°.
     assert!(missed_lost_deg < 0.1, "{missed_lost_deg}");
+    // At 8 kHz, with 0.42 deg/s of noise on each reading, such a clip may pass the clip by
+    // 1.4 deg/s and lose up to 0.2°.
+    assert!(missed_noisy_lost_deg < 0.25, "{missed_noisy_lost_deg}");
 }

@@ -63,6 +63,7 @@ pub use kalman::{KalmanBias, KalmanConfig};
 pub use motion::{MotionConfig, MotionDetector, MotionState, Phase};
 pub use pipeline::{
     beyond_range, Compensation, Config, Event, Movement, Output, Pipeline, CLIP_PLATEAU_LEAD_DPS,
-    CLIP_PLATEAU_LONG_S, CLIP_PLATEAU_MIN_DPS, CLIP_PLATEAU_SAMPLES, RANGE_MARGIN,
+    CLIP_PLATEAU_LONG_S, CLIP_PLATEAU_MIN_DPS, CLIP_PLATEAU_SAMPLES, CLIP_PLATEAU_SHORT_S,
+    RANGE_MARGIN,
 };
 pub use sos::{Biquad, Sos, SosState, MAX_SECTIONS};

@@ -82,6 +82,14 @@ pub const RANGE_MARGIN: f32 = 0.005;
 /// [`Config::range_dps`] for such a sensor rather than rely on the plateau.
 pub const CLIP_PLATEAU_SAMPLES: u8 = 16;
 
+/// How long (s) identical readings last, at least, to make a clip plateau
+/// ([`Pipeline::clip_plateau_samples`]: [`CLIP_PLATEAU_SAMPLES`] readings up to 1 kHz, 128
+/// at 8 kHz). Above 1 kHz, 16 readings are shorter than the filtered rate's step from one
+/// output to the next: a low-noise gyro holds a reading that long on the slope into a
+/// smooth peak, while the filter is still catching up, and the lead would read that as a
+/// clip (at 8 kHz a turn easing into 60 deg/s was).
+pub const CLIP_PLATEAU_SHORT_S: f32 = 0.016;
+
 /// The least |rate| (deg/s) a clip plateau sits at: far above any gyro's bias, so that a
 /// rest on a quantised output (the same reading again and again) is never one.
 pub const CLIP_PLATEAU_MIN_DPS: f32 = 30.0;
@@ -196,7 +204,7 @@ pub struct Movement {
     pub raw_angle_deg: f32,
     /// A reading during the movement (its confirming run included) reached the sensor's
     /// range ([`Config::range_dps`], within [`RANGE_MARGIN`]) or sat on a clip plateau
-    /// ([`CLIP_PLATEAU_SAMPLES`] identical readings at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`],
+    /// ([`Pipeline::clip_plateau_samples`] identical readings at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`],
     /// standing [`CLIP_PLATEAU_LEAD_DPS`] beyond the filtered rate, or lasting
     /// [`CLIP_PLATEAU_LONG_S`]): the angle is then a lower bound of the turn. Reaching the
     /// range does not count once a reading has gone beyond it by more than
@@ -342,7 +350,7 @@ const CLIP_PLATEAU: u8 = 2;
 /// Clip watch flag: a reading went beyond the range by more than [`RANGE_MARGIN`] (kept
 /// for the whole run: the range is not this sensor's).
 const CLIP_BEYOND: u8 = 4;
-/// Clip watch flag, never kept: a reading is the [`CLIP_PLATEAU_SAMPLES`]-th or later of
+/// Clip watch flag, never kept: a reading is the [`Pipeline::clip_plateau_samples`]-th or later of
 /// identical readings at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`], which [`Pipeline::plateau`]
 /// turns into [`CLIP_PLATEAU`] or drops.
 const CLIP_REPEATS: u8 = 8;
@@ -357,7 +365,7 @@ const BEYOND_FACTOR: f32 = (1.0 + RANGE_MARGIN) / (1.0 - RANGE_MARGIN);
 /// reading shows the range is not this sensor's ([`Pipeline::range_contradicted`]). The
 /// pipeline's own test, in its arithmetic.
 pub fn beyond_range(range_dps: f32, magnitude_dps: f32) -> bool {
-    let levels = ClipLevels::at(range_dps * (1.0 - RANGE_MARGIN));
+    let levels = ClipLevels::at(range_dps * (1.0 - RANGE_MARGIN), u16::MAX);
     range_flags(levels, magnitude_dps) & CLIP_BEYOND != 0
 }
 
@@ -369,23 +377,28 @@ struct ClipLevels {
     reach_dps: f32,
     /// A reading above it goes beyond the range.
     beyond_dps: f32,
+    /// Identical readings in a row that may make a clip plateau.
+    plateau_samples: u16,
 }
 
 impl ClipLevels {
-    /// No range: neither level is ever met.
-    const NONE: Self = Self {
-        reach_dps: f32::INFINITY,
-        beyond_dps: f32::INFINITY,
-    };
-
-    /// The levels of a range reached at `reach_dps`.
+    /// The levels of a range reached at `reach_dps` (infinite: no range), with plateaus of
+    /// `plateau_samples` readings.
     #[inline(always)]
-    fn at(reach_dps: f32) -> Self {
+    fn at(reach_dps: f32, plateau_samples: u16) -> Self {
         Self {
             reach_dps,
             beyond_dps: reach_dps * BEYOND_FACTOR,
+            plateau_samples,
         }
     }
+}
+
+/// Readings at `input_rate_hz` that last `duration_s`, at least [`CLIP_PLATEAU_SAMPLES`]
+/// and at most 65 535 (the run counter's limit).
+fn plateau_samples(duration_s: f32, input_rate_hz: f32) -> u16 {
+    // `as` saturates at 65 535 (and takes NaN, which a validated rate never is, to 0).
+    (libm::roundf(duration_s * input_rate_hz) as u16).max(u16::from(CLIP_PLATEAU_SAMPLES))
 }
 
 /// Whether flags `seen` during a movement make it saturated: a clip plateau, or the range
@@ -403,19 +416,19 @@ fn range_flags(levels: ClipLevels, magnitude: f32) -> u8 {
 }
 
 /// One reading through the clip watch: `last` and `run` (the last reading and how many
-/// times in a row it came, up to 255) move on; its flags:
+/// times in a row it came, up to 65 535) move on; its flags:
 /// whether it reaches the range or goes beyond it ([`range_flags`]), or is one of enough
 /// identical readings to make a clip plateau ([`CLIP_REPEATS`], for
 /// [`Pipeline::plateau`]). Judged on the reading, before correction.
 #[inline(always)]
-fn clip_seen(levels: ClipLevels, last: &mut f32, run: &mut u8, reading_dps: f32) -> u8 {
+fn clip_seen(levels: ClipLevels, last: &mut f32, run: &mut u16, reading_dps: f32) -> u8 {
     // Without branches: whether a reading repeats is a coin toss on a quantised sensor.
-    let repeat = u8::from(reading_dps == *last);
-    *run = (run.saturating_add(1) & 0_u8.wrapping_sub(repeat)) | (1 - repeat);
+    let repeat = u16::from(reading_dps == *last);
+    *run = (run.saturating_add(1) & 0_u16.wrapping_sub(repeat)) | (1 - repeat);
     *last = reading_dps;
     let magnitude = libm::fabsf(reading_dps);
     range_flags(levels, magnitude)
-        | (u8::from((*run >= CLIP_PLATEAU_SAMPLES) & (magnitude >= CLIP_PLATEAU_MIN_DPS)) << 3)
+        | (u8::from((*run >= levels.plateau_samples) & (magnitude >= CLIP_PLATEAU_MIN_DPS)) << 3)
 }
 
 /// Where the clip watch ends over readings none of which repeats the one before it (the
@@ -424,7 +437,12 @@ fn clip_seen(levels: ClipLevels, last: &mut f32, run: &mut u8, reading_dps: f32)
 /// and its run. `None` if some reading after the first repeats the one before, or if
 /// there are none.
 #[inline(always)]
-fn distinct_run(rates_dps: &[f32], last_dps: f32, run: u8) -> Option<DistinctRun> {
+fn distinct_run(
+    rates_dps: &[f32],
+    last_dps: f32,
+    run: u16,
+    plateau_samples: u16,
+) -> Option<DistinctRun> {
     let (&first, rest) = rates_dps.split_first()?;
     // Without early exit, so that the comparisons go in vector lanes.
     let distinct = rates_dps
@@ -435,7 +453,8 @@ fn distinct_run(rates_dps: &[f32], last_dps: f32, run: u8) -> Option<DistinctRun
         return None;
     }
     let (mut last, mut run) = (last_dps, run);
-    let first_clipped = clip_seen(ClipLevels::NONE, &mut last, &mut run, first);
+    let levels = ClipLevels::at(f32::INFINITY, plateau_samples);
+    let first_clipped = clip_seen(levels, &mut last, &mut run, first);
     Some(DistinctRun {
         first_clipped,
         last_dps: rates_dps[rates_dps.len() - 1],
@@ -447,7 +466,7 @@ fn distinct_run(rates_dps: &[f32], last_dps: f32, run: u8) -> Option<DistinctRun
 struct DistinctRun {
     first_clipped: u8,
     last_dps: f32,
-    run: u8,
+    run: u16,
 }
 
 /// Group delay at DC of a cascade (output samples): for each section `B/A`,
@@ -476,7 +495,9 @@ pub struct Pipeline {
     clip_level_dps: f32,
     /// The last accepted reading and how many times in a row it came (up to the plateau).
     clip_last_dps: f32,
-    clip_run: u8,
+    clip_run: u16,
+    /// Identical readings that make a clip plateau ([`Self::clip_plateau_samples`]).
+    clip_plateau_samples: u16,
     /// The clip watch's flags: [`CLIP_RANGE`] and [`CLIP_PLATEAU`] seen since the last
     /// output step, or during the run that may become a movement; [`CLIP_BEYOND`] once
     /// seen, for good.
@@ -528,6 +549,8 @@ impl Pipeline {
         if let Some(tightening) = &config.tightening {
             tightening.validate()?;
         }
+        // As `clip_plateau_long_samples` works it out, from the factor and the period.
+        let input_rate_hz = f32::from(factor) / output_period_s;
         let clip_level_dps = match config.range_dps {
             Some(range_dps) => {
                 check_range("range_dps", range_dps.into(), 1e-3, 1e30)?;
@@ -540,6 +563,7 @@ impl Pipeline {
             clip_level_dps,
             clip_last_dps: f32::NAN,
             clip_run: 0,
+            clip_plateau_samples: plateau_samples(CLIP_PLATEAU_SHORT_S, input_rate_hz),
             clip_flags: 0,
             corrector: Corrector::try_new(&config.correction)?,
             corrects: !config.correction.is_identity(),
@@ -779,7 +803,7 @@ impl Pipeline {
 
         let mut block = self.decimator.run();
         let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
-        let levels = ClipLevels::at(self.clip_level_dps);
+        let levels = ClipLevels::at(self.clip_level_dps, self.clip_plateau_samples);
         let mut clipped = 0;
         for (i, &reading) in rates_dps.iter().enumerate() {
             if TEMPERATURE {
@@ -924,18 +948,23 @@ impl Pipeline {
             let repeats = before.iter().rev().take_while(|&&x| x == last).count();
             self.clip_run = if repeats == before.len() && last == self.clip_last_dps {
                 self.clip_run
-                    .saturating_add(u8::try_from(rates_dps.len()).unwrap_or(u8::MAX))
+                    .saturating_add(u16::try_from(rates_dps.len()).unwrap_or(u16::MAX))
             } else {
-                u8::try_from(repeats + 1).unwrap_or(u8::MAX)
+                u16::try_from(repeats + 1).unwrap_or(u16::MAX)
             };
             self.clip_last_dps = last;
-        } else if let Some(distinct) = distinct_run(rates_dps, self.clip_last_dps, self.clip_run) {
+        } else if let Some(distinct) = distinct_run(
+            rates_dps,
+            self.clip_last_dps,
+            self.clip_run,
+            self.clip_plateau_samples,
+        ) {
             // No reading repeats the one before it, but perhaps the first: a plateau can
             // only complete there, and the watch ends on a run of one (or the first's).
             if distinct.first_clipped & CLIP_REPEATS != 0 {
                 return None;
             }
-            let levels = ClipLevels::at(self.clip_level_dps);
+            let levels = ClipLevels::at(self.clip_level_dps, self.clip_plateau_samples);
             for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
                 *clipped = block
                     .iter()
@@ -945,7 +974,7 @@ impl Pipeline {
             (self.clip_last_dps, self.clip_run) = (distinct.last_dps, distinct.run);
         } else {
             let (mut clip_last, mut clip_run) = (self.clip_last_dps, self.clip_run);
-            let levels = ClipLevels::at(self.clip_level_dps);
+            let levels = ClipLevels::at(self.clip_level_dps, self.clip_plateau_samples);
             for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
                 for &reading in block {
                     *clipped |= clip_seen(levels, &mut clip_last, &mut clip_run, reading);
@@ -966,7 +995,7 @@ impl Pipeline {
     /// [`Self::clip_plateau_long_samples`] readings; else 0.
     #[cold]
     #[inline(never)]
-    fn plateau(&self, level_dps: f32, run: u8) -> u8 {
+    fn plateau(&self, level_dps: f32, run: u16) -> u8 {
         let lead_dps = libm::copysignf(1.0, level_dps) * (level_dps - self.previous.0);
         if lead_dps >= CLIP_PLATEAU_LEAD_DPS || run >= self.clip_plateau_long_samples() {
             CLIP_PLATEAU
@@ -978,11 +1007,18 @@ impl Pipeline {
     /// Identical readings that make a clip plateau whatever the filtered rate:
     /// [`CLIP_PLATEAU_LONG_S`] at the input rate (128 at 1 kHz), at least
     /// [`CLIP_PLATEAU_SAMPLES`] (below 125 Hz every plateau counts, as 16 readings then
-    /// last longer) and at most 255, the run counter's limit (above 2 kHz a shorter time).
-    pub fn clip_plateau_long_samples(&self) -> u8 {
+    /// last longer) and at most 65 535, the run counter's limit (1024 at 8 kHz; only
+    /// above 512 kHz a shorter time).
+    pub fn clip_plateau_long_samples(&self) -> u16 {
         let input_rate_hz = f32::from(self.decimator.factor()) / self.output_period_s();
-        // `as` saturates at 255 (and takes NaN, which a validated rate never is, to 0).
-        (libm::roundf(CLIP_PLATEAU_LONG_S * input_rate_hz) as u8).max(CLIP_PLATEAU_SAMPLES)
+        plateau_samples(CLIP_PLATEAU_LONG_S, input_rate_hz)
+    }
+
+    /// Identical readings (at |rate| ≥ [`CLIP_PLATEAU_MIN_DPS`]) that may make a clip
+    /// plateau: [`CLIP_PLATEAU_SHORT_S`] at the input rate, at least
+    /// [`CLIP_PLATEAU_SAMPLES`] (16 up to 1 kHz, 128 at 8 kHz).
+    pub const fn clip_plateau_samples(&self) -> u16 {
+        self.clip_plateau_samples
     }
 
     /// Plausible: finite and within `max_abs_rate_dps`.

@@ -358,7 +358,7 @@ fn a_steady_reading_is_a_clip_plateau_only_beyond_the_filtered_rate_or_long() {
 }
 
 /// The long plateau is a time: 128 readings at 1 kHz, every plateau (16 readings) below
-/// 125 Hz, and the run counter's 255 above 2 kHz.
+/// 125 Hz, 1024 at 8 kHz, and the run counter's 65 535 only above 512 kHz.
 #[test]
 fn the_long_plateau_is_a_time() {
     let long = |sample_rate_hz: f32| {
@@ -372,6 +372,75 @@ fn the_long_plateau_is_a_time() {
     };
     assert_eq!(long(1000.0), 128);
     assert_eq!(long(500.0), 64);
-    assert_eq!(long(100.0), CLIP_PLATEAU_SAMPLES);
-    assert_eq!(long(8000.0), u8::MAX);
+    assert_eq!(long(100.0), u16::from(CLIP_PLATEAU_SAMPLES));
+    assert_eq!(long(8000.0), 1024);
+    assert_eq!(long(1.0e6), u16::MAX);
+}
+
+/// At 8 kHz the plateaus last what they last at 1 kHz: 16 ms (128 readings) and, whatever
+/// the filtered rate, 128 ms (1024). A reading held 100 ms at the top of a smooth turn is
+/// not a clip (16 readings, 2 ms, on its slope stand beyond the filtered rate); a turn
+/// clipped steeply for 20 ms, or slowly for a second, is.
+#[test]
+fn the_long_plateau_holds_at_8_khz() {
+    const FS_8K_HZ: f64 = 8000.0;
+    let config = Config {
+        sample_rate_hz: FS_8K_HZ as f32,
+        range_dps: None,
+        ..Config::default()
+    };
+    let flags_8k = |samples: &[f32]| -> Vec<bool> {
+        run(&config, samples, FS_8K_HZ)
+            .movements
+            .iter()
+            .map(|(_, m)| m.saturated)
+            .collect()
+    };
+    let quantised = |rate: f64| ((rate / LSB_DPS).round() * LSB_DPS) as f32;
+    // Eases into 60 deg/s over 1 s, holds it 100 ms, eases out.
+    let ease = |t: f64| 30.0 * (1.0 - (std::f64::consts::PI * t.clamp(0.0, 1.0)).cos());
+    let hold_s = 0.1;
+    let n = (6.1 * FS_8K_HZ) as usize;
+    let steady: Vec<f32> = (0..n)
+        .map(|i| {
+            let t = i as f64 / FS_8K_HZ - 2.0;
+            quantised(ease(t).min(ease(2.0 + hold_s - t)))
+        })
+        .collect();
+    let top = steady.iter().filter(|&&r| r == 60.0).count();
+    assert!((800..1024).contains(&top), "{top}");
+    assert_eq!(flags_8k(&steady), [false]);
+
+    // Rises at `slope` deg/s per s to 70, cut off at 60: steeply (1000 deg/s per s, 20 ms
+    // on the clip, reached far ahead of the filtered rate) and slowly (a second).
+    let cut = |slope_dps_per_s: f64| -> Vec<f32> {
+        let rise_s = 70.0 / slope_dps_per_s;
+        let n = ((4.0 + 2.0 * rise_s) * FS_8K_HZ) as usize;
+        (0..n)
+            .map(|i| {
+                let t = i as f64 / FS_8K_HZ - 2.0;
+                quantised((70.0 - slope_dps_per_s * (t - rise_s).abs()).max(0.0)).min(60.0)
+            })
+            .collect()
+    };
+    assert_eq!(flags_8k(&cut(1000.0)), [true]);
+    assert_eq!(flags_8k(&cut(20.0)), [true]);
+}
+
+/// The short plateau is a time above 1 kHz: 16 readings up to 1 kHz, 128 at 8 kHz.
+#[test]
+fn the_short_plateau_is_a_time_above_1_khz() {
+    let short = |sample_rate_hz: f32| {
+        let config = Config {
+            sample_rate_hz,
+            ..Config::default()
+        };
+        Pipeline::try_new(&config)
+            .expect("config")
+            .clip_plateau_samples()
+    };
+    assert_eq!(short(100.0), u16::from(CLIP_PLATEAU_SAMPLES));
+    assert_eq!(short(1000.0), u16::from(CLIP_PLATEAU_SAMPLES));
+    assert_eq!(short(2000.0), 32);
+    assert_eq!(short(8000.0), 128);
 }

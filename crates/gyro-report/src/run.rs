@@ -299,9 +299,11 @@ fn saturation_warning(index: usize, range_dps: Option<f32>) -> String {
     let what = match range_dps {
         Some(r) => format!("reached the sensor range ({r} deg/s) or clipped below it"),
         None => format!(
-            "clipped ({} or more identical readings at >= {} deg/s, {} deg/s ahead of the \
-             filtered rate or lasting {} ms; sensor range unknown)",
+            "clipped ({} or more identical readings, and {} ms or more of them, at >= {} \
+             deg/s, {} deg/s ahead of the filtered rate or lasting {} ms; sensor range \
+             unknown)",
             gyro_core::CLIP_PLATEAU_SAMPLES,
+            gyro_core::CLIP_PLATEAU_SHORT_S * 1000.0,
             gyro_core::CLIP_PLATEAU_MIN_DPS,
             gyro_core::CLIP_PLATEAU_LEAD_DPS,
             gyro_core::CLIP_PLATEAU_LONG_S * 1000.0
