@@ -424,13 +424,16 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
                     low_jerk[i],
                 )
             };
-            let (mut low, _) = regress(n, &all, low_row);
+            let normal = Normal::of(n, &all, low_row);
+            let mut low = normal.solve(&all);
             let linear: Vec<usize> = all
                 .iter()
                 .copied()
                 .filter(|c| !NONLINEAR_COLUMNS.contains(c))
                 .collect();
-            low[reg::RATE] = regress(n, &linear, low_row).0[reg::RATE];
+            // The straight line's normal equations are a block of those of every column:
+            // the same sums, in the same order, without a second pass over the samples.
+            low[reg::RATE] = normal.block(&all, &linear).solve(&linear)[reg::RATE];
             low
         }
         _ => [f64::NAN; N_REG],
@@ -539,37 +542,91 @@ fn regress(
     columns: &[usize],
     row: impl Fn(usize) -> Option<([f64; N_REG], f64)>,
 ) -> ([f64; N_REG], usize) {
-    let used = columns.len().min(N_REG);
-    let mut xtx = [[0.0f64; N_REG]; N_REG];
-    let mut xty = [0.0f64; N_REG];
-    let mut samples = 0usize;
-    // The whole square at a fixed size (the columns past `used` are zero): a loop the
-    // compiler vectorises, and both halves are the same products.
-    for i in 0..n {
-        if let Some((full, y)) = row(i) {
-            samples += 1;
-            let mut x = [0.0f64; N_REG];
-            for (k, &c) in columns.iter().take(used).enumerate() {
-                x[k] = full[c];
-            }
-            for a in 0..N_REG {
-                let xa = x[a];
-                for b in 0..N_REG {
-                    xtx[a][b] += xa * x[b];
+    let normal = Normal::of(n, columns, row);
+    (normal.solve(columns), normal.samples)
+}
+
+/// The normal equations of a least-squares regression: `Σ x xᵀ` and `Σ x y` over the rows,
+/// `x` the row's `columns` in order (zero past them), and the number of rows.
+struct Normal {
+    xtx: [[f64; N_REG]; N_REG],
+    xty: [f64; N_REG],
+    samples: usize,
+}
+
+impl Normal {
+    /// The sums over the rows `row` gives for `0..n` (`None`: left out).
+    fn of(n: usize, columns: &[usize], row: impl Fn(usize) -> Option<([f64; N_REG], f64)>) -> Self {
+        let used = columns.len().min(N_REG);
+        let mut xtx = [[0.0f64; N_REG]; N_REG];
+        let mut xty = [0.0f64; N_REG];
+        let mut samples = 0usize;
+        // The upper triangle at a fixed size (the columns past `used` are zero), mirrored
+        // at the end: `x[b]·x[a]` is `x[a]·x[b]` bit for bit.
+        for i in 0..n {
+            if let Some((full, y)) = row(i) {
+                samples += 1;
+                let mut x = [0.0f64; N_REG];
+                for (k, &c) in columns.iter().take(used).enumerate() {
+                    x[k] = full[c];
                 }
-                xty[a] += xa * y;
+                for a in 0..N_REG {
+                    let xa = x[a];
+                    for b in a..N_REG {
+                        xtx[a][b] += xa * x[b];
+                    }
+                    xty[a] += xa * y;
+                }
             }
         }
-    }
-    let mut coef = [f64::NAN; N_REG];
-    if samples > used + 2 {
-        if let Some(c) = solve_spd(&xtx, &xty, used) {
-            for (k, &col) in columns.iter().take(used).enumerate() {
-                coef[col] = c[k];
+        for a in 0..N_REG {
+            for b in 0..a {
+                xtx[a][b] = xtx[b][a];
             }
         }
+        Self { xtx, xty, samples }
     }
-    (coef, samples)
+
+    /// The equations of the regression on `keep` alone (each of them one of `columns`,
+    /// the columns these equations were summed over): the same sums as a pass over the
+    /// rows with `keep`, bit for bit, since each is made of the same products in the same
+    /// order.
+    fn block(&self, columns: &[usize], keep: &[usize]) -> Self {
+        let position = |c: usize| columns.iter().position(|&k| k == c);
+        let at: Vec<Option<usize>> = keep.iter().map(|&c| position(c)).collect();
+        let mut xtx = [[0.0f64; N_REG]; N_REG];
+        let mut xty = [0.0f64; N_REG];
+        for (a, pa) in at.iter().enumerate().take(N_REG) {
+            let Some(pa) = *pa else { continue };
+            xty[a] = self.xty[pa];
+            for (b, pb) in at.iter().enumerate().take(N_REG) {
+                if let Some(pb) = *pb {
+                    xtx[a][b] = self.xtx[pa][pb];
+                }
+            }
+        }
+        Self {
+            xtx,
+            xty,
+            samples: self.samples,
+        }
+    }
+
+    /// The coefficients of `columns` (the columns these equations were summed over),
+    /// each at its column's index; NaN where there are too few rows or the system is
+    /// singular.
+    fn solve(&self, columns: &[usize]) -> [f64; N_REG] {
+        let used = columns.len().min(N_REG);
+        let mut coef = [f64::NAN; N_REG];
+        if self.samples > used + 2 {
+            if let Some(c) = solve_spd(&self.xtx, &self.xty, used) {
+                for (k, &col) in columns.iter().take(used).enumerate() {
+                    coef[col] = c[k];
+                }
+            }
+        }
+        coef
+    }
 }
 
 /// See [`Features::bias_dps`].
@@ -707,6 +764,59 @@ mod tests {
             }
         }
         assert!(xy / xx < -0.01, "whole band: {}", xy / xx);
+    }
+
+    /// A block of the normal equations is the pass over the rows with those columns alone,
+    /// bit for bit, and solves to the same coefficients.
+    #[test]
+    fn a_block_of_the_normal_equations_is_their_pass_alone() {
+        let n = 5000;
+        let row = |i: usize| -> Option<([f64; N_REG], f64)> {
+            if i % 7 == 3 {
+                return None;
+            }
+            let t = i as f64 * 1e-3;
+            let w = 80.0 * (1.3 * t).sin() + 0.1 * (37.0 * t).cos();
+            let x = [
+                1.0,
+                w,
+                w.abs(),
+                w * w * w * 1e-6,
+                1.7 * t.cos(),
+                t.sin(),
+                w * w * 1e-4,
+                t,
+                0.0,
+                0.0,
+            ];
+            let y = 0.3 + 0.01 * w + 2e-5 * w * w + 0.02 * (91.0 * t).sin();
+            Some((x, y))
+        };
+        let all: Vec<usize> = (0..N_REG - 2).collect();
+        let linear: Vec<usize> = all
+            .iter()
+            .copied()
+            .filter(|c| !NONLINEAR_COLUMNS.contains(c))
+            .collect();
+        assert!(linear.len() < all.len());
+        let block = Normal::of(n, &all, row).block(&all, &linear);
+        let pass = Normal::of(n, &linear, row);
+        assert_eq!(block.samples, pass.samples);
+        for a in 0..N_REG {
+            assert_eq!(block.xty[a].to_bits(), pass.xty[a].to_bits(), "{a}");
+            for b in 0..N_REG {
+                assert_eq!(
+                    block.xtx[a][b].to_bits(),
+                    pass.xtx[a][b].to_bits(),
+                    "{a} {b}"
+                );
+            }
+        }
+        let (solved, direct) = (block.solve(&linear), pass.solve(&linear));
+        assert!(solved[reg::RATE].is_finite());
+        for c in 0..N_REG {
+            assert_eq!(solved[c].to_bits(), direct[c].to_bits(), "{c}");
+        }
     }
 
     #[test]
