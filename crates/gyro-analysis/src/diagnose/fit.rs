@@ -97,6 +97,61 @@ pub fn direct_evidence(
     }
 }
 
+/// Smallest z on the held-out runs with which a regression effect's coefficient
+/// replicates its training fit ([`regression_replicates`]): one-sided 2.3%.
+pub const REPLICATION_Z: f64 = 2.0;
+
+/// Whether a regression effect fitted on the training runs (`trained_z`, its test's
+/// z-score, whose sign is the coefficient's deviation) shows again on the held-out `runs`:
+/// their coefficient of its regressor deviates from their `null` replicas' mean by at
+/// least [`REPLICATION_Z`] of the test's standard error (the replicas' spread, or the
+/// runs' own scatter where larger), in the same direction. The test named in advance
+/// for this effect's signature: a weak effect (a temperature bias of 0.05 °/s/°C over a
+/// 2 °C warm-up, beside the bias's wander) moves one coefficient by a few standard
+/// errors, and the held-out likelihood of every statistic, each with its simulation
+/// noise, may not show it at P < 5% over a few runs. Against the nominal model: the
+/// share of the coefficient other effects would give is a product of effects, left out.
+/// False for the other fit procedures.
+pub fn regression_replicates(
+    effect: &Effect,
+    trained_z: f64,
+    runs: &[&RealRun],
+    null: &[Vec<Member>],
+) -> bool {
+    let FitProcedure::Regression { regressor, .. } = effect.info().fit else {
+        return false;
+    };
+    let index = regressor_index(regressor);
+    let coefficients: Vec<(f64, Vec<f64>)> = runs
+        .iter()
+        .zip(null)
+        .map(|(run, members)| {
+            let replicas = members.iter().map(|m| m.features.coef[index]).collect();
+            (run.features.coef[index], replicas)
+        })
+        .collect();
+    let z = replication_z(&coefficients);
+    z.is_finite() && trained_z.is_finite() && z * trained_z.signum() >= REPLICATION_Z
+}
+
+/// The z-score of the runs' mean coefficient against their replicas', from each run's
+/// coefficient and its replicas' (member `j` of every run makes pooled replica `j`): the
+/// deviation over the pooled replicas' spread, or over the runs' own scatter where that is
+/// larger ([`scatter_of`]), as the training test reads it ([`regression_fit`]).
+fn replication_z(coefficients: &[(f64, Vec<f64>)]) -> f64 {
+    let real = mean(coefficients.iter().map(|(c, _)| *c));
+    let members = coefficients.iter().map(|(_, r)| r.len()).min().unwrap_or(0);
+    let replicas: Vec<f64> = (0..members)
+        .map(|j| mean(coefficients.iter().map(|(_, r)| r[j])))
+        .collect();
+    let (m0, s0) = mean_sd(&replicas);
+    let se = match scatter_of(coefficients) {
+        Some(scatter) if scatter.se > s0 => scatter.se,
+        _ => s0,
+    };
+    (real - m0) / se
+}
+
 /// The between-run spread of the bias ([`super::features::Features::bias_dps`]) of
 /// `runs` against
 /// their null ensembles: `(n−1) s²/v0` is χ²(n−1) without a turn-on bias (s²: the runs'
@@ -1638,5 +1693,60 @@ mod whiteness_tests {
             .notes
             .iter()
             .any(|s| s.contains("the rest noise is not white")));
+    }
+}
+
+#[cfg(test)]
+mod replication_tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    /// `runs` runs of 40 replicas each of unit spread, each run's coefficient `shift` (in
+    /// units of the pooled replicas' spread, 1/√runs) above its replicas' mean, plus a
+    /// run-to-run scatter of standard deviation `scatter`.
+    fn coefficients(runs: usize, shift: f64, scatter: f64, seed: u64) -> Vec<(f64, Vec<f64>)> {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut normal = || -> f64 { StandardNormal.sample(&mut rng) };
+        // Evenly spread about zero, of standard deviation `scatter`.
+        let centre = (runs as f64 - 1.0) / 2.0;
+        let spread = ((runs * runs - 1) as f64 / 12.0).sqrt();
+        let offsets: Vec<f64> = (0..runs)
+            .map(|i| scatter * (i as f64 - centre) / spread)
+            .collect();
+        (0..runs)
+            .map(|i| {
+                let replicas: Vec<f64> = (0..40).map(|_| normal()).collect();
+                let m = replicas.iter().sum::<f64>() / 40.0;
+                let real = m + shift / (runs as f64).sqrt() + offsets[i];
+                (real, replicas)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_shift_replicates_in_standard_errors_of_the_pooled_replicas() {
+        for seed in 0..20 {
+            // Replicas' spread pooled over 5 runs: 1/√5, so a shift of 3 of those is z ≈ 3.
+            let z = replication_z(&coefficients(5, 3.0, 0.0, seed));
+            assert!((2.0..4.2).contains(&z), "seed {seed}: {z}");
+            let z = replication_z(&coefficients(5, 0.0, 0.0, seed));
+            assert!(z.abs() < 1.8, "seed {seed}: {z}");
+        }
+    }
+
+    #[test]
+    fn runs_that_scatter_beyond_their_replicas_widen_the_error() {
+        // The same shift among runs that disagree by 3 replica spreads: the standard error
+        // is their scatter's, and the shift no longer replicates.
+        for seed in 0..20 {
+            let tight = replication_z(&coefficients(5, 3.0, 0.0, seed));
+            let loose = replication_z(&coefficients(5, 3.0, 3.0, seed));
+            assert!(
+                loose.abs() < tight.abs(),
+                "seed {seed}: {loose} against {tight}"
+            );
+            assert!(loose < REPLICATION_Z, "seed {seed}: {loose}");
+        }
     }
 }

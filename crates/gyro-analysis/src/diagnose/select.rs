@@ -123,7 +123,9 @@ impl<'a> Scorer<'a> {
     }
 
     /// The fit is significant given its held-out step: its direct evidence replicates
-    /// on the held-out runs, or its ΔBIC is positive with bootstrap P < 5%.
+    /// on the held-out runs, or its ΔBIC is positive with bootstrap P < 5% or, for a
+    /// regression effect, with its coefficient replicated on the held-out runs
+    /// ([`fit::regression_replicates`]).
     fn qualifies(&self, f: &Fit, st: &Step) -> bool {
         if f.direct {
             f.passes
@@ -134,7 +136,15 @@ impl<'a> Scorer<'a> {
                     self.nominal(),
                 )
         } else {
-            f.passes && st.delta_bic > 0.0 && st.p < 0.05
+            f.passes
+                && st.delta_bic > 0.0
+                && (st.p < 0.05
+                    || fit::regression_replicates(
+                        &f.effect,
+                        f.z,
+                        &self.runs.holdout,
+                        &self.baseline.holdout.members,
+                    ))
         }
     }
 
@@ -386,7 +396,8 @@ fn leave_one_out(
             candidates[i].fit.effect.params().len(),
             scorer.seed("leave one out", i),
         );
-        if !(st.delta_bic > 0.0 && st.p < 0.05) {
+        // Kept on the evidence that selected it, now against the others alone.
+        if !scorer.qualifies(&candidates[i].fit, &st) {
             selected.retain(|&j| j != i);
             candidates[i].added = None;
             dropped.push(i);
