@@ -121,35 +121,68 @@ pub fn regression_replicates(
     let FitProcedure::Regression { regressor, .. } = effect.info().fit else {
         return false;
     };
-    let index = regressor_index(regressor);
-    let coefficients: Vec<(f64, Vec<f64>)> = runs
-        .iter()
+    let z = replication_z(&run_coefficients(runs, null, regressor_index(regressor)));
+    z.is_finite() && trained_z.is_finite() && z * trained_z.signum() >= REPLICATION_Z
+}
+
+/// The z-score of the runs' mean coefficient against their replicas'
+/// ([`CoefficientTest`]), as the training test reads it ([`regression_fit`]).
+fn replication_z(coefficients: &[(f64, Vec<f64>)]) -> f64 {
+    let test = CoefficientTest::of(coefficients);
+    test.deviation / test.se()
+}
+
+/// Each run's coefficient `index` and its null replicas' values.
+fn run_coefficients(runs: &[&RealRun], null: &[Vec<Member>], index: usize) -> Vec<(f64, Vec<f64>)> {
+    runs.iter()
         .zip(null)
         .map(|(run, members)| {
             let replicas = members.iter().map(|m| m.features.coef[index]).collect();
             (run.features.coef[index], replicas)
         })
-        .collect();
-    let z = replication_z(&coefficients);
-    z.is_finite() && trained_z.is_finite() && z * trained_z.signum() >= REPLICATION_Z
+        .collect()
 }
 
-/// The z-score of the runs' mean coefficient against their replicas', from each run's
-/// coefficient and its replicas' (member `j` of every run makes pooled replica `j`): the
-/// deviation over the pooled replicas' spread, or over the runs' own scatter where that is
-/// larger ([`scatter_of`]), as the training test reads it ([`regression_fit`]).
-fn replication_z(coefficients: &[(f64, Vec<f64>)]) -> f64 {
-    let real = mean(coefficients.iter().map(|(c, _)| *c));
-    let members = coefficients.iter().map(|(_, r)| r.len()).min().unwrap_or(0);
-    let replicas: Vec<f64> = (0..members)
-        .map(|j| mean(coefficients.iter().map(|(_, r)| r[j])))
-        .collect();
-    let (m0, s0) = mean_sd(&replicas);
-    let se = match scatter_of(coefficients) {
-        Some(scatter) if scatter.se > s0 => scatter.se,
-        _ => s0,
-    };
-    (real - m0) / se
+/// A regression coefficient of real runs against their null replicas: the one reading of
+/// it the training test and the held-out replication share.
+struct CoefficientTest {
+    /// The runs' mean coefficient less the pooled replicas' mean (member `j` of every run
+    /// makes pooled replica `j`).
+    deviation: f64,
+    /// The pooled replicas' standard deviation.
+    replica_sd: f64,
+    /// Pooled replicas.
+    replicas: usize,
+    /// The runs' own scatter, when it exceeds the null's ([`scatter_of`]).
+    scatter: Option<Scatter>,
+}
+
+impl CoefficientTest {
+    fn of(coefficients: &[(f64, Vec<f64>)]) -> Self {
+        let real = mean(coefficients.iter().map(|(c, _)| *c));
+        let members = coefficients.iter().map(|(_, r)| r.len()).min().unwrap_or(0);
+        let replicas: Vec<f64> = (0..members)
+            .map(|j| mean(coefficients.iter().map(|(_, r)| r[j])))
+            .collect();
+        let (m0, replica_sd) = mean_sd(&replicas);
+        Self {
+            deviation: real - m0,
+            replica_sd,
+            replicas: replicas.len(),
+            scatter: scatter_of(coefficients),
+        }
+    }
+
+    /// The runs' scatter where it exceeds the replicas' spread.
+    fn wider_scatter(&self) -> Option<&Scatter> {
+        self.scatter.as_ref().filter(|s| s.se > self.replica_sd)
+    }
+
+    /// The standard error of [`Self::deviation`]: the replicas' spread, or the runs' own
+    /// scatter where that is larger.
+    fn se(&self) -> f64 {
+        self.wider_scatter().map_or(self.replica_sd, |s| s.se)
+    }
 }
 
 /// The between-run spread of the bias ([`super::features::Features::bias_dps`]) of
@@ -802,17 +835,13 @@ fn regression_fit(
     make: &dyn Fn(f64) -> Effect,
     to_param: &dyn Fn(f64) -> f64,
 ) -> (Effect, f64, (f64, f64)) {
-    let (real, replicas) = input.pooled(&|f| f.coef[index]);
-    let (m0, s0) = mean_sd(&replicas);
-    let raw = real - m0 - (known.with_effects[index] - known.quiet[index]);
-    let mut half = 1.96 * s0 * (1.0 + 1.0 / replicas.len().max(1) as f64).sqrt();
-    let se = match run_scatter(input, index) {
-        Some(scatter) if scatter.se > s0 => {
-            half = half.max(t95(scatter.runs - 1) * scatter.se);
-            scatter.se
-        }
-        _ => s0,
-    };
+    let test = CoefficientTest::of(&run_coefficients(input.train, input.null, index));
+    let raw = test.deviation - (known.with_effects[index] - known.quiet[index]);
+    let mut half = 1.96 * test.replica_sd * (1.0 + 1.0 / test.replicas.max(1) as f64).sqrt();
+    if let Some(scatter) = test.wider_scatter() {
+        half = half.max(t95(scatter.runs - 1) * scatter.se);
+    }
+    let se = test.se();
     let z = raw / se;
     let response = |x: f64| -> f64 {
         let mut set = known.effects.clone();
@@ -874,20 +903,7 @@ struct Scatter {
 /// about that mean: when their variance exceeds the null's beyond chance (χ² with
 /// runs − 1 degrees of freedom, one-sided [`SCATTER_P`]), the runs' own standard error
 /// is returned. `None`: fewer than 3 runs, or no excess scatter.
-fn run_scatter(input: &FitInput, index: usize) -> Option<Scatter> {
-    let runs: Vec<(f64, Vec<f64>)> = input
-        .train
-        .iter()
-        .zip(input.null)
-        .map(|(run, null)| {
-            let coefs = null.iter().map(|m| m.features.coef[index]).collect();
-            (run.features.coef[index], coefs)
-        })
-        .collect();
-    scatter_of(&runs)
-}
-
-/// [`run_scatter`] on each run's real value and its replicas' values.
+/// On each run's real value and its replicas' values ([`run_coefficients`]).
 fn scatter_of(runs: &[(f64, Vec<f64>)]) -> Option<Scatter> {
     let mut excess = Vec::new();
     let mut null_var = Vec::new();
