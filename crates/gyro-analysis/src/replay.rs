@@ -162,6 +162,9 @@ pub struct RunReport {
     pub decimation_factor: u16,
     /// Output rate (Hz).
     pub output_rate_hz: f32,
+    /// The configured output rate (Hz) when the log was slower and ran at its own rate
+    /// ([`config_for_rate`]); `None` otherwise.
+    pub output_rate_lowered_from_hz: Option<f32>,
     /// What was irregular in the input.
     pub input: Quality,
     /// The configuration used.
@@ -295,12 +298,41 @@ pub enum ReplayFileError {
     },
 }
 
+/// Slowest log (Hz) that runs at its own rate when it is slower than the configured
+/// output rate. Below it, time stamps in ms read as seconds are likelier than so slow a
+/// gyro (a 1 kHz log then reads 1 Hz, an 8 kHz one 8 Hz): refused, with that hint.
+pub const MIN_OWN_RATE_HZ: f64 = 10.0;
+
+/// `config` for a log at `sample_rate_hz` (its sample rate replaced). A log slower than
+/// the output rate, and at least [`MIN_OWN_RATE_HZ`], runs at its own rate without
+/// decimation, the low-pass cutoff scaled by the same factor (its share of the output
+/// rate kept: 12.5 Hz of 50 becomes 6.25 Hz of 25); the configured output rate is
+/// returned beside it, to be said in every output. Anything else is left to
+/// [`Pipeline::try_new`] to accept or refuse.
+pub fn config_for_rate(config: &Config, sample_rate_hz: f64) -> (Config, Option<f32>) {
+    let mut placed = Config {
+        sample_rate_hz: sample_rate_hz as f32,
+        ..*config
+    };
+    let configured_hz = config.output_rate_hz;
+    if sample_rate_hz.is_finite()
+        && sample_rate_hz >= MIN_OWN_RATE_HZ
+        && sample_rate_hz < f64::from(configured_hz)
+    {
+        let factor = placed.sample_rate_hz / configured_hz;
+        placed.output_rate_hz = placed.sample_rate_hz;
+        placed.filter.cutoff_hz = config.filter.cutoff_hz * factor;
+        return (placed, Some(configured_hz));
+    }
+    (placed, None)
+}
+
 /// Why a sample rate cannot be decimated to the output rate, when that is the reason: a
 /// rate below it is most often stamps in ms read as seconds.
 fn rate_hint(sample_rate_hz: f64, output_rate_hz: f32) -> String {
     if sample_rate_hz < f64::from(output_rate_hz) {
         format!(
-            " (its stamps give {} Hz, below the output rate of {output_rate_hz} Hz: time stamps in ms read as seconds? --time-unit ms; else a model file's config.output_rate_hz at most the sample rate)",
+            " (its stamps give {} Hz, below the output rate of {output_rate_hz} Hz and the {MIN_OWN_RATE_HZ} Hz a log runs at its own rate from: time stamps in ms read as seconds? --time-unit ms; else a model file's config.output_rate_hz at most the sample rate)",
             (sample_rate_hz * 1e3).round() / 1e3
         )
     } else {
@@ -438,6 +470,8 @@ impl SlotSink for ReplaySink<'_> {
 pub struct Replayer {
     sample_rate_hz: f64,
     config: Config,
+    /// The configured output rate, when the log runs at its own ([`config_for_rate`]).
+    output_rate_lowered_from_hz: Option<f32>,
     reference_delay_s: f64,
     /// The log has a temperature column: every sample goes in with its temperature.
     has_temperature: bool,
@@ -507,10 +541,7 @@ impl Replayer {
         options: &ReplayOptions,
         has_temperature: bool,
     ) -> Result<Self, gyro_core::Error> {
-        let config = Config {
-            sample_rate_hz: sample_rate_hz as f32,
-            ..*config
-        };
+        let (config, output_rate_lowered_from_hz) = config_for_rate(config, sample_rate_hz);
         let pipeline = Pipeline::try_new(&config)?;
         let factor = config.decimation_factor()?;
         let output_rate_hz = config.effective_output_rate_hz()?;
@@ -529,6 +560,7 @@ impl Replayer {
         Ok(Self {
             sample_rate_hz,
             config,
+            output_rate_lowered_from_hz,
             reference_delay_s: options.reference_delay_s,
             has_temperature,
             pipeline,
@@ -830,6 +862,7 @@ impl Replayer {
             sample_rate_hz: self.sample_rate_hz,
             decimation_factor: self.factor,
             output_rate_hz: self.output_rate_hz,
+            output_rate_lowered_from_hz: self.output_rate_lowered_from_hz,
             input,
             config: self.config,
             reference_delay_s: self.reference_delay_s,
@@ -942,6 +975,24 @@ fn movement_result(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_log_slower_than_the_output_rate_runs_at_its_own() {
+        let config = Config::default();
+        let (placed, lowered) = config_for_rate(&config, 25.0);
+        assert_eq!(lowered, Some(50.0));
+        assert_eq!((placed.sample_rate_hz, placed.output_rate_hz), (25.0, 25.0));
+        assert_eq!(placed.filter.cutoff_hz, 6.25);
+        assert!(Pipeline::try_new(&placed).is_ok());
+        // At or above the output rate, and below the floor, only the rate is placed.
+        for rate in [50.0, 1000.0, 9.9, f64::NAN] {
+            let (placed, lowered) = config_for_rate(&config, rate);
+            assert_eq!(lowered, None, "{rate}");
+            assert_eq!(placed.output_rate_hz, 50.0);
+            assert_eq!(placed.filter.cutoff_hz, config.filter.cutoff_hz);
+        }
+        assert!(Pipeline::try_new(&config_for_rate(&config, 9.9).0).is_err());
+    }
 
     fn slots(references: &[Option<f64>]) -> Vec<Slot> {
         references

@@ -890,3 +890,67 @@ fn a_micros_counter_that_wraps_is_unwrapped_and_said() {
     assert_eq!(from_mcap["input"]["backward_steps"].as_u64(), Some(0));
     assert_eq!(movements(&from_mcap), movements(&expected));
 }
+
+/// A log slower than the 50 Hz output rate (a 25 Hz IMU) runs at its own rate, its
+/// low-pass scaled alike (12.5 of 50 Hz → 6.25 of 25 Hz), and every output says so; one
+/// at 8 Hz, as a 1 kHz log with ms stamps read as seconds would look, is still refused.
+#[test]
+fn a_log_slower_than_the_output_rate_runs_at_its_own_rate_and_says_so() {
+    let dir = temp_dir("slow-log");
+    let slow = dir.join("slow.csv");
+    let slow = slow.to_str().unwrap();
+    let sim = gyro(&[
+        "simulate",
+        "--sample-rate-hz",
+        "25",
+        "--duration-s",
+        "30",
+        "--seed",
+        "3",
+        "-o",
+        slow,
+    ]);
+    assert!(sim.status.success(), "{sim:?}");
+    let out = gyro(&["run", slow, "--format", "json"]);
+    let report = json_of(&out);
+    assert_eq!(report["output_rate_hz"].as_f64(), Some(25.0), "{report}");
+    assert_eq!(report["output_rate_lowered_from_hz"].as_f64(), Some(50.0));
+    assert_eq!(report["decimation_factor"].as_u64(), Some(1));
+    assert_eq!(report["config"]["filter"]["cutoff_hz"].as_f64(), Some(6.25));
+    let warnings = report["warnings"].to_string();
+    assert!(
+        warnings.contains("below the configured output rate of 50 Hz"),
+        "{warnings}"
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("below the configured output rate"));
+    // The simulation's three 90° turns, each within 0.2° of the truth.
+    let movements = report["movements"].as_array().unwrap();
+    assert_eq!(movements.len(), 3, "{report}");
+    for m in movements {
+        assert!(m["error_deg"].as_f64().unwrap().abs() < 0.2, "{m}");
+    }
+    let table = String::from_utf8_lossy(&gyro(&["run", slow]).stdout).into_owned();
+    assert!(
+        table.contains("decimate x1 -> 25 Hz (the log's rate, below the configured 50 Hz), Butterworth order 2 at 6.25 Hz"),
+        "{table}"
+    );
+
+    let slower = dir.join("slower.csv");
+    let slower = slower.to_str().unwrap();
+    let sim = gyro(&[
+        "simulate",
+        "--sample-rate-hz",
+        "8",
+        "--duration-s",
+        "30",
+        "--seed",
+        "3",
+        "-o",
+        slower,
+    ]);
+    assert!(sim.status.success(), "{sim:?}");
+    let out = gyro(&["run", slower]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("time stamps in ms read as seconds?"), "{err}");
+}

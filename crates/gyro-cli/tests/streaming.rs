@@ -389,7 +389,7 @@ fn streaming_equals_materialising_on_fixtures_and_generated_logs() {
         ("ragged.csv", "ragged.csv:3: row has 1 fields"),
         (
             "rate3.csv",
-            "rate3.csv: cannot configure the pipeline for this log (its stamps give 3 Hz, below the output rate of 50 Hz: time stamps in ms read as seconds? --time-unit ms",
+            "rate3.csv: cannot configure the pipeline for this log (its stamps give 3 Hz, below the output rate of 50 Hz and the 10 Hz a log runs at its own rate from: time stamps in ms read as seconds? --time-unit ms",
         ),
         ("rate3_gap.csv", "rate3_gap.csv:103: gap of 7.000 s"),
     ] {

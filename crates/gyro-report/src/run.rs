@@ -18,9 +18,14 @@ pub fn table(file: &str, report: &RunReport) -> String {
     s.push_str(&crate::input::table(q));
     let _ = writeln!(
         s,
-        "pipeline: decimate x{} -> {} Hz, Butterworth order {} at {} Hz, compensation {}{}",
+        "pipeline: decimate x{} -> {} Hz{}, Butterworth order {} at {} Hz, compensation {}{}",
         report.decimation_factor,
         report.output_rate_hz,
+        report
+            .output_rate_lowered_from_hz
+            .map_or(String::new(), |hz| format!(
+                " (the log's rate, below the configured {hz} Hz)"
+            )),
         c.filter.order,
         c.filter.cutoff_hz,
         match c.compensation {
@@ -205,12 +210,25 @@ pub fn table(file: &str, report: &RunReport) -> String {
 /// Every warning about what the figures and verdicts mean, in the order the table gives
 /// them: the JSON's `warnings`, and stderr for the CSV.
 pub fn warnings(report: &RunReport) -> Vec<String> {
-    range_warning(report)
+    rate_warning(report)
         .into_iter()
+        .chain(range_warning(report))
         .chain(unguarded_warning(report))
         .chain(scale_warning(report))
         .chain(lag_warning(report))
         .collect()
+}
+
+/// The warning for a log slower than the configured output rate, run at its own rate
+/// ([`gyro_analysis::replay::config_for_rate`]): the low-pass is scaled with it, so the
+/// rate is smoothed more than the configuration says.
+pub fn rate_warning(report: &RunReport) -> Option<String> {
+    let configured_hz = report.output_rate_lowered_from_hz?;
+    Some(format!(
+        "the log's {} Hz is below the configured output rate of {configured_hz} Hz: the pipeline runs at the log's rate without decimation, its low-pass at {} Hz (the configured cutoff's share of the output rate)",
+        (report.sample_rate_hz * 1e3).round() / 1e3,
+        report.config.filter.cutoff_hz
+    ))
 }
 
 /// The warning for readings beyond the sensor range in use: a sensor reads at most its
