@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Print the trimmed JSON example of docs/diagnose-json.md from a `diagnose --format json` output.
+"""Print the trimmed JSON examples of docs/diagnose-json.md from a `diagnose --format json` output
+(or a `diagnose --self-test --format json` one).
 
 Numbers are rounded to 4 significant digits; `…` marks left-out entries; `inputs`,
 `effective_noise` and `turns` are left out. Usage (the commands of the doc's example, then):
@@ -7,6 +8,9 @@ Numbers are rounded to 4 significant digits; `…` marks left-out entries; `inpu
     gyro-cli diagnose --train r1.csv r2.csv r3.csv --holdout r4.csv r5.csv r6.csv \\
         --format json -o corrected.json > out.json
     python3 scripts/diagnose_json_example.py out.json
+
+or `gyro-cli diagnose --self-test --seed 8 --only scale_factor --format json > st.json`, then
+`python3 scripts/diagnose_json_example.py st.json`.
 """
 import json
 import sys
@@ -26,9 +30,26 @@ def j(x):
     return json.dumps(r4(x), ensure_ascii=False)
 
 
+def self_test(d):
+    out = ["{", f' "seed": {d["seed"]},', f' "magnitudes": {j(d["magnitudes"][:2])[:-1]}, …],']
+    case = dict(d["cases"][0])
+    effects = case.pop("effects")
+    first = j(case)[:-1] + f', "effects": [{j(effects[0])}, …]}}'
+    out.append(f' "cases": [\n   {first}, …],')
+    for k in d:
+        if k not in ("seed", "magnitudes", "cases"):
+            out.append(f' "{k}": {j(d[k])},')
+    out[-1] = out[-1].rstrip(",")
+    out.append("}")
+    print("\n".join(out))
+
+
 def main():
     with open(sys.argv[1]) as f:
         d = json.load(f)
+    if "cases" in d:
+        self_test(d)
+        return
     out = ["{", f' "gap": {j(d["gap"])},', ' "where": [']
     where = [j(w) for w in d["where"][:3]]
     out.append("   " + ",\n   ".join(where) + ", …],")

@@ -53,6 +53,10 @@ pub struct Fit {
     /// between-run effect (turn-on bias): it is significant when the same test also
     /// passes on the held-out runs.
     pub direct: bool,
+    /// A regression effect's coefficient on the held-out runs: its z against their null
+    /// replicas, in the direction of the training test's `z` (`None` for the other fit
+    /// procedures).
+    pub holdout_z: Option<f64>,
 }
 
 /// The held-out replication of an effect whose significance is its own test passing
@@ -101,28 +105,27 @@ pub fn direct_evidence(
 /// replicates its training fit ([`regression_replicates`]): one-sided 2.3%.
 pub const REPLICATION_Z: f64 = 2.0;
 
-/// Whether a regression effect fitted on the training runs (`trained_z`, its test's
-/// z-score, whose sign is the coefficient's deviation) shows again on the held-out `runs`:
-/// their coefficient of its regressor deviates from their `null` replicas' mean by at
+/// Whether a regression effect fitted on the training runs shows again on the held-out
+/// runs: their coefficient of its regressor deviates from their null replicas' mean by at
 /// least [`REPLICATION_Z`] of the test's standard error (the replicas' spread, or the
-/// runs' own scatter where larger), in the same direction. The test named in advance
-/// for this effect's signature: a weak effect (a temperature bias of 0.05 °/s/°C over a
-/// 2 °C warm-up, beside the bias's wander) moves one coefficient by a few standard
-/// errors, and the held-out likelihood of every statistic, each with its simulation
-/// noise, may not show it at P < 5% over a few runs. Against the nominal model: the
-/// share of the coefficient other effects would give is a product of effects, left out.
-/// False for the other fit procedures.
-pub fn regression_replicates(
-    effect: &Effect,
-    trained_z: f64,
-    runs: &[&RealRun],
-    null: &[Vec<Member>],
-) -> bool {
-    let FitProcedure::Regression { regressor, .. } = effect.info().fit else {
-        return false;
-    };
-    let z = replication_z(&run_coefficients(runs, null, regressor_index(regressor)));
-    z.is_finite() && trained_z.is_finite() && z * trained_z.signum() >= REPLICATION_Z
+/// runs' own scatter where larger), in the direction of the training test
+/// ([`Fit::holdout_z`]). The test named in advance for this effect's signature: a weak
+/// effect (a temperature bias of 0.05 °/s/°C over a 2 °C warm-up, beside the bias's
+/// wander) moves one coefficient by a few standard errors, and the held-out likelihood
+/// of every statistic, each with its simulation noise, may not show it at P < 5% over a
+/// few runs. Against the nominal model: the share of the coefficient other effects
+/// would give is a product of effects, left out. False for the other fit procedures.
+pub fn regression_replicates(fit: &Fit) -> bool {
+    fit.holdout_z
+        .is_some_and(|z| z.is_finite() && fit.z.is_finite() && z * fit.z.signum() >= REPLICATION_Z)
+}
+
+/// Stouffer's combination of a test on `train_runs` runs (`train_z`) and the same test
+/// on `holdout_runs` other runs (`holdout_z`), each weighted by the square root of its
+/// runs: standard normal when both are, as the test on all the runs together would be.
+pub fn pooled_z(train_z: f64, train_runs: usize, holdout_z: f64, holdout_runs: usize) -> f64 {
+    let (a, b) = (train_runs as f64, holdout_runs as f64);
+    (a.sqrt() * train_z + b.sqrt() * holdout_z) / (a + b).sqrt()
 }
 
 /// The z-score of the runs' mean coefficient against their replicas'
@@ -591,6 +594,11 @@ pub struct FitInput<'a> {
     pub temperature_ok: bool,
     /// Seed of the ensembles (training run `i` has seed index `i`).
     pub seed: u64,
+    /// Held-out runs: a regression coefficient's test is also read on them
+    /// ([`Fit::holdout_z`]), and pooled with the training runs' ([`pooled_z`]).
+    pub holdout: &'a [&'a RealRun],
+    /// Their baseline ensembles.
+    pub holdout_null: &'a [Vec<Member>],
 }
 
 impl FitInput<'_> {
@@ -826,16 +834,18 @@ pub fn fit_all<'a>(input: &'a FitInput<'a>) -> (Vec<Fit>, Vec<Untestable>, Joint
 /// The estimate is the coefficient's excess over the null replicas, less what the known
 /// effects give; the parameter is the one whose noise-free simulation of the training
 /// runs (with the known effects) shows that excess: one gain step, then, for a candidate
-/// (|z| ≥ [`Z_CRITICAL`]), secant steps until it matches within [`CALIBRATION_TOL`]
-/// (held-out statistics resolve strong effects to a fraction of a percent).
+/// ([`RegressionFit::screens`]), secant steps until it matches within
+/// [`CALIBRATION_TOL`] (held-out statistics resolve strong effects to a fraction of a
+/// percent).
 fn regression_fit(
     input: &FitInput,
     known: &Known,
     index: usize,
     make: &dyn Fn(f64) -> Effect,
     to_param: &dyn Fn(f64) -> f64,
-) -> (Effect, f64, (f64, f64)) {
+) -> RegressionFit {
     let test = CoefficientTest::of(&run_coefficients(input.train, input.null, index));
+    let holdout_z = replication_z(&run_coefficients(input.holdout, input.holdout_null, index));
     let raw = test.deviation - (known.with_effects[index] - known.quiet[index]);
     let mut half = 1.96 * test.replica_sd * (1.0 + 1.0 / test.replicas.max(1) as f64).sqrt();
     if let Some(scatter) = test.wider_scatter() {
@@ -843,6 +853,7 @@ fn regression_fit(
     }
     let se = test.se();
     let z = raw / se;
+    let screened = RegressionFit::screens(z, holdout_z, input);
     let response = |x: f64| -> f64 {
         let mut set = known.effects.clone();
         set.push(make(to_param(x)));
@@ -855,7 +866,7 @@ fn regression_fit(
         let g = r0 / raw;
         if g.is_finite() && g > 0.2 && g < 5.0 {
             x = raw / g;
-            if z.abs() >= Z_CRITICAL {
+            if screened {
                 let (mut xa, mut ra) = (raw, r0);
                 for _ in 0..4 {
                     let rb = response(x);
@@ -879,7 +890,85 @@ fn regression_fit(
     // Plus the systematic allowance of the simulation-calibrated gain.
     let half = (half * half + (SYSTEMATIC_REL * raw).powi(2)).sqrt();
     let (lo, hi) = ((raw - half) / gain, (raw + half) / gain);
-    (make(to_param(x)), z, (to_param(lo), to_param(hi)))
+    RegressionFit {
+        effect: make(to_param(x)),
+        z,
+        holdout_z,
+        ci: (to_param(lo), to_param(hi)),
+    }
+}
+
+/// A regression effect fitted on the training runs, with its coefficient's z-scores in
+/// the coefficient's direction.
+struct RegressionFit {
+    effect: Effect,
+    /// The training runs' z, less what the known effects give.
+    z: f64,
+    /// The held-out runs' z against their null replicas (NaN without held-out runs).
+    holdout_z: f64,
+    /// The parameter's 95% interval, in the order of the coefficient's bounds.
+    ci: (f64, f64),
+}
+
+impl RegressionFit {
+    /// The test in direction `sign` (+1: the coefficient's; −1 for readings that negate
+    /// it; `two_sided` tests take |z|) passes on the training runs, or on all the runs:
+    /// each half shows the coefficient at least [`REPLICATION_Z`] standard errors from
+    /// its null in the same direction (so the interval fitted on the training runs does
+    /// not hold the effect's absence), and the two pooled ([`pooled_z`]) reach
+    /// [`Z_CRITICAL`]. A weak effect's coefficient is then tested on every run at the
+    /// same bound (either test alone has its false-alarm rate; the held-out runs must
+    /// still qualify it, `select`).
+    fn passes(
+        z: f64,
+        holdout_z: f64,
+        (train_runs, holdout_runs): (usize, usize),
+        sign: f64,
+        two_sided: bool,
+    ) -> bool {
+        let (z, holdout_z) = (sign * z, sign * holdout_z);
+        let judge = |v: f64| if two_sided { v.abs() } else { v };
+        if judge(z) >= Z_CRITICAL {
+            return true;
+        }
+        let pooled = pooled_z(z, train_runs, holdout_z, holdout_runs);
+        judge(z) >= REPLICATION_Z
+            && holdout_z * z.signum() >= REPLICATION_Z
+            && pooled * z.signum() >= Z_CRITICAL
+    }
+
+    /// Screened for calibration: passes two-sided in the coefficient's direction.
+    fn screens(z: f64, holdout_z: f64, input: &FitInput) -> bool {
+        Self::passes(z, holdout_z, Self::runs(input), 1.0, true)
+    }
+
+    /// Training and held-out runs.
+    fn runs(input: &FitInput) -> (usize, usize) {
+        (input.train.len(), input.holdout.len())
+    }
+
+    /// The fit judged in direction `sign`, `two_sided` or not, with the interval
+    /// `ci95`.
+    fn judged(
+        self,
+        input: &FitInput,
+        sign: f64,
+        ci95: Vec<(Option<f64>, Option<f64>)>,
+        two_sided: bool,
+        test: &str,
+    ) -> Fit {
+        let (z, holdout_z) = (sign * self.z, sign * self.holdout_z);
+        let mut fit = judged(self.effect, z, ci95, two_sided, test);
+        fit.holdout_z = holdout_z.is_finite().then_some(holdout_z);
+        if !fit.passes && Self::passes(self.z, self.holdout_z, Self::runs(input), sign, two_sided) {
+            fit.passes = true;
+            let pooled = pooled_z(z, input.train.len(), holdout_z, input.holdout.len());
+            fit.test = format!(
+                "{test}; z {z:.1} on the training runs, {pooled:.1} pooled with the held-out runs"
+            );
+        }
+        fit
+    }
 }
 
 /// Share of the null's chi-square above which the real runs' scatter of a coefficient is
@@ -989,6 +1078,7 @@ fn clock_fit(input: &FitInput) -> Result<Fit, FitError> {
         passes: z.abs() >= Z_CRITICAL,
         test: "time stamps' period vs the nominal sample rate".into(),
         direct: false,
+        holdout_z: None,
     })
 }
 
@@ -1068,6 +1158,7 @@ fn judged(
         passes,
         test: test.to_string(),
         direct: false,
+        holdout_z: None,
     }
 }
 
@@ -1163,30 +1254,35 @@ fn regression_procedure(
     }
     Ok(match reading {
         Reading::Coefficient => {
-            let (e, z, ci) = regression_fit(input, known, index, &make, &|x| x);
-            judged(e, z, ordered(ci), true, test)
+            let f = regression_fit(input, known, index, &make, &|x| x);
+            let ci = ordered(f.ci);
+            f.judged(input, 1.0, ci, true, test)
         }
         Reading::CubicCoefficient => {
             let scale = CUBIC_SCALE_DPS.powi(3);
-            let (e, z, ci) = regression_fit(input, known, index, &make, &|x| x / scale);
-            judged(e, z, ordered(ci), true, test)
+            let f = regression_fit(input, known, index, &make, &|x| x / scale);
+            let ci = ordered(f.ci);
+            f.judged(input, 1.0, ci, true, test)
         }
         Reading::SquareCoefficient => {
             let scale = CUBIC_SCALE_DPS.powi(2);
-            let (e, z, ci) = regression_fit(input, known, index, &make, &|x| x / scale);
-            judged(e, z, ordered(ci), true, test)
+            let f = regression_fit(input, known, index, &make, &|x| x / scale);
+            let ci = ordered(f.ci);
+            f.judged(input, 1.0, ci, true, test)
         }
         Reading::Delay => {
             let range = info.params[0].range;
             let make = |d: f64| make(range.clamp(d));
-            let (e, z, ci) = regression_fit(input, known, index, &make, &|x| -x);
-            judged(e, -z, ordered(ci), true, test)
+            let f = regression_fit(input, known, index, &make, &|x| -x);
+            let ci = ordered(f.ci);
+            f.judged(input, -1.0, ci, true, test)
         }
         Reading::ClockPpm => {
             let range = info.params[0].range;
             let make = |p: f64| make(range.clamp(p));
-            let (e, z, ci) = regression_fit(input, known, index, &make, &|x| -x * 1e6);
-            judged(e, -z, ordered(ci), true, test)
+            let f = regression_fit(input, known, index, &make, &|x| -x * 1e6);
+            let ci = ordered(f.ci);
+            f.judged(input, -1.0, ci, true, test)
         }
         Reading::LowPassDelay => {
             // A two-pole low-pass delays slow motion by 2/(2π f_pole), f_pole = 1.554 f_c:
@@ -1201,11 +1297,11 @@ fn regression_procedure(
                 }
             };
             let make = |d: f64| make(to_cutoff(d));
-            let (e, z, (d_lo, d_hi)) = regression_fit(input, known, index, &make, &|x| -x);
+            let f = regression_fit(input, known, index, &make, &|x| -x);
             // Interval: the (calibrated) delay's, mapped like the estimate.
-            let (d_lo, d_hi) = (d_lo.min(d_hi), d_lo.max(d_hi));
+            let (d_lo, d_hi) = (f.ci.0.min(f.ci.1), f.ci.0.max(f.ci.1));
             let bound = |dd: f64| (dd > 0.0).then(|| to_cutoff(dd));
-            judged(e, -z, vec![(bound(d_hi), bound(d_lo))], false, test)
+            f.judged(input, -1.0, vec![(bound(d_hi), bound(d_lo))], false, test)
         }
     })
 }
@@ -1403,6 +1499,7 @@ mod wander_shape_tests {
             passes: true,
             test: String::new(),
             direct: false,
+            holdout_z: None,
         };
         let holds = |effect, lo, hi, fs| {
             let model = SensorModel {
@@ -1519,6 +1616,7 @@ fn grid_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
                 z: EXACT,
                 passes,
                 direct: true,
+                holdout_z: None,
                 test: format!(
                     "output grid step {step:.6} deg/s vs nominal {nominal:.6} (named above {QUANT_RATIO}x)"
                 ),
@@ -1530,6 +1628,7 @@ fn grid_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
             z: EXACT,
             passes: false,
             direct: true,
+            holdout_z: None,
             test: "no output grid coarser than the nominal step".into(),
         },
     })
@@ -1566,6 +1665,7 @@ fn gaps_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
         z: EXACT,
         passes: gaps >= MIN_GAPS,
         direct: true,
+        holdout_z: None,
         test: format!("{gaps} gaps ({filled} samples filled) in the training runs; the nominal model has none (named from {MIN_GAPS})"),
     })
 }
@@ -1606,6 +1706,7 @@ fn line_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
         z: line.z,
         passes: line.z >= Z_CRITICAL && line.ratio >= super::line::LINE_MIN_RATIO,
         direct: true,
+        holdout_z: None,
         test: format!(
             "strongest line of the gyro's spectrum not coherent with the reference, above {} Hz ({:.1} times its local floor, at least {}) vs the null replicas' strongest (one-sided; replicated on the held-out runs)",
             super::line::MIN_LINE_HZ,
@@ -1749,6 +1850,76 @@ mod replication_tests {
             let z = replication_z(&coefficients(5, 0.0, 0.0, seed));
             assert!(z.abs() < 1.8, "seed {seed}: {z}");
         }
+    }
+
+    /// A fit of `z` on the training runs whose held-out coefficient reads `holdout_z`,
+    /// both in the test's direction.
+    fn fit(z: f64, holdout_z: Option<f64>) -> Fit {
+        Fit {
+            effect: Effect::Latency { delay_s: 0.005 },
+            ci95: vec![(Some(0.004), Some(0.006))],
+            z,
+            passes: true,
+            test: String::new(),
+            direct: false,
+            holdout_z,
+        }
+    }
+
+    #[test]
+    fn replication_is_read_in_the_training_tests_direction() {
+        // A delay is the negated acceleration coefficient: its test's z and the held-out
+        // z are both negated, and a negative pair replicates.
+        assert!(regression_replicates(&fit(-6.0, Some(-2.5))));
+        assert!(regression_replicates(&fit(6.0, Some(2.0))));
+        assert!(!regression_replicates(&fit(-6.0, Some(2.5))));
+        assert!(!regression_replicates(&fit(6.0, Some(1.9))));
+        assert!(!regression_replicates(&fit(6.0, None)));
+        assert!(!regression_replicates(&fit(f64::NAN, Some(3.0))));
+    }
+
+    #[test]
+    fn a_weak_coefficient_passes_on_all_runs_in_the_training_direction() {
+        let runs = (5, 5);
+        let passes = |z, hz, sign, two_sided| RegressionFit::passes(z, hz, runs, sign, two_sided);
+        // Training alone.
+        assert!(passes(4.2, f64::NAN, 1.0, true));
+        assert!(passes(-4.2, f64::NAN, 1.0, true));
+        assert!(!passes(3.5, f64::NAN, 1.0, true));
+        // 3.1 on training and 3.0 held out: 4.3 on all ten runs.
+        assert!(passes(3.1, 3.0, 1.0, true));
+        assert!(passes(-3.1, -3.0, 1.0, true));
+        // Not when the held-out runs show less, or the other way.
+        assert!(!passes(3.1, 2.0, 1.0, true));
+        assert!(!passes(3.1, -3.0, 1.0, true));
+        // A one-sided test in the negated direction (a bandwidth's delay): the
+        // coefficient's −3.1 and −3.0 pass, +3.1 and +3.0 do not.
+        assert!(passes(-3.1, -3.0, -1.0, false));
+        assert!(!passes(3.1, 3.0, -1.0, false));
+        // A held-out z that drags the training z past 4: the training half must show
+        // the effect too (its interval would hold the effect's absence).
+        assert!(!passes(1.9, 11.0, 1.0, true));
+        assert!(!passes(-1.0, 7.0, 1.0, true));
+        // Nor a held-out half below 2 that a training z near 4 carries.
+        assert!(!passes(3.9, 1.9, 1.0, true));
+    }
+
+    #[test]
+    fn the_pooled_z_is_the_test_on_all_runs() {
+        // Equal runs: the mean of the two z-scores times √2.
+        assert!((pooled_z(3.0, 5, 3.0, 5) - 3.0 * 2f64.sqrt()).abs() < 1e-12);
+        // A held-out half that shows nothing dilutes the training half.
+        assert!((pooled_z(4.0, 5, 0.0, 5) - 4.0 / 2f64.sqrt()).abs() < 1e-12);
+        // Weighted by runs: 1 held-out run of 9 barely moves it.
+        assert!((pooled_z(3.0, 9, 0.0, 1) - 3.0 * 0.9f64.sqrt()).abs() < 1e-12);
+        // Standard normal without an effect: simulated pairs of independent N(0, 1).
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut normal = || -> f64 { StandardNormal.sample(&mut rng) };
+        let z: Vec<f64> = (0..20_000)
+            .map(|_| pooled_z(normal(), 3, normal(), 7))
+            .collect();
+        let (m, sd) = mean_sd(&z);
+        assert!(m.abs() < 0.03 && (sd - 1.0).abs() < 0.03, "{m} {sd}");
     }
 
     #[test]

@@ -12,7 +12,8 @@
 //! 3. **Which**: every effect of the vocabulary is fitted on the training runs
 //!    (`fit`); each testable one is added to the nominal model and the held-out runs are
 //!    re-simulated with the same seeds ([`Options::candidate_members`] of them). An effect
-//!    is significant when its parameter test passes on the training runs, its held-out
+//!    is significant when its parameter test passes on the training runs (or, for a
+//!    regression coefficient, pooled with the same test on the held-out runs), its held-out
 //!    ΔBIC is positive and the bootstrap over held-out runs gives P(no improvement) < 5%.
 //!    Effects are ranked by held-out gap reduction. When several are significant, each is
 //!    dropped in turn from the model holding all of them (leave-one-out); one whose
@@ -209,6 +210,8 @@ pub fn diagnose(
         model: &base.nominal,
         temperature_ok: train.iter().all(|r| r.features.temperature_varies),
         seed: options.seed,
+        holdout: &runs.holdout,
+        holdout_null: &base.holdout.members,
     };
     let (fits, untestable, joint) = fit::fit_all(&input);
 

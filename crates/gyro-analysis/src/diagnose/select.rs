@@ -136,15 +136,7 @@ impl<'a> Scorer<'a> {
                     self.nominal(),
                 )
         } else {
-            f.passes
-                && st.delta_bic > 0.0
-                && (st.p < 0.05
-                    || fit::regression_replicates(
-                        &f.effect,
-                        f.z,
-                        &self.runs.holdout,
-                        &self.baseline.holdout.members,
-                    ))
+            f.passes && st.delta_bic > 0.0 && (st.p < 0.05 || fit::regression_replicates(f))
         }
     }
 

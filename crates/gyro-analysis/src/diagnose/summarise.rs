@@ -90,6 +90,7 @@ fn effect_results(
                     significant: order.is_some(),
                     ci95,
                     z: c.fit.z.is_finite().then_some(c.fit.z),
+                    holdout_z: c.fit.holdout_z,
                     test: format!(
                         "{}: {}",
                         c.fit.test,

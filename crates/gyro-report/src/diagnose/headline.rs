@@ -403,6 +403,7 @@ mod tests {
             significant: true,
             ci95: BTreeMap::from([("delay_s", [Some(lo), Some(hi)])]),
             z: Some(10.0),
+            holdout_z: None,
             test: String::new(),
             bootstrap_p: 0.0,
             confounded_with: Vec::new(),

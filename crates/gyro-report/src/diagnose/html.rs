@@ -1401,6 +1401,7 @@ mod tests {
             significant: false,
             ci95: std::collections::BTreeMap::new(),
             z: Some(4.4),
+            holdout_z: None,
             test: String::new(),
             bootstrap_p: 0.0,
             confounded_with: Vec::new(),
