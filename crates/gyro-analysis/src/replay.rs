@@ -327,6 +327,15 @@ pub fn config_for_rate(config: &Config, sample_rate_hz: f64) -> (Config, Option<
     (placed, None)
 }
 
+/// What [`config_for_rate`] did to a log at `sample_rate_hz` slower than the configured
+/// `configured_hz`, its low-pass now at `cutoff_hz`: the words every output says it in.
+pub fn lowered_rate_note(sample_rate_hz: f64, configured_hz: f32, cutoff_hz: f32) -> String {
+    format!(
+        "the log's {} Hz is below the configured output rate of {configured_hz} Hz: the pipeline runs at the log's rate without decimation, its low-pass at {cutoff_hz} Hz (the configured cutoff's share of the output rate)",
+        (sample_rate_hz * 1e3).round() / 1e3
+    )
+}
+
 /// Why a sample rate cannot be decimated to the output rate, when that is the reason: a
 /// rate below it is most often stamps in ms read as seconds.
 fn rate_hint(sample_rate_hz: f64, output_rate_hz: f32) -> String {

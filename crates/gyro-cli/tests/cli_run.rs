@@ -935,6 +935,16 @@ fn a_log_slower_than_the_output_rate_runs_at_its_own_rate_and_says_so() {
         "{table}"
     );
 
+    // `calibrate` replays it the same way and says so.
+    let model = dir.join("model.json");
+    let out = gyro(&["calibrate", slow, "-o", model.to_str().unwrap()]);
+    assert!(out.status.success(), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("slow.csv: the log's 25 Hz is below the configured output rate of 50 Hz"),
+        "{err}"
+    );
+
     let slower = dir.join("slower.csv");
     let slower = slower.to_str().unwrap();
     let sim = gyro(&[

@@ -224,10 +224,10 @@ pub fn warnings(report: &RunReport) -> Vec<String> {
 /// rate is smoothed more than the configuration says.
 pub fn rate_warning(report: &RunReport) -> Option<String> {
     let configured_hz = report.output_rate_lowered_from_hz?;
-    Some(format!(
-        "the log's {} Hz is below the configured output rate of {configured_hz} Hz: the pipeline runs at the log's rate without decimation, its low-pass at {} Hz (the configured cutoff's share of the output rate)",
-        (report.sample_rate_hz * 1e3).round() / 1e3,
-        report.config.filter.cutoff_hz
+    Some(gyro_analysis::replay::lowered_rate_note(
+        report.sample_rate_hz,
+        configured_hz,
+        report.config.filter.cutoff_hz,
     ))
 }
 

@@ -3,6 +3,7 @@
 use anyhow::{Context, Result};
 use gyro_analysis::calibrate::{calibrate, BenchRun, CalibrateOptions, ChoiceReason, Objective};
 use gyro_analysis::model;
+use gyro_analysis::replay::{config_for_rate, lowered_rate_note};
 use gyro_core::Config;
 use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -85,6 +86,20 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let train = load_runs(&args.logs, args)?;
     let holdout = load_runs(&args.holdout, args)?;
+    for run in train.iter().chain(&holdout) {
+        let (placed, lowered) = config_for_rate(&base.config, run.log.sample_rate_hz);
+        if let Some(configured_hz) = lowered {
+            super::warn(&format!(
+                "{}: {}; the written model keeps the configured rates",
+                run.name,
+                lowered_rate_note(
+                    run.log.sample_rate_hz,
+                    configured_hz,
+                    placed.filter.cutoff_hz
+                )
+            ));
+        }
+    }
     let bar = ProgressBar::new_spinner();
     bar.set_style(
         ProgressStyle::with_template("{spinner} {elapsed} {msg}")
