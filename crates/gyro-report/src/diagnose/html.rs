@@ -673,7 +673,7 @@ fn effect_row(s: &mut String, e: &EffectResult) {
         .collect();
     let _ = writeln!(
         s,
-        "<tr{}><td><code>{}</code></td><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td><td>{}</td></tr>",
+        "<tr{}><td><code>{}</code></td><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td><td>{}</td></tr>",
         if e.significant { " class=\"sig\"" } else { "" },
         esc(e.id),
         if e.significant {
@@ -685,6 +685,7 @@ fn effect_row(s: &mut String, e: &EffectResult) {
         },
         params.join("<br>"),
         e.z.map_or("exact".to_string(), |z| format!("{z:.2}")),
+        e.holdout_z.map_or("–".to_string(), |z| format!("{z:.2}")),
         format_args!(
             "{} ({})",
             super::evidence(e.delta_bic),
@@ -951,17 +952,20 @@ fn tables(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(
         s,
         "<p>Significant effects first, then by held-out gap reduction. An effect is significant \
-when its parameter test passes on the training runs, its held-out ΔBIC is positive and the \
-bootstrap over held-out runs gives P(no improvement) &lt; 0.05 (an effect seen directly in \
+when its parameter test passes on the training runs (|z| ≥ 4; for a regression coefficient \
+also on all the runs: at least 2 on the training and the held-out runs alike, 4 pooled), its \
+held-out ΔBIC is positive and the bootstrap over held-out runs gives P(no improvement) &lt; \
+0.05 or, for a regression coefficient, the held-out z reaches 2 (an effect seen directly in \
 the raw data — a clip plateau, an output grid, gaps — when the same direct test passes on the \
 held-out runs too); one that adds nothing once the others are in the model is confounded \
 with them and not named. Intervals are 95%; \
-z is the parameter test on the training runs (“exact” where the test is not a z-test); \
+z is the parameter test on the training runs (“exact” where the test is not a z-test), \
+held-out z the same coefficient's test on the held-out runs, in the same direction; \
 “closed” is (before − after) / (before − floor).</p>"
     );
     let _ = writeln!(
         s,
-        "<table><tr><th>effect</th><th>significant</th><th>parameters [95% interval]</th><th>z</th><th>held-out evidence (ΔBIC)</th><th>held-out G before</th><th>after</th><th>closed</th><th>bootstrap p</th><th>confounded with</th><th>test</th></tr>"
+        "<table><tr><th>effect</th><th>significant</th><th>parameters [95% interval]</th><th>z</th><th>held-out z</th><th>held-out evidence (ΔBIC)</th><th>held-out G before</th><th>after</th><th>closed</th><th>bootstrap p</th><th>confounded with</th><th>test</th></tr>"
     );
     for e in &d.effects {
         effect_row(s, e);

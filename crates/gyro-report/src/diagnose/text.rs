@@ -213,8 +213,8 @@ pub fn table(d: &Diagnosis) -> String {
     );
     let _ = writeln!(
         s,
-        "  {:<18} {:>4} {:>9} {:>24} {:>9} {:>9}  parameters [95% interval]",
-        "effect", "sig", "z", "held-out evidence", "gap", "closed"
+        "  {:<18} {:>4} {:>9} {:>10} {:>24} {:>9} {:>9}  parameters [95% interval]",
+        "effect", "sig", "z", "held-out z", "held-out evidence", "gap", "closed"
     );
     for e in &d.effects {
         let params: Vec<String> = e
@@ -230,10 +230,11 @@ pub fn table(d: &Diagnosis) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "  {:<18} {:>4} {:>9} {:>24} {:>9} {:>9}  {}{}",
+            "  {:<18} {:>4} {:>9} {:>10} {:>24} {:>9} {:>9}  {}{}",
             e.id,
             if e.significant { "yes" } else { "" },
             e.z.map_or("exact".to_string(), |z| format!("{z:.1}")),
+            e.holdout_z.map_or("-".to_string(), |z| format!("{z:.1}")),
             super::evidence(e.delta_bic),
             num(e.holdout_gap_after),
             num(e.fraction_closed),
