@@ -958,11 +958,12 @@ impl RegressionFit {
         test: &str,
     ) -> Fit {
         let (z, holdout_z) = (sign * self.z, sign * self.holdout_z);
+        let runs = Self::runs(input);
         let mut fit = judged(self.effect, z, ci95, two_sided, test);
         fit.holdout_z = holdout_z.is_finite().then_some(holdout_z);
-        if !fit.passes && Self::passes(self.z, self.holdout_z, Self::runs(input), sign, two_sided) {
+        if !fit.passes && Self::passes(self.z, self.holdout_z, runs, sign, two_sided) {
             fit.passes = true;
-            let pooled = pooled_z(z, input.train.len(), holdout_z, input.holdout.len());
+            let pooled = pooled_z(z, runs.0, holdout_z, runs.1);
             fit.test = format!(
                 "{test}; z {z:.1} on the training runs, {pooled:.1} pooled with the held-out runs"
             );
