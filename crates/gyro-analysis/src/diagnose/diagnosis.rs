@@ -77,8 +77,9 @@ pub struct EffectResult {
     pub ci95: BTreeMap<&'static str, [Option<f64>; 2]>,
     /// Parameter test z on the training runs (null where the test is exact).
     pub z: Option<f64>,
-    /// A regression effect's coefficient tested on the held-out runs, in the direction
-    /// of `z` (null for the other effects).
+    /// The parameter test read on the held-out runs, in the direction of `z`: a
+    /// regression effect's coefficient, a wander's Allan-variance excess (null for the
+    /// other effects).
     pub holdout_z: Option<f64>,
     /// The parameter test and its outcome.
     pub test: String,

@@ -124,8 +124,9 @@ impl<'a> Scorer<'a> {
 
     /// The fit is significant given its held-out step: its direct evidence replicates
     /// on the held-out runs, or its ΔBIC is positive with bootstrap P < 5% or, for a
-    /// regression effect, with its coefficient replicated on the held-out runs
-    /// ([`fit::regression_replicates`]).
+    /// regression or wander effect, with its test replicated on the held-out runs
+    /// ([`fit::replicates`]); never when its own test on the held-out runs points the
+    /// other way ([`fit::contradicted`]).
     fn qualifies(&self, f: &Fit, st: &Step) -> bool {
         if f.direct {
             f.passes
@@ -136,7 +137,10 @@ impl<'a> Scorer<'a> {
                     self.nominal(),
                 )
         } else {
-            f.passes && st.delta_bic > 0.0 && (st.p < 0.05 || fit::regression_replicates(f))
+            f.passes
+                && !fit::contradicted(f)
+                && st.delta_bic > 0.0
+                && (st.p < 0.05 || fit::replicates(f))
         }
     }
 
@@ -494,9 +498,10 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
         let mut first_failed = None;
         for &i in &selection.selected {
             let check = posterior::check(
-                candidates[i].fit.effect.id(),
+                &candidates[i].fit,
                 &scorer.before,
                 &selection.holdout_scores,
+                &candidates[i].alone_scores,
                 scorer.sample_rate_hz(),
             );
             if !check.passes && first_failed.is_none() {
@@ -518,14 +523,15 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
             .iter()
             .map(|&i| candidates[i].fit.effect)
             .collect();
+        // Not refitted, a latency whose interval lies under a tenth of a sample either way
+        // is as good as absent too ([`fit::negligible`]).
         let absent = selection
             .selected
             .iter()
             .zip(scorer.joint.fits(&set))
-            .find(|(_, refit)| {
-                refit
-                    .as_ref()
-                    .is_some_and(|f| fit::interval_holds_absence(f, scorer.nominal()))
+            .find(|(&i, refit)| match refit {
+                Some(f) => fit::interval_holds_absence(f, scorer.nominal()),
+                None => fit::negligible(&candidates[i].fit, scorer.nominal()),
             })
             .map(|(&i, _)| i);
         if let Some(i) = absent {
@@ -535,8 +541,9 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
         for c in candidates.iter_mut() {
             if c.posterior.is_none() {
                 c.posterior = Some(posterior::check(
-                    c.fit.effect.id(),
+                    &c.fit,
                     &scorer.before,
+                    &c.alone_scores,
                     &c.alone_scores,
                     scorer.sample_rate_hz(),
                 ));
