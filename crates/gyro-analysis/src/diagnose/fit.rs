@@ -123,6 +123,15 @@ pub fn replicates(fit: &Fit) -> bool {
         .is_some_and(|z| z.is_finite() && fit.z.is_finite() && z * fit.z.signum() >= REPLICATION_Z)
 }
 
+/// [`replicates`], for an effect added to the effects `beside`: a wander's held-out test
+/// reads the Allan-variance excess over the nominal model, which another wander beside it
+/// already explains (a bias instability named on top of a rate random walk on the
+/// walk's held-out excess), so a wander replicates only with no other wander beside it.
+pub fn replicates_beside(fit: &Fit, beside: &[Effect]) -> bool {
+    let wander = |e: &Effect| matches!(e.info().fit, FitProcedure::Wander(_));
+    replicates(fit) && !(wander(&fit.effect) && beside.iter().any(wander))
+}
+
 /// Whether an effect's own test, read on the held-out runs ([`Fit::holdout_z`]), points
 /// the other way from the training runs' (below zero in the training direction). Such
 /// an effect is not named, however the held-out likelihood of every statistic takes it:
@@ -1938,6 +1947,18 @@ mod replication_tests {
         assert!(!replicates(&fit(6.0, Some(1.9))));
         assert!(!replicates(&fit(6.0, None)));
         assert!(!replicates(&fit(f64::NAN, Some(3.0))));
+        // A wander replicates only with no other wander beside it.
+        let walk = Fit {
+            effect: Effect::RateRandomWalk {
+                k_dps_per_rt_s: 0.02,
+            },
+            ..fit(30.0, Some(20.0))
+        };
+        let instability = Effect::BiasInstability { sigma_dps: 0.05 };
+        let scale = Effect::ScaleFactor { k: 0.01 };
+        assert!(replicates_beside(&walk, &[scale]));
+        assert!(!replicates_beside(&walk, &[scale, instability]));
+        assert!(replicates_beside(&fit(-6.0, Some(-2.5)), &[instability]));
         assert!(contradicted(&fit(-5.3, Some(1.1))));
         assert!(contradicted(&fit(4.3, Some(-1.1))));
         assert!(!contradicted(&fit(4.3, Some(0.4))));

@@ -126,8 +126,10 @@ impl<'a> Scorer<'a> {
     /// on the held-out runs, or its ΔBIC is positive with bootstrap P < 5% or, for a
     /// regression or wander effect, with its test replicated on the held-out runs
     /// ([`fit::replicates`]); never when its own test on the held-out runs points the
-    /// other way ([`fit::contradicted`]).
-    fn qualifies(&self, f: &Fit, st: &Step) -> bool {
+    /// other way ([`fit::contradicted`]). `beside` holds the effects it is added to: a
+    /// wander's held-out test is against the nominal model, so beside another wander it
+    /// is that one's evidence, not its own ([`fit::replicates_beside`]).
+    fn qualifies(&self, f: &Fit, st: &Step, beside: &[Effect]) -> bool {
         if f.direct {
             f.passes
                 && fit::direct_evidence(
@@ -140,7 +142,7 @@ impl<'a> Scorer<'a> {
             f.passes
                 && !fit::contradicted(f)
                 && st.delta_bic > 0.0
-                && (st.p < 0.05 || fit::replicates(f))
+                && (st.p < 0.05 || fit::replicates_beside(f, beside))
         }
     }
 
@@ -193,7 +195,7 @@ pub(crate) fn score_alone(scorer: &Scorer, fits: Vec<Fit>) -> Vec<Candidate> {
             f.effect.params().len(),
             scorer.seed("alone", i),
         );
-        let alone_ok = scorer.qualifies(&f, &alone);
+        let alone_ok = scorer.qualifies(&f, &alone, &[]);
         candidates.push(Candidate {
             fit: f,
             alone,
@@ -279,7 +281,11 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
         }
         let mut ok: Vec<(usize, Step, Vec<RunScore>)> = tried
             .into_iter()
-            .filter(|(i, st, _)| scorer.qualifies(&candidates[*i].fit, st))
+            .filter(|(i, st, _)| {
+                let beside: Vec<Effect> =
+                    selected.iter().map(|&j| candidates[j].fit.effect).collect();
+                scorer.qualifies(&candidates[*i].fit, st, &beside)
+            })
             .collect();
         // Best held-out ΔBIC: look-alikes are told apart by the evidence (and by the
         // posterior check on their signature statistics), never by vocabulary order.
@@ -393,7 +399,7 @@ fn leave_one_out(
             scorer.seed("leave one out", i),
         );
         // Kept on the evidence that selected it, now against the others alone.
-        if !scorer.qualifies(&candidates[i].fit, &st) {
+        if !scorer.qualifies(&candidates[i].fit, &st, &rest) {
             selected.retain(|&j| j != i);
             candidates[i].added = None;
             dropped.push(i);
