@@ -4,7 +4,9 @@
 //! The self-test's random-walk case (0.02 °/s/√s over 5 + 5 simulated CRM100 bench runs of
 //! 60 s), as `gyro-cli diagnose --self-test --seed 104 --only rate_random_walk` runs it.
 //! A random walk is one draw per run: the held-out likelihood rests on the one or two runs
-//! that wandered most (here `bootstrap_p` 0.06), and the runs that wandered less than
+//! that wandered most (with the self-test's ensembles, `bootstrap_p` 0.06 here, and
+//! `bias_instability` was named instead before the wander's test was read on the
+//! held-out runs), and the runs that wandered less than
 //! the fitted value predicts would fail a check made with that value alone. The
 //! Allan-variance excess of the held-out runs replicates the training test.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
@@ -23,8 +25,12 @@ fn a_random_walk_is_named_on_its_replicated_allan_excess() {
     let truth = magnitudes[k];
     let case_seed = derive_seed(104, "self-test case", k as u64);
     let (train, holdout) = case_runs(&[truth], case_seed);
+    // Small ensembles keep it quick (the self-test's are 50 and 20 members).
     let options = Options {
         seed: derive_seed(case_seed, "diagnosis", 0),
+        members: 12,
+        candidate_members: 6,
+        bootstrap: 300,
         ..Options::default()
     };
     let d = diagnose(&train, &holdout, &options, &Silent).unwrap();
