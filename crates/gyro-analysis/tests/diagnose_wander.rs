@@ -5,10 +5,10 @@
 //! 60 s), as `gyro-cli diagnose --self-test --seed 104 --only rate_random_walk` runs it.
 //! A random walk is one draw per run: the held-out likelihood rests on the one or two runs
 //! that wandered most (with the self-test's ensembles, `bootstrap_p` 0.06 here, and
-//! `bias_instability` was named instead before the wander's test was read on the
-//! held-out runs), and the runs that wandered less than
-//! the fitted value predicts would fail a check made with that value alone. The
-//! Allan-variance excess of the held-out runs replicates the training test.
+//! without the wander's held-out test `bias_instability` is named instead), and the runs
+//! that wandered less than the fitted value predicts would fail a check made with that
+//! value alone. The Allan-variance excess of the held-out runs replicates the training
+//! test.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use gyro_analysis::diagnose::selftest::{case_runs, magnitudes};
