@@ -1399,12 +1399,12 @@ fn wander_fit(
     for (k, &tau) in WANDER_TAUS_S.iter().enumerate() {
         let (real, replicas) = input.pooled(&|f| f.wander_avar[k]);
         let (m0, s0) = mean_sd(&replicas);
-        per_tau.push((real, replicas, m0, s0, shape_at(tau)));
+        per_tau.push((real, m0, s0, shape_at(tau)));
     }
     // Weighted least squares of the excess on the shape: θ = σ² or K².
     let solve = |excess: &dyn Fn(usize) -> f64| -> f64 {
         let (mut num, mut den) = (0.0, 0.0);
-        for (k, (_, _, _, s0, f)) in per_tau.iter().enumerate() {
+        for (k, (_, _, s0, f)) in per_tau.iter().enumerate() {
             let w = 1.0 / (s0 * s0).max(1e-30);
             num += w * f * excess(k);
             den += w * f * f;
@@ -1472,7 +1472,7 @@ fn wander_fit(
         let per_tau_values: Vec<(f64, f64, f64)> = per_tau
             .iter()
             .enumerate()
-            .map(|(k, (real, _, m0, _, _))| {
+            .map(|(k, (real, m0, _, _))| {
                 let simulated = mean(
                     (0..input.train.len())
                         .map(|r| mean(sims[r].iter().map(|m| m.features.wander_avar[k]))),

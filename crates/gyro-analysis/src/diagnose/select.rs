@@ -279,13 +279,10 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
                 tried.push((i, st, scores));
             }
         }
+        let beside: Vec<Effect> = selected.iter().map(|&j| candidates[j].fit.effect).collect();
         let mut ok: Vec<(usize, Step, Vec<RunScore>)> = tried
             .into_iter()
-            .filter(|(i, st, _)| {
-                let beside: Vec<Effect> =
-                    selected.iter().map(|&j| candidates[j].fit.effect).collect();
-                scorer.qualifies(&candidates[*i].fit, st, &beside)
-            })
+            .filter(|(i, st, _)| scorer.qualifies(&candidates[*i].fit, st, &beside))
             .collect();
         // Best held-out ΔBIC: look-alikes are told apart by the evidence (and by the
         // posterior check on their signature statistics), never by vocabulary order.
