@@ -462,6 +462,35 @@ fn distinct_run(
     })
 }
 
+/// The sums of `f` of the samples of whole blocks (`rows`, of the first's length), side by
+/// side, each in its samples' order. The samples are read 4 of a block at a time: one
+/// load for 4 values, which shuffles then turn into 4 columns of the lanes. The rows cut
+/// to one length up front leave no bounds check in the loop.
+#[inline(always)]
+fn column_sums<const LANES: usize>(rows: &[&[f32]; LANES], f: impl Fn(f32) -> f32) -> [f32; LANES] {
+    let factor = rows.first().map_or(0, |row| row.len());
+    let rows: [&[f32]; LANES] = core::array::from_fn(|k| &rows[k][..factor]);
+    let mut sums = [0.0_f32; LANES];
+    let whole = factor / 4;
+    for q in 0..whole {
+        let quads: [[f32; 4]; LANES] = core::array::from_fn(|k| {
+            let quad = &rows[k][4 * q..4 * q + 4];
+            [quad[0], quad[1], quad[2], quad[3]]
+        });
+        for j in 0..4 {
+            for (sum, quad) in sums.iter_mut().zip(&quads) {
+                *sum += f(quad[j]);
+            }
+        }
+    }
+    for i in 4 * whole..factor {
+        for (sum, row) in sums.iter_mut().zip(&rows) {
+            *sum += f(row[i]);
+        }
+    }
+    sums
+}
+
 /// See [`distinct_run`].
 struct DistinctRun {
     first_clipped: u8,
@@ -878,38 +907,16 @@ impl Pipeline {
     }
 
     /// The sums of whole blocks (`rows`, of one length), side by side, each in its
-    /// samples' order (as [`Decimator`] sums them). The samples are read 4 of a block at a
-    /// time: one load and one bounds check for 4 values, which shuffles then turn into 4
-    /// columns of the lanes, rather than a load and a check for each value.
+    /// samples' order (as [`Decimator`] sums them).
     #[inline(always)]
     fn block_sums<const LANES: usize>(&self, rows: &[&[f32]; LANES]) -> [f32; LANES] {
-        let factor = rows.first().map_or(0, |row| row.len());
         // Without temperature: a temperature that would change the rate keeps the blocks
-        // out of here.
-        let mut sums = [0.0_f32; LANES];
-        let mut i = 0;
-        while i + 4 <= factor {
-            let quads: [[f32; 4]; LANES] = core::array::from_fn(|k| {
-                rows[k]
-                    .get(i..i + 4)
-                    .and_then(|quad| <[f32; 4]>::try_from(quad).ok())
-                    .unwrap_or_default()
-            });
-            // Column by column straight from the quads (an array of the columns first
-            // measured slower).
-            for j in 0..4 {
-                for (sum, quad) in sums.iter_mut().zip(&quads) {
-                    *sum += self.corrected::<false>(quad[j]);
-                }
-            }
-            i += 4;
+        // out of here. The identity's loop apart, so that no sample tests for it.
+        if self.corrects {
+            column_sums(rows, |x| self.corrector.correct(x))
+        } else {
+            column_sums(rows, |x| x)
         }
-        for i in i..factor {
-            for (sum, row) in sums.iter_mut().zip(rows) {
-                *sum += self.corrected::<false>(row.get(i).copied().unwrap_or_default());
-            }
-        }
-        sums
     }
 
     /// The plausibility test and the clip watch over whole blocks of `factor` samples in
