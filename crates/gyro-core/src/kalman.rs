@@ -333,17 +333,34 @@ fn propagate_static(p: &Matrix2<f32>, phi: f32, q_bias: f32) -> Matrix2<f32> {
     let (p00, p01, p10, p11) = (p[(0, 0)], p[(0, 1)], p[(1, 0)], p[(1, 1)]);
     let (f01, f10, f11) = (p01 * phi, phi * p10, phi * p11);
     let g11 = f11 * phi;
-    let values = [p00, p01, p10, p11, f01, f10, f11, g11];
-    // Without early exit: the test is off the chain from one P to the next.
-    let finite = values.iter().fold(true, |all, v| all & v.is_finite());
-    let nonzero = [p00, p01, f01, f10, f11, g11]
-        .iter()
-        .fold(true, |all, &v| all & (v != 0.0));
-    if finite & nonzero {
+    if short_form_holds(p00, p01, f01, f10, f11, g11) {
         Matrix2::new(p00, f01, f10, g11 + q_bias)
     } else {
         propagate(p, 0.0, phi, 0.0, q_bias)
     }
+}
+
+/// Whether [`propagate_static`]'s short form gives the whole computation's bits: all of
+/// P's elements and the products `f01 = P01·φ`, `f10 = φ·P10`, `f11 = φ·P11`,
+/// `g11 = f11·φ` finite, and `P00`, `P01` and the four products not zero.
+///
+/// Six tests stand for those fourteen: `f10` and `f11` finite and not zero imply `P10` and
+/// `P11` finite (a product with an infinite or NaN factor is infinite or NaN, or NaN when
+/// the other factor is zero). Each test is one integer comparison on the magnitude's bits
+/// (zero wraps to the top, infinity and NaN lie above `f32::MAX`), without early exit: it
+/// is off the chain from one P to the next, and needs no f64 (software on a single
+/// precision FPU).
+#[inline(always)]
+fn short_form_holds(p00: f32, p01: f32, f01: f32, f10: f32, f11: f32, g11: f32) -> bool {
+    [p00, p01, f01, f10, f11, g11]
+        .iter()
+        .fold(true, |all, &v| all & finite_nonzero(v))
+}
+
+/// `v` is finite and not zero: the bits of |v|, less one, are below those of `f32::MAX`.
+#[inline(always)]
+fn finite_nonzero(v: f32) -> bool {
+    (v.to_bits() & 0x7fff_ffff).wrapping_sub(1) < f32::MAX.to_bits()
 }
 
 /// φ = e^(−β·dt·α) for `beta_dt` = β·dt and `wander_scale` = α.
@@ -407,6 +424,48 @@ mod tests {
                             assert!(
                                 w.to_bits() == g.to_bits() || w.is_nan() && g.is_nan(),
                                 "{p:?} {coupling} {phi} {q_angle} {q_bias}: {want:?} vs {got:?}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// [`short_form_holds`] is the fourteen tests it stands for, on special values and
+    /// their neighbours, for any φ.
+    #[test]
+    fn short_form_test_is_the_full_test() {
+        let special = [
+            0.0_f32,
+            -0.0,
+            1.0,
+            -0.75,
+            f32::from_bits(1),
+            -f32::from_bits(0x007f_ffff),
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -f32::NAN,
+        ];
+        for &phi in &special {
+            for &p00 in &special {
+                for &p01 in &special {
+                    for &p10 in &special {
+                        for &p11 in &special {
+                            let (f01, f10, f11) = (p01 * phi, phi * p10, phi * p11);
+                            let g11 = f11 * phi;
+                            let values = [p00, p01, p10, p11, f01, f10, f11, g11];
+                            let finite = values.iter().all(|v| v.is_finite());
+                            let nonzero = [p00, p01, f01, f10, f11, g11].iter().all(|&v| v != 0.0);
+                            assert_eq!(
+                                short_form_holds(p00, p01, f01, f10, f11, g11),
+                                finite && nonzero,
+                                "{p00} {p01} {p10} {p11} {phi}"
                             );
                         }
                     }
