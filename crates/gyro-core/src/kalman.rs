@@ -192,6 +192,7 @@ impl KalmanBias {
     }
 
     /// Propagate one step; `moving` if the angle integrates this step.
+    #[inline]
     pub fn predict(&mut self, moving: bool) {
         let (phi, q_bias) = self.transition();
         self.p = if moving {

@@ -248,6 +248,7 @@ impl MotionDetector {
     /// movement if it is further (1–3 deg/s at the end of a tightening); before the first
     /// rest the bias is unknown, so a steady level up to `5 × enter_dps` is the rest (the
     /// power-up bias), not a movement.
+    #[inline]
     pub fn update(&mut self, rate_dps: f32) -> Phase {
         let deviation = libm::fabsf(rate_dps - self.bias_dps);
         let quiet = deviation <= self.exit_dps;
