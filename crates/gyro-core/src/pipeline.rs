@@ -936,16 +936,25 @@ impl Pipeline {
     ) -> Option<[u8; LANES]> {
         let quiet_dps = self.clip_level_dps.min(CLIP_PLATEAU_MIN_DPS);
         let max_dps = self.max_abs_rate_dps;
-        // Below the quiet level (and plausible): NaN fails both.
-        let (quiet, plausible) = rates_dps
+        // Below both levels, as rests are, the samples are quiet and plausible: one
+        // comparison a sample. Else each level on its own. NaN fails every test.
+        let low_dps = quiet_dps.min(max_dps);
+        let low = rates_dps
             .iter()
-            .fold((true, true), |(quiet, plausible), &x| {
-                let magnitude = libm::fabsf(x);
-                (
-                    quiet & (magnitude < quiet_dps),
-                    plausible & (magnitude <= max_dps),
-                )
-            });
+            .fold(true, |low, &x| low & (libm::fabsf(x) < low_dps));
+        let (quiet, plausible) = if low {
+            (true, true)
+        } else {
+            rates_dps
+                .iter()
+                .fold((true, true), |(quiet, plausible), &x| {
+                    let magnitude = libm::fabsf(x);
+                    (
+                        quiet & (magnitude < quiet_dps),
+                        plausible & (magnitude <= max_dps),
+                    )
+                })
+        };
         if !plausible {
             return None;
         }
