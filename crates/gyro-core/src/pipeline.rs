@@ -980,11 +980,15 @@ impl Pipeline {
             if distinct.first_clipped & CLIP_REPEATS != 0 {
                 return None;
             }
-            let levels = ClipLevels::at(self.clip_level_dps, self.clip_plateau_samples);
-            for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
-                *clipped = block
-                    .iter()
-                    .fold(0, |seen, &x| seen | range_flags(levels, libm::fabsf(x)));
+            // Without a known range (an infinite level) no plausible reading reaches it:
+            // the blocks' range flags stay 0.
+            if self.clip_level_dps < f32::INFINITY {
+                let levels = ClipLevels::at(self.clip_level_dps, self.clip_plateau_samples);
+                for (block, clipped) in rates_dps.chunks_exact(factor).zip(&mut clipped) {
+                    *clipped = block
+                        .iter()
+                        .fold(0, |seen, &x| seen | range_flags(levels, libm::fabsf(x)));
+                }
             }
             clipped[0] |= distinct.first_clipped;
             (self.clip_last_dps, self.clip_run) = (distinct.last_dps, distinct.run);
