@@ -1,4 +1,7 @@
-//! Benchmarks live in `benches/benches/`; this library holds shared input generators.
+//! Benchmarks live in `benches/benches/`; this library holds shared input generators and
+//! the pipeline's plain-loop floor.
+
+use gyro_core::Config;
 
 /// A bench-like 1 kHz gyro signal in deg/s: 90° raised-cosine rotations of 1 s every 6 s,
 /// a constant bias and a small deterministic ripple standing in for noise.
@@ -40,4 +43,57 @@ pub fn bridge_bytes(n: usize, noise_every: Option<usize>) -> Vec<u8> {
         }
     }
     bytes
+}
+
+/// The pipeline's floor: the same math as the plainest loop (average-decimate, one
+/// biquad section in direct form, a threshold detector, trapezoid integration while
+/// moving), with the settings of a pipeline configuration.
+#[derive(Clone, Copy)]
+pub struct Plain {
+    factor: usize,
+    /// `[b0, b1, b2, a1, a2]` of the single section (`a0` = 1).
+    biquad: [f32; 5],
+    enter_dps: f32,
+    half_dt_s: f32,
+}
+
+impl Plain {
+    /// The floor of `config`'s pipeline. Panics if `config` is invalid (the benches pass
+    /// valid ones).
+    pub fn new(config: &Config) -> Self {
+        let factor = usize::from(config.decimation_factor().expect("valid config"));
+        let output_rate_hz = config.effective_output_rate_hz().expect("valid config");
+        let design = config
+            .filter
+            .design(output_rate_hz.into())
+            .expect("valid filter");
+        let [b0, b1, b2, a0, a1, a2] = design.sections()[0];
+        Self {
+            factor,
+            biquad: [b0 / a0, b1 / a0, b2 / a0, a1 / a0, a2 / a0].map(|c| c as f32),
+            enter_dps: config.motion.enter_dps,
+            half_dt_s: 0.5 / output_rate_hz,
+        }
+    }
+
+    /// Decimate, filter, detect, integrate: the angle turned while moving (deg).
+    pub fn run(&self, signal: &[f32]) -> f32 {
+        let [b0, b1, b2, a1, a2] = self.biquad;
+        let (mut x1, mut x2, mut y1, mut y2) = (0.0_f32, 0.0_f32, 0.0_f32, 0.0_f32);
+        let mut angle_deg = 0.0_f32;
+        let scale = 1.0 / self.factor as f32;
+        for block in signal.chunks_exact(self.factor) {
+            let mut sum = 0.0_f32;
+            for &x in block {
+                sum += x;
+            }
+            let x = sum * scale;
+            let y = b0 * x + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2;
+            if y.abs() > self.enter_dps {
+                angle_deg += self.half_dt_s * (y1 + y);
+            }
+            (x2, x1, y2, y1) = (x1, x, y1, y);
+        }
+        angle_deg
+    }
 }
