@@ -18,6 +18,9 @@ pub(crate) struct Step {
     pub(crate) gap_after: f64,
     /// ΔBIC (positive favours "after").
     pub(crate) delta_bic: f64,
+    /// Σ Δℓ over the held-out runs: the log-likelihood gained, without the ΔBIC's charge
+    /// for the parameters.
+    pub(crate) loglik_gain: f64,
     /// Bootstrap over runs: P(no likelihood improvement).
     pub(crate) p: f64,
 }
@@ -118,15 +121,19 @@ impl<'a> Scorer<'a> {
             gap_before: gap(before),
             gap_after: gap(after),
             delta_bic: delta_bic(&diffs, params, self.observations),
+            loglik_gain: diffs.iter().sum(),
             p: bootstrap_p(&diffs, self.options.bootstrap, seed),
         }
     }
 
     /// The fit is significant given its held-out step: its direct evidence replicates
-    /// on the held-out runs, or its ΔBIC is positive with bootstrap P < 5% or, for a
-    /// regression or wander effect, with its test replicated on the held-out runs
-    /// ([`fit::replicates`]); never when its own test on the held-out runs points the
-    /// other way ([`fit::contradicted`]). `beside` holds the effects it is added to: a
+    /// on the held-out runs, or its ΔBIC is positive with bootstrap P < 5%, or, for a
+    /// regression or wander effect, its test replicated on the held-out runs
+    /// ([`fit::replicates`]) and the held-out likelihood not lowered (Σ Δℓ > 0: the
+    /// replicated test is the evidence named in advance, the likelihood of every
+    /// statistic only must not contradict it, so the ΔBIC's charge for the parameter is
+    /// not asked again); never when its own test on the held-out runs points the other
+    /// way ([`fit::contradicted`]). `beside` holds the effects it is added to: a
     /// wander's held-out test is against the nominal model, so beside another wander it
     /// is that one's evidence, not its own ([`fit::replicates_beside`]).
     fn qualifies(&self, f: &Fit, st: &Step, beside: &[Effect]) -> bool {
@@ -141,8 +148,7 @@ impl<'a> Scorer<'a> {
         } else {
             f.passes
                 && !fit::contradicted(f)
-                && st.delta_bic > 0.0
-                && (st.p < 0.05 || fit::replicates_beside(f, beside))
+                && held_out_evidence(st, fit::replicates_beside(f, beside))
         }
     }
 
@@ -166,6 +172,13 @@ impl<'a> Scorer<'a> {
         )
         .scores
     }
+}
+
+/// Whether the held-out runs bear out an effect (not seen directly) whose parameter test
+/// passes: its ΔBIC positive with bootstrap P < 5%, or its own test `replicated` on them
+/// with the held-out likelihood not lowered (Σ Δℓ > 0).
+fn held_out_evidence(st: &Step, replicated: bool) -> bool {
+    st.delta_bic > 0.0 && st.p < 0.05 || replicated && st.loglik_gain > 0.0
 }
 
 fn loglik_diffs(after: &[RunScore], before: &[RunScore]) -> Vec<f64> {
@@ -553,5 +566,36 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
             }
         }
         return selection;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn step(delta_bic: f64, loglik_gain: f64, p: f64) -> Step {
+        Step {
+            gap_before: 1.0,
+            gap_after: 1.0,
+            delta_bic,
+            loglik_gain,
+            p,
+        }
+    }
+
+    #[test]
+    fn a_replicated_test_needs_the_likelihood_not_lowered_only() {
+        // 20261130's temperature_bias beside scale_asymmetry: ΔBIC −4.5 (the charge for
+        // its parameter, ln N ≈ 5.5, exceeds 2 Σ Δℓ ≈ 1), P 0.50, coefficient replicated.
+        let weak = step(-4.5, 0.5, 0.50);
+        assert!(held_out_evidence(&weak, true));
+        assert!(!held_out_evidence(&weak, false));
+        // A likelihood that falls is not borne out, replicated or not.
+        let lower = step(-6.0, -0.2, 0.60);
+        assert!(!held_out_evidence(&lower, true));
+        // The bootstrap route needs both a positive ΔBIC and P < 5%.
+        assert!(held_out_evidence(&step(12.0, 8.8, 0.01), false));
+        assert!(!held_out_evidence(&step(12.0, 8.8, 0.06), false));
+        assert!(!held_out_evidence(&step(-1.0, 2.2, 0.01), false));
     }
 }
