@@ -585,9 +585,10 @@ mod tests {
 
     #[test]
     fn a_replicated_test_needs_the_likelihood_not_lowered_only() {
-        // 20261130's temperature_bias beside scale_asymmetry: ΔBIC −4.5 (the charge for
-        // its parameter, ln N ≈ 5.5, exceeds 2 Σ Δℓ ≈ 1), P 0.50, coefficient replicated.
-        let weak = step(-4.5, 0.5, 0.50);
+        // A temperature_bias beside scale_asymmetry (self-test seed 20261130): ΔBIC −4.5
+        // (the charge for its parameter, ln N ≈ 5.9, exceeds 2 Σ Δℓ ≈ 1.4), P 0.50,
+        // coefficient replicated.
+        let weak = step(-4.5, 0.7, 0.50);
         assert!(held_out_evidence(&weak, true));
         assert!(!held_out_evidence(&weak, false));
         // A likelihood that falls is not borne out, replicated or not.
