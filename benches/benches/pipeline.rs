@@ -30,7 +30,7 @@ fn pipeline_per_sample(c: &mut Criterion) {
     let times_s: Vec<f64> = (0..N).map(|i| i as f64 * 1e-3).collect();
     let mut group = c.benchmark_group("pipeline_90s_1khz");
     group.throughput(Throughput::Elements(N as u64));
-    let plain = Plain::new(&Config::default());
+    let plain = Plain::try_new(&Config::default()).expect("default config is valid");
     group.bench_with_input("plain_loop", &signal, |b, signal| {
         b.iter(|| plain.run(black_box(signal)))
     });

@@ -13,7 +13,7 @@
 //! `cargo run --release -p gyro-benches --example ratio [REPETITIONS]` (default 200).
 
 use gyro_benches::{bench_signal_dps, Plain};
-use gyro_core::{Compensation, Config, Pipeline};
+use gyro_core::{Compensation, Config, Error, Pipeline};
 use std::hint::black_box;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -33,15 +33,18 @@ fn timed(work: impl FnOnce()) -> f64 {
 
 /// The last output angle of a pipeline fed `signal` by `push_block` in calls of `chunk`
 /// samples, or by `push` one sample at a time.
-fn angle_deg(config: &Config, chunk: Option<usize>, times_s: &[f64], signal: &[f32]) -> f32 {
-    let mut pipeline = Pipeline::try_new(config).expect("default config is valid");
+fn angle_deg(
+    config: &Config,
+    chunk: Option<usize>,
+    times_s: &[f64],
+    signal: &[f32],
+) -> Result<f32, Error> {
+    let mut pipeline = Pipeline::try_new(config)?;
     let mut last = 0.0_f32;
     match chunk {
         Some(chunk) => {
             for (times_s, rates_dps) in times_s.chunks(chunk).zip(signal.chunks(chunk)) {
-                pipeline
-                    .push_block(times_s, black_box(rates_dps), |out| last = out.angle_deg)
-                    .expect("same lengths");
+                pipeline.push_block(times_s, black_box(rates_dps), |out| last = out.angle_deg)?;
             }
         }
         None => {
@@ -53,7 +56,7 @@ fn angle_deg(config: &Config, chunk: Option<usize>, times_s: &[f64], signal: &[f
             }
         }
     }
-    last
+    Ok(last)
 }
 
 fn median(values: &mut [f64]) -> f64 {
@@ -67,7 +70,6 @@ fn median(values: &mut [f64]) -> f64 {
 }
 
 fn main() -> ExitCode {
-    const N: usize = 90_000; // 90 s at 1 kHz, as the criterion bench
     let repetitions = match std::env::args().nth(1).map(|arg| arg.parse::<usize>()) {
         None => 200,
         Some(Ok(n)) if n > 0 => n,
@@ -76,9 +78,21 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
+    match run(repetitions) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("ratio: the configuration is refused: {error}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Time every bench `repetitions` times and print the table.
+fn run(repetitions: usize) -> Result<(), Error> {
+    const N: usize = 90_000; // 90 s at 1 kHz, as the criterion bench
     let signal = bench_signal_dps(N);
     let times_s: Vec<f64> = (0..N).map(|i| i as f64 * 1e-3).collect();
-    let plain = Plain::new(&Config::default());
+    let plain = Plain::try_new(&Config::default())?;
     let configs = MODES.map(|(_, compensation)| Config {
         compensation,
         ..Config::default()
@@ -103,9 +117,11 @@ fn main() -> ExitCode {
             black_box(plain.run(black_box(&signal)));
         }));
         for ((_, config, chunk), times) in benches.iter().zip(&mut bench_s) {
+            let mut angle = Ok(0.0);
             times.push(timed(|| {
-                black_box(angle_deg(config, *chunk, &times_s, &signal));
+                angle = black_box(angle_deg(config, *chunk, &times_s, &signal));
             }));
+            angle?;
         }
     }
     let ns = |seconds: f64| seconds * 1e9 / N as f64;
@@ -127,5 +143,5 @@ fn main() -> ExitCode {
             median(&mut ratios)
         );
     }
-    ExitCode::SUCCESS
+    Ok(())
 }

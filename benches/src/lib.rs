@@ -1,7 +1,7 @@
 //! Benchmarks live in `benches/benches/`; this library holds shared input generators and
 //! the pipeline's plain-loop floor.
 
-use gyro_core::Config;
+use gyro_core::{Config, Error};
 
 /// A bench-like 1 kHz gyro signal in deg/s: 90° raised-cosine rotations of 1 s every 6 s,
 /// a constant bias and a small deterministic ripple standing in for noise.
@@ -58,22 +58,18 @@ pub struct Plain {
 }
 
 impl Plain {
-    /// The floor of `config`'s pipeline. Panics if `config` is invalid (the benches pass
-    /// valid ones).
-    pub fn new(config: &Config) -> Self {
-        let factor = usize::from(config.decimation_factor().expect("valid config"));
-        let output_rate_hz = config.effective_output_rate_hz().expect("valid config");
-        let design = config
-            .filter
-            .design(output_rate_hz.into())
-            .expect("valid filter");
+    /// The floor of `config`'s pipeline, or the error that makes `config` invalid.
+    pub fn try_new(config: &Config) -> Result<Self, Error> {
+        let factor = usize::from(config.decimation_factor()?);
+        let output_rate_hz = config.effective_output_rate_hz()?;
+        let design = config.filter.design(output_rate_hz.into())?;
         let [b0, b1, b2, a0, a1, a2] = design.sections()[0];
-        Self {
+        Ok(Self {
             factor,
             biquad: [b0 / a0, b1 / a0, b2 / a0, a1 / a0, a2 / a0].map(|c| c as f32),
             enter_dps: config.motion.enter_dps,
             half_dt_s: 0.5 / output_rate_hz,
-        }
+        })
     }
 
     /// Decimate, filter, detect, integrate: the angle turned while moving (deg).

@@ -117,11 +117,12 @@ impl<'a> Scorer<'a> {
     /// draws with `seed`.
     fn step_of(&self, after: &[RunScore], before: &[RunScore], params: usize, seed: u64) -> Step {
         let diffs = loglik_diffs(after, before);
+        let loglik_gain = diffs.iter().sum();
         Step {
             gap_before: gap(before),
             gap_after: gap(after),
-            delta_bic: delta_bic(&diffs, params, self.observations),
-            loglik_gain: diffs.iter().sum(),
+            delta_bic: delta_bic(loglik_gain, params, self.observations),
+            loglik_gain,
             p: bootstrap_p(&diffs, self.options.bootstrap, seed),
         }
     }
@@ -189,8 +190,10 @@ fn loglik_diffs(after: &[RunScore], before: &[RunScore]) -> Vec<f64> {
         .collect()
 }
 
-fn delta_bic(diffs: &[f64], params: usize, observations: usize) -> f64 {
-    2.0 * diffs.iter().sum::<f64>() - params as f64 * (observations.max(1) as f64).ln()
+/// `2 Σ Δℓ − p ln N` for a log-likelihood gain `loglik_gain` (Σ Δℓ) with `params`
+/// parameters over `observations` statistics.
+fn delta_bic(loglik_gain: f64, params: usize, observations: usize) -> f64 {
+    2.0 * loglik_gain - params as f64 * (observations.max(1) as f64).ln()
 }
 
 /// Every fit added alone to the nominal model and scored on the held-out runs.
