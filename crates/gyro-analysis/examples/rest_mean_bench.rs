@@ -3,8 +3,8 @@
 //! and the median |error| per movement; then each movement's `angle_std_deg` against its
 //! error (|e|/σ quantiles, 95% coverage) and the tightening decisions it gives.
 //!
-//! `cargo run --release -p gyro-analysis --example rest_mean_bench [RUNS]` (default 20 runs
-//! of 90 s at 1 kHz per scenario, seeds 1..=RUNS).
+//! `cargo run --release -p gyro-analysis --example rest_mean_bench [RUNS [FIRST_SEED]]`
+//! (default 20 runs of 90 s at 1 kHz per scenario, seeds FIRST_SEED.. (1..) on).
 use gyro_analysis::rest_mean::{score_report, simulate_bench_run};
 use gyro_core::Config;
 use gyro_sim::{Effect, SensorModel};
@@ -20,6 +20,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let runs: u64 = std::env::args().nth(1).map_or(Ok(20), |a| a.parse())?;
+    let first_seed: u64 = std::env::args().nth(2).map_or(Ok(1), |a| a.parse())?;
     let scenarios: [(&str, &[&str]); 6] = [
         ("nominal model", &[]),
         ("turn-on bias 0.3 deg/s", &["turn_on_bias:sigma_dps=0.3"]),
@@ -57,7 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut stds = vec![];
         let mut ratios = vec![];
         let mut decisions = Decisions::default();
-        for seed in 1..=runs {
+        for seed in first_seed..first_seed + runs {
             let run = simulate_bench_run(&SensorModel::default(), &effects, seed)?;
             // One replay, scored both ways.
             let report = gyro_analysis::replay::replay(&run.log, &Config::default())?;
