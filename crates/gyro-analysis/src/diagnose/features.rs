@@ -22,7 +22,9 @@
 //!   read from the same regression in the low band ([`super::low_band`]: both signals
 //!   low-passed alike, where a sensor's roll-off above a few hertz leaves a gain alone),
 //!   and the ω column there from the straight line alone ([`NONLINEAR_COLUMNS`] left
-//!   out: the least-squares slope that defines a scale factor).
+//!   out: the least-squares slope that defines a scale factor). A column the others
+//!   determine in a run (|ω| = −ω when it turns one way only) is left out of that run's
+//!   regressions, its coefficient NaN; the rest are read as usual (`solve_spd`).
 //! - **Wander**: Allan variance of the regression residual at [`WANDER_TAUS_S`] (bias
 //!   wander not explained by the regressors: `bias_instability`, `rate_random_walk`).
 //! - **Plateau**: the largest |rate| and how many samples sit on it while the reference
@@ -121,7 +123,8 @@ pub const MIN_TEMPERATURE_RANGE_C: f64 = 0.5;
 /// Features of one run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Features {
-    /// Regression coefficients ([`REGRESSORS`] order); NaN where the regressor was not used.
+    /// Regression coefficients ([`REGRESSORS`] order); NaN where the regressor was not used
+    /// or the others determine it.
     pub coef: [f64; N_REG],
     /// Samples in the regression.
     pub samples: usize,
@@ -424,16 +427,23 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
                     low_jerk[i],
                 )
             };
-            let normal = Normal::of(n, &all, low_row);
-            let mut low = normal.solve(&all);
-            let linear: Vec<usize> = all
+            // A column aliased in the whole band (|ω| = −ω in a run turning one way) stays
+            // out of the low band too, where the filter's ringing leaves it only nearly so.
+            let kept: Vec<usize> = all
+                .iter()
+                .copied()
+                .filter(|&k| coef[k].is_finite())
+                .collect();
+            let normal = Normal::of(n, &kept, low_row);
+            let mut low = normal.solve(&kept);
+            let linear: Vec<usize> = kept
                 .iter()
                 .copied()
                 .filter(|c| !NONLINEAR_COLUMNS.contains(c))
                 .collect();
             // The straight line's normal equations are a block of those of every column:
             // the same sums, in the same order, without a second pass over the samples.
-            low[reg::RATE] = normal.block(&all, &linear).solve(&linear)[reg::RATE];
+            low[reg::RATE] = normal.block(&kept, &linear).solve(&linear)[reg::RATE];
             low
         }
         _ => [f64::NAN; N_REG],
@@ -445,7 +455,13 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
     if wander && coef[0].is_finite() {
         residual = (0..n)
             .map(|i| match row(i) {
-                Some((x, y)) => y - (0..used).map(|k| coef[k] * x[k]).sum::<f64>(),
+                // An aliased column (NaN) adds nothing to the fit.
+                Some((x, y)) => {
+                    y - (0..used)
+                        .filter(|&k| coef[k].is_finite())
+                        .map(|k| coef[k] * x[k])
+                        .sum::<f64>()
+                }
                 None => f64::NAN,
             })
             .collect();
@@ -613,8 +629,8 @@ impl Normal {
     }
 
     /// The coefficients of `columns` (the columns these equations were summed over),
-    /// each at its column's index; NaN where there are too few rows or the system is
-    /// singular.
+    /// each at its column's index; NaN everywhere when there are too few rows, and for a
+    /// column the others determine ([`solve_spd`]).
     fn solve(&self, columns: &[usize]) -> [f64; N_REG] {
         let used = columns.len().min(N_REG);
         let mut coef = [f64::NAN; N_REG];
@@ -652,35 +668,59 @@ fn run_bias(r: &Residuals, intercept: f64) -> f64 {
     }
 }
 
-/// Solve the leading `n`×`n` block of a symmetric positive definite system by Cholesky
-/// with the regressors scaled to unit diagonal; `None` if it is singular.
+/// Solve the leading `n`×`n` block of a symmetric positive semi-definite system by
+/// Cholesky with the regressors scaled to unit diagonal. A column that is zero, or that
+/// the columns before it determine (its scaled pivot, 1 − R² on them, under 1e-12), is
+/// aliased: its coefficient is NaN and the others are the least-squares fit without it,
+/// as R's `lm` leaves an aliased coefficient NA. A run that turns one way only has
+/// |ω| = ±ω: its asymmetry cannot be read, but its bias, temperature and timing terms
+/// can (the whole regression given up, such a run lost every coefficient, and its bias
+/// fell back to the mean residual, which holds the mean of every rate-dependent error
+/// and of the temperature drift). `None` when the intercept itself is aliased.
 fn solve_spd(a: &[[f64; N_REG]; N_REG], b: &[f64; N_REG], n: usize) -> Option<[f64; N_REG]> {
     let mut d = [1.0f64; N_REG];
+    let mut aliased = [false; N_REG];
     for i in 0..n {
-        if a[i][i] <= 0.0 || !a[i][i].is_finite() {
-            return None;
+        if a[i][i] > 0.0 && a[i][i].is_finite() {
+            d[i] = a[i][i].sqrt();
+        } else {
+            aliased[i] = true;
         }
-        d[i] = a[i][i].sqrt();
     }
+    // Rows and columns of aliased regressors stay zero in `l`.
     let mut l = [[0.0f64; N_REG]; N_REG];
     for i in 0..n {
+        if aliased[i] {
+            continue;
+        }
         for j in 0..=i {
+            if aliased[j] {
+                continue;
+            }
             let mut s = a[i][j] / (d[i] * d[j]);
             for k in 0..j {
                 s -= l[i][k] * l[j][k];
             }
             if i == j {
                 if s <= 1e-12 {
-                    return None;
+                    aliased[i] = true;
+                    l[i] = [0.0; N_REG];
+                } else {
+                    l[i][i] = s.sqrt();
                 }
-                l[i][i] = s.sqrt();
             } else {
                 l[i][j] = s / l[j][j];
             }
         }
     }
+    if n == 0 || aliased[0] {
+        return None;
+    }
     let mut y = [0.0f64; N_REG];
     for i in 0..n {
+        if aliased[i] {
+            continue;
+        }
         let mut s = b[i] / d[i];
         for k in 0..i {
             s -= l[i][k] * y[k];
@@ -689,6 +729,9 @@ fn solve_spd(a: &[[f64; N_REG]; N_REG], b: &[f64; N_REG], n: usize) -> Option<[f
     }
     let mut x = [0.0f64; N_REG];
     for i in (0..n).rev() {
+        if aliased[i] {
+            continue;
+        }
         let mut s = y[i];
         for k in i + 1..n {
             s -= l[k][i] * x[k];
@@ -696,7 +739,7 @@ fn solve_spd(a: &[[f64; N_REG]; N_REG], b: &[f64; N_REG], n: usize) -> Option<[f
         x[i] = s / l[i][i];
     }
     for i in 0..n {
-        x[i] /= d[i];
+        x[i] = if aliased[i] { f64::NAN } else { x[i] / d[i] };
     }
     Some(x)
 }
@@ -705,7 +748,9 @@ fn solve_spd(a: &[[f64; N_REG]; N_REG], b: &[f64; N_REG], n: usize) -> Option<[f
 mod tests {
     use super::*;
     use crate::diagnose::stats::residuals_of;
-    use gyro_sim::{simulate_series, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+    use gyro_sim::{
+        simulate_series, BenchProfile, Effect, Motion, Rotation, SensorModel, SimOptions,
+    };
 
     fn run_features(effects: &[Effect], seed: u64) -> Features {
         let model = SensorModel::default();
@@ -719,6 +764,76 @@ mod tests {
         let time: Vec<f64> = (0..s.rate_dps.len()).map(|k| k as f64 / fs).collect();
         let r = residuals_of(fs, time, s.rate_dps, &s.reference_deg, s.temperature_c).unwrap();
         features_with_spectra(&r, model.lsb_dps)
+    }
+
+    /// A run that turns one way only (the self-test's bench motion does in about one run
+    /// in fourteen: five or six turns of random sign): |ω| = −ω, so the asymmetry is
+    /// aliased with the scale, but the regression still reads the bias at the starting
+    /// temperature and the temperature term. Given up whole, it lost both, and the run's
+    /// bias became its mean residual: here 0.3 + the asymmetry's 0.005·mean|ω| + the
+    /// temperature drift's mean.
+    #[test]
+    fn a_run_turning_one_way_keeps_its_regression() {
+        let rotations = (0..6)
+            .map(|i| Rotation {
+                start_s: 4.0 + 9.0 * i as f64,
+                duration_s: 2.0,
+                angle_deg: -90.0,
+            })
+            .collect();
+        let motion = Motion::from_rotations(rotations, 60.0);
+        let model = SensorModel::default().noise_free();
+        let effects = [
+            Effect::ScaleAsymmetry { k: 0.005 },
+            Effect::TemperatureBias { dps_per_c: 0.05 },
+        ];
+        let s = simulate_series(&model, &effects, &motion, &SimOptions::default(), None);
+        let fs = s.sample_rate_hz;
+        let time: Vec<f64> = (0..s.rate_dps.len()).map(|k| k as f64 / fs).collect();
+        let r = residuals_of(fs, time, s.rate_dps, &s.reference_deg, s.temperature_c).unwrap();
+        let (f, residual) = real_features(&r, 1e-9);
+        assert!(f.coef[reg::ABS_RATE].is_nan(), "{:?}", f.coef);
+        assert!((f.bias_dps - model.bias_dps).abs() < 0.01, "{}", f.bias_dps);
+        let dt = f.coef[reg::DELTA_T];
+        assert!((dt - 0.05).abs() < 0.005, "{dt}");
+        // The scale column reads the asymmetry on negative turns: ω(1 − k).
+        assert!(
+            (f.coef[reg::RATE] + 0.005).abs() < 5e-4,
+            "{}",
+            f.coef[reg::RATE]
+        );
+        assert!(residual.iter().any(|v| v.is_finite()));
+        assert!(
+            f.wander_avar.iter().all(|v| v.is_finite()),
+            "{:?}",
+            f.wander_avar
+        );
+    }
+
+    #[test]
+    fn an_aliased_column_is_left_out_of_the_solve() {
+        // y = 2 + 3x on columns [1, x, −x, x²]: the third is the second's negative.
+        let xs: Vec<f64> = (0..50).map(|i| i as f64 * 0.1 - 2.0).collect();
+        let columns = [0, 1, 2, 3];
+        let normal = Normal::of(xs.len(), &columns, |i| {
+            let x = xs[i];
+            let mut row = [0.0; N_REG];
+            row[..4].copy_from_slice(&[1.0, x, -x, x * x]);
+            Some((row, 2.0 + 3.0 * x + 0.5 * x * x))
+        });
+        let c = normal.solve(&columns);
+        assert!((c[0] - 2.0).abs() < 1e-9, "{c:?}");
+        assert!((c[1] - 3.0).abs() < 1e-9, "{c:?}");
+        assert!(c[2].is_nan(), "{c:?}");
+        assert!((c[3] - 0.5).abs() < 1e-9, "{c:?}");
+        // A zero column is aliased too.
+        let normal = Normal::of(xs.len(), &[0, 1], |_| {
+            let mut row = [0.0; N_REG];
+            row[0] = 1.0;
+            Some((row, 1.5))
+        });
+        let c = normal.solve(&[0, 1]);
+        assert!((c[0] - 1.5).abs() < 1e-12 && c[1].is_nan(), "{c:?}");
     }
 
     /// A gyro whose response rolls off above a few hertz (a 15 Hz two-pole low-pass)
