@@ -108,7 +108,9 @@ def header(title):
 
 
 def main():
-    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    # Positional arguments: neither an option nor the value after one.
+    args = [a for i, a in enumerate(sys.argv[1:], 1)
+            if not a.startswith("--") and not sys.argv[i - 1].startswith("--")]
     data = args[0] if args else os.path.join(os.path.dirname(__file__), "../../shared/data/real/rasteiro")
     gyro = sys.argv[sys.argv.index("--gyro") + 1] if "--gyro" in sys.argv else "target/release/gyro-cli"
     paths = [path_of(data, s, v, a) for s in SENSORS for v in SPEEDS for a in "xyz"]

@@ -120,7 +120,9 @@ def run_series(gyro, t, w_logged, radians, model=None):
 
 
 def main():
-    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    # Positional arguments: neither an option nor the value after one.
+    args = [a for i, a in enumerate(sys.argv[1:], 1)
+            if not a.startswith("--") and not sys.argv[i - 1].startswith("--")]
     if not args:
         sys.exit(__doc__)
     root = os.path.join(args[0], "DataSets")
