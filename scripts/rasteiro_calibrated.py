@@ -39,7 +39,7 @@ import tempfile
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from rasteiro_turns import turns  # noqa: E402
+from rasteiro_turns import positional_args, turns  # noqa: E402
 
 SPEEDS = ("V_300", "V_800", "V1500")
 SENSORS = ("MPU6050", "MPU6500")
@@ -192,9 +192,7 @@ def trust(gyro, data, cache):
 
 
 def main():
-    # Positional arguments: neither an option nor the value after one.
-    args = [a for i, a in enumerate(sys.argv[1:], 1)
-            if not a.startswith("--") and not sys.argv[i - 1].startswith("--")]
+    args = positional_args()
     data = args[0] if args else os.path.join(os.path.dirname(__file__), "../../shared/data/real/rasteiro")
     gyro = sys.argv[sys.argv.index("--gyro") + 1] if "--gyro" in sys.argv else "target/release/gyro-cli"
     paths = sorted(glob.glob(os.path.join(data, "rasteiro_*.csv")))

@@ -31,7 +31,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from rasteiro_calibrated import SENSORS, SPEEDS, line, path_of, plain_scale  # noqa: E402
-from rasteiro_turns import turns  # noqa: E402
+from rasteiro_turns import positional_args, turns  # noqa: E402
 
 
 def diagnose(gyro, train, holdout, model):
@@ -108,9 +108,7 @@ def header(title):
 
 
 def main():
-    # Positional arguments: neither an option nor the value after one.
-    args = [a for i, a in enumerate(sys.argv[1:], 1)
-            if not a.startswith("--") and not sys.argv[i - 1].startswith("--")]
+    args = positional_args()
     data = args[0] if args else os.path.join(os.path.dirname(__file__), "../../shared/data/real/rasteiro")
     gyro = sys.argv[sys.argv.index("--gyro") + 1] if "--gyro" in sys.argv else "target/release/gyro-cli"
     paths = [path_of(data, s, v, a) for s in SENSORS for v in SPEEDS for a in "xyz"]

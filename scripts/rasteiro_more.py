@@ -49,7 +49,7 @@ import scipy.io as sio
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from rasteiro_calibrated import calibrate, plain_scale  # noqa: E402
-from rasteiro_turns import turns  # noqa: E402
+from rasteiro_turns import positional_args, turns  # noqa: E402
 
 SENSORS = ["MPU6050RM3100", "MPU6500RM3100", "MPU9150", "LSM9DS0"]
 SPEEDS = ["V_300", "V_500", "V_800", "V1000", "V1500", "eV50p"]
@@ -120,9 +120,7 @@ def run_series(gyro, t, w_logged, radians, model=None):
 
 
 def main():
-    # Positional arguments: neither an option nor the value after one.
-    args = [a for i, a in enumerate(sys.argv[1:], 1)
-            if not a.startswith("--") and not sys.argv[i - 1].startswith("--")]
+    args = positional_args()
     if not args:
         sys.exit(__doc__)
     root = os.path.join(args[0], "DataSets")

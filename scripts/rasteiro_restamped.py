@@ -74,9 +74,7 @@ def plain_on(tt, ww, t_rest0, t_rest1, t0, t1):
 
 
 def main():
-    # Positional arguments: neither an option nor the value after one.
-    args = [a for i, a in enumerate(sys.argv[1:], 1)
-            if not a.startswith("--") and not sys.argv[i - 1].startswith("--")]
+    args = rt.positional_args()
     data = args[0] if args else os.path.join(os.path.dirname(__file__), "../../shared/data/real/rasteiro")
     gyro = sys.argv[sys.argv.index("--gyro") + 1] if "--gyro" in sys.argv else "target/release/gyro-cli"
     errors = {}

@@ -145,10 +145,15 @@ def turns(path, gyro, run_args=()):
     return out
 
 
-def main():
-    # Positional arguments: neither an option nor the value after one.
-    args = [a for i, a in enumerate(sys.argv[1:], 1)
+def positional_args():
+    """The command line's positional arguments: neither an option (`--gyro`) nor the value
+    after one."""
+    return [a for i, a in enumerate(sys.argv[1:], 1)
             if not a.startswith("--") and not sys.argv[i - 1].startswith("--")]
+
+
+def main():
+    args = positional_args()
     data = args[0] if args else os.path.join(os.path.dirname(__file__), "../../shared/data/real/rasteiro")
     gyro = sys.argv[sys.argv.index("--gyro") + 1] if "--gyro" in sys.argv else "target/release/gyro-cli"
     groups = {}
