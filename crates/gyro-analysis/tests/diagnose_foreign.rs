@@ -144,8 +144,10 @@ fn an_even_nonlinearity_from_another_generator_is_fitted_as_even() {
 /// low band the filter leaves alone). The filter's lag (9.74 ms at low frequency, scipy's
 /// group delay) is named as a latency with an interval covering it, or as its look-alike
 /// bandwidth, and nothing else; what stays unexplained is the static residual's high band
-/// (the simulated noise stays white); the written model does not make the held-out angles
-/// worse.
+/// (the simulated noise stays white) and the shape of the dynamic response: the
+/// Butterworth's second-order term (1/ω₀², 6.3e-5 s² on the rate's second derivative)
+/// is not a pure delay's (d²/2, 4.7e-5 s²), which the residual's jerk coefficient and
+/// lag-1 autocorrelation show; the written model does not make the held-out angles worse.
 #[test]
 fn a_low_passed_gyro_with_rests_gets_its_low_band_noise_and_its_lag() {
     let d = diagnosed("dlpf_train.csv", "dlpf_holdout.csv");
@@ -170,10 +172,10 @@ fn a_low_passed_gyro_with_rests_gets_its_low_band_noise_and_its_lag() {
     if named[0] == "latency" {
         covers(&d, "latency", "delay_s", 0.00974);
     }
+    let response_shape = ["regression_jerk", "lag1_autocorrelation"];
     assert!(
-        d.unexplained
-            .iter()
-            .all(|u| u.segment.starts_with("static")),
+        d.unexplained.iter().all(|u| u.segment.starts_with("static")
+            || (u.segment == "dynamic" && response_shape.contains(&u.statistic.as_str()))),
         "{:?}",
         d.unexplained
             .iter()

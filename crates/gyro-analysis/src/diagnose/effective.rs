@@ -27,7 +27,7 @@
 
 use super::ensemble::RealRun;
 use super::stats::stretches;
-use crate::noise::export::{residual_random_walk, white_bound};
+use crate::noise::export::{residual_random_walk, white_bound, white_level};
 use crate::noise::{characterize, Characterization, NoiseOptions, TauGrid};
 use serde::Serialize;
 
@@ -51,6 +51,11 @@ pub struct MeasuredNoise {
     /// Angle random walk N (deg/√h): 60 × the largest white noise (deg/s/√Hz) the
     /// residual's Allan deviation (its upper 68% bound) allows from τ = 1 s to 10 s.
     pub arw_deg_per_rt_h: f64,
+    /// The white noise the residual reads (deg/√h): 60 × the level its Allan deviation
+    /// gives from τ = 1 s to 10 s, an estimate rather than a bound
+    /// ([`crate::noise::export::white_level`]); what the baseline of runs that never
+    /// rest simulates.
+    pub white_level_deg_per_rt_h: f64,
     /// Rate random walk K (deg/s/√s), as the filter YAML writes it: the fitted +1/2 line
     /// and a fitted Gauss-Markov bias of correlation time ≥ 3 s read at τ = 3 s, else the
     /// +1/2 line's upper bound.
@@ -116,12 +121,14 @@ pub fn measure(runs: &[&RealRun], label: &'static str) -> Option<MeasuredNoise> 
     };
     let c = characterize(&segments, fs, &options).ok()?;
     let arw = 60.0 * white_bound(&c)?;
+    let level = 60.0 * white_level(&c)?;
     let (k, resolved) = residual_random_walk(&c);
     Some(MeasuredNoise {
         runs: label,
         run_count: same_rate.len(),
         samples,
         arw_deg_per_rt_h: arw,
+        white_level_deg_per_rt_h: level,
         rate_random_walk_dps_per_rt_s: k,
         rate_random_walk_resolved: resolved,
         bias_instability_dps: c.fit.bias_instability_dps.value,
@@ -246,6 +253,13 @@ mod tests {
                 "{effects:?}: {}",
                 m.describe()
             );
+            // The white level (what a baseline simulates) is the estimate under it.
+            assert!(m.white_level_deg_per_rt_h <= m.arw_deg_per_rt_h);
+            assert!(
+                (0.93..1.07).contains(&(m.white_level_deg_per_rt_h / 6.0)),
+                "{effects:?}: {}",
+                m.white_level_deg_per_rt_h
+            );
             assert!((m.ratio_to_model - m.arw_deg_per_rt_h / 0.5).abs() < 1e-12);
             // No bias wander was simulated: none is resolved.
             assert!(!m.rate_random_walk_resolved, "{}", m.describe());
@@ -253,8 +267,8 @@ mod tests {
         }
     }
 
-    /// Runs that never rest give the nominal model the white noise of their moving
-    /// residual, not the prior's, and its note says so; without the measurement it is the
+    /// Runs that never rest give the nominal model the white level of their moving
+    /// residual (not its bound, not the prior's), and its note says so; without the measurement it is the
     /// prior's.
     #[test]
     fn runs_without_rest_give_the_baseline_their_moving_noise() {
@@ -270,8 +284,8 @@ mod tests {
         } = super::super::fit::nominal_model(&refs, &prior, Some(&m));
         assert!(white_target.is_none(), "these runs do not rest");
         assert!(whiteness.is_none(), "these runs do not rest");
-        assert_eq!(model.arw_deg_per_rt_h, m.arw_deg_per_rt_h);
-        assert!((0.9..1.2).contains(&(model.arw_deg_per_rt_h / 6.0)));
+        assert_eq!(model.arw_deg_per_rt_h, m.white_level_deg_per_rt_h);
+        assert!((0.93..1.07).contains(&(model.arw_deg_per_rt_h / 6.0)));
         let text = notes.join("\n");
         assert!(text.contains("fitted to the moving residual"), "{text}");
         assert!(text.contains("; its wander: K "), "{text}");

@@ -321,7 +321,9 @@ pub struct Nominal {
 ///
 /// The white noise comes from the runs' rests when they hold 2 s of them, else from
 /// `moving`, the effective noise of their moving residual ([`super::effective`]: the
-/// largest white noise its Allan deviation allows from 1 to 10 s), else from the prior.
+/// white level its Allan deviation reads from 1 to 10 s, an estimate: the bound the
+/// effective noise reports would widen every simulated residual by its margin), else from
+/// the prior.
 /// At rest it is matched to the first differences, unless the rests' Allan variance at
 /// [`super::features::WHITE_CHECK_TAU_S`] reads a white noise that differs beyond
 /// [`WHITE_CHECK_Z`]: a low-pass inside the band (a MEMS gyro's digital filter) leaves
@@ -425,11 +427,11 @@ pub fn nominal_model(
                 model.arw_deg_per_rt_h
             ),
         });
-    } else if let Some(m) = moving.filter(|m| m.arw_deg_per_rt_h > 0.0) {
-        model.arw_deg_per_rt_h = m.arw_deg_per_rt_h;
+    } else if let Some(m) = moving.filter(|m| m.white_level_deg_per_rt_h > 0.0) {
+        model.arw_deg_per_rt_h = m.white_level_deg_per_rt_h;
         notes.push(format!(
-            "angle random walk {:.4} deg/sqrt(h): fewer than 2 s of static samples, so fitted to the moving residual of the training runs (the largest white noise its Allan deviation allows from 1 to 10 s; it holds what the reference does not resolve as well as the sensor's own noise; the prior's is {:.4})",
-            model.arw_deg_per_rt_h, prior.arw_deg_per_rt_h
+            "angle random walk {:.4} deg/sqrt(h): fewer than 2 s of static samples, so fitted to the moving residual of the training runs (the white level its Allan deviation reads from 1 to 10 s, degrees-of-freedom weighted, at most the largest the curve allows, {:.4}; it holds what the reference does not resolve as well as the sensor's own noise; the prior's is {:.4})",
+            model.arw_deg_per_rt_h, m.arw_deg_per_rt_h, prior.arw_deg_per_rt_h
         ));
     } else {
         notes.push(format!(

@@ -328,6 +328,34 @@ pub fn white_bound(c: &Characterization) -> Option<f64> {
         .min_by(f64::total_cmp)
 }
 
+/// N (deg/s/√Hz): the white noise the Allan deviation of `c` reads over [`WHITE_TAUS_S`],
+/// as an estimate rather than a bound ([`white_bound`] is the largest the curve allows,
+/// which over-reads pure white noise by the upper bound's margin, several percent on
+/// minutes of data): the points' τ·AVAR(τ), the fitted rate random walk taken off,
+/// averaged with their equivalent degrees of freedom as weights, and never above
+/// [`white_bound`] (a bounded error, whose Allan deviation falls as 1/τ, raises the mean
+/// over the range but not the bound at its far end). `None` when no computed τ lies in
+/// the range.
+pub fn white_level(c: &Characterization) -> Option<f64> {
+    let bound = white_bound(c)?;
+    let walk = c.fit.rate_random_walk_dps_per_rt_s.value.powi(2) / 3.0;
+    let (lo, hi) = WHITE_TAUS_S;
+    let (sum, weights) = c
+        .allan
+        .points
+        .iter()
+        .filter(|p| p.tau_s >= lo * (1.0 - 1e-9) && p.tau_s <= hi * (1.0 + 1e-9))
+        .fold((0.0, 0.0), |(sum, weights), p| {
+            let w = if p.edf.is_finite() && p.edf > 0.0 {
+                p.edf
+            } else {
+                1.0
+            };
+            (sum + w * (p.avar() - walk * p.tau_s) * p.tau_s, weights + w)
+        });
+    Some((sum / weights).max(0.0).sqrt().min(bound))
+}
+
 /// K (deg/s/√s) of a residual's characterisation `c` ([`NoiseParams::from_residual`]) and
 /// whether the fit resolved it (else it is the +½ upper bound).
 pub fn residual_random_walk(c: &Characterization) -> (f64, bool) {
@@ -693,6 +721,50 @@ mod tests {
         // Nothing computed in the range.
         c.allan.points.retain(|p| p.tau_s < 1.0);
         assert_eq!(white_bound(&c), None);
+        assert_eq!(white_level(&c), None);
+    }
+
+    /// The white level reads the points, not their upper bound: exact for white noise;
+    /// with a bounded error it is the bound; a random walk the fit resolved is taken off.
+    #[test]
+    fn white_level_is_the_estimate_under_the_bound() {
+        let mut c = crate::noise::characterize(
+            &[&(0..4000)
+                .map(|k| ((k * 7919) % 13) as f64)
+                .collect::<Vec<_>>()],
+            100.0,
+            &crate::noise::NoiseOptions::default(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        c.fit.rate_random_walk_dps_per_rt_s.value = 0.0;
+        let template = c.allan.points[0];
+        let curve = |avar: &dyn Fn(f64) -> f64| -> Vec<crate::noise::AllanPoint> {
+            [0.5, 1.0, 2.0, 5.0, 10.0, 20.0]
+                .iter()
+                .map(|&tau_s| crate::noise::AllanPoint {
+                    tau_s,
+                    adev_dps: avar(tau_s).sqrt(),
+                    upper_dps: 1.1 * avar(tau_s).sqrt(),
+                    edf: 1000.0 / tau_s,
+                    ..template
+                })
+                .collect()
+        };
+        let close = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() < 1e-9);
+        c.allan.points = curve(&|t| 0.09 / t);
+        assert!(close(white_level(&c), 0.3), "{:?}", white_level(&c));
+        assert!(close(white_bound(&c), 0.33), "{:?}", white_bound(&c));
+        // A bounded error: the bound at the range's far end, under the mean.
+        c.allan.points = curve(&|t| 0.09 / t + 1.0 / (t * t));
+        assert_eq!(white_level(&c), white_bound(&c));
+        assert!(close(white_bound(&c), 1.1 * (0.09f64 + 0.1).sqrt()));
+        c.allan.points = curve(&|t| 0.09 / t + 0.04 * t / 3.0);
+        c.fit.rate_random_walk_dps_per_rt_s.value = 0.2;
+        assert!(close(white_level(&c), 0.3), "{:?}", white_level(&c));
+        // A curve rising with τ (a wander the fit did not resolve) reads its mean level,
+        // never above the bound.
+        c.fit.rate_random_walk_dps_per_rt_s.value = 0.0;
+        assert!(white_level(&c) <= white_bound(&c));
     }
 
     /// Static white noise of 3.0 deg/√h through a one-pole low-pass at 10 Hz (a MEMS
