@@ -674,12 +674,8 @@ fn one_line(text: &str) -> String {
 mod tests {
     use super::*;
 
-    /// The white bound is the −½ line under the curve's upper bound from 1 s to 10 s
-    /// (here 1/0.9 of the point estimates, which it does not read): exact for white
-    /// noise; a bounded error (Allan deviation ∝ 1/τ) counts only as much as it still
-    /// shows at 10 s; a fitted random walk is taken off; τ outside the range is ignored.
-    #[test]
-    fn white_bound_is_the_half_line_under_the_curve() {
+    /// A characterisation to put synthetic Allan points into (no fitted random walk).
+    fn synthetic() -> Characterization {
         let mut c = crate::noise::characterize(
             &[&(0..4000)
                 .map(|k| ((k * 7919) % 13) as f64)
@@ -689,18 +685,39 @@ mod tests {
         )
         .unwrap_or_else(|e| panic!("{e}"));
         c.fit.rate_random_walk_dps_per_rt_s.value = 0.0;
+        c
+    }
+
+    /// Allan points (`template` otherwise) at 0.5–20 s of the Allan variance `avar(τ)`: the point estimate and
+    /// the upper bound `adev_ratio` and `upper_ratio` times its square root, 1000/τ degrees
+    /// of freedom.
+    fn on_curve(
+        template: crate::noise::AllanPoint,
+        adev_ratio: f64,
+        upper_ratio: f64,
+        avar: &dyn Fn(f64) -> f64,
+    ) -> Vec<crate::noise::AllanPoint> {
+        [0.5, 1.0, 2.0, 5.0, 10.0, 20.0]
+            .iter()
+            .map(|&tau_s| crate::noise::AllanPoint {
+                tau_s,
+                adev_dps: adev_ratio * avar(tau_s).sqrt(),
+                upper_dps: upper_ratio * avar(tau_s).sqrt(),
+                edf: 1000.0 / tau_s,
+                ..template
+            })
+            .collect()
+    }
+
+    /// The white bound is the −½ line under the curve's upper bound from 1 s to 10 s
+    /// (here 1/0.9 of the point estimates, which it does not read): exact for white
+    /// noise; a bounded error (Allan deviation ∝ 1/τ) counts only as much as it still
+    /// shows at 10 s; a fitted random walk is taken off; τ outside the range is ignored.
+    #[test]
+    fn white_bound_is_the_half_line_under_the_curve() {
+        let mut c = synthetic();
         let template = c.allan.points[0];
-        let curve = |avar: &dyn Fn(f64) -> f64| -> Vec<crate::noise::AllanPoint> {
-            [0.5, 1.0, 2.0, 5.0, 10.0, 20.0]
-                .iter()
-                .map(|&tau_s| crate::noise::AllanPoint {
-                    tau_s,
-                    adev_dps: 0.9 * avar(tau_s).sqrt(),
-                    upper_dps: avar(tau_s).sqrt(),
-                    ..template
-                })
-                .collect()
-        };
+        let curve = |avar: &dyn Fn(f64) -> f64| on_curve(template, 0.9, 1.0, avar);
         let close = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() < 1e-12);
         // White noise alone, with a deeper dip at 0.5 s and 20 s (outside the range).
         c.allan.points = curve(&|t| {
@@ -728,28 +745,9 @@ mod tests {
     /// with a bounded error it is the bound; a random walk the fit resolved is taken off.
     #[test]
     fn white_level_is_the_estimate_under_the_bound() {
-        let mut c = crate::noise::characterize(
-            &[&(0..4000)
-                .map(|k| ((k * 7919) % 13) as f64)
-                .collect::<Vec<_>>()],
-            100.0,
-            &crate::noise::NoiseOptions::default(),
-        )
-        .unwrap_or_else(|e| panic!("{e}"));
-        c.fit.rate_random_walk_dps_per_rt_s.value = 0.0;
+        let mut c = synthetic();
         let template = c.allan.points[0];
-        let curve = |avar: &dyn Fn(f64) -> f64| -> Vec<crate::noise::AllanPoint> {
-            [0.5, 1.0, 2.0, 5.0, 10.0, 20.0]
-                .iter()
-                .map(|&tau_s| crate::noise::AllanPoint {
-                    tau_s,
-                    adev_dps: avar(tau_s).sqrt(),
-                    upper_dps: 1.1 * avar(tau_s).sqrt(),
-                    edf: 1000.0 / tau_s,
-                    ..template
-                })
-                .collect()
-        };
+        let curve = |avar: &dyn Fn(f64) -> f64| on_curve(template, 1.0, 1.1, avar);
         let close = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() < 1e-9);
         c.allan.points = curve(&|t| 0.09 / t);
         assert!(close(white_level(&c), 0.3), "{:?}", white_level(&c));
