@@ -301,6 +301,15 @@ pub fn bandwidth_term(c: &Characterization) -> Option<(f64, f64)> {
 /// the convention reads N, to 10 s, the length of a long movement.
 pub const WHITE_TAUS_S: (f64, f64) = (1.0, 10.0);
 
+/// The computed Allan points of `c` whose τ lies in [`WHITE_TAUS_S`] (ends included).
+fn white_points(c: &Characterization) -> impl Iterator<Item = &crate::noise::AllanPoint> {
+    let (lo, hi) = WHITE_TAUS_S;
+    c.allan
+        .points
+        .iter()
+        .filter(move |p| p.tau_s >= lo * (1.0 - 1e-9) && p.tau_s <= hi * (1.0 + 1e-9))
+}
+
 /// N (deg/s/√Hz): the largest white noise the Allan deviation of `c` allows at every
 /// computed τ in [`WHITE_TAUS_S`]: the −½ line under its upper confidence bound (68%)
 /// there, after taking off the fitted rate random walk's K²·τ/3 (the point estimates'
@@ -312,11 +321,7 @@ pub const WHITE_TAUS_S: (f64, f64) = (1.0, 10.0);
 /// the same curve as white noise there.) `None` when no computed τ lies in the range.
 pub fn white_bound(c: &Characterization) -> Option<f64> {
     let walk = c.fit.rate_random_walk_dps_per_rt_s.value.powi(2) / 3.0;
-    let (lo, hi) = WHITE_TAUS_S;
-    c.allan
-        .points
-        .iter()
-        .filter(|p| p.tau_s >= lo * (1.0 - 1e-9) && p.tau_s <= hi * (1.0 + 1e-9))
+    white_points(c)
         .map(|p| {
             let upper = if p.upper_dps.is_finite() {
                 p.upper_dps
@@ -339,20 +344,14 @@ pub fn white_bound(c: &Characterization) -> Option<f64> {
 pub fn white_level(c: &Characterization) -> Option<f64> {
     let bound = white_bound(c)?;
     let walk = c.fit.rate_random_walk_dps_per_rt_s.value.powi(2) / 3.0;
-    let (lo, hi) = WHITE_TAUS_S;
-    let (sum, weights) = c
-        .allan
-        .points
-        .iter()
-        .filter(|p| p.tau_s >= lo * (1.0 - 1e-9) && p.tau_s <= hi * (1.0 + 1e-9))
-        .fold((0.0, 0.0), |(sum, weights), p| {
-            let w = if p.edf.is_finite() && p.edf > 0.0 {
-                p.edf
-            } else {
-                1.0
-            };
-            (sum + w * (p.avar() - walk * p.tau_s) * p.tau_s, weights + w)
-        });
+    let (sum, weights) = white_points(c).fold((0.0, 0.0), |(sum, weights), p| {
+        let w = if p.edf.is_finite() && p.edf > 0.0 {
+            p.edf
+        } else {
+            1.0
+        };
+        (sum + w * (p.avar() - walk * p.tau_s) * p.tau_s, weights + w)
+    });
     Some((sum / weights).max(0.0).sqrt().min(bound))
 }
 
