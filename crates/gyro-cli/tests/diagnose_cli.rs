@@ -114,6 +114,14 @@ fn names_an_injected_scale_factor_and_compensates_it() {
     ] {
         assert!(first[key].is_number(), "effects[0].{key}: {first}");
     }
+    // An effect whose test does not pass is not scored on the held-out runs: its
+    // held-out figures are null, said so in the table.
+    for e in d["effects"].as_array().unwrap() {
+        let passes = !e["test"].as_str().unwrap().ends_with("does not pass");
+        assert_eq!(e["delta_bic"].is_number(), passes, "{e}");
+        assert_eq!(e["holdout_gap_after"].is_number(), passes, "{e}");
+        assert!(e["holdout_gap_before"].is_number(), "{e}");
+    }
     assert_eq!(first["id"], "scale_factor", "{}", d["effects"]);
     assert_eq!(first["significant"], true);
     let k = first["params"]["k"].as_f64().unwrap();

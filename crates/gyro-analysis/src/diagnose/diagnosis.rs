@@ -62,15 +62,18 @@ pub struct EffectResult {
     pub id: &'static str,
     /// Fitted parameters by name.
     pub params: BTreeMap<&'static str, f64>,
-    /// BIC(nominal) − BIC(nominal + effect) on the held-out runs (positive favours it).
-    pub delta_bic: f64,
+    /// BIC(nominal) − BIC(nominal + effect) on the held-out runs (positive favours it);
+    /// null when the effect was not scored on the held-out runs (its parameter test does
+    /// not pass on the training runs, so it can never be named; `--score-every-candidate`
+    /// scores it anyway). The same for the other held-out figures.
+    pub delta_bic: Option<f64>,
     /// G of the held-out runs, nominal (the candidate ensemble's seeds).
     pub holdout_gap_before: f64,
     /// G of the held-out runs with this effect added.
-    pub holdout_gap_after: f64,
+    pub holdout_gap_after: Option<f64>,
     /// (before − after) / (before − floor); 0 when before is within 10% of the floor
     /// (no gap to close).
-    pub fraction_closed: f64,
+    pub fraction_closed: Option<f64>,
     /// Named in the verdict.
     pub significant: bool,
     /// 95% intervals of the parameters (null: unbounded).
@@ -84,12 +87,12 @@ pub struct EffectResult {
     /// The parameter test and its outcome.
     pub test: String,
     /// Bootstrap over held-out runs: P(no likelihood improvement).
-    pub bootstrap_p: f64,
+    pub bootstrap_p: Option<f64>,
     /// Effects it is confounded with (indistinguishable on these runs).
     pub confounded_with: Vec<&'static str>,
     /// The posterior check on its signature statistics (see
-    /// [`super::posterior`]): with the named set for a named effect, alone otherwise.
-    /// An effect that fails it is not named.
+    /// [`super::posterior`]): with the named set for a named effect, alone otherwise
+    /// (null when not scored on the held-out runs). An effect that fails it is not named.
     pub posterior_check: Option<super::posterior::PosteriorCheck>,
 }
 

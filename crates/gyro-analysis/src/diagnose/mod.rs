@@ -10,8 +10,9 @@
 //! 2. **Where**: z-scores of each statistic against the run's ensemble, combined over runs
 //!    (Stouffer: Σz/√n); the gap G and its floor (`score`).
 //! 3. **Which**: every effect of the vocabulary is fitted on the training runs
-//!    (`fit`); each testable one is added to the nominal model and the held-out runs are
-//!    re-simulated with the same seeds ([`Options::candidate_members`] of them). An effect
+//!    (`fit`); each one whose parameter test passes is added to the nominal model and the
+//!    held-out runs are re-simulated with the same seeds ([`Options::candidate_members`]
+//!    of them; every testable one with [`Options::score_every_candidate`]). An effect
 //!    is significant when its parameter test passes on the training runs (or, for a
 //!    regression coefficient, pooled with the same test on the held-out runs), its held-out
 //!    ΔBIC is positive and the bootstrap over held-out runs gives P(no improvement) < 5%.
@@ -88,6 +89,11 @@ pub struct Options {
     /// The model file whose pipeline configuration replays the held-out runs, and to
     /// which the corrections are added.
     pub base_model: ModelFile,
+    /// Score every fitted effect alone on the held-out runs, also those whose parameter
+    /// test does not pass on the training runs (which can never be named): their
+    /// held-out figures and posterior checks are then reported too, for one more
+    /// candidate ensemble each.
+    pub score_every_candidate: bool,
 }
 
 impl Default for Options {
@@ -100,6 +106,7 @@ impl Default for Options {
             prior: SensorModel::default(),
             fixed_model: false,
             base_model: ModelFile::new(gyro_core::Config::default()),
+            score_every_candidate: false,
         }
     }
 }

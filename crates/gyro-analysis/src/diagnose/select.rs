@@ -1,5 +1,6 @@
-//! Stage 4, select: every fitted candidate scored alone on the held-out runs, then
-//! forward selection, swaps, leave-one-out ablations and confounds.
+//! Stage 4, select: every fitted candidate whose parameter test passes scored alone on
+//! the held-out runs, then forward selection, swaps, leave-one-out ablations and
+//! confounds.
 
 use super::baseline::{evaluate, Baseline, Runs};
 use super::fit::{self, Fit, Joint};
@@ -25,14 +26,23 @@ pub(crate) struct Step {
     pub(crate) p: f64,
 }
 
+/// A fitted effect added alone to the nominal model and scored on the held-out runs.
+pub(crate) struct Alone {
+    /// Against the nominal model.
+    pub(crate) step: Step,
+    /// The held-out scores.
+    pub(crate) scores: Vec<RunScore>,
+}
+
 /// A fitted effect and how it scored on the held-out runs.
 pub(crate) struct Candidate {
     /// The fit on the training runs.
     pub(crate) fit: Fit,
-    /// Added alone to the nominal model.
-    pub(crate) alone: Step,
-    /// The held-out scores with it alone.
-    pub(crate) alone_scores: Vec<RunScore>,
+    /// Added alone to the nominal model and scored on the held-out runs: a fit whose
+    /// parameter test passes (every fit with [`Options::score_every_candidate`]). A fit
+    /// whose test does not pass can never be named, so by default its ensembles are
+    /// not simulated.
+    pub(crate) alone: Option<Alone>,
     /// Qualified when added alone.
     pub(crate) alone_ok: bool,
     /// Added on top of the effects selected before it (selected effects only).
@@ -59,6 +69,11 @@ pub(crate) struct Scorer<'a> {
 }
 
 impl Candidate {
+    /// The held-out scores with it alone (empty when not scored).
+    fn alone_scores(&self) -> &[RunScore] {
+        self.alone.as_ref().map_or(&[], |a| &a.scores)
+    }
+
     /// May be selected: its parameter test passes and it has not failed its posterior
     /// check.
     fn eligible(&self) -> bool {
@@ -196,26 +211,33 @@ fn delta_bic(loglik_gain: f64, params: usize, observations: usize) -> f64 {
     2.0 * loglik_gain - params as f64 * (observations.max(1) as f64).ln()
 }
 
-/// Every fit added alone to the nominal model and scored on the held-out runs.
+/// Every fit whose parameter test passes (every fit with
+/// [`Options::score_every_candidate`]) added alone to the nominal model and scored on
+/// the held-out runs.
 pub(crate) fn score_alone(scorer: &Scorer, fits: Vec<Fit>) -> Vec<Candidate> {
+    let scored = |f: &Fit| f.passes || scorer.options.score_every_candidate;
     scorer.progress.stage(
         "candidate effects on held-out runs",
-        (fits.len() * scorer.per_set()) as u64,
+        (fits.iter().filter(|f| scored(f)).count() * scorer.per_set()) as u64,
     );
     let mut candidates = Vec::new();
     for (i, f) in fits.into_iter().enumerate() {
-        let scores = scorer.eval_set(&[f.effect]);
-        let alone = scorer.step_of(
-            &scores,
-            &scorer.before,
-            f.effect.params().len(),
-            scorer.seed("alone", i),
-        );
-        let alone_ok = scorer.qualifies(&f, &alone, &[]);
+        let alone = scored(&f).then(|| {
+            let scores = scorer.eval_set(&[f.effect]);
+            let step = scorer.step_of(
+                &scores,
+                &scorer.before,
+                f.effect.params().len(),
+                scorer.seed("alone", i),
+            );
+            Alone { step, scores }
+        });
+        let alone_ok = alone
+            .as_ref()
+            .is_some_and(|a| scorer.qualifies(&f, &a.step, &[]));
         candidates.push(Candidate {
             fit: f,
             alone,
-            alone_scores: scores,
             alone_ok,
             added: None,
             excluded: false,
@@ -266,15 +288,16 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
         }
         let mut tried: Vec<(usize, Step, Vec<RunScore>)> = Vec::new();
         if step == 0 {
+            // Every eligible fit passes its test: each was scored alone.
             for &i in &pool {
                 let c = &candidates[i];
                 let st = scorer.step_of(
-                    &c.alone_scores,
+                    c.alone_scores(),
                     &current,
                     c.fit.effect.params().len(),
                     scorer.seed("alone", i),
                 );
-                tried.push((i, st, c.alone_scores.clone()));
+                tried.push((i, st, c.alone_scores().to_vec()));
             }
         } else {
             scorer.progress.stage(
@@ -450,10 +473,10 @@ fn confounds(
         if selected.contains(&i) || !candidates[i].alone_ok {
             continue;
         }
-        let si = shift(&candidates[i].alone_scores);
+        let si = shift(candidates[i].alone_scores());
         let best = selected
             .iter()
-            .map(|&j| (j, cosine(&si, &shift(&candidates[j].alone_scores))))
+            .map(|&j| (j, cosine(&si, &shift(candidates[j].alone_scores()))))
             .max_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((j, c)) = best {
             if c > CONFOUND_COSINE || dropped.contains(&i) {
@@ -507,7 +530,7 @@ fn cosine(a: &[f64], b: &[f64]) -> f64 {
 /// named set ([`posterior`]). When some fail, the first of them in the order added is
 /// left out (an effect named early for the wrong reason drags the fits of those added
 /// on top of it) and the selection is made again, until every named effect passes
-/// (each round leaves one out). Every candidate gets its posterior check.
+/// (each round leaves one out). Every candidate scored alone gets its posterior check.
 pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> Selection {
     loop {
         let selection = select(scorer, candidates);
@@ -520,7 +543,7 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
                 &candidates[i].fit,
                 &scorer.before,
                 &selection.holdout_scores,
-                &candidates[i].alone_scores,
+                candidates[i].alone_scores(),
                 scorer.sample_rate_hz(),
             );
             if !check.passes && first_failed.is_none() {
@@ -557,13 +580,14 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
             candidates[i].excluded = true;
             continue;
         }
+        // Alone, for every candidate scored alone.
         for c in candidates.iter_mut() {
-            if c.posterior.is_none() {
+            if let (None, Some(alone)) = (&c.posterior, &c.alone) {
                 c.posterior = Some(posterior::check(
                     &c.fit,
                     &scorer.before,
-                    &c.alone_scores,
-                    &c.alone_scores,
+                    &alone.scores,
+                    &alone.scores,
                     scorer.sample_rate_hz(),
                 ));
             }

@@ -53,9 +53,11 @@ fn closed(floor: f64, before: f64, after: f64) -> f64 {
 }
 
 /// Each candidate's result: the selected ones in the order they were added, then the
-/// rest by held-out gap reduction when added alone.
+/// rest by held-out gap reduction when added alone, then those not scored on the
+/// held-out runs (`gap_before`: the nominal model's held-out G with the candidate seeds).
 fn effect_results(
     floor: f64,
+    gap_before: f64,
     candidates: &[Candidate],
     selection: &Selection,
 ) -> Vec<EffectResult> {
@@ -76,17 +78,17 @@ fn effect_results(
             let mut with = selection.partners.get(&i).cloned().unwrap_or_default();
             with.sort_unstable();
             with.dedup();
-            let st = c.added.as_ref().unwrap_or(&c.alone);
+            let st = c.added.as_ref().or(c.alone.as_ref().map(|a| &a.step));
             let order = selected.iter().position(|&j| j == i);
             (
                 order,
                 EffectResult {
                     id: info.id,
                     params,
-                    delta_bic: st.delta_bic,
-                    holdout_gap_before: st.gap_before,
-                    holdout_gap_after: st.gap_after,
-                    fraction_closed: closed(floor, st.gap_before, st.gap_after),
+                    delta_bic: st.map(|st| st.delta_bic),
+                    holdout_gap_before: st.map_or(gap_before, |st| st.gap_before),
+                    holdout_gap_after: st.map(|st| st.gap_after),
+                    fraction_closed: st.map(|st| closed(floor, st.gap_before, st.gap_after)),
                     significant: order.is_some(),
                     ci95,
                     z: c.fit.z.is_finite().then_some(c.fit.z),
@@ -100,7 +102,7 @@ fn effect_results(
                             "does not pass"
                         }
                     ),
-                    bootstrap_p: st.p,
+                    bootstrap_p: st.map(|st| st.p),
                     confounded_with: with,
                     posterior_check: c.posterior.clone(),
                 },
@@ -111,8 +113,12 @@ fn effect_results(
         (Some(x), Some(y)) => x.cmp(y),
         (Some(_), None) => std::cmp::Ordering::Less,
         (None, Some(_)) => std::cmp::Ordering::Greater,
-        (None, None) => (a.holdout_gap_after - a.holdout_gap_before)
-            .total_cmp(&(b.holdout_gap_after - b.holdout_gap_before)),
+        (None, None) => match (a.holdout_gap_after, b.holdout_gap_after) {
+            (Some(x), Some(y)) => (x - a.holdout_gap_before).total_cmp(&(y - b.holdout_gap_before)),
+            (Some(_), None) => std::cmp::Ordering::Less,
+            (None, Some(_)) => std::cmp::Ordering::Greater,
+            (None, None) => std::cmp::Ordering::Equal,
+        },
     });
     effects.into_iter().map(|(_, e)| e).collect()
 }
@@ -168,7 +174,7 @@ pub(crate) struct Findings<'a> {
 /// Stage 6: the diagnosis.
 pub(crate) fn summarise(f: Findings) -> Diagnosis {
     let floor = f.baseline.floor;
-    let effects = effect_results(floor, &f.candidates, &f.selection);
+    let effects = effect_results(floor, gap(&f.holdout_before), &f.candidates, &f.selection);
     let unmodelled: Vec<&'static str> = effects
         .iter()
         .filter(|e| e.significant)

@@ -57,6 +57,11 @@ pub struct Args {
     /// Members per held-out run for each candidate effect.
     #[arg(long, default_value_t = 20, value_parser = at_least_two)]
     candidate_members: usize,
+    /// Score on the held-out runs also the effects whose parameter test does not pass on
+    /// the training runs. They can never be named; by default their held-out figures and
+    /// posterior checks are left out, which saves one candidate ensemble per effect.
+    #[arg(long)]
+    score_every_candidate: bool,
     /// Run the injection–recovery self-check instead of diagnosing logs.
     #[arg(long)]
     self_test: bool,
@@ -188,6 +193,7 @@ pub fn run(args: &Args) -> Result<()> {
         seed: args.seed,
         members: args.members,
         candidate_members: args.candidate_members,
+        score_every_candidate: args.score_every_candidate,
         ..Options::default()
     };
     if args.members < 2 || args.candidate_members < 2 {
@@ -256,6 +262,7 @@ fn self_test(args: &Args) -> Result<()> {
     let options = Options {
         members: args.members,
         candidate_members: args.candidate_members,
+        score_every_candidate: args.score_every_candidate,
         ..Options::default()
     };
     let bar = ProgressBar::new(0);

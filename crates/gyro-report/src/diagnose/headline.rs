@@ -4,6 +4,10 @@
 
 use gyro_analysis::diagnose::{Diagnosis, EffectResult};
 
+/// What the held-out columns of an effect not scored on the held-out runs say: its
+/// parameter test does not pass on the training runs, so it can never be named.
+pub const NOT_SCORED: &str = "not scored";
+
 /// Kass & Raftery's words for a BIC difference in favour of a model.
 pub fn evidence(delta_bic: f64) -> &'static str {
     if !delta_bic.is_finite() || delta_bic <= 0.0 {
@@ -155,7 +159,7 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
             "{}: {} (evidence on the held-out runs {})",
             e.id,
             sentence(e),
-            evidence(e.delta_bic)
+            e.delta_bic.map_or(NOT_SCORED, evidence)
         )
     }));
     if lines.len() == leading {
@@ -396,16 +400,16 @@ mod tests {
         EffectResult {
             id: "latency",
             params: BTreeMap::from([("delay_s", v)]),
-            delta_bic: 34_905_881.7,
+            delta_bic: Some(34_905_881.7),
             holdout_gap_before: 1.0,
-            holdout_gap_after: 1.0,
-            fraction_closed: 0.0,
+            holdout_gap_after: Some(1.0),
+            fraction_closed: Some(0.0),
             significant: true,
             ci95: BTreeMap::from([("delay_s", [Some(lo), Some(hi)])]),
             z: Some(10.0),
             holdout_z: None,
             test: String::new(),
-            bootstrap_p: 0.0,
+            bootstrap_p: Some(0.0),
             confounded_with: Vec::new(),
             posterior_check: None,
         }

@@ -686,15 +686,15 @@ fn effect_row(s: &mut String, e: &EffectResult) {
         params.join("<br>"),
         e.z.map_or("exact".to_string(), |z| format!("{z:.2}")),
         e.holdout_z.map_or("–".to_string(), |z| format!("{z:.2}")),
-        format_args!(
+        e.delta_bic.map_or(super::NOT_SCORED.to_string(), |d| format!(
             "{} ({})",
-            super::evidence(e.delta_bic),
-            sig(e.delta_bic, 3)
-        ),
+            super::evidence(d),
+            sig(d, 3)
+        )),
         num(e.holdout_gap_before),
-        num(e.holdout_gap_after),
-        num(e.fraction_closed),
-        num(e.bootstrap_p),
+        num(e.holdout_gap_after.unwrap_or(f64::NAN)),
+        num(e.fraction_closed.unwrap_or(f64::NAN)),
+        num(e.bootstrap_p.unwrap_or(f64::NAN)),
         if e.confounded_with.is_empty() {
             "–".to_string()
         } else {
@@ -1398,16 +1398,16 @@ mod tests {
         d.effects.push(gyro_analysis::diagnose::EffectResult {
             id: "clock_error_count_stamped",
             params: std::collections::BTreeMap::from([("ppm", 5737.0)]),
-            delta_bic: 360.0,
+            delta_bic: Some(360.0),
             holdout_gap_before: 296.0,
-            holdout_gap_after: 199.0,
-            fraction_closed: 0.33,
+            holdout_gap_after: Some(199.0),
+            fraction_closed: Some(0.33),
             significant: false,
             ci95: std::collections::BTreeMap::new(),
             z: Some(4.4),
             holdout_z: None,
             test: String::new(),
-            bootstrap_p: 0.0,
+            bootstrap_p: Some(0.0),
             confounded_with: Vec::new(),
             posterior_check: Some(gyro_analysis::diagnose::posterior::PosteriorCheck {
                 passes: false,

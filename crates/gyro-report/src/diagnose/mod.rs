@@ -5,7 +5,7 @@ mod headline;
 mod html;
 mod text;
 
-pub use headline::{evidence, headline, rounded, sentence, sig3};
+pub use headline::{evidence, headline, rounded, sentence, sig3, NOT_SCORED};
 
 pub use html::{
     write_report, ReportError, GAP_MAP_CLIP, GAP_MAP_COLUMNS, MIN_BIN_SAMPLES, REPORT_FILES,

@@ -235,9 +235,9 @@ pub fn table(d: &Diagnosis) -> String {
             if e.significant { "yes" } else { "" },
             e.z.map_or("exact".to_string(), |z| format!("{z:.1}")),
             e.holdout_z.map_or("-".to_string(), |z| format!("{z:.1}")),
-            super::evidence(e.delta_bic),
-            num(e.holdout_gap_after),
-            num(e.fraction_closed),
+            e.delta_bic.map_or(super::NOT_SCORED, super::evidence),
+            num(e.holdout_gap_after.unwrap_or(f64::NAN)),
+            num(e.fraction_closed.unwrap_or(f64::NAN)),
             params.join(", "),
             if e.confounded_with.is_empty() {
                 String::new()
