@@ -6,7 +6,7 @@ use gyro_analysis::diagnose::{Diagnosis, EffectResult};
 
 /// What the held-out columns of an effect not scored on the held-out runs say: its
 /// parameter test does not pass on the training runs, so it can never be named.
-pub const NOT_SCORED: &str = "not scored";
+pub const NOT_SCORED: &str = "not scored (test fails)";
 
 /// Kass & Raftery's words for a BIC difference in favour of a model.
 pub fn evidence(delta_bic: f64) -> &'static str {

@@ -752,7 +752,7 @@ Effects are fitted on the training runs only and scored on the held-out runs.</p
     );
     let _ = writeln!(
         s,
-        "<p>Ensembles: {} members per run (baseline), {} per held-out run for each candidate; seed {}; {} bootstrap resamples.{}</p>",
+        "<p>Ensembles: {} members per run (baseline), {} per held-out run for each candidate whose test passes; seed {}; {} bootstrap resamples.{}</p>",
         options.members,
         options.candidate_members,
         options.seed,
@@ -958,7 +958,9 @@ held-out ΔBIC is positive and the bootstrap over held-out runs gives P(no impro
 0.05 or, for a regression coefficient, the held-out z reaches 2 (an effect seen directly in \
 the raw data — a clip plateau, an output grid, gaps — when the same direct test passes on the \
 held-out runs too); one that adds nothing once the others are in the model is confounded \
-with them and not named. Intervals are 95%; \
+with them and not named. An effect whose parameter test does not pass can never be named and \
+is not scored on the held-out runs (“not scored”; <code>--score-every-candidate</code> scores \
+it too). Intervals are 95%; \
 z is the parameter test on the training runs (“exact” where the test is not a z-test), \
 held-out z the same coefficient's test on the held-out runs, in the same direction; \
 “closed” is (before − after) / (before − floor).</p>"
