@@ -657,7 +657,8 @@ th{background:#f2f2f2}td.n{text-align:right;font-variant-numeric:tabular-nums;wh
 tr.sig td{background:#eef6ee}tr.sig td:first-child{font-weight:bold}
 .gap{font-size:1.05em}.verdict{font-size:1.15em;padding:.5em .8em;background:#f4f4f8;border-left:4px solid #0072b2}
 .figure svg{max-width:100%;height:auto;display:block}.read{background:#fafafa;border-left:3px solid #bbb;padding:.4em .8em;font-size:.92em}
-.warn{color:#a04000}code{font-size:.95em}";
+.warn{color:#a04000}code{font-size:.95em}
+.wide{overflow-x:auto}table.effects{font-size:.8em}td.test{min-width:12em}";
 
 fn effect_row(s: &mut String, e: &EffectResult) {
     let params: Vec<String> = e
@@ -673,7 +674,7 @@ fn effect_row(s: &mut String, e: &EffectResult) {
         .collect();
     let _ = writeln!(
         s,
-        "<tr{}><td><code>{}</code></td><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td><td>{}</td></tr>",
+        "<tr{}><td><code>{}</code></td><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td><td class=\"test\">{}</td></tr>",
         if e.significant { " class=\"sig\"" } else { "" },
         esc(e.id),
         if e.significant {
@@ -967,12 +968,12 @@ held-out z the same coefficient's test on the held-out runs, in the same directi
     );
     let _ = writeln!(
         s,
-        "<table><tr><th>effect</th><th>significant</th><th>parameters [95% interval]</th><th>z</th><th>held-out z</th><th>held-out evidence (ΔBIC)</th><th>held-out G before</th><th>after</th><th>closed</th><th>bootstrap p</th><th>confounded with</th><th>test</th></tr>"
+        "<div class=\"wide\"><table class=\"effects\"><tr><th>effect</th><th>significant</th><th>parameters [95% interval]</th><th>z</th><th>held-out z</th><th>held-out evidence (ΔBIC)</th><th>held-out G before</th><th>after</th><th>closed</th><th>bootstrap p</th><th>confounded with</th><th>test</th></tr>"
     );
     for e in &d.effects {
         effect_row(s, e);
     }
-    let _ = writeln!(s, "</table>");
+    let _ = writeln!(s, "</table></div>");
     if !d.untestable.is_empty() {
         let _ = writeln!(
             s,
