@@ -84,6 +84,11 @@ pub struct EffectResult {
     /// regression effect's coefficient, a wander's Allan-variance excess (null for the
     /// other effects).
     pub holdout_z: Option<f64>,
+    /// A bias wander's shape evidence: the log-likelihood of the residual's Allan
+    /// variances at 1, 4 and 16 s over the training and the held-out runs under the
+    /// wander as fitted; of two look-alike wanders that qualify, the larger is named
+    /// (null for the other effects and for a wander whose test does not pass).
+    pub shape_loglik: Option<f64>,
     /// The parameter test and its outcome.
     pub test: String,
     /// Bootstrap over held-out runs: P(no likelihood improvement).

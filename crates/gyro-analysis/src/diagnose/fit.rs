@@ -57,6 +57,12 @@ pub struct Fit {
     /// test's `z`: a regression effect's coefficient, or a wander's Allan-variance excess,
     /// against their null replicas (`None` for the other fit procedures).
     pub holdout_z: Option<f64>,
+    /// A bias wander's shape evidence: the log-likelihood of the residual's Allan
+    /// variances at [`WANDER_TAUS_S`], pooled over the training runs and over the
+    /// held-out runs, under the wander as fitted ([`wander_shape_loglik`]; `None` for
+    /// the other fit procedures and for a wander whose test does not pass). The
+    /// look-alike wanders are told apart by it.
+    pub shape_loglik: Option<f64>,
 }
 
 /// The held-out replication of an effect whose significance is its own test passing
@@ -101,6 +107,11 @@ pub fn direct_evidence(
     }
 }
 
+/// A bias wander (a random walk or a bias instability).
+pub(crate) fn is_wander(effect: &Effect) -> bool {
+    matches!(effect.info().fit, FitProcedure::Wander(_))
+}
+
 /// Smallest z on the held-out runs with which an effect's test replicates its training
 /// fit ([`replicates`]): one-sided 2.3%.
 pub const REPLICATION_Z: f64 = 2.0;
@@ -128,8 +139,7 @@ pub fn replicates(fit: &Fit) -> bool {
 /// already explains (a bias instability named on top of a rate random walk on the
 /// walk's held-out excess), so a wander replicates only with no other wander beside it.
 pub fn replicates_beside(fit: &Fit, beside: &[Effect]) -> bool {
-    let wander = |e: &Effect| matches!(e.info().fit, FitProcedure::Wander(_));
-    replicates(fit) && !(wander(&fit.effect) && beside.iter().any(wander))
+    replicates(fit) && !(is_wander(&fit.effect) && beside.iter().any(is_wander))
 }
 
 /// Whether an effect's own test, read on the held-out runs ([`Fit::holdout_z`]), points
@@ -1121,6 +1131,7 @@ fn clock_fit(input: &FitInput) -> Result<Fit, FitError> {
         test: "time stamps' period vs the nominal sample rate".into(),
         direct: false,
         holdout_z: None,
+        shape_loglik: None,
     })
 }
 
@@ -1201,6 +1212,7 @@ fn judged(
         test: test.to_string(),
         direct: false,
         holdout_z: None,
+        shape_loglik: None,
     }
 }
 
@@ -1430,6 +1442,7 @@ fn wander_fit(
     let mut half = t95(thetas.len().saturating_sub(1)) * sd / (thetas.len() as f64).sqrt();
     let make = |theta: f64| single(theta.max(0.0).sqrt());
     let mut overshoot = None;
+    let mut shape_loglik = None;
     if z >= Z_CRITICAL && theta > 0.0 {
         // Gain: the same estimator on the training runs simulated with the
         // effect, against the same seeds without it.
@@ -1470,7 +1483,8 @@ fn wander_fit(
             1.0
         };
         // The shape: the wander fitted (mostly at 1 s, where the replicas scatter least)
-        // must not predict far more wander at any τ than the runs show.
+        // must not predict far more wander at any τ than the runs show, training and
+        // held-out pooled (one minute holds about three 16 s windows).
         let per_tau_values: Vec<(f64, f64, f64)> = per_tau
             .iter()
             .enumerate()
@@ -1482,21 +1496,101 @@ fn wander_fit(
                 (*real, *m0, simulated)
             })
             .collect();
-        overshoot = wander_overshoot(&per_tau_values, gain);
+        let terms = shape_terms(input, &per_tau_values, &sims, gain);
+        overshoot = wander_overshoot(&terms);
+        shape_loglik = wander_shape_loglik(&terms);
     }
     let lo = (theta - half).max(0.0).sqrt();
     let hi = (theta + half).max(0.0).sqrt();
     let test = "Allan variance of the regression residual at 1/4/16 s vs null replicas (one-sided)";
     let mut fit = judged(make(theta), z, vec![(Some(lo), Some(hi))], false, test);
     fit.holdout_z = holdout_z;
+    fit.shape_loglik = shape_loglik.filter(|_| fit.passes);
     if let Some((tau, ratio)) = overshoot.filter(|_| fit.passes) {
         fit.passes = false;
         fit.test = format!(
             "{test}, and its shape: at {tau} s the fitted wander's Allan variance is {ratio:.0} \
-             times the training runs' (more than {WANDER_OVERSHOOT}: not a bias wander)"
+             times the runs' (more than {WANDER_OVERSHOOT}: not a bias wander)"
         );
     }
     Ok(fit)
+}
+
+/// One τ of a wander's shape evidence ([`wander_shape_loglik`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ShapeTerm {
+    /// The pooled Allan variance of the runs and the mean of their null replicas'
+    /// ((deg/s)²), for the training runs and, when at least two measure it, the held-out
+    /// runs.
+    observed: [Option<(f64, f64)>; 2],
+    /// The excess over the null the fitted wander predicts ((deg/s)²).
+    excess: f64,
+    /// The spread of the pooled value under the fitted wander, relative to its mean.
+    relative_sd: f64,
+}
+
+/// The shape terms of a wander fitted to `input`'s training runs: `per_tau` as
+/// [`wander_overshoot`] takes it, `sims` the training runs simulated with the wander
+/// before its `gain` correction (member `j` of every run pooled makes replica `j`).
+fn shape_terms(
+    input: &FitInput,
+    per_tau: &[(f64, f64, f64)],
+    sims: &[Vec<Member>],
+    gain: f64,
+) -> Vec<ShapeTerm> {
+    let replicas = sims.iter().map(Vec::len).min().unwrap_or(0);
+    let pooled_runs = |runs: &[&RealRun], null: &[Vec<Member>], k: usize| {
+        let usable: Vec<usize> = (0..runs.len().min(null.len()))
+            .filter(|&r| runs[r].features.wander_avar[k].is_finite() && !null[r].is_empty())
+            .collect();
+        (usable.len() >= 2).then(|| {
+            let real = mean(usable.iter().map(|&r| runs[r].features.wander_avar[k]));
+            let null = mean(
+                usable
+                    .iter()
+                    .map(|&r| mean(null[r].iter().map(|m| m.features.wander_avar[k]))),
+            );
+            (real, null)
+        })
+    };
+    per_tau
+        .iter()
+        .enumerate()
+        .map(|(k, &(real, null, simulated))| {
+            let pooled: Vec<f64> = (0..replicas)
+                .map(|j| mean(sims.iter().map(|run| run[j].features.wander_avar[k])))
+                .collect();
+            ShapeTerm {
+                observed: [
+                    Some((real, null)),
+                    pooled_runs(input.holdout, input.holdout_null, k),
+                ],
+                excess: (simulated - null) / gain,
+                relative_sd: mean_sd(&pooled).1 / simulated,
+            }
+        })
+        .collect()
+}
+
+/// The log-likelihood of the runs' pooled Allan variances at [`WANDER_TAUS_S`] under a
+/// fitted wander: at each τ and for the training and the held-out runs, a normal of
+/// mean the runs' null mean plus the wander's predicted excess and of the simulated
+/// relative spread. A random walk's Allan variance grows as τ, a bias instability's is
+/// flat: fitted mostly at 1 s, where the replicas scatter least, each predicts the
+/// other's 16 s value several times off. Training and held-out runs are pooled: one
+/// minute holds about three 16 s windows, so the shape of five runs is often not
+/// decisive. `None` when a term is not finite.
+fn wander_shape_loglik(terms: &[ShapeTerm]) -> Option<f64> {
+    let mut total = 0.0;
+    for t in terms {
+        for (real, null) in t.observed.iter().flatten() {
+            let predicted = null + t.excess;
+            let sd = t.relative_sd * predicted;
+            let z = (real - predicted) / sd;
+            total += -0.5 * z * z - sd.ln();
+        }
+    }
+    (total.is_finite() && !terms.is_empty()).then_some(total)
 }
 
 /// The wander estimator `per_run` (a run's excess over its ensemble's mean, read on the
@@ -1533,15 +1627,34 @@ fn wander_excess(
 }
 
 /// The τ (s) and ratio where a fitted wander predicts the most Allan variance against
-/// the training runs', if more than [`WANDER_OVERSHOOT`] times. `per_tau` holds, at each
-/// of [`WANDER_TAUS_S`], the runs' pooled value, the null replicas' mean and the mean of
-/// simulations with the wander as fitted before its gain correction; the prediction is
-/// the null mean plus the simulated excess over `gain`.
-fn wander_overshoot(per_tau: &[(f64, f64, f64)], gain: f64) -> Option<(f64, f64)> {
-    per_tau
+/// the runs', if more than [`WANDER_OVERSHOOT`] times; `terms` at each of
+/// [`WANDER_TAUS_S`]. The runs are the training runs, with the held-out runs' pooled
+/// values added when the wander predicts their value at the first τ (1 s, where it is
+/// fitted) within the same factor: one minute holds about three 16 s windows, so five
+/// runs of a random walk can fall 3 times under its 16 s value by chance, and held-out
+/// runs that wander like the training ones tell it; held-out runs whose 1 s value the
+/// wander is far from (motion at another speed leaving another residual) cannot vouch
+/// for its shape.
+fn wander_overshoot(terms: &[ShapeTerm]) -> Option<(f64, f64)> {
+    let ratio =
+        |t: &ShapeTerm, half: usize| t.observed[half].map(|(real, null)| (null + t.excess) / real);
+    let holdout_alike = terms
+        .first()
+        .and_then(|t| ratio(t, 1))
+        .is_some_and(|r| r.is_finite() && (1.0 / WANDER_OVERSHOOT..=WANDER_OVERSHOOT).contains(&r));
+    let halves: &[usize] = if holdout_alike { &[0, 1] } else { &[0] };
+    terms
         .iter()
         .zip(WANDER_TAUS_S)
-        .map(|(&(real, null, simulated), tau)| (tau, (null + (simulated - null) / gain) / real))
+        .map(|(t, tau)| {
+            let (predicted, real) = halves
+                .iter()
+                .filter_map(|&h| t.observed[h])
+                .fold((0.0, 0.0), |(p, r), (real, null)| {
+                    (p + null + t.excess, r + real)
+                });
+            (tau, predicted / real)
+        })
         .filter(|(_, ratio)| ratio.is_finite() && *ratio > WANDER_OVERSHOOT)
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
@@ -1562,6 +1675,7 @@ mod wander_shape_tests {
             test: String::new(),
             direct: false,
             holdout_z: None,
+            shape_loglik: None,
         };
         let holds = |effect, lo, hi, fs| {
             let model = SensorModel {
@@ -1604,7 +1718,7 @@ mod wander_shape_tests {
             (0.05, 0.0005, 0.06),
             (0.2, 0.0002, 0.3),
         ];
-        assert_eq!(wander_overshoot(&per_tau, 1.0), None);
+        assert_eq!(wander_overshoot(&training(&per_tau, 1.0)), None);
     }
 
     #[test]
@@ -1615,11 +1729,100 @@ mod wander_shape_tests {
             (0.008, 0.0005, 0.03),
             (0.0004, 0.0002, 0.11),
         ];
-        let (tau, ratio) = wander_overshoot(&per_tau, 1.0).unwrap();
+        let (tau, ratio) = wander_overshoot(&training(&per_tau, 1.0)).unwrap();
         assert_eq!(tau, 16.0);
         assert!((ratio - 275.0).abs() < 1.0, "{ratio}");
         // The gain correction scales the simulated excess back.
-        assert!(wander_overshoot(&per_tau, 1000.0).is_none());
+        assert!(wander_overshoot(&training(&per_tau, 1000.0)).is_none());
+    }
+
+    #[test]
+    fn the_overshoot_reads_the_held_out_runs_too() {
+        // Self-test seed 20261204, a 0.02 deg/s/sqrt(s) random walk beside a scale
+        // factor ((deg/s)²): the training runs wandered little at 16 s (the random walk
+        // fitted to them predicts 3.4 times their value), the held-out runs twice the
+        // prediction.
+        let rows = [
+            (1.807e-4, 4.153e-5, 1.368e-4, 1.979e-4, 3.975e-5),
+            (3.376e-4, 5.990e-5, 3.265e-4, 3.875e-4, 5.837e-5),
+            (1.698e-4, 1.029e-4, 5.698e-4, 1.181e-3, 9.447e-5),
+        ];
+        let mut terms = training(&rows.map(|(r, n, p, _, _)| (r, n, p)), 1.0);
+        let (tau, ratio) = wander_overshoot(&terms).unwrap();
+        assert_eq!(tau, 16.0);
+        assert!((ratio - 3.36).abs() < 0.01, "{ratio}");
+        for (t, (_, _, _, real, null)) in terms.iter_mut().zip(rows) {
+            t.observed[1] = Some((real, null));
+        }
+        assert_eq!(wander_overshoot(&terms), None);
+        // ssong yaw, slow → medium: the medium runs' 1 s value is 60 times what a wander
+        // fitted to the slow runs predicts; they cannot vouch for its shape.
+        let slow = [
+            (2.0e-4, 4.0e-5, 2.0e-4),
+            (2.0e-4, 5.0e-5, 1.4e-4),
+            (1.0e-5, 8.0e-6, 9.7e-5),
+        ];
+        let mut terms = training(&slow, 1.0);
+        for (t, scale) in terms.iter_mut().zip([60.0, 6.0, 1.5]) {
+            let predicted = t.observed[0].map_or(0.0, |(_, null)| null + t.excess);
+            t.observed[1] = Some((predicted * scale, t.observed[0].map_or(0.0, |o| o.1)));
+        }
+        let (tau, ratio) = wander_overshoot(&terms).unwrap();
+        assert_eq!(tau, 16.0);
+        assert!((ratio - 9.7).abs() < 0.01, "{ratio}");
+    }
+
+    /// Shape terms of the training runs alone from (real, null, simulated) per τ and a
+    /// gain.
+    fn training(per_tau: &[(f64, f64, f64)], gain: f64) -> Vec<ShapeTerm> {
+        per_tau
+            .iter()
+            .map(|&(real, null, simulated)| ShapeTerm {
+                observed: [Some((real, null)), None],
+                excess: (simulated - null) / gain,
+                relative_sd: 0.3,
+            })
+            .collect()
+    }
+
+    /// Shape terms from (training real, null, predicted, spread of the prediction) and
+    /// (held-out real, null) at 1, 4 and 16 s.
+    fn terms(rows: [[f64; 6]; 3], holdout: bool) -> Vec<ShapeTerm> {
+        rows.iter()
+            .map(|&[real, null, predicted, sd, h_real, h_null]| ShapeTerm {
+                observed: [Some((real, null)), holdout.then_some((h_real, h_null))],
+                excess: predicted - null,
+                relative_sd: sd / predicted,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_shape_tells_a_random_walk_from_a_bias_instability() {
+        // Self-test seed 20261205, a 0.02 deg/s/sqrt(s) random walk alone ((deg/s)²):
+        // the runs' 16 s Allan variance is 3.6 times what the bias instability fitted
+        // to them predicts; the random walk fitted to them matches it.
+        let instability = [
+            [1.944e-4, 4.086e-5, 2.196e-4, 8.74e-6, 2.245e-4, 4.265e-5],
+            [5.198e-4, 5.804e-5, 3.171e-4, 5.43e-5, 3.445e-4, 5.997e-5],
+            [9.012e-4, 9.939e-5, 2.492e-4, 1.04e-4, 5.192e-4, 8.492e-5],
+        ];
+        let walk = [
+            [1.944e-4, 4.086e-5, 2.024e-4, 1.19e-5, 2.245e-4, 4.265e-5],
+            [5.198e-4, 5.804e-5, 4.742e-4, 5.84e-5, 3.445e-4, 5.997e-5],
+            [9.012e-4, 9.939e-5, 9.293e-4, 3.19e-4, 5.192e-4, 8.492e-5],
+        ];
+        let all = |rows| wander_shape_loglik(&terms(rows, true)).unwrap();
+        assert!(all(walk) > all(instability) + 10.0);
+        // The held-out runs alone wandered less at 16 s and lean the other way: the
+        // shape of five one-minute runs is often not decisive, so both halves count.
+        let held_out_only = |rows: [[f64; 6]; 3]| {
+            let swapped =
+                rows.map(|[_, null, p, sd, hr, hn]| [hr, hn, p - null + hn, sd, 0.0, 0.0]);
+            wander_shape_loglik(&terms(swapped, false)).unwrap()
+        };
+        assert!(held_out_only(instability) > held_out_only(walk));
+        assert_eq!(wander_shape_loglik(&[]), None);
     }
 }
 
@@ -1690,6 +1893,7 @@ fn grid_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
                 passes,
                 direct: true,
                 holdout_z: None,
+                shape_loglik: None,
                 test: format!(
                     "output grid step {step:.6} deg/s vs nominal {nominal:.6} (named above {QUANT_RATIO}x)"
                 ),
@@ -1702,6 +1906,7 @@ fn grid_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
             passes: false,
             direct: true,
             holdout_z: None,
+            shape_loglik: None,
             test: "no output grid coarser than the nominal step".into(),
         },
     })
@@ -1739,6 +1944,7 @@ fn gaps_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
         passes: gaps >= MIN_GAPS,
         direct: true,
         holdout_z: None,
+        shape_loglik: None,
         test: format!("{gaps} gaps ({filled} samples filled) in the training runs; the nominal model has none (named from {MIN_GAPS})"),
     })
 }
@@ -1780,6 +1986,7 @@ fn line_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
         passes: line.z >= Z_CRITICAL && line.ratio >= super::line::LINE_MIN_RATIO,
         direct: true,
         holdout_z: None,
+        shape_loglik: None,
         test: format!(
             "strongest line of the gyro's spectrum not coherent with the reference, above {} Hz ({:.1} times its local floor, at least {}) vs the null replicas' strongest (one-sided; replicated on the held-out runs)",
             super::line::MIN_LINE_HZ,
@@ -1936,6 +2143,7 @@ mod replication_tests {
             test: String::new(),
             direct: false,
             holdout_z,
+            shape_loglik: None,
         }
     }
 

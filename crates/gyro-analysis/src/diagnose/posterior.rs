@@ -311,6 +311,7 @@ mod tests {
             test: String::new(),
             direct: false,
             holdout_z: None,
+            shape_loglik: None,
         }
     }
 

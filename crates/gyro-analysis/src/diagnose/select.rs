@@ -280,8 +280,12 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
     let mut selected: Vec<usize> = Vec::new();
     let mut current = scorer.before.clone();
     for step in 0..MAX_EFFECTS {
+        // One bias wander per model: the look-alike wanders are told apart by their
+        // shape, not stacked.
+        let wander_selected = selected.iter().any(|&j| is_wander(&candidates[j].fit));
         let pool: Vec<usize> = (0..candidates.len())
             .filter(|i| !selected.contains(i) && candidates[*i].eligible())
+            .filter(|i| !(wander_selected && is_wander(&candidates[*i].fit)))
             .collect();
         if pool.is_empty() {
             break;
@@ -329,13 +333,37 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
         if ok.is_empty() {
             break;
         }
-        let pos = 0;
+        let pos = wander_by_shape(&ok, candidates);
         let (i, st, scores) = ok.swap_remove(pos);
         candidates[i].added = Some(st);
         selected.push(i);
         current = scores;
     }
     (selected, current)
+}
+
+/// A bias wander ([`fit::is_wander`]).
+fn is_wander(f: &Fit) -> bool {
+    fit::is_wander(&f.effect)
+}
+
+/// The position in `ok` (sorted by held-out ΔBIC, best first) of the effect to add: the
+/// first, unless it is a bias wander and a look-alike wander that also qualifies fits
+/// the shape of the runs' Allan variance better ([`Fit::shape_loglik`]). The held-out
+/// ΔBIC of a wander rests on the angle errors of the one or two runs that wandered
+/// most; the shape (a random walk's Allan variance grows with τ, a bias instability's
+/// is flat) reads every run at three averaging times.
+fn wander_by_shape(ok: &[(usize, Step, Vec<RunScore>)], candidates: &[Candidate]) -> usize {
+    let first = &candidates[ok[0].0].fit;
+    let shape = |f: &Fit| f.shape_loglik.unwrap_or(f64::NEG_INFINITY);
+    if !is_wander(first) || first.shape_loglik.is_none() {
+        return 0;
+    }
+    ok.iter()
+        .enumerate()
+        .filter(|(_, (i, _, _))| is_wander(&candidates[*i].fit))
+        .max_by(|a, b| shape(&candidates[a.1 .0].fit).total_cmp(&shape(&candidates[b.1 .0].fit)))
+        .map_or(0, |(pos, _)| pos)
 }
 
 /// Swaps: a selected effect replaced by another that passed its parameter test, kept
@@ -361,7 +389,10 @@ fn swaps(
     );
     for slot in 0..selected.len() {
         for &a in &alternatives {
-            if selected.contains(&a) || candidates[selected[slot]].fit.direct {
+            // A wander for its look-alike: told apart by their shape in the forward step.
+            let look_alike =
+                is_wander(&candidates[selected[slot]].fit) && is_wander(&candidates[a].fit);
+            if selected.contains(&a) || candidates[selected[slot]].fit.direct || look_alike {
                 continue;
             }
             let set: Vec<Effect> = selected
@@ -608,6 +639,52 @@ mod tests {
             loglik_gain,
             p,
         }
+    }
+
+    fn candidate(effect: Effect, shape_loglik: Option<f64>) -> Candidate {
+        Candidate {
+            fit: Fit {
+                effect,
+                ci95: vec![(None, None)],
+                z: 10.0,
+                passes: true,
+                test: String::new(),
+                direct: false,
+                holdout_z: Some(5.0),
+                shape_loglik,
+            },
+            alone: None,
+            alone_ok: true,
+            added: None,
+            excluded: false,
+            posterior: None,
+        }
+    }
+
+    #[test]
+    fn look_alike_wanders_are_told_apart_by_their_shape() {
+        let candidates = [
+            candidate(Effect::BiasInstability { sigma_dps: 0.045 }, Some(26.6)),
+            candidate(
+                Effect::RateRandomWalk {
+                    k_dps_per_rt_s: 0.02,
+                },
+                Some(53.0),
+            ),
+            candidate(Effect::ScaleFactor { k: 0.01 }, None),
+        ];
+        let ok = |order: &[usize]| -> Vec<(usize, Step, Vec<RunScore>)> {
+            order
+                .iter()
+                .map(|&i| (i, step(300.0 - 50.0 * i as f64, 150.0, 0.0), Vec::new()))
+                .collect()
+        };
+        // The bias instability leads on the held-out ΔBIC; the random walk fits the shape.
+        assert_eq!(wander_by_shape(&ok(&[0, 1, 2]), &candidates), 1);
+        assert_eq!(wander_by_shape(&ok(&[1, 0]), &candidates), 0);
+        // Another effect first, or a wander without its look-alike: the ΔBIC order.
+        assert_eq!(wander_by_shape(&ok(&[2, 0, 1]), &candidates), 0);
+        assert_eq!(wander_by_shape(&ok(&[0, 2]), &candidates), 0);
     }
 
     #[test]

@@ -93,6 +93,7 @@ fn effect_results(
                     ci95,
                     z: c.fit.z.is_finite().then_some(c.fit.z),
                     holdout_z: c.fit.holdout_z,
+                    shape_loglik: c.fit.shape_loglik,
                     test: format!(
                         "{}: {}",
                         c.fit.test,

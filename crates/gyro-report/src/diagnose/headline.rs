@@ -408,6 +408,7 @@ mod tests {
             ci95: BTreeMap::from([("delay_s", [Some(lo), Some(hi)])]),
             z: Some(10.0),
             holdout_z: None,
+            shape_loglik: None,
             test: String::new(),
             bootstrap_p: Some(0.0),
             confounded_with: Vec::new(),

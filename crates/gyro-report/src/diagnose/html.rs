@@ -705,8 +705,19 @@ fn effect_row(s: &mut String, e: &EffectResult) {
                 .collect::<Vec<_>>()
                 .join(", ")
         },
-        esc(&e.test)
+        test_cell(e)
     );
+}
+
+/// The test column: the parameter test and, for a bias wander, its shape evidence.
+fn test_cell(e: &EffectResult) -> String {
+    match e.shape_loglik {
+        Some(l) => format!(
+            "{}<br>shape: log-likelihood {l:.1} of the 1/4/16 s Allan variances, all runs",
+            esc(&e.test)
+        ),
+        None => esc(&e.test),
+    }
 }
 
 fn header(s: &mut String, d: &Diagnosis, options: &Options) {
@@ -1409,6 +1420,7 @@ mod tests {
             ci95: std::collections::BTreeMap::new(),
             z: Some(4.4),
             holdout_z: None,
+            shape_loglik: None,
             test: String::new(),
             bootstrap_p: Some(0.0),
             confounded_with: Vec::new(),
@@ -1428,6 +1440,21 @@ mod tests {
                 "clock_error_count_stamped fails  its signature statistic is not measured"
             ),
             "{text}"
+        );
+        // A wander's shape evidence is in its test cell; another effect's is not.
+        assert!(!test_cell(&d.effects[d.effects.len() - 1]).contains("shape"));
+        let mut walk = d.effects[d.effects.len() - 1].clone();
+        walk.id = "rate_random_walk";
+        walk.test = "Allan variance <test>".into();
+        walk.shape_loglik = Some(53.04);
+        let cell = test_cell(&walk);
+        assert!(
+            cell.starts_with("Allan variance &lt;test&gt;<br>"),
+            "{cell}"
+        );
+        assert!(
+            cell.contains("log-likelihood 53.0 of the 1/4/16 s"),
+            "{cell}"
         );
     }
 
