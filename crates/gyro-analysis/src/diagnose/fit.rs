@@ -644,13 +644,11 @@ impl FitInput<'_> {
         self.null.iter().map(Vec::len).min().unwrap_or(0)
     }
 
-    /// Pooled value of `f` over the real runs and over each null replica.
+    /// Pooled value of `f` over the training runs and over each null replica
+    /// ([`pooled`]).
     fn pooled(&self, f: &dyn Fn(&super::features::Features) -> f64) -> (f64, Vec<f64>) {
-        let real = mean(self.train.iter().map(|r| f(&r.features)));
-        let replicas = (0..self.members())
-            .map(|j| mean(self.null.iter().map(|m| f(&m[j].features))))
-            .collect();
-        (real, replicas)
+        let null: Vec<&[Member]> = self.null.iter().map(Vec::as_slice).collect();
+        pooled(self.train, &null, f)
     }
 
     /// Pooled regression coefficients of noise-free simulations with `effects`.
@@ -663,6 +661,29 @@ impl FitInput<'_> {
             .collect();
         std::array::from_fn(|i| mean(coefs.iter().map(|c| c[i])))
     }
+}
+
+/// Pooled value of `f`: its mean over `runs`, and over each replica of their ensembles
+/// in `null` ([`pooled_replicas`]).
+fn pooled(
+    runs: &[&RealRun],
+    null: &[&[Member]],
+    f: &dyn Fn(&super::features::Features) -> f64,
+) -> (f64, Vec<f64>) {
+    let real = mean(runs.iter().map(|r| f(&r.features)));
+    (real, pooled_replicas(null, f))
+}
+
+/// The mean of `f` over each replica of the runs' ensembles `members`: member `j` of
+/// every run makes replica `j`, as many as the smallest ensemble holds.
+fn pooled_replicas(
+    members: &[&[Member]],
+    f: &dyn Fn(&super::features::Features) -> f64,
+) -> Vec<f64> {
+    let replicas = members.iter().map(|m| m.len()).min().unwrap_or(0);
+    (0..replicas)
+        .map(|j| mean(members.iter().map(|m| f(&m[j].features))))
+        .collect()
 }
 
 /// What the regression fits share: the noise-free coefficients without any effect, and
@@ -1485,18 +1506,9 @@ fn wander_fit(
         // The shape: the wander fitted (mostly at 1 s, where the replicas scatter least)
         // must not predict far more wander at any τ than the runs show, training and
         // held-out pooled (one minute holds about three 16 s windows).
-        let per_tau_values: Vec<(f64, f64, f64)> = per_tau
-            .iter()
-            .enumerate()
-            .map(|(k, (real, m0, _, _))| {
-                let simulated = mean(
-                    (0..input.train.len())
-                        .map(|r| mean(sims[r].iter().map(|m| m.features.wander_avar[k]))),
-                );
-                (*real, *m0, simulated)
-            })
-            .collect();
-        let terms = shape_terms(input, &per_tau_values, &sims, gain);
+        let observed: Vec<(f64, f64)> =
+            per_tau.iter().map(|&(real, m0, _, _)| (real, m0)).collect();
+        let terms = shape_terms(input, &observed, &sims, gain);
         overshoot = wander_overshoot(&terms);
         shape_loglik = wander_shape_loglik(&terms);
     }
@@ -1529,44 +1541,40 @@ struct ShapeTerm {
     relative_sd: f64,
 }
 
-/// The shape terms of a wander fitted to `input`'s training runs: `per_tau` as
-/// [`wander_overshoot`] takes it, `sims` the training runs simulated with the wander
-/// before its `gain` correction (member `j` of every run pooled makes replica `j`).
+/// The shape terms of a wander fitted to `input`'s training runs: `observed` the
+/// training runs' pooled Allan variance and their null replicas' mean at each of
+/// [`WANDER_TAUS_S`], `sims` the training runs simulated with the wander before its
+/// `gain` correction (member `j` of every run pooled makes replica `j`).
 fn shape_terms(
     input: &FitInput,
-    per_tau: &[(f64, f64, f64)],
+    observed: &[(f64, f64)],
     sims: &[Vec<Member>],
     gain: f64,
 ) -> Vec<ShapeTerm> {
-    let replicas = sims.iter().map(Vec::len).min().unwrap_or(0);
-    let pooled_runs = |runs: &[&RealRun], null: &[Vec<Member>], k: usize| {
-        let usable: Vec<usize> = (0..runs.len().min(null.len()))
-            .filter(|&r| runs[r].features.wander_avar[k].is_finite() && !null[r].is_empty())
-            .collect();
-        (usable.len() >= 2).then(|| {
-            let real = mean(usable.iter().map(|&r| runs[r].features.wander_avar[k]));
-            let null = mean(
-                usable
-                    .iter()
-                    .map(|&r| mean(null[r].iter().map(|m| m.features.wander_avar[k]))),
-            );
-            (real, null)
+    let train: Vec<&[Member]> = sims.iter().map(Vec::as_slice).collect();
+    // The held-out runs that measure the τ, pooled when at least two do.
+    let holdout = |k: usize| -> Option<(f64, f64)> {
+        let (runs, null): (Vec<&RealRun>, Vec<&[Member]>) = input
+            .holdout
+            .iter()
+            .zip(input.holdout_null)
+            .filter(|(r, m)| r.features.wander_avar[k].is_finite() && !m.is_empty())
+            .map(|(r, m)| (*r, m.as_slice()))
+            .unzip();
+        (runs.len() >= 2).then(|| {
+            let (real, replicas) = pooled(&runs, &null, &|f| f.wander_avar[k]);
+            (real, mean(replicas.into_iter()))
         })
     };
-    per_tau
+    observed
         .iter()
         .enumerate()
-        .map(|(k, &(real, null, simulated))| {
-            let pooled: Vec<f64> = (0..replicas)
-                .map(|j| mean(sims.iter().map(|run| run[j].features.wander_avar[k])))
-                .collect();
+        .map(|(k, &(real, null))| {
+            let (simulated, sd) = mean_sd(&pooled_replicas(&train, &|f| f.wander_avar[k]));
             ShapeTerm {
-                observed: [
-                    Some((real, null)),
-                    pooled_runs(input.holdout, input.holdout_null, k),
-                ],
+                observed: [Some((real, null)), holdout(k)],
                 excess: (simulated - null) / gain,
-                relative_sd: mean_sd(&pooled).1 / simulated,
+                relative_sd: sd / simulated,
             }
         })
         .collect()
