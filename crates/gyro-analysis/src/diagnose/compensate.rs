@@ -5,15 +5,15 @@
 //! What the core corrects is each effect's [`CoreCorrection`] in the effect table
 //! (`gyro_sim::EFFECTS`): a scale, asymmetry or temperature coefficient of the core's
 //! correction (ΔT from the first temperature of the run, as the simulator defines it),
-//! the model file's reference delay (a low-pass: its low-frequency delay
-//! 2 / (2π · 1.554 f_c)), or Kalman compensation of the bias at every rest.
+//! the model file's reference delay (a low-pass: its low-frequency delay,
+//! [`gyro_sim::low_pass_delay_s`]), or Kalman compensation of the bias at every rest.
 
 use super::ensemble::RealRun;
 use super::{CompensationRun, CompensationSummary, NotCorrected};
 use crate::model::ModelFile;
 use crate::replay::{replay_with, ReplayOptions};
 use gyro_core::Compensation;
-use gyro_sim::{CoreCorrection, Effect, LOW_PASS_POLE_RATIO};
+use gyro_sim::{CoreCorrection, Effect};
 use rayon::prelude::*;
 
 /// `base` with the corrections of `effects`, and the ids corrected.
@@ -48,8 +48,7 @@ pub fn corrected_model(base: &ModelFile, effects: &[Effect]) -> (ModelFile, Vec<
                 true
             }
             CoreCorrection::LowPassReferenceDelay => {
-                model.reference_delay_s +=
-                    1.0 / (std::f64::consts::PI * LOW_PASS_POLE_RATIO * value);
+                model.reference_delay_s += gyro_sim::low_pass_delay_s(value);
                 true
             }
             CoreCorrection::KalmanBias => {

@@ -16,7 +16,6 @@ use crate::noise::fit::gauss_markov_avar_continuous;
 use crate::noise::{chi2_quantile, rate_step};
 use gyro_sim::{
     Effect, EffectInfo, FitProcedure, Reading, Regressor, SensorModel, WanderShape, EFFECTS,
-    LOW_PASS_POLE_RATIO,
 };
 use rayon::prelude::*;
 
@@ -1360,9 +1359,10 @@ fn regression_procedure(
             f.judged(input, -1.0, ci, true, test)
         }
         Reading::LowPassDelay => {
-            // A two-pole low-pass delays slow motion by 2/(2π f_pole), f_pole = 1.554 f_c:
-            // fitted as a delay (its first-order parameter), calibrated as a low-pass.
-            let per_delay = 1.0 / (std::f64::consts::PI * LOW_PASS_POLE_RATIO);
+            // A two-pole low-pass delays slow motion by a delay inverse to its cutoff
+            // (`low_pass_delay_s`): fitted as a delay (its first-order parameter),
+            // calibrated as a low-pass.
+            let per_delay = gyro_sim::low_pass_delay_s(1.0);
             let nyquist = 0.5 * input.model.sample_rate_hz;
             let to_cutoff = |d: f64| -> f64 {
                 if d > 0.0 {

@@ -188,6 +188,12 @@ effect_enum! {
 /// of f_c, `1/√(√2 − 1)`; it delays slow motion by 2/(2π · ratio · f_c).
 pub const LOW_PASS_POLE_RATIO: f64 = 1.553_773_974_030_037_1;
 
+/// The delay (s) by which the `bandwidth` low-pass of `cutoff_hz` holds back slow
+/// motion: 2/(2π · [`LOW_PASS_POLE_RATIO`] · f_c), its two stages' time constants.
+pub fn low_pass_delay_s(cutoff_hz: f64) -> f64 {
+    1.0 / (std::f64::consts::PI * LOW_PASS_POLE_RATIO * cutoff_hz)
+}
+
 /// The `bias_instability` effect of standard deviation `sigma_dps` as the sum of its six
 /// first-order Gauss-Markov processes: `(σ_i, τ_i)` with τ_i = 10^(0.6 i) s, i = 0..5
 /// (1 s to 1000 s), each σ_i = σ/√6, so that the variances add up to σ².
