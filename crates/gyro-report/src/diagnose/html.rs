@@ -713,7 +713,8 @@ fn effect_row(s: &mut String, e: &EffectResult) {
 fn test_cell(e: &EffectResult) -> String {
     match e.shape_loglik {
         Some(l) => format!(
-            "{}<br>shape: log-likelihood {l:.1} of the 1/4/16 s Allan variances, all runs",
+            "{}<br>shape: log-likelihood {l:.1} of the 1/4/16 s Allan variances, all runs \
+             (of two look-alike wanders, the larger is named)",
             esc(&e.test)
         ),
         None => esc(&e.test),
@@ -1456,6 +1457,7 @@ mod tests {
             cell.contains("log-likelihood 53.0 of the 1/4/16 s"),
             "{cell}"
         );
+        assert!(cell.ends_with("the larger is named)"), "{cell}");
     }
 
     #[test]
