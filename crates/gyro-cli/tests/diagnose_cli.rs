@@ -3,44 +3,10 @@
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 mod common;
-use common::{gyro, json_of, map_column, ok, temp_dir, write};
+use common::{gyro, json_of, map_column, ok, run_csv, temp_dir, write};
 
-use gyro_log as log;
-use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+use gyro_sim::Effect;
 use std::path::Path;
-
-/// A simulated bench run of `duration_s` at `fs`, written as CSV.
-fn run_csv(
-    dir: &Path,
-    name: &str,
-    fs: f64,
-    duration_s: f64,
-    effects: &[Effect],
-    seed: u64,
-) -> String {
-    let model = SensorModel {
-        sample_rate_hz: fs,
-        ..SensorModel::default()
-    };
-    let profile = BenchProfile {
-        duration_s,
-        ..BenchProfile::default()
-    };
-    let log = simulate(
-        &model,
-        effects,
-        &Motion::bench(&profile, seed),
-        &SimOptions {
-            seed: seed + 100,
-            ..SimOptions::default()
-        },
-    );
-    let path = dir.join(name);
-    let mut file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
-    log::write_csv(&mut file, &log).unwrap();
-    drop(file);
-    path.to_string_lossy().into_owned()
-}
 
 fn runs(dir: &Path, prefix: &str, count: usize, effects: &[Effect], seed: u64) -> Vec<String> {
     (0..count)

@@ -4,10 +4,9 @@
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 mod common;
-use common::{gyro, json_of, ok, temp_dir, workspace_root};
+use common::{gyro, json_of, ok, run_csv, temp_dir, workspace_root};
 
-use gyro_log as log;
-use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
+use gyro_sim::Effect;
 use std::path::Path;
 
 /// `fixtures/noise/noise_yaml_input.csv` (`make_noise_yaml_input.py`): white noise of
@@ -153,28 +152,7 @@ fn never_overwrites_an_input() {
 
 /// A simulated bench run (CRM100 at 250 Hz, 45 s) with `effects`.
 fn bench_csv(dir: &Path, name: &str, effects: &[Effect], seed: u64) -> String {
-    let model = SensorModel {
-        sample_rate_hz: 250.0,
-        ..SensorModel::default()
-    };
-    let profile = BenchProfile {
-        duration_s: 45.0,
-        ..BenchProfile::default()
-    };
-    let log = simulate(
-        &model,
-        effects,
-        &Motion::bench(&profile, seed),
-        &SimOptions {
-            seed: seed + 100,
-            ..SimOptions::default()
-        },
-    );
-    let path = dir.join(name);
-    let mut file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
-    log::write_csv(&mut file, &log).unwrap();
-    drop(file);
-    path.to_string_lossy().into_owned()
+    run_csv(dir, name, 250.0, 45.0, effects, seed)
 }
 
 /// `diagnose --noise-yaml` writes the effective noise measured on the training runs, as

@@ -119,3 +119,36 @@ pub fn map_column(text: &str, column: &str, f: impl Fn(f64) -> f64) -> String {
     }
     out
 }
+
+/// A simulated bench run of `duration_s` at `fs`, written as CSV.
+pub fn run_csv(
+    dir: &Path,
+    name: &str,
+    fs: f64,
+    duration_s: f64,
+    effects: &[gyro_sim::Effect],
+    seed: u64,
+) -> String {
+    let model = gyro_sim::SensorModel {
+        sample_rate_hz: fs,
+        ..gyro_sim::SensorModel::default()
+    };
+    let profile = gyro_sim::BenchProfile {
+        duration_s,
+        ..gyro_sim::BenchProfile::default()
+    };
+    let log = gyro_sim::simulate(
+        &model,
+        effects,
+        &gyro_sim::Motion::bench(&profile, seed),
+        &gyro_sim::SimOptions {
+            seed: seed + 100,
+            ..gyro_sim::SimOptions::default()
+        },
+    );
+    let path = dir.join(name);
+    let mut file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+    gyro_log::write_csv(&mut file, &log).unwrap();
+    drop(file);
+    path.to_string_lossy().into_owned()
+}
