@@ -4,6 +4,7 @@
 use super::effective::{measure, MeasuredNoise};
 use super::ensemble::{ensembles, Member, RealRun};
 use super::score::{self, gap, score, RunScore};
+use super::short_white::short_white;
 use super::{fit, Options, Progress};
 use gyro_sim::{Effect, SensorModel};
 
@@ -105,6 +106,14 @@ pub(crate) struct Baseline {
 /// baseline ensembles of every run.
 pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) -> Baseline {
     let moving = measure(&runs.train, "training");
+    // Runs that never rest: the moving residual's white level, read again where it
+    // holds the most blocks.
+    let short = match &moving {
+        Some(m) if !options.fixed_model && !fit::rests_suffice(&runs.train) => {
+            short_white(&runs.train, &options.prior, m, options.seed)
+        }
+        _ => None,
+    };
     let (nominal, notes, white_target, whiteness) = if options.fixed_model {
         let mut m = options.prior;
         if let Some(first) = runs.train.first() {
@@ -122,7 +131,7 @@ pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) 
             mut notes,
             white_target,
             whiteness,
-        } = fit::nominal_model(&runs.train, &options.prior, moving.as_ref());
+        } = fit::nominal_model(&runs.train, &options.prior, moving.as_ref(), short.as_ref());
         // The prior's range is the CRM100's: any run, trained on or held out, that reads
         // beyond it shows it is not this sensor's (it is not fitted, only refused).
         let largest = crate::model::largest_plausible_abs_rate(

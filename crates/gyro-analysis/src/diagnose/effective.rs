@@ -94,12 +94,42 @@ pub struct EffectiveNoise {
 /// compared with anything ([`MeasuredNoise::compared_to`]).
 pub fn measure(runs: &[&RealRun], label: &'static str) -> Option<MeasuredNoise> {
     let fs = runs.first()?.sample_rate_hz;
-    let min_len = (MIN_STRETCH_S * fs).ceil() as usize;
     let same_rate: Vec<&&RealRun> = runs.iter().filter(|r| r.sample_rate_hz == fs).collect();
-    let segments: Vec<&[f64]> = same_rate
+    let residuals: Vec<&[f64]> = same_rate
         .iter()
-        .flat_map(|r| {
-            let residual = &r.residual_dps;
+        .map(|r| r.residual_dps.as_slice())
+        .collect();
+    let (c, samples) = characterize_residuals(&residuals, fs)?;
+    let arw = 60.0 * white_bound(&c)?;
+    let level = 60.0 * white_level(&c)?;
+    let (k, resolved) = residual_random_walk(&c);
+    Some(MeasuredNoise {
+        runs: label,
+        run_count: same_rate.len(),
+        samples,
+        arw_deg_per_rt_h: arw,
+        white_level_deg_per_rt_h: level,
+        rate_random_walk_dps_per_rt_s: k,
+        rate_random_walk_resolved: resolved,
+        bias_instability_dps: c.fit.bias_instability_dps.value,
+        model_arw_deg_per_rt_h: f64::NAN,
+        compared_with: "nothing",
+        ratio_to_model: f64::NAN,
+        characterization: c,
+    })
+}
+
+/// The Allan characterisation, from τ = [`MIN_TAU_S`], of the finite stretches of at
+/// least [`MIN_STRETCH_S`] of `residuals` (regression residuals at `fs` Hz), with the
+/// samples used; `None` when no stretch is long enough or it cannot be characterised.
+pub(crate) fn characterize_residuals(
+    residuals: &[&[f64]],
+    fs: f64,
+) -> Option<(Characterization, usize)> {
+    let min_len = (MIN_STRETCH_S * fs).ceil() as usize;
+    let segments: Vec<&[f64]> = residuals
+        .iter()
+        .flat_map(|residual| {
             stretches(residual.len(), |i| residual[i].is_finite())
                 .into_iter()
                 .filter(|s| s.len() >= min_len)
@@ -119,24 +149,9 @@ pub fn measure(runs: &[&RealRun], label: &'static str) -> Option<MeasuredNoise> 
         ),
         ..NoiseOptions::default()
     };
-    let c = characterize(&segments, fs, &options).ok()?;
-    let arw = 60.0 * white_bound(&c)?;
-    let level = 60.0 * white_level(&c)?;
-    let (k, resolved) = residual_random_walk(&c);
-    Some(MeasuredNoise {
-        runs: label,
-        run_count: same_rate.len(),
-        samples,
-        arw_deg_per_rt_h: arw,
-        white_level_deg_per_rt_h: level,
-        rate_random_walk_dps_per_rt_s: k,
-        rate_random_walk_resolved: resolved,
-        bias_instability_dps: c.fit.bias_instability_dps.value,
-        model_arw_deg_per_rt_h: f64::NAN,
-        compared_with: "nothing",
-        ratio_to_model: f64::NAN,
-        characterization: c,
-    })
+    characterize(&segments, fs, &options)
+        .ok()
+        .map(|c| (c, samples))
 }
 
 impl MeasuredNoise {
@@ -192,7 +207,7 @@ impl MeasuredNoise {
     }
 }
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
     use super::*;
     use gyro_log::{regularize, GridOptions};
@@ -200,7 +215,7 @@ mod tests {
 
     /// Runs of continuous back-and-forth motion (no rest) at 100 Hz from a gyro with
     /// white noise of `arw` deg/√h and `effects`.
-    fn moving_runs(arw: f64, effects: &[Effect]) -> Vec<RealRun> {
+    pub(crate) fn moving_runs(arw: f64, effects: &[Effect]) -> Vec<RealRun> {
         let fs = 100.0;
         let model = SensorModel {
             sample_rate_hz: fs,
@@ -281,7 +296,7 @@ mod tests {
             notes,
             white_target,
             whiteness,
-        } = super::super::fit::nominal_model(&refs, &prior, Some(&m));
+        } = super::super::fit::nominal_model(&refs, &prior, Some(&m), None);
         assert!(white_target.is_none(), "these runs do not rest");
         assert!(whiteness.is_none(), "these runs do not rest");
         assert_eq!(model.arw_deg_per_rt_h, m.white_level_deg_per_rt_h);
@@ -290,7 +305,7 @@ mod tests {
         assert!(text.contains("fitted to the moving residual"), "{text}");
         assert!(text.contains("; its wander: K "), "{text}");
         let super::super::fit::Nominal { model, notes, .. } =
-            super::super::fit::nominal_model(&refs, &prior, None);
+            super::super::fit::nominal_model(&refs, &prior, None, None);
         assert_eq!(model.arw_deg_per_rt_h, prior.arw_deg_per_rt_h);
         assert!(notes.join("\n").contains("from the prior model"));
     }

@@ -293,6 +293,11 @@ pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
     features_of(r, plateau_tol_dps, true).0
 }
 
+/// The regression residual of `r` alone, as [`real_features`] takes it.
+pub fn regression_residual(r: &Residuals) -> Vec<f64> {
+    features_of(r, 1e-9, true).1
+}
+
 /// The regression coefficients of `r` alone ([`Features::coef`]; the noise-free
 /// calibrations read nothing else).
 pub fn coefficients(r: &Residuals) -> [f64; N_REG] {

@@ -346,6 +346,7 @@ pub fn nominal_model(
     train: &[&RealRun],
     prior: &SensorModel,
     moving: Option<&super::effective::MeasuredNoise>,
+    short: Option<&super::short_white::ShortWhite>,
 ) -> Nominal {
     let mut model = *prior;
     let mut notes = Vec::new();
@@ -377,11 +378,10 @@ pub fn nominal_model(
     };
     let (diff_var, count) = pooled(|r| r.features.static_diff_var);
     let (block_var, block_count) = pooled(|r| r.features.static_block_var);
-    let needed = (2.0 * model.sample_rate_hz) as usize;
     let mut target = None;
     let mut whiteness = None;
     let arw_of = |sigma: f64, model: &SensorModel| sigma * 60.0 / model.sample_rate_hz.sqrt();
-    if count >= needed.max(20) {
+    if rests_suffice(train) {
         let diff_target = WhiteTarget {
             avar_dps2: diff_var,
             block: 1,
@@ -437,11 +437,29 @@ pub fn nominal_model(
             ),
         });
     } else if let Some(m) = moving.filter(|m| m.white_level_deg_per_rt_h > 0.0) {
-        model.arw_deg_per_rt_h = m.white_level_deg_per_rt_h;
-        notes.push(format!(
-            "angle random walk {:.4} deg/sqrt(h): fewer than 2 s of static samples, so fitted to the moving residual of the training runs (the white level its Allan deviation reads from 1 to 10 s, degrees-of-freedom weighted, at most the largest the curve allows, {:.4}; it holds what the reference does not resolve as well as the sensor's own noise; the prior's is {:.4})",
-            model.arw_deg_per_rt_h, m.arw_deg_per_rt_h, prior.arw_deg_per_rt_h
-        ));
+        let (lo, hi) = super::short_white::SHORT_TAUS_S;
+        match short {
+            Some(w) if w.agrees => {
+                model.arw_deg_per_rt_h = w.level_deg_per_rt_h;
+                notes.push(format!(
+                    "angle random walk {:.4} deg/sqrt(h): fewer than 2 s of static samples, so fitted to the moving residual of the training runs, read from {lo} to {hi} s and matched by simulating the runs (the smoothing, the reference's differentiation and the output step shape the residual there); it agrees with the level read from 1 to 10 s, {:.4} (z {:.1}), and has more blocks; it holds what the reference does not resolve as well as the sensor's own noise; the prior's is {:.4}",
+                    model.arw_deg_per_rt_h, w.long_level_deg_per_rt_h, w.z, prior.arw_deg_per_rt_h
+                ));
+            }
+            _ => {
+                model.arw_deg_per_rt_h = m.white_level_deg_per_rt_h;
+                let short_note = short.map_or(String::new(), |w| {
+                    format!(
+                        "; from {lo} to {hi} s, matched by simulation, it reads {:.4} (z {:.1}): more there than white noise, such as a rig's line or a response the model lacks",
+                        w.level_deg_per_rt_h, w.z
+                    )
+                });
+                notes.push(format!(
+                    "angle random walk {:.4} deg/sqrt(h): fewer than 2 s of static samples, so fitted to the moving residual of the training runs (the white level its Allan deviation reads from 1 to 10 s, degrees-of-freedom weighted, at most the largest the curve allows, {:.4}{short_note}; it holds what the reference does not resolve as well as the sensor's own noise; the prior's is {:.4})",
+                    model.arw_deg_per_rt_h, m.arw_deg_per_rt_h, prior.arw_deg_per_rt_h
+                ));
+            }
+        }
     } else {
         notes.push(format!(
             "angle random walk {:.4} deg/sqrt(h) from the prior model: fewer than 2 s of static samples and no moving residual to measure",
@@ -471,6 +489,21 @@ pub fn nominal_model(
         white_target: target,
         whiteness,
     }
+}
+
+/// The training runs hold the 2 s of static samples (at least 20) from which the
+/// nominal model's white noise is measured at rest.
+pub fn rests_suffice(train: &[&RealRun]) -> bool {
+    let Some(fs) = train.first().map(|r| r.sample_rate_hz) else {
+        return false;
+    };
+    let count: usize = train
+        .iter()
+        .map(|r| r.features.static_diff_var)
+        .filter(|(v, n)| *n > 0 && v.is_finite())
+        .map(|(_, n)| n)
+        .sum();
+    count >= ((2.0 * fs) as usize).max(20)
 }
 
 /// The white-noise σ (deg/s per sample) whose simulated static output — bias, the
@@ -2057,7 +2090,7 @@ mod whiteness_tests {
             lsb_dps: 0.0,
             ..SensorModel::default()
         };
-        nominal_model(&refs, &prior, None)
+        nominal_model(&refs, &prior, None, None)
     }
 
     /// White rest noise passes the check, and the white noise is the first differences'

@@ -45,6 +45,7 @@ pub mod posterior;
 pub(crate) mod score;
 mod select;
 pub mod selftest;
+pub mod short_white;
 pub(crate) mod stats;
 mod summarise;
 pub mod turns;

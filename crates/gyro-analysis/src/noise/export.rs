@@ -303,11 +303,42 @@ pub const WHITE_TAUS_S: (f64, f64) = (1.0, 10.0);
 
 /// The computed Allan points of `c` whose τ lies in [`WHITE_TAUS_S`] (ends included).
 fn white_points(c: &Characterization) -> impl Iterator<Item = &crate::noise::AllanPoint> {
-    let (lo, hi) = WHITE_TAUS_S;
+    band_points(c, WHITE_TAUS_S)
+}
+
+/// The computed Allan points of `c` whose τ lies in `(lo, hi)` s (ends included).
+fn band_points(
+    c: &Characterization,
+    (lo, hi): (f64, f64),
+) -> impl Iterator<Item = &crate::noise::AllanPoint> {
     c.allan
         .points
         .iter()
         .filter(move |p| p.tau_s >= lo * (1.0 - 1e-9) && p.tau_s <= hi * (1.0 + 1e-9))
+}
+
+/// The white level that the Allan points of `c` with τ in `band` (s, ends included) read:
+/// N² (deg²/s² per Hz), their τ·AVAR(τ) with the fitted rate random walk taken off,
+/// averaged with their equivalent degrees of freedom as weights; and the largest of
+/// those degrees of freedom (the points share their data, so the average is about as
+/// precise as its best point: N² to a relative standard error of about √(2/edf)).
+/// `None` when no computed τ lies in the band.
+pub fn band_white_variance(c: &Characterization, band: (f64, f64)) -> Option<(f64, f64)> {
+    let walk = c.fit.rate_random_walk_dps_per_rt_s.value.powi(2) / 3.0;
+    let (sum, weights, best) =
+        band_points(c, band).fold((0.0, 0.0, 0.0f64), |(sum, weights, best), p| {
+            let w = if p.edf.is_finite() && p.edf > 0.0 {
+                p.edf
+            } else {
+                1.0
+            };
+            (
+                sum + w * (p.avar() - walk * p.tau_s) * p.tau_s,
+                weights + w,
+                best.max(w),
+            )
+        });
+    (weights > 0.0).then(|| ((sum / weights).max(0.0), best))
 }
 
 /// N (deg/s/√Hz): the largest white noise the Allan deviation of `c` allows at every
@@ -343,16 +374,8 @@ pub fn white_bound(c: &Characterization) -> Option<f64> {
 /// the range.
 pub fn white_level(c: &Characterization) -> Option<f64> {
     let bound = white_bound(c)?;
-    let walk = c.fit.rate_random_walk_dps_per_rt_s.value.powi(2) / 3.0;
-    let (sum, weights) = white_points(c).fold((0.0, 0.0), |(sum, weights), p| {
-        let w = if p.edf.is_finite() && p.edf > 0.0 {
-            p.edf
-        } else {
-            1.0
-        };
-        (sum + w * (p.avar() - walk * p.tau_s) * p.tau_s, weights + w)
-    });
-    Some((sum / weights).max(0.0).sqrt().min(bound))
+    let (variance, _) = band_white_variance(c, WHITE_TAUS_S)?;
+    Some(variance.sqrt().min(bound))
 }
 
 /// K (deg/s/√s) of a residual's characterisation `c` ([`NoiseParams::from_residual`]) and
