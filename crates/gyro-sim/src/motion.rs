@@ -79,8 +79,20 @@ pub enum Motion {
         period_s: f64,
         /// Angle (deg), relative to the first sample.
         angle_deg: Vec<f64>,
+        /// Rate at each sample (deg/s): see [`Motion::rate_dps`].
+        rate_dps: Vec<f64>,
     },
 }
+
+/// Smallest third difference taken for an acceleration step, in units of the
+/// reference's resolution. Rounding alone makes up to 4 (the stencil's weights 1, 3, 3, 1
+/// times half a step); the one-sided derivative adds the rounding of 1.1 steps per
+/// period, and a step's centred error is about its third difference over 4 periods, so
+/// from 10 the one-sided rate is the better by twice its rounding.
+const STEP_FLOOR: f64 = 10.0;
+/// An acceleration step's third difference is at least this many times any of those
+/// three to five samples away on either side (the smooth motion's, or the noise's).
+const STEP_RATIO: f64 = 4.0;
 
 impl Motion {
     /// Motion made of `rotations` over `duration_s`.
@@ -129,27 +141,73 @@ impl Motion {
         reference_deg: &[f64],
         smooth_samples: usize,
     ) -> Self {
-        let origin = reference_deg.first().copied().unwrap_or(0.0);
-        let half = smooth_samples / 2;
-        let n = reference_deg.len();
-        let mut prefix = Vec::with_capacity(n + 1);
-        prefix.push(0.0);
-        for r in reference_deg {
-            prefix.push(prefix.last().copied().unwrap_or(0.0) + (r - origin));
-        }
-        let smoothed: Vec<f64> = (0..n)
-            .map(|i| {
-                let lo = i.saturating_sub(half);
-                let hi = (i + half + 1).min(n);
-                (prefix[hi] - prefix[lo]) / (hi - lo) as f64
-            })
-            .collect();
-        let start = smoothed.first().copied().unwrap_or(0.0);
-        let angle_deg = smoothed.iter().map(|a| a - start).collect();
+        let (angle_deg, rate_dps) = smoothed(period_s, reference_deg, smooth_samples);
         Motion::Trajectory {
             start_s,
             period_s,
             angle_deg,
+            rate_dps,
+        }
+    }
+
+    /// [`Motion::from_reference`], with the rate beside each step of the acceleration
+    /// that `reference_deg` (on a grid of `resolution_deg`, 0 when exact) shows taken
+    /// from that sample's own side of the step.
+    ///
+    /// A turn whose angle is a raised cosine, or a trapezoidal rate profile, changes its
+    /// acceleration at once where it starts and ends. A gyro sampled there reads the
+    /// rate of its own side of the step; a centred derivative of the reference mixes both
+    /// sides, several deg/s off at 100 Hz for a sample or two. A step between samples `m`
+    /// and `m + 1` shows as a peak of the third difference `d3[m]` (the stencil
+    /// `m − 1 … m + 2`, weights `(1 − ε)²/2`, `(1 + 2ε − 2ε²)/2`, `ε²/2` of the step times
+    /// the period squared at `m − 1`, `m`, `m + 1` for a step at `m + ε`): its neighbours
+    /// `d3[m ± 1]` of the same sign or within what the smooth motion and rounding make (a
+    /// step of the rate itself, a kink of the angle, gives neighbours of the other sign
+    /// as large as the peak and is left alone), [`STEP_RATIO`] times those three samples
+    /// to five samples away (the smooth motion's) and [`STEP_FLOOR`] steps of the
+    /// resolution.
+    /// The samples whose centred stencil (and smoothing) reaches across it take a
+    /// four-point one-sided derivative of `reference_deg` (third order) on their own
+    /// side, when that side holds four samples clear of another step. Smooth motion
+    /// (a minimum-jerk turn, whose acceleration is continuous) is left as it was.
+    pub fn from_reference_with_steps(
+        start_s: f64,
+        period_s: f64,
+        reference_deg: &[f64],
+        smooth_samples: usize,
+        resolution_deg: f64,
+    ) -> Self {
+        let (angle_deg, mut rate_dps) = smoothed(period_s, reference_deg, smooth_samples);
+        let n = reference_deg.len().min(rate_dps.len());
+        let raw = &reference_deg[..n];
+        let steps = acceleration_steps(raw, resolution_deg);
+        // The centred stencil reaches two samples, the smoothing its half width.
+        let reach = 2 + smooth_samples / 2;
+        for (i, &m) in steps.iter().enumerate() {
+            let previous = if i > 0 { steps[i - 1] + 1 } else { 0 };
+            let next = steps.get(i + 1).copied().unwrap_or(n);
+            // Left of the step: samples m − reach + 1 ..= m, stencils k − 3 ..= k.
+            for k in m.saturating_sub(reach - 1)..=m {
+                if k >= previous + 3 && k < n {
+                    rate_dps[k] = (11.0 * raw[k] - 18.0 * raw[k - 1] + 9.0 * raw[k - 2]
+                        - 2.0 * raw[k - 3])
+                        / (6.0 * period_s);
+                }
+            }
+            // Right of it: samples m + 1 ..= m + reach, stencils k ..= k + 3.
+            for k in m + 1..=m + reach {
+                if k + 3 <= next.min(n - 1) {
+                    rate_dps[k] = (-11.0 * raw[k] + 18.0 * raw[k + 1] - 9.0 * raw[k + 2]
+                        + 2.0 * raw[k + 3])
+                        / (6.0 * period_s);
+                }
+            }
+        }
+        Motion::Trajectory {
+            start_s,
+            period_s,
+            angle_deg,
+            rate_dps,
         }
     }
 
@@ -192,6 +250,7 @@ impl Motion {
                 start_s,
                 period_s,
                 angle_deg,
+                ..
             } => {
                 let (i, w) = locate(time_s - start_s, *period_s, angle_deg.len());
                 let a = angle_deg.get(i).copied().unwrap_or(0.0);
@@ -215,38 +274,101 @@ impl Motion {
             Motion::Trajectory {
                 start_s,
                 period_s,
-                angle_deg,
+                rate_dps,
+                ..
             } => {
-                // Centred five-point derivatives at the samples, linearly interpolated:
-                // the rate at a sample is centred on it (the slope of the segment after
-                // it would lead the angle by half a sample), its sum over the samples
-                // telescopes to the angle change (up to the ends), and its truncation
-                // error is O(h⁴). The simulated gyro measures the motion's rate, not the
-                // ±1-sample difference that `diagnose` takes of the reference: with the
-                // same difference in both, a re-simulation would lack the difference's
-                // own error (−h²·ω‴/6), which a real gyro against a 100 Hz reference
-                // shows where turns start and end. Three points at the ends.
-                let (i, w) = locate(time_s - start_s, *period_s, angle_deg.len());
-                let slope_at = |k: usize| -> f64 {
-                    let n = angle_deg.len();
-                    if n < 2 {
-                        return 0.0;
-                    }
-                    if k >= 2 && k + 2 < n {
-                        let near = angle_deg[k + 1] - angle_deg[k - 1];
-                        let far = angle_deg[k + 2] - angle_deg[k - 2];
-                        return (8.0 * near - far) / (12.0 * period_s);
-                    }
-                    let (lo, hi) = (k.saturating_sub(1), (k + 1).min(n - 1));
-                    (angle_deg[hi] - angle_deg[lo]) / (period_s * (hi - lo) as f64)
-                };
-                if i + 1 >= angle_deg.len() {
-                    return slope_at(angle_deg.len().saturating_sub(1));
+                // The rates at the samples ([`centred_rate`], and beside acceleration
+                // steps [`Motion::from_reference_with_steps`]), linearly interpolated.
+                let n = rate_dps.len();
+                if n == 0 {
+                    return 0.0;
                 }
-                slope_at(i) + w * (slope_at(i + 1) - slope_at(i))
+                let (i, w) = locate(time_s - start_s, *period_s, n);
+                if i + 1 >= n {
+                    return rate_dps[n - 1];
+                }
+                rate_dps[i] + w * (rate_dps[i + 1] - rate_dps[i])
             }
         }
     }
+}
+
+/// The angle of `reference_deg` less its first sample, smoothed by a centred moving
+/// average of `smooth_samples` ([`Motion::from_reference`]), and its rate at each sample
+/// ([`centred_rate`]).
+fn smoothed(period_s: f64, reference_deg: &[f64], smooth_samples: usize) -> (Vec<f64>, Vec<f64>) {
+    let origin = reference_deg.first().copied().unwrap_or(0.0);
+    let half = smooth_samples / 2;
+    let n = reference_deg.len();
+    let mut prefix = Vec::with_capacity(n + 1);
+    prefix.push(0.0);
+    for r in reference_deg {
+        prefix.push(prefix.last().copied().unwrap_or(0.0) + (r - origin));
+    }
+    let smoothed: Vec<f64> = (0..n)
+        .map(|i| {
+            let lo = i.saturating_sub(half);
+            let hi = (i + half + 1).min(n);
+            (prefix[hi] - prefix[lo]) / (hi - lo) as f64
+        })
+        .collect();
+    let start = smoothed.first().copied().unwrap_or(0.0);
+    let angle_deg: Vec<f64> = smoothed.iter().map(|a| a - start).collect();
+    let rate_dps = (0..n)
+        .map(|k| centred_rate(&angle_deg, period_s, k))
+        .collect();
+    (angle_deg, rate_dps)
+}
+
+/// The rate at sample `k` of `angle_deg` (period `period_s`): a centred five-point
+/// derivative, so the rate at a sample is centred on it (the slope of the segment after
+/// it would lead the angle by half a sample), its sum over the samples telescopes to the
+/// angle change (up to the ends), and its truncation error is O(h⁴). The simulated gyro
+/// measures the motion's rate, not the ±1-sample difference that `diagnose` takes of the
+/// reference: with the same difference in both, a re-simulation would lack the
+/// difference's own error (−h²·ω‴/6), which a real gyro against a 100 Hz reference shows
+/// where turns start and end. Three points at the ends.
+fn centred_rate(angle_deg: &[f64], period_s: f64, k: usize) -> f64 {
+    let n = angle_deg.len();
+    if n < 2 {
+        return 0.0;
+    }
+    if k >= 2 && k + 2 < n {
+        let near = angle_deg[k + 1] - angle_deg[k - 1];
+        let far = angle_deg[k + 2] - angle_deg[k - 2];
+        return (8.0 * near - far) / (12.0 * period_s);
+    }
+    let (lo, hi) = (k.saturating_sub(1), (k + 1).min(n - 1));
+    (angle_deg[hi] - angle_deg[lo]) / (period_s * (hi - lo) as f64)
+}
+
+/// The acceleration steps of `raw` (on a grid of `resolution_deg`): each `m` such that a
+/// step lies between samples `m` and `m + 1` ([`Motion::from_reference_with_steps`]), in
+/// order.
+fn acceleration_steps(raw: &[f64], resolution_deg: f64) -> Vec<usize> {
+    let n = raw.len();
+    if n < 16 {
+        return Vec::new();
+    }
+    // d3[j] = x[j+2] − 3x[j+1] + 3x[j] − x[j−1], for j in 1 ..= n − 3.
+    let d3 = |j: usize| raw[j + 2] - 3.0 * raw[j + 1] + 3.0 * raw[j] - raw[j - 1];
+    let floor = STEP_FLOOR * resolution_deg.max(0.0);
+    (6..n - 8)
+        .filter(|&m| {
+            let (here, before, after) = (d3(m), d3(m - 1), d3(m + 1));
+            let smooth = (3..=5)
+                .map(|o| d3(m - o).abs().max(d3(m + o).abs()))
+                .fold(0.0, f64::max);
+            // A neighbour of the other sign is the smooth motion's or the rounding's.
+            let beside = |x: f64| here * x >= 0.0 || x.abs() <= floor + smooth;
+            here.abs() > floor
+                && here.abs() >= before.abs()
+                && here.abs() >= after.abs()
+                && beside(before)
+                && beside(after)
+                && here.abs() > STEP_RATIO * smooth
+        })
+        .collect()
 }
 
 /// Segment index and weight of `offset_s` in a uniform series of `n` samples.
@@ -337,5 +459,97 @@ mod tests {
             .fold(0.0, f64::max);
         let peak = 30.0 * std::f64::consts::TAU * f_hz;
         assert!(worst < 2e-4 * peak, "{worst} of {peak}");
+    }
+    /// Raised-cosine turns sampled at 100 Hz (the rate a half sine, the acceleration
+    /// stepping where a turn starts and ends), and the exact rate at the samples.
+    fn raised_cosine_turns(round_deg: f64) -> (Vec<f64>, Vec<f64>) {
+        let fs = 100.0;
+        let turns = [
+            (1.003, 0.4, 120.0),
+            (3.0571, 0.55, -80.0),
+            (5.5, 0.37, 135.0),
+        ];
+        let (mut angle, mut rate) = (Vec::new(), Vec::new());
+        for k in 0..800 {
+            let t = k as f64 / fs;
+            let (mut a, mut r) = (0.0, 0.0);
+            for &(start, d, turn) in &turns {
+                let x = ((t - start) / d).clamp(0.0, 1.0);
+                a += turn * (1.0 - (std::f64::consts::PI * x).cos()) / 2.0;
+                if t > start && t < start + d {
+                    r += turn * std::f64::consts::PI / (2.0 * d)
+                        * (std::f64::consts::PI * (t - start) / d).sin();
+                }
+            }
+            angle.push(if round_deg > 0.0 {
+                (a / round_deg).round() * round_deg
+            } else {
+                a
+            });
+            rate.push(r);
+        }
+        (angle, rate)
+    }
+
+    /// The largest error of `m`'s rate within four samples of a turn's start or end.
+    fn worst_error(m: &Motion, rate: &[f64]) -> f64 {
+        let moving = |k: usize| rate[k] != 0.0;
+        (4..rate.len() - 4)
+            .filter(|&k| (k - 4..=k + 4).any(|j| moving(j) != moving(k)))
+            .map(|k| (m.rate_dps(k as f64 * 0.01) - rate[k]).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// Where a turn's acceleration steps, the centred derivative is several deg/s off
+    /// the gyro's rate at 100 Hz; the one-sided one is within 0.5 deg/s (exact angles,
+    /// and angles printed to 0.001 deg and smoothed over three samples as an encoder's),
+    /// within four samples of a turn's start or end.
+    #[test]
+    fn acceleration_steps_take_the_rate_of_their_own_side() {
+        for (round_deg, smooth) in [(0.0, 1), (0.001, 3)] {
+            let (angle, rate) = raised_cosine_turns(round_deg);
+            let centred = Motion::from_reference(0.0, 0.01, &angle, smooth);
+            let sided = Motion::from_reference_with_steps(0.0, 0.01, &angle, smooth, round_deg);
+            let (before, after) = (worst_error(&centred, &rate), worst_error(&sided, &rate));
+            assert!(before > 3.0, "{round_deg}: {before}");
+            assert!(after < 0.5, "{round_deg}: {before} -> {after}");
+            // The angle is the smoothed reference's either way.
+            assert_eq!(centred.angle_deg(3.3), sided.angle_deg(3.3));
+        }
+    }
+
+    /// Smooth motion is left as it was: minimum-jerk turns at 1 kHz (the acceleration
+    /// continuous, its derivative stepping; within 0.01 deg/s, a fifteenth of the CRM100's
+    /// white noise per sample), and a piecewise-linear angle (a step of the rate itself,
+    /// which no derivative of the samples resolves) exactly.
+    #[test]
+    fn smooth_turns_and_rate_steps_are_left_alone() {
+        let m = Motion::bench(&BenchProfile::default(), 11);
+        let angle: Vec<f64> = (0..60_000)
+            .map(|k| (m.angle_deg(k as f64 * 1e-3) * 1e6).round() / 1e6)
+            .collect();
+        let centred = Motion::from_reference(0.0, 1e-3, &angle, 1);
+        let sided = Motion::from_reference_with_steps(0.0, 1e-3, &angle, 1, 0.0);
+        let (mut worst, mut changed) = (0.0f64, 0);
+        for k in 0..60_000 {
+            let d = (centred.rate_dps(k as f64 * 1e-3) - sided.rate_dps(k as f64 * 1e-3)).abs();
+            worst = worst.max(d);
+            changed += usize::from(d > 0.0);
+        }
+        // Rounding to 1e-6 deg can make a third difference peak where the turn's jerk
+        // passes zero; the rate there moves by a few thousandths of a deg/s.
+        assert!(worst < 0.01, "{worst} deg/s at {changed} samples");
+        let ramps: Vec<f64> = (0..400)
+            .map(|k| match k {
+                0..=99 => 0.0,
+                100..=199 => (k - 100) as f64 * 0.5,
+                _ => 50.0 - (k as f64 - 200.0).min(100.0) * 0.5,
+            })
+            .collect();
+        assert!(
+            Motion::from_reference(0.0, 0.01, &ramps, 1)
+                == Motion::from_reference_with_steps(0.0, 0.01, &ramps, 1, 0.0),
+            "a rate step was taken for an acceleration step"
+        );
     }
 }

@@ -151,7 +151,13 @@ impl RealRun {
         } else {
             1
         };
-        let motion = Motion::from_reference(0.0, 1.0 / fs, &reference, smooth);
+        let motion = Motion::from_reference_with_steps(
+            0.0,
+            1.0 / fs,
+            &reference,
+            smooth,
+            reference_step_deg.unwrap_or(0.0),
+        );
         let temperature_c = log.has_temperature.then(|| {
             log.slots
                 .iter()

@@ -12,21 +12,25 @@
 //! prior's wander and output step, once with the 1–10 s white level σ₁ and once without
 //! white noise (same seeds, [`SHORT_MEMBERS`] each), its residual taken as a real run's,
 //! and `σ² = σ₁² (A − A₀) / (A₁ − A₀)`, with A the residuals' white variance over the
-//! band ([`band_white_variance`]). The short level replaces the 1–10 s one only when
+//! band ([`robust_band_variance`]: from the median squared difference of block means,
+//! so that a few spikes, a rate step where a log's windows join or a turn's end the
+//! re-simulation does not follow, do not read as white noise; a mean would take them
+//! for it). The short level replaces the 1–10 s one only when
 //! the two agree within [`WHITE_CHECK_Z`] of their combined standard error, the rule of
 //! the rests' whiteness check: a rig's line or a response the model lacks puts more in
 //! the short band than white noise, and then the 1–10 s level stays.
 
-use super::effective::{characterize_residuals, MeasuredNoise};
+use super::effective::MeasuredNoise;
 use super::ensemble::{simulate_residuals, RealRun};
 use super::features::regression_residual;
 use super::fit::WHITE_CHECK_Z;
+use super::stats::stretches;
 use crate::noise::export::{band_white_variance, WHITE_TAUS_S};
 use crate::seed::derive_seed;
 use gyro_sim::SensorModel;
 use serde::Serialize;
 
-/// The averaging times of the short band (s, ends included).
+/// The averaging times of the short band (s, ends included; [`SHORT_TAUS`]).
 pub const SHORT_TAUS_S: (f64, f64) = (0.1, 1.0);
 /// Simulations per training run and white level.
 pub const SHORT_MEMBERS: usize = 4;
@@ -59,12 +63,8 @@ pub fn short_white(
     if sigma1.is_nan() || sigma1 <= 0.0 {
         return None;
     }
-    let band = |residuals: &[&[f64]]| {
-        characterize_residuals(residuals, fs)
-            .and_then(|(c, _)| band_white_variance(&c, SHORT_TAUS_S))
-    };
     let real: Vec<&[f64]> = runs.iter().map(|r| r.residual_dps.as_slice()).collect();
-    let (a_real, edf_real) = band(&real)?;
+    let (a_real, edf_real) = robust_band_variance(&real, fs)?;
     let simulated = |arw: f64| simulated_band(&runs, prior, arw, seed);
     let (a1, a0) = (simulated(sigma1)?, simulated(0.0)?);
     if a1.is_nan() || a0.is_nan() || a1 <= a0 {
@@ -118,9 +118,51 @@ fn simulated_band(
         })
         .collect();
     let slices: Vec<&[f64]> = residuals.iter().map(Vec::as_slice).collect();
-    characterize_residuals(&slices, fs)
-        .and_then(|(c, _)| band_white_variance(&c, SHORT_TAUS_S))
-        .map(|(a, _)| a)
+    robust_band_variance(&slices, fs).map(|(a, _)| a)
+}
+
+/// Averaging times of the short band (s).
+const SHORT_TAUS: [f64; 4] = [0.1, 0.2, 0.5, 1.0];
+/// Median of a χ² variable of one degree of freedom: the median squared difference of
+/// two white block means over twice the Allan variance.
+const CHI2_1_MEDIAN: f64 = 0.454_936_423_119_572_7;
+/// Efficiency of a variance read from a median of squares against one read from their
+/// mean (Gaussian differences: the median's variance is 1/(4 n f(m)²), f the χ²₁ density
+/// at its median).
+const MEDIAN_EFFICIENCY: f64 = 0.368;
+
+/// The white variance N² ((deg/s)²/Hz) that `residuals` (at `fs` Hz) read over
+/// [`SHORT_TAUS`]: at each τ, non-overlapping block means within each finite stretch,
+/// the median squared difference of neighbouring ones over 2·[`CHI2_1_MEDIAN`] (the
+/// Allan variance, robust to a few spikes) times τ; averaged with the differences'
+/// counts as weights. With it, the equivalent degrees of freedom of the shortest τ
+/// (N² to a relative standard error of about √(2/edf)). `None` without a block pair.
+pub fn robust_band_variance(residuals: &[&[f64]], fs: f64) -> Option<(f64, f64)> {
+    let (mut sum, mut weights, mut best) = (0.0, 0.0, 0.0f64);
+    for tau_s in SHORT_TAUS {
+        let m = ((tau_s * fs).round() as usize).max(1);
+        let mut squares: Vec<f64> = Vec::new();
+        for residual in residuals {
+            for stretch in stretches(residual.len(), |i| residual[i].is_finite()) {
+                let means: Vec<f64> = residual[stretch]
+                    .chunks_exact(m)
+                    .map(|c| c.iter().sum::<f64>() / m as f64)
+                    .collect();
+                squares.extend(means.windows(2).map(|w| (w[1] - w[0]).powi(2)));
+            }
+        }
+        if squares.is_empty() {
+            continue;
+        }
+        let n = squares.len();
+        let mid = n / 2;
+        let median = *squares.select_nth_unstable_by(mid, f64::total_cmp).1;
+        let avar = median / (2.0 * CHI2_1_MEDIAN);
+        sum += n as f64 * avar * (m as f64 / fs);
+        weights += n as f64;
+        best = best.max(n as f64 * MEDIAN_EFFICIENCY);
+    }
+    (weights > 0.0).then(|| (sum / weights, best))
 }
 
 #[cfg(test)]
@@ -177,5 +219,36 @@ mod tests {
         assert_eq!(model.arw_deg_per_rt_h, m.white_level_deg_per_rt_h);
         let text = notes.join("\n");
         assert!(text.contains("more there than white noise"), "{text}");
+    }
+    /// White noise reads its own variance in the short band; a few spikes (one sample in
+    /// 2000 off by 20σ, as a rate step the re-simulation does not follow) move the
+    /// robust reading by a few percent, and a mean of squares by more than 10%.
+    #[test]
+    fn the_short_band_reads_white_noise_through_a_few_spikes() {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        let fs = 100.0;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let mut x: Vec<f64> = (0..60_000)
+            .map(|_| StandardNormal.sample(&mut rng))
+            .collect();
+        // N² of unit white noise at fs: 1/fs.
+        let (clean, edf) = robust_band_variance(&[&x], fs).unwrap();
+        assert!((clean * fs - 1.0).abs() < 0.05, "{clean}");
+        assert!(edf > 1000.0, "{edf}");
+        for k in (100..x.len()).step_by(2000) {
+            x[k] += 20.0;
+        }
+        let (spiked, _) = robust_band_variance(&[&x], fs).unwrap();
+        assert!((spiked * fs - 1.0).abs() < 0.1, "{spiked}");
+        let mean_of_squares = {
+            let means: Vec<f64> = x
+                .chunks_exact(10)
+                .map(|c| c.iter().sum::<f64>() / 10.0)
+                .collect();
+            let d: Vec<f64> = means.windows(2).map(|w| (w[1] - w[0]).powi(2)).collect();
+            d.iter().sum::<f64>() / d.len() as f64 / 2.0 * 0.1
+        };
+        assert!(mean_of_squares * fs > 1.1, "{mean_of_squares}");
     }
 }
