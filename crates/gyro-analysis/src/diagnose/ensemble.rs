@@ -145,19 +145,7 @@ impl RealRun {
         stats.extend(feature_stats(&features));
         let fs = log.sample_rate_hz;
         let reference: Vec<f64> = filled_reference(&log);
-        let reference_step_deg = reference_step(&reference);
-        let smooth = if reference_step_deg.is_some() {
-            ((QUANTISED_SMOOTH_S * fs).round() as usize).max(1)
-        } else {
-            1
-        };
-        let motion = Motion::from_reference_with_steps(
-            0.0,
-            1.0 / fs,
-            &reference,
-            smooth,
-            reference_step_deg.unwrap_or(0.0),
-        );
+        let (motion, reference_step_deg) = motion_from_reference(&reference, fs);
         let temperature_c = log.has_temperature.then(|| {
             log.slots
                 .iter()
@@ -202,6 +190,29 @@ impl RealRun {
     pub fn is_empty(&self) -> bool {
         self.log.slots.is_empty()
     }
+}
+
+/// The motion a reference's samples `reference_deg` (at `fs` Hz) show, as a re-simulation
+/// takes it, and the reference's grid step (deg) when it is quantised
+/// ([`reference_step`]): smoothed over [`QUANTISED_SMOOTH_S`] when it is (an encoder's
+/// steps would otherwise be rate spikes in the simulated gyro), its rate a one-sided
+/// derivative beside each step of the acceleration
+/// ([`Motion::from_reference_with_steps`]).
+pub fn motion_from_reference(reference_deg: &[f64], fs: f64) -> (Motion, Option<f64>) {
+    let step = reference_step(reference_deg);
+    let smooth = if step.is_some() {
+        ((QUANTISED_SMOOTH_S * fs).round() as usize).max(1)
+    } else {
+        1
+    };
+    let motion = Motion::from_reference_with_steps(
+        0.0,
+        1.0 / fs,
+        reference_deg,
+        smooth,
+        step.unwrap_or(0.0),
+    );
+    (motion, step)
 }
 
 /// The step of an encoder reference (deg), if its values lie on a grid coarser than

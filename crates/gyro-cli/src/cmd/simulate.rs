@@ -23,7 +23,9 @@ pub struct Args {
     /// Duration of the generated bench-like motion (s).
     #[arg(long, default_value_t = 90.0, value_parser = value::positive::<f64>)]
     duration_s: f64,
-    /// Re-simulate the motion of this log's `reference_deg` instead of generating motion.
+    /// Re-simulate the motion of this log's `reference_deg` instead of generating motion
+    /// (as `diagnose` re-simulates a run: smoothed over 20 ms when the reference is an
+    /// encoder's, one-sided beside a step of the acceleration).
     #[arg(long)]
     motion_from: Option<PathBuf>,
     /// Add an effect: `id` or `id:name=value,...` (e.g. `scale_factor:k=0.01`); repeatable.
@@ -113,7 +115,6 @@ pub fn run(args: &Args) -> Result<()> {
                     path.display()
                 );
             }
-            let period_s = 1.0 / regular.sample_rate_hz;
             let reference: Vec<f64> = regular
                 .slots
                 .iter()
@@ -125,9 +126,9 @@ pub fn run(args: &Args) -> Result<()> {
                         path.display()
                     )
                 })?;
-            // Smooth over ~20 ms: encoder steps would otherwise be rate spikes.
-            let smooth = ((0.02 * regular.sample_rate_hz).round() as usize).max(1);
-            Motion::from_reference(0.0, period_s, &reference, smooth)
+            // As `diagnose` re-simulates a run: smoothed when the reference is an
+            // encoder's, one-sided beside a step of the acceleration.
+            gyro_analysis::diagnose::motion_from_reference(&reference, regular.sample_rate_hz).0
         }
         None => {
             if !(args.duration_s > 0.0 && args.duration_s <= 86_400.0) {
