@@ -122,10 +122,7 @@ pub fn measure(runs: &[&RealRun], label: &'static str) -> Option<MeasuredNoise> 
 /// The Allan characterisation, from τ = [`MIN_TAU_S`], of the finite stretches of at
 /// least [`MIN_STRETCH_S`] of `residuals` (regression residuals at `fs` Hz), with the
 /// samples used; `None` when no stretch is long enough or it cannot be characterised.
-pub(crate) fn characterize_residuals(
-    residuals: &[&[f64]],
-    fs: f64,
-) -> Option<(Characterization, usize)> {
+fn characterize_residuals(residuals: &[&[f64]], fs: f64) -> Option<(Characterization, usize)> {
     let min_len = (MIN_STRETCH_S * fs).ceil() as usize;
     let segments: Vec<&[f64]> = residuals
         .iter()

@@ -30,8 +30,8 @@ use crate::seed::derive_seed;
 use gyro_sim::SensorModel;
 use serde::Serialize;
 
-/// The averaging times of the short band (s, ends included; [`SHORT_TAUS`]).
-pub const SHORT_TAUS_S: (f64, f64) = (0.1, 1.0);
+/// The averaging times of the short band (s, ends included): [`SHORT_TAUS`]' first and last.
+pub const SHORT_TAUS_S: (f64, f64) = (SHORT_TAUS[0], SHORT_TAUS[SHORT_TAUS.len() - 1]);
 /// Simulations per training run and white level.
 pub const SHORT_MEMBERS: usize = 4;
 
