@@ -329,10 +329,12 @@ mod tests {
     use super::*;
     use gyro_core::Compensation;
 
-    fn temp(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("gyro-model-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
+    /// A fresh folder, removed when the guard is dropped.
+    fn temp_dir() -> tempfile::TempDir {
+        tempfile::Builder::new()
+            .prefix("gyro-model-test-")
+            .tempdir()
+            .unwrap()
     }
 
     #[test]
@@ -342,7 +344,8 @@ mod tests {
             ..Config::default()
         };
         config.paper.b0_dps = 0.25;
-        let path = temp("m.json");
+        let scratch = temp_dir();
+        let path = scratch.path().join("m.json");
         save(&path, &ModelFile::new(config)).unwrap();
         assert_eq!(load(&path).unwrap().config, config);
     }
@@ -360,7 +363,8 @@ mod tests {
             scale_sigma: 0.0016,
             ..ModelFile::new(config)
         };
-        let path = temp("corrected.json");
+        let scratch = temp_dir();
+        let path = scratch.path().join("corrected.json");
         save(&path, &model).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.contains("\"reference_delay_s\": 0.0125"), "{text}");
@@ -371,7 +375,8 @@ mod tests {
 
     #[test]
     fn partial_file_takes_defaults_and_typos_are_errors() {
-        let path = temp("partial.json");
+        let scratch = temp_dir();
+        let path = scratch.path().join("partial.json");
         std::fs::write(
             &path,
             r#"{"format":"gyro-model","version":1,"config":{"compensation":"none"}}"#,

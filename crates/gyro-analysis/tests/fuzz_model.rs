@@ -10,7 +10,7 @@ use gyro_analysis::model::{self, ModelFile};
 use gyro_core::{Config, Pipeline};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::OnceLock;
 
 /// Cases of the mutation property (the random-bytes one runs a quarter as many).
@@ -19,16 +19,20 @@ const CASES: u32 = 3000;
 /// Longest error message accepted beyond the path (see `gyro-log`'s fuzz tests).
 const MAX_ERROR_CHARS: usize = 400;
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gyro-analysis-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder for one test, named after it; removed with everything in it when the
+/// returned guard is dropped, so that test runs leave nothing in the temporary folder.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("gyro-analysis-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn seeds() -> &'static [String] {
     static SEEDS: OnceLock<Vec<String>> = OnceLock::new();
     SEEDS.get_or_init(|| {
-        let dir = temp_dir("fuzz-model-seeds");
+        let scratch = temp_dir("fuzz-model-seeds");
+        let dir = scratch.path();
         let mut fitted = ModelFile::new(Config::default());
         fitted.config.correction.scale_k = 0.02;
         fitted.config.correction.bias_dps_per_c = 0.05;
@@ -203,7 +207,8 @@ fn check(path: &Path, bytes: &[u8]) -> Result<(), TestCaseError> {
 
 #[test]
 fn the_unmutated_seeds_load() {
-    let path = temp_dir("fuzz-model-unmutated").join("model.json");
+    let scratch = temp_dir("fuzz-model-unmutated");
+    let path = scratch.path().join("model.json");
     for seed in seeds() {
         std::fs::write(&path, seed).unwrap();
         model::load(&path).unwrap();
@@ -235,7 +240,7 @@ proptest! {
                 .chain(String::from_utf8_lossy(&data).encode_utf16().flat_map(u16::to_le_bytes))
                 .collect(),
         };
-        check(&temp_dir("fuzz-model").join("model.json"), &data)?;
+        check(&temp_dir("fuzz-model").path().join("model.json"), &data)?;
     }
 }
 
@@ -254,7 +259,7 @@ proptest! {
         bytes in proptest::collection::vec(any::<u8>(), 0..300),
     ) {
         let data = if brace { [b"{\"format\": ".as_slice(), &bytes].concat() } else { bytes };
-        check(&temp_dir("fuzz-model-random").join("model.json"), &data)?;
+        check(&temp_dir("fuzz-model-random").path().join("model.json"), &data)?;
     }
 }
 
@@ -262,7 +267,8 @@ proptest! {
 /// was quoted whole (and serde's position repeated).
 #[test]
 fn long_values_are_quoted_cut() {
-    let path = temp_dir("fuzz-model-regressions").join("model.json");
+    let scratch = temp_dir("fuzz-model-regressions");
+    let path = scratch.path().join("model.json");
     let long = "w".repeat(500);
     for text in [
         format!("{{\"format\": \"gyro-model\", \"version\": \"{long}\"}}"),

@@ -17,16 +17,19 @@ use gyro_bridge::{
 use gyro_log::{self as log, McapOptions};
 use gyro_sim::SensorModel;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 const LSB_DPS: f64 = 1.0 / 24.0; // ±300 °/s range
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gyro-record-test-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder for one test, named after it; removed with everything in it when the
+/// returned guard is dropped, so that test runs leave nothing in the temporary folder.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("gyro-record-test-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// A simulated bench run at 1 kHz in the ±300 °/s range.
@@ -114,7 +117,8 @@ fn messages(path: &Path) -> Vec<Message> {
 /// emulator's to the LSB, and the file is what Foxglove and `read_mcap` expect.
 #[test]
 fn sixty_seconds_with_faults_every_intact_frame_once_every_loss_counted() {
-    let dir = temp_dir("mcap");
+    let scratch = temp_dir("mcap");
+    let dir = scratch.path();
     let path = dir.join("run.mcap");
     let source = simulated(60.0, 11);
     let config = EmulatorConfig {
@@ -287,13 +291,14 @@ fn sixty_seconds_with_faults_every_intact_frame_once_every_loss_counted() {
         .count();
     assert_eq!(missing as u64, stats.checksum_errors);
     assert_eq!(read.log.metadata_rate_hz(), Some(1000.0));
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// `--csv`: the same rows as CSV, read back by the CSV reader.
 #[test]
 fn csv_output_has_a_row_per_intact_frame() {
-    let dir = temp_dir("csv");
+    let scratch = temp_dir("csv");
+    let dir = scratch.path();
     let path = dir.join("run.csv");
     let source = simulated(5.0, 4);
     let config = EmulatorConfig {
@@ -330,14 +335,15 @@ fn csv_output_has_a_row_per_intact_frame() {
         .filter_map(|l| l.strip_prefix("# ")?.split_once(": "))
         .collect();
     assert_eq!(header["range_dps"], "300");
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// A bridge clock that steps back (a restart) is counted and warned about, and the bridge
 /// time of the summary sums the clock's forward steps instead of wrapping to 2^64 µs.
 #[test]
 fn a_bridge_clock_stepping_back_is_counted_not_wrapped() {
-    let dir = temp_dir("clock-back");
+    let scratch = temp_dir("clock-back");
+    let dir = scratch.path();
     let path = dir.join("run.csv");
     let mut planned: Vec<PlannedFrame> =
         Emulator::new(simulated(2.0, 3).into_iter(), EmulatorConfig::default()).collect();

@@ -71,19 +71,20 @@ fn s(path: &Path) -> &str {
 /// Crashes: an absurd declared rate, a run too long to simulate, a full stdout.
 #[test]
 fn absurd_sizes_and_a_full_stdout_are_one_line_errors() {
-    let dir = temp_dir("crash");
+    let scratch = temp_dir("crash");
+    let dir = scratch.path();
     // 1e9 Hz declared on rows 1 ms apart: many rows (the median says 1000 Hz) and a few.
     let many = write(
-        &dir,
+        dir,
         "many.csv",
         &log_text("# sample_rate_hz: 1e9\n", 3000, 0.001),
     );
     let few = write(
-        &dir,
+        dir,
         "few.csv",
         &log_text("# sample_rate_hz: 1e9\n", 10, 0.001),
     );
-    let good = write(&dir, "good.csv", &log_text("", 3000, 0.001));
+    let good = write(dir, "good.csv", &log_text("", 3000, 0.001));
     let model = dir.join("m.json");
     let sim = dir.join("sim.csv");
     for log in [&many, &few] {
@@ -118,7 +119,7 @@ fn absurd_sizes_and_a_full_stdout_are_one_line_errors() {
     for i in 0..2000_u64 {
         epoch.push_str(&format!("{},0.0,0.0\n", 1_700_000_000_000_000 + i * 1000));
     }
-    let epoch = write(&dir, "epoch_us.csv", &epoch);
+    let epoch = write(dir, "epoch_us.csv", &epoch);
     let out = gyro(&["simulate", "--motion-from", &epoch, "-o", s(&sim)]);
     refused(&out, 1, "epoch_us.csv: cannot simulate its motion");
     refused(
@@ -169,17 +170,18 @@ fn absurd_sizes_and_a_full_stdout_are_one_line_errors() {
             refused(&out, 1, "cannot write to stdout: No space left on device");
         }
     }
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// Hangs: a 1e9 Hz grid under `run`, an emulator whose port nobody reads; each must end
 /// on its own well within the limit.
 #[test]
 fn nothing_waits_forever() {
-    let dir = temp_dir("hang");
+    let scratch = temp_dir("hang");
+    let dir = scratch.path();
     let limit = Duration::from_secs(60);
     for (name, rows) in [("few.csv", 10), ("many.csv", 3000)] {
-        let log = write(&dir, name, &log_text("", rows, 0.001));
+        let log = write(dir, name, &log_text("", rows, 0.001));
         let out = within(&["run", &log, "--sample-rate-hz", "1e9"], limit)
             .unwrap_or_else(|| panic!("run on a 1e9 Hz grid ({name}) did not end"));
         refused(&out, 1, "--sample-rate-hz option gives 1000000000 Hz");
@@ -206,14 +208,15 @@ fn nothing_waits_forever() {
         );
         assert!(started.elapsed() < Duration::from_secs(20));
     }
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// Wrong output: fits that cannot be made are untestable (not NaN), rates that overflow
 /// are refused, and numbers that make no sense are refused at parse time.
 #[test]
 fn no_nan_fits_no_inf_tables_no_empty_simulations() {
-    let dir = temp_dir("wrong");
+    let scratch = temp_dir("wrong");
+    let dir = scratch.path();
     let runs: Vec<String> = (1..=4)
         .map(|seed| {
             let path = dir.join(format!("short{seed}.csv"));
@@ -282,7 +285,7 @@ fn no_nan_fits_no_inf_tables_no_empty_simulations() {
         let sign = if i % 2 == 0 { "-" } else { "" };
         huge.push_str(&format!("{:.3},{sign}1e300\n", i as f64 * 0.001));
     }
-    let huge = write(&dir, "huge.csv", &huge);
+    let huge = write(dir, "huge.csv", &huge);
     refused(
         &gyro(&["noise", &huge]),
         1,
@@ -302,7 +305,7 @@ fn no_nan_fits_no_inf_tables_no_empty_simulations() {
         refused(&out, 2, &format!("invalid value '{value}' for '{option}"));
         assert!(!out_csv.exists(), "{arg}");
     }
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// Silent accepts: bad metadata, duplicate or missing named columns, a run given twice,
@@ -310,7 +313,8 @@ fn no_nan_fits_no_inf_tables_no_empty_simulations() {
 /// show the input report.
 #[test]
 fn nothing_bad_is_accepted_silently() {
-    let dir = temp_dir("silent");
+    let scratch = temp_dir("silent");
+    let dir = scratch.path();
     for (name, metadata, line) in [
         ("negative.csv", "# sample_rate_hz: -1000\n", 1),
         ("zero.csv", "# sample_rate_hz: 0\n", 1),
@@ -323,7 +327,7 @@ fn nothing_bad_is_accepted_silently() {
             2,
         ),
     ] {
-        let log = write(&dir, name, &log_text(metadata, 100, 0.001));
+        let log = write(dir, name, &log_text(metadata, 100, 0.001));
         for command in ["run", "noise"] {
             refused(
                 &gyro(&[command, &log]),
@@ -333,7 +337,7 @@ fn nothing_bad_is_accepted_silently() {
         }
     }
     let dup = write(
-        &dir,
+        dir,
         "dup.csv",
         "time_s,rate_dps,rate_dps\n0.000,1,2\n0.001,1,2\n0.002,1,2\n",
     );
@@ -342,7 +346,7 @@ fn nothing_bad_is_accepted_silently() {
         1,
         "dup.csv:1: column `rate_dps` appears twice",
     );
-    let good = write(&dir, "good.csv", &log_text("", 3000, 0.001));
+    let good = write(dir, "good.csv", &log_text("", 3000, 0.001));
     refused(
         &gyro(&["run", &good, "--reference-column", "ref_deg"]),
         1,
@@ -446,15 +450,16 @@ fn nothing_bad_is_accepted_silently() {
         stderr.contains("input: 40000 rows -> 40000 samples"),
         "{stderr}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// A setting of the other format (CSV columns on an MCAP log, MCAP channels on a CSV log)
 /// would be ignored: it is refused, naming the file and the flag.
 #[test]
 fn options_of_the_other_format_are_refused() {
-    let dir = temp_dir("not-applicable");
-    let csv = write(&dir, "log.csv", &log_text("", 3000, 0.001));
+    let scratch = temp_dir("not-applicable");
+    let dir = scratch.path();
+    let csv = write(dir, "log.csv", &log_text("", 3000, 0.001));
     let mcap = dir.join("log.mcap");
     ok(&gyro(&["convert", &csv, mcap.to_str().unwrap()]));
     let mcap = mcap.to_str().unwrap();
@@ -479,8 +484,9 @@ fn a_full_stderr_does_not_panic() {
     let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
         return; // no /dev/full on this system
     };
-    let dir = temp_dir("full-stderr");
-    let empty = write(&dir, "empty.csv", "");
+    let scratch = temp_dir("full-stderr");
+    let dir = scratch.path();
+    let empty = write(dir, "empty.csv", "");
     let out = Command::new(env!("CARGO_BIN_EXE_gyro-cli"))
         .args(["run", &empty])
         .stderr(full)
@@ -508,9 +514,10 @@ fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
 /// file keeps its bytes and nothing else is written.
 #[test]
 fn existing_outputs_are_refused_without_force() {
-    let dir = temp_dir("existing");
-    let good = write(&dir, "good.csv", &log_text("", 3000, 0.001));
-    let other = write(&dir, "other.csv", &log_text("", 3000, 0.001));
+    let scratch = temp_dir("existing");
+    let dir = scratch.path();
+    let good = write(dir, "good.csv", &log_text("", 3000, 0.001));
+    let other = write(dir, "other.csv", &log_text("", 3000, 0.001));
     let bench = bench_log();
     let bench = s(&bench);
     let out = dir.join("out");
@@ -618,13 +625,14 @@ fn existing_outputs_are_refused_without_force() {
         "refusing to overwrite it",
     );
     assert_eq!(std::fs::read(&good).unwrap(), before);
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// With --force, every output that exists is replaced, whole (no partial file is left).
 #[test]
 fn force_replaces_existing_outputs() {
-    let dir = temp_dir("force");
+    let scratch = temp_dir("force");
+    let dir = scratch.path();
     let earlier = b"an earlier output\n";
     let existing = |name: &str| {
         let path = dir.join(name);
@@ -638,7 +646,7 @@ fn force_replaces_existing_outputs() {
             "{path} was not replaced"
         );
     };
-    let good = write(&dir, "good.csv", &log_text("", 3000, 0.001));
+    let good = write(dir, "good.csv", &log_text("", 3000, 0.001));
     let bench = bench_log();
     let bench = s(&bench);
 
@@ -756,20 +764,21 @@ fn force_replaces_existing_outputs() {
             .unwrap()
             .starts_with(b"\x89MCAP0\r\n"));
     }
-    let left: Vec<String> = contents(&dir)
+    let left: Vec<String> = contents(dir)
         .into_iter()
         .map(|(name, _)| name)
         .filter(|name| name.contains(".partial"))
         .collect();
     assert!(left.is_empty(), "partial files left: {left:?}");
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// Silent accept: a column option of a column the command does not read (noise reads the
 /// rate alone) or that the log lacks is refused, naming the option or the column.
 #[test]
 fn temperature_and_reference_columns_that_are_not_used_are_refused() {
-    let dir = temp_dir("unused-columns");
+    let scratch = temp_dir("unused-columns");
+    let dir = scratch.path();
     let bench = bench_log();
     let bench = s(&bench);
     for (flag, value) in [
@@ -784,7 +793,7 @@ fn temperature_and_reference_columns_that_are_not_used_are_refused() {
         );
     }
     // A log without a temperature column: the column named is not there.
-    let plain = write(&dir, "plain.csv", &log_text("", 3000, 0.001));
+    let plain = write(dir, "plain.csv", &log_text("", 3000, 0.001));
     for command in ["run", "convert"] {
         let mut args = vec![command, &plain, "--temperature-column", "temperature_c"];
         let copy = dir.join("copy.csv");
@@ -805,5 +814,5 @@ fn temperature_and_reference_columns_that_are_not_used_are_refused() {
         "--temperature-column",
         "temperature_c",
     ]));
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }

@@ -48,7 +48,8 @@ fn bench_fixture_json_contract_and_accuracy_by_mode() {
 
 #[test]
 fn table_and_csv_formats_and_series_output() {
-    let dir = temp_dir("formats");
+    let scratch = temp_dir("formats");
+    let dir = scratch.path();
     let series = dir.join("series.csv");
     let log = bench_log();
     let out = gyro(&[
@@ -113,8 +114,9 @@ fn wart_log() -> String {
 
 #[test]
 fn irregular_100hz_log_is_handled_and_reported() {
-    let dir = temp_dir("warts");
-    let path = write(&dir, "warts.csv", &wart_log());
+    let scratch = temp_dir("warts");
+    let dir = scratch.path();
+    let path = write(dir, "warts.csv", &wart_log());
     let report = json_of(&gyro(&["run", &path, "--format", "json"]));
     let input = &report["input"];
     assert_eq!(input["duplicate_rows"].as_u64(), Some(1));
@@ -131,7 +133,8 @@ fn irregular_100hz_log_is_handled_and_reported() {
 
 #[test]
 fn bad_input_is_a_clear_error_naming_file_and_line() {
-    let dir = temp_dir("bad");
+    let scratch = temp_dir("bad");
+    let dir = scratch.path();
     let cases = [
         (
             "value.csv",
@@ -177,7 +180,7 @@ fn bad_input_is_a_clear_error_naming_file_and_line() {
         ),
     ];
     for (name, text, expected) in cases {
-        let path = write(&dir, name, text);
+        let path = write(dir, name, text);
         let out = gyro(&["run", &path]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{name} should fail");
@@ -192,11 +195,12 @@ fn bad_input_is_a_clear_error_naming_file_and_line() {
 
 #[test]
 fn model_file_is_used_and_bad_models_are_refused() {
-    let dir = temp_dir("model");
+    let scratch = temp_dir("model");
+    let dir = scratch.path();
     let log = bench_log();
     let log = log.to_str().unwrap();
     let good = write(
-        &dir,
+        dir,
         "kalman.json",
         r#"{"format": "gyro-model", "version": 1, "config": {"compensation": "kalman"}}"#,
     );
@@ -205,7 +209,7 @@ fn model_file_is_used_and_bad_models_are_refused() {
     assert!(report["movements"][0]["angle_deg"].is_number());
 
     let bad = write(
-        &dir,
+        dir,
         "bad.json",
         r#"{"format": "gyro-model", "version": 1, "config": {"filter": {"order": 2, "cutoff_hz": 40}}}"#,
     );
@@ -217,14 +221,15 @@ fn model_file_is_used_and_bad_models_are_refused() {
         "{stderr}"
     );
 
-    let broken = write(&dir, "broken.json", "{\"format\": ");
+    let broken = write(dir, "broken.json", "{\"format\": ");
     let out = gyro(&["run", log, "--model", &broken]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("broken.json:1:"));
 }
 
 #[test]
 fn calibrate_and_noise_take_mcap_and_refuse_logs_without_reference() {
-    let dir = temp_dir("mcap-commands");
+    let scratch = temp_dir("mcap-commands");
+    let dir = scratch.path();
     let log = bench_log();
     let mcap = dir.join("bench.mcap");
     let out = gyro(&["convert", log.to_str().unwrap(), mcap.to_str().unwrap()]);
@@ -262,7 +267,7 @@ fn calibrate_and_noise_take_mcap_and_refuse_logs_without_reference() {
     );
 
     let no_reference = write(
-        &dir,
+        dir,
         "noref.csv",
         "time_s,rate_dps\n0.000,0.1\n0.001,0.1\n0.002,0.1\n",
     );
@@ -306,7 +311,8 @@ fn a_declared_rate_the_stamps_contradict_is_refused() {
 /// byte-order mark before the header or the model file; an invalid `--max-gap-s` is refused.
 #[test]
 fn unusual_encodings_are_read_and_bad_gap_limits_refused() {
-    let dir = temp_dir("encodings");
+    let scratch = temp_dir("encodings");
+    let dir = scratch.path();
     let latin = dir.join("latin.csv");
     std::fs::write(
         &latin,
@@ -403,7 +409,8 @@ fn unusual_encodings_are_read_and_bad_gap_limits_refused() {
 /// refused.
 #[test]
 fn calibrate_writes_the_scale_and_the_reference_delay() {
-    let dir = temp_dir("calibrate-scale");
+    let scratch = temp_dir("calibrate-scale");
+    let dir = scratch.path();
     let mut runs = Vec::new();
     for seed in 41..=44 {
         let path = dir.join(format!("run{seed}.csv"));
@@ -516,7 +523,8 @@ fn calibrate_writes_the_scale_and_the_reference_delay() {
 /// scored with that delay, or on the bench fixture, it does not.
 #[test]
 fn a_lagging_reference_is_measured_and_said() {
-    let dir = temp_dir("reference-lag");
+    let scratch = temp_dir("reference-lag");
+    let dir = scratch.path();
     let log = dir.join("late.csv");
     let out = gyro(&[
         "simulate",
@@ -550,7 +558,7 @@ fn a_lagging_reference_is_measured_and_said() {
     assert!(String::from_utf8_lossy(&csv.stderr).contains("warning: the gyro lags"));
 
     let model = write(
-        &dir,
+        dir,
         "delay.json",
         r#"{"format": "gyro-model", "version": 1, "reference_delay_s": 0.06}"#,
     );
@@ -687,8 +695,9 @@ fn a_stalled_link_s_backlog_is_not_counted_twice() {
         previous_stamp = stamp;
         text.push_str(&format!("{stamp:.6},{rate:.4},{reference_deg:.4}\n"));
     }
-    let dir = temp_dir("stall");
-    let log = write(&dir, "stall.csv", &text);
+    let scratch = temp_dir("stall");
+    let dir = scratch.path();
+    let log = write(dir, "stall.csv", &text);
     let out = json_of(&gyro(&[
         "run",
         &log,
@@ -731,8 +740,9 @@ fn printed(args: &[&str]) -> String {
 /// turns 57 times as far, and the warning names `--rate-unit rads`, which removes it.
 #[test]
 fn a_reference_of_the_opposite_sense_is_said() {
-    let dir = temp_dir("opposite-sense");
-    let log = write(&dir, "negated.csv", &bench_with("reference_deg", |v| -v));
+    let scratch = temp_dir("opposite-sense");
+    let dir = scratch.path();
+    let log = write(dir, "negated.csv", &bench_with("reference_deg", |v| -v));
 
     let bench = bench_log();
     let as_made = json_of(&gyro(&["run", bench.to_str().unwrap(), "--format", "json"]));
@@ -768,11 +778,7 @@ fn a_reference_of_the_opposite_sense_is_said() {
         "{all}"
     );
 
-    let radians = write(
-        &dir,
-        "radians.csv",
-        &bench_with("rate_dps", f64::to_radians),
-    );
+    let radians = write(dir, "radians.csv", &bench_with("rate_dps", f64::to_radians));
     let all = printed(&["run", &radians]);
     assert!(
         all.contains("radians.csv: the reference turns 57.") && all.contains("--rate-unit rads"),
@@ -796,9 +802,10 @@ fn a_reference_of_the_opposite_sense_is_said() {
 /// rows in bursts, every movement keeps its angle, and the report says what was done.
 #[test]
 fn rows_stamped_by_a_coarse_timer_keep_their_angles() {
-    let dir = temp_dir("coarse-timer");
+    let scratch = temp_dir("coarse-timer");
+    let dir = scratch.path();
     let log = write(
-        &dir,
+        dir,
         "timer.csv",
         &bench_with("time_s", |t| (t / 0.015625).floor() * 0.015625),
     );
@@ -822,12 +829,13 @@ fn rows_stamped_by_a_coarse_timer_keep_their_angles() {
 /// line), and every movement is the one of the same log without the wrap.
 #[test]
 fn a_micros_counter_that_wraps_is_unwrapped_and_said() {
-    let dir = temp_dir("micros");
+    let scratch = temp_dir("micros");
+    let dir = scratch.path();
     let span_us = 4_294_967_296.0;
     let count = |t: f64| (t * 1e6).round() + span_us - 25e6;
-    let unwrapped = write(&dir, "unwrapped.csv", &bench_with("time_s", count));
+    let unwrapped = write(dir, "unwrapped.csv", &bench_with("time_s", count));
     let wrapped = write(
-        &dir,
+        dir,
         "micros.csv",
         &bench_with("time_s", |t| count(t).rem_euclid(span_us)),
     );
@@ -896,7 +904,8 @@ fn a_micros_counter_that_wraps_is_unwrapped_and_said() {
 /// at 8 Hz, as a 1 kHz log with ms stamps read as seconds would look, is still refused.
 #[test]
 fn a_log_slower_than_the_output_rate_runs_at_its_own_rate_and_says_so() {
-    let dir = temp_dir("slow-log");
+    let scratch = temp_dir("slow-log");
+    let dir = scratch.path();
     let slow = dir.join("slow.csv");
     let slow = slow.to_str().unwrap();
     let sim = gyro(&[

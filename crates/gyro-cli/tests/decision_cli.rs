@@ -83,8 +83,9 @@ fn a_movement_across_a_gap_is_invalid() {
                 .is_none_or(|t| !(4.0..4.2).contains(&t))
         })
         .collect();
-    let dir = temp_dir("decision-gap");
-    let path = write(&dir, "gap.csv", &(kept.join("\n") + "\n"));
+    let scratch = temp_dir("decision-gap");
+    let dir = scratch.path();
+    let path = write(dir, "gap.csv", &(kept.join("\n") + "\n"));
     let args = [
         "run",
         path.as_str(),
@@ -108,9 +109,10 @@ fn a_movement_across_a_gap_is_invalid() {
 /// The window can come from the model file (`config.tightening`); a bad one is refused.
 #[test]
 fn the_window_comes_from_the_model_file() {
-    let dir = temp_dir("decision-model");
+    let scratch = temp_dir("decision-model");
+    let dir = scratch.path();
     let model = write(
-        &dir,
+        dir,
         "model.json",
         r#"{"format":"gyro-model","version":1,"config":{"tightening":{"target_deg":90,"tolerance_deg":1}}}"#,
     );
@@ -119,7 +121,7 @@ fn the_window_comes_from_the_model_file() {
     assert!(out.contains("tightening 90 ± 1 deg"), "{out}");
     assert!(out.contains("ok 2, nok 0"), "{out}");
     let bad = write(
-        &dir,
+        dir,
         "bad.json",
         r#"{"format":"gyro-model","version":1,"config":{"tightening":{"target_deg":90,"tolerance_deg":-1}}}"#,
     );

@@ -37,10 +37,11 @@ fn fails_with(args: &[&str], needle: &str) {
 
 #[test]
 fn names_an_injected_scale_factor_and_compensates_it() {
-    let dir = temp_dir("diagnose_scale");
+    let scratch = temp_dir("diagnose_scale");
+    let dir = scratch.path();
     let effect = [Effect::ScaleFactor { k: 0.02 }];
-    let train = runs(&dir, "train", 4, &effect, 10);
-    let holdout = runs(&dir, "hold", 3, &effect, 50);
+    let train = runs(dir, "train", 4, &effect, 10);
+    let holdout = runs(dir, "hold", 3, &effect, 50);
     let model = dir.join("model.json");
     let mut args = vec![
         "diagnose",
@@ -151,10 +152,11 @@ fn diagnose_json(train: &[String], holdout: &[String]) -> serde_json::Value {
 
 #[test]
 fn a_clock_error_is_named_from_the_time_stamps_not_as_a_scale_factor() {
-    let dir = temp_dir("diagnose_clock");
+    let scratch = temp_dir("diagnose_clock");
+    let dir = scratch.path();
     let effect = [Effect::ClockError { ppm: 5000.0 }];
-    let train = runs(&dir, "train", 4, &effect, 20);
-    let holdout = runs(&dir, "hold", 3, &effect, 60);
+    let train = runs(dir, "train", 4, &effect, 20);
+    let holdout = runs(dir, "hold", 3, &effect, 60);
     let d = diagnose_json(&train, &holdout);
     let first = &d["effects"][0];
     assert_eq!(first["id"], "clock_error", "{}", d["effects"]);
@@ -180,7 +182,7 @@ fn a_clock_error_is_named_from_the_time_stamps_not_as_a_scale_factor() {
                     .filter(|l| !l.starts_with("# sample_rate_hz"))
                     .map(|l| format!("{l}\n"))
                     .collect();
-                write(&dir, &format!("{prefix}{i}.csv"), &kept)
+                write(dir, &format!("{prefix}{i}.csv"), &kept)
             })
             .collect()
     };
@@ -201,9 +203,10 @@ fn a_clock_error_is_named_from_the_time_stamps_not_as_a_scale_factor() {
 
 #[test]
 fn nothing_significant_without_an_effect() {
-    let dir = temp_dir("diagnose_null");
-    let train = runs(&dir, "train", 4, &[], 200);
-    let holdout = runs(&dir, "hold", 3, &[], 300);
+    let scratch = temp_dir("diagnose_null");
+    let dir = scratch.path();
+    let train = runs(dir, "train", 4, &[], 200);
+    let holdout = runs(dir, "hold", 3, &[], 300);
     let mut args = vec![
         "diagnose",
         "--members",
@@ -235,13 +238,14 @@ fn nothing_significant_without_an_effect() {
 
 #[test]
 fn bad_input_is_refused_with_a_clear_message() {
-    let dir = temp_dir("diagnose_bad");
-    let a = run_csv(&dir, "a.csv", 250.0, 20.0, &[], 1);
-    let b = run_csv(&dir, "b.csv", 250.0, 20.0, &[], 2);
-    let c = run_csv(&dir, "c.csv", 250.0, 20.0, &[], 3);
-    let fast = run_csv(&dir, "fast.csv", 500.0, 20.0, &[], 4);
+    let scratch = temp_dir("diagnose_bad");
+    let dir = scratch.path();
+    let a = run_csv(dir, "a.csv", 250.0, 20.0, &[], 1);
+    let b = run_csv(dir, "b.csv", 250.0, 20.0, &[], 2);
+    let c = run_csv(dir, "c.csv", 250.0, 20.0, &[], 3);
+    let fast = run_csv(dir, "fast.csv", 500.0, 20.0, &[], 4);
     let no_reference = write(
-        &dir,
+        dir,
         "noref.csv",
         "time_s,rate_dps\n0.0,0.1\n0.004,0.1\n0.008,0.2\n0.012,0.1\n",
     );
@@ -310,7 +314,8 @@ fn bad_input_is_refused_with_a_clear_message() {
 /// effect it fits against such a reference measures the mismatch.
 #[test]
 fn a_reference_of_the_opposite_sense_leads_the_diagnosis() {
-    let dir = temp_dir("diagnose_opposite");
+    let scratch = temp_dir("diagnose_opposite");
+    let dir = scratch.path();
     let negate = |paths: Vec<String>, prefix: &str| -> Vec<String> {
         paths
             .iter()
@@ -318,12 +323,12 @@ fn a_reference_of_the_opposite_sense_leads_the_diagnosis() {
             .map(|(i, p)| {
                 let text = std::fs::read_to_string(p).unwrap();
                 let negated = map_column(&text, "reference_deg", |x| -x);
-                write(&dir, &format!("{prefix}{i}.csv"), &negated)
+                write(dir, &format!("{prefix}{i}.csv"), &negated)
             })
             .collect()
     };
-    let train = negate(runs(&dir, "train", 3, &[], 400), "negated_train");
-    let holdout = negate(runs(&dir, "hold", 2, &[], 500), "negated_hold");
+    let train = negate(runs(dir, "train", 3, &[], 400), "negated_train");
+    let holdout = negate(runs(dir, "hold", 2, &[], 500), "negated_hold");
     let mut args = vec![
         "diagnose",
         "--members",

@@ -11,7 +11,8 @@ use std::path::PathBuf;
 
 #[test]
 fn report_is_self_contained_with_every_figure_and_the_ranked_table() {
-    let dir = temp_dir("diagnose-report");
+    let scratch = temp_dir("diagnose-report");
+    let dir = scratch.path();
     let runs: Vec<String> = (1..=6)
         .map(|seed| {
             let path = dir.join(format!("run{seed}.csv"));
@@ -107,6 +108,6 @@ fn report_is_self_contained_with_every_figure_and_the_ranked_table() {
     assert!(html.contains("<b>Verdict:</b> unmodelled: <code>scale_factor</code>"));
 
     if std::env::var_os("GYRO_REPORT_DIR").is_none() {
-        std::fs::remove_dir_all(&dir).unwrap();
+        std::fs::remove_dir_all(dir).unwrap();
     }
 }

@@ -16,7 +16,8 @@ fn summary_without_file(json: &str) -> serde_json::Value {
 
 #[test]
 fn run_on_mcap_gives_the_same_summary_as_on_csv() {
-    let dir = temp_dir("run");
+    let scratch = temp_dir("run");
+    let dir = scratch.path();
     let csv = workspace_root().join("fixtures/logs/bench_run.csv");
     let csv = csv.to_str().unwrap();
     let mcap = dir.join("bench_run.mcap");
@@ -69,7 +70,8 @@ fn run_on_mcap_gives_the_same_summary_as_on_csv() {
 
 #[test]
 fn convert_ros2_bag_with_axis_options_and_errors() {
-    let dir = temp_dir("ros2");
+    let scratch = temp_dir("ros2");
+    let dir = scratch.path();
     let bag = workspace_root().join("fixtures/mcap/ros2_imu.mcap");
     let bag = bag.to_str().unwrap();
     let out_csv = dir.join("imu.csv");
@@ -153,7 +155,8 @@ fn kill_child() {
 
 #[test]
 fn killed_writer_loses_at_most_the_open_chunk() {
-    let dir = temp_dir("kill");
+    let scratch = temp_dir("kill");
+    let dir = scratch.path();
     let path = dir.join("killed.mcap");
     let status = Command::new(std::env::current_exe().unwrap())
         .args([
@@ -195,7 +198,8 @@ fn killed_writer_loses_at_most_the_open_chunk() {
 /// by time, and would give the rows back interleaved, a log that reads.
 #[test]
 fn convert_refuses_time_that_goes_back() {
-    let dir = temp_dir("convert_back");
+    let scratch = temp_dir("convert_back");
+    let dir = scratch.path();
     let csv = dir.join("back.csv");
     let mut text = String::from("time_s,rate_dps,reference_deg\n");
     for k in 0..400 {

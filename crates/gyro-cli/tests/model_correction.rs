@@ -67,7 +67,8 @@ fn max_abs_error_deg(log: &RegularLog, config: &Config, options: &ReplayOptions)
 /// (read back from a model file), and the correction and the delay each contribute.
 #[test]
 fn true_model_reduces_the_max_abs_error_of_every_run() {
-    let dir = temp_dir("model-correction");
+    let scratch = temp_dir("model-correction");
+    let dir = scratch.path();
     let path = dir.join("model.json");
     model::save(&path, &true_model()).unwrap();
     let loaded = model::load(&path).unwrap();
@@ -104,7 +105,8 @@ fn true_model_reduces_the_max_abs_error_of_every_run() {
 /// applied.
 #[test]
 fn run_command_applies_the_model() {
-    let dir = temp_dir("model-correction-cli");
+    let scratch = temp_dir("model-correction-cli");
+    let dir = scratch.path();
     let csv = dir.join("warm.csv");
     log::write_log(&csv, &simulated(5), None).unwrap();
     let model_path = dir.join("model.json");
@@ -148,9 +150,10 @@ fn run_command_applies_the_model() {
 /// and replays exactly as the built-in configuration.
 #[test]
 fn model_files_without_the_new_keys_still_load() {
-    let dir = temp_dir("model-correction-compat");
+    let scratch = temp_dir("model-correction-compat");
+    let dir = scratch.path();
     let old = write(
-        &dir,
+        dir,
         "old.json",
         r#"{"format": "gyro-model", "version": 1,
             "config": {"compensation": "kalman", "paper": {"beta_per_s": 0.01, "b0_dps": 0.2, "o0_deg": 0.0}},
@@ -184,9 +187,10 @@ fn model_files_without_the_new_keys_still_load() {
 /// Typos in the new keys are errors naming them, and implausible values are refused.
 #[test]
 fn unknown_keys_and_bad_values_are_refused() {
-    let dir = temp_dir("model-correction-refused");
+    let scratch = temp_dir("model-correction-refused");
+    let dir = scratch.path();
     let load = |name: &str, text: &str| -> ModelError {
-        let path = write(&dir, name, text);
+        let path = write(dir, name, text);
         model::load(path.as_ref()).unwrap_err()
     };
     let err = load(

@@ -64,9 +64,10 @@ fn assert_error(out: &Output, what: &[&str]) {
 
 #[test]
 fn static_log_json_table_and_model_file() {
-    let dir = temp_dir("static");
+    let scratch = temp_dir("static");
+    let dir = scratch.path();
     let log = simulated(
-        &dir,
+        dir,
         "static.csv",
         &model(),
         &Motion::from_rotations(vec![], 1000.0),
@@ -151,16 +152,17 @@ fn static_log_json_table_and_model_file() {
 
 #[test]
 fn several_logs_are_pooled_and_psd_written() {
-    let dir = temp_dir("pooled");
+    let scratch = temp_dir("pooled");
+    let dir = scratch.path();
     let a = simulated(
-        &dir,
+        dir,
         "a.csv",
         &model(),
         &Motion::from_rotations(vec![], 200.0),
         1,
     );
     let b = simulated(
-        &dir,
+        dir,
         "b.csv",
         &model(),
         &Motion::from_rotations(vec![], 300.0),
@@ -200,7 +202,8 @@ fn several_logs_are_pooled_and_psd_written() {
 
 #[test]
 fn static_only_uses_the_rest_stretches_of_a_log_with_motion() {
-    let dir = temp_dir("motion");
+    let scratch = temp_dir("motion");
+    let dir = scratch.path();
     let rotations: Vec<Rotation> = (0..8)
         .map(|i| Rotation {
             start_s: 15.0 + 25.0 * f64::from(i),
@@ -214,7 +217,7 @@ fn static_only_uses_the_rest_stretches_of_a_log_with_motion() {
         ..model()
     };
     let log = simulated(
-        &dir,
+        dir,
         "bench.csv",
         &sensor,
         &Motion::from_rotations(rotations, 210.0),
@@ -261,8 +264,9 @@ fn static_only_uses_the_rest_stretches_of_a_log_with_motion() {
 
 #[test]
 fn bad_input_is_a_one_line_error_naming_the_file() {
-    let dir = temp_dir("bad");
-    let empty = write(&dir, "empty.csv", "time_s,rate_dps\n");
+    let scratch = temp_dir("bad");
+    let dir = scratch.path();
+    let empty = write(dir, "empty.csv", "time_s,rate_dps\n");
     assert_error(&gyro(&["noise", &empty]), &["empty.csv"]);
 
     let missing = dir.join("missing.csv").to_string_lossy().into_owned();
@@ -272,13 +276,13 @@ fn bad_input_is_a_one_line_error_naming_the_file() {
     for k in 0..10 {
         short.push_str(&format!("{:.2},0.{k}\n", f64::from(k) * 0.01));
     }
-    let short = write(&dir, "short.csv", &short);
+    let short = write(dir, "short.csv", &short);
     assert_error(
         &gyro(&["noise", &short]),
         &["short.csv", "too short", "10 samples"],
     );
 
-    let garbage = write(&dir, "garbage.csv", "time_s,rate_dps\n0.0,abc\n");
+    let garbage = write(dir, "garbage.csv", "time_s,rate_dps\n0.0,abc\n");
     assert_error(&gyro(&["noise", &garbage]), &["garbage.csv", "abc"]);
 
     // Always turning: no rest stretch.
@@ -286,7 +290,7 @@ fn bad_input_is_a_one_line_error_naming_the_file() {
     for k in 0..2000 {
         turning.push_str(&format!("{:.2},50.0\n", f64::from(k) * 0.01));
     }
-    let turning = write(&dir, "turning.csv", &turning);
+    let turning = write(dir, "turning.csv", &turning);
     assert_error(
         &gyro(&["noise", &turning, "--static-only"]),
         &["turning.csv", "no rest stretch"],
@@ -294,7 +298,7 @@ fn bad_input_is_a_one_line_error_naming_the_file() {
 
     // A good log and a bad one: the bad one is named.
     let good = simulated(
-        &dir,
+        dir,
         "good.csv",
         &model(),
         &Motion::from_rotations(vec![], 20.0),
@@ -304,7 +308,7 @@ fn bad_input_is_a_one_line_error_naming_the_file() {
 
     // A model file needs one data set: logs of two rates cannot be pooled.
     let other = simulated(
-        &dir,
+        dir,
         "other.csv",
         &SensorModel {
             sample_rate_hz: 200.0,

@@ -43,7 +43,8 @@ fn num(v: &serde_yaml::Value, key: &str) -> f64 {
 /// the tolerances are about 3 of those standard deviations.
 #[test]
 fn noise_writes_the_known_density_and_random_walk() {
-    let dir = temp_dir("noise_yaml_golden");
+    let scratch = temp_dir("noise_yaml_golden");
+    let dir = scratch.path();
     let out = dir.join("imu.yaml");
     let run = gyro(&[
         "noise",
@@ -76,7 +77,8 @@ fn noise_writes_the_known_density_and_random_walk() {
 /// All three formats from one log: the same numbers under each tool's keys.
 #[test]
 fn every_format_is_written_and_parses() {
-    let dir = temp_dir("noise_yaml_formats");
+    let scratch = temp_dir("noise_yaml_formats");
+    let dir = scratch.path();
     let mut values = Vec::new();
     for (format, nested, keys) in [
         (
@@ -124,7 +126,8 @@ fn every_format_is_written_and_parses() {
 /// `--noise-yaml` naming an input is refused; the input is left as it was.
 #[test]
 fn never_overwrites_an_input() {
-    let dir = temp_dir("noise_yaml_overwrite");
+    let scratch = temp_dir("noise_yaml_overwrite");
+    let dir = scratch.path();
     let log = dir.join("in.csv");
     std::fs::copy(golden_log(), &log).unwrap();
     let original = std::fs::read(&log).unwrap();
@@ -161,15 +164,16 @@ fn bench_csv(dir: &Path, name: &str, effects: &[Effect], seed: u64) -> String {
 /// 0.02 deg/s/√s injected, the measured K is near it.
 #[test]
 fn diagnose_writes_the_measured_effective_noise() {
-    let dir = temp_dir("noise_yaml_diagnose");
+    let scratch = temp_dir("noise_yaml_diagnose");
+    let dir = scratch.path();
     let effect = [Effect::RateRandomWalk {
         k_dps_per_rt_s: 0.02,
     }];
     let train: Vec<String> = (0..4)
-        .map(|i| bench_csv(&dir, &format!("t{i}.csv"), &effect, 10 + i))
+        .map(|i| bench_csv(dir, &format!("t{i}.csv"), &effect, 10 + i))
         .collect();
     let holdout: Vec<String> = (0..3)
-        .map(|i| bench_csv(&dir, &format!("h{i}.csv"), &effect, 50 + i))
+        .map(|i| bench_csv(dir, &format!("h{i}.csv"), &effect, 50 + i))
         .collect();
     let out = dir.join("vins.yaml");
     let out_s = out.to_string_lossy().into_owned();

@@ -7,7 +7,8 @@ use common::{bench_log, gyro, temp_dir};
 
 #[test]
 fn outputs_never_overwrite_inputs() {
-    let dir = temp_dir("overwrite");
+    let scratch = temp_dir("overwrite");
+    let dir = scratch.path();
     let log = dir.join("in.csv");
     std::fs::copy(bench_log(), &log).unwrap();
     let original = std::fs::read(&log).unwrap();
@@ -56,7 +57,8 @@ fn outputs_never_overwrite_inputs() {
 /// leaves the file that was there and no partial one; `simulate -o x.mcap` writes MCAP.
 #[test]
 fn recordings_and_outputs_are_kept_or_written_whole() {
-    let dir = temp_dir("kept");
+    let scratch = temp_dir("kept");
+    let dir = scratch.path();
     let earlier = dir.join("earlier.mcap");
     std::fs::write(&earlier, b"an earlier recording").unwrap();
     let out = gyro(&[
@@ -81,7 +83,7 @@ fn recordings_and_outputs_are_kept_or_written_whole() {
     ]);
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(std::fs::read(&earlier).unwrap(), b"an earlier recording");
-    let mut left: Vec<_> = std::fs::read_dir(&dir)
+    let mut left: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name())
         .collect();

@@ -17,14 +17,24 @@ use gyro_report::plot::{self, CalibrationPlot, Figure, ImageFormat, NoisePlot, R
 use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
 use std::path::{Path, PathBuf};
 
-/// Where plots go: `GYRO_PLOT_DIR` if set, else a fresh temporary directory.
-fn out_dir(name: &str) -> PathBuf {
-    let dir = match std::env::var_os("GYRO_PLOT_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => std::env::temp_dir().join(format!("gyro-cli-plots-{}-{name}", std::process::id())),
-    };
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// Where plots go: `GYRO_PLOT_DIR` if set (kept, to look at), else a fresh temporary
+/// directory, removed when the guard returned beside it is dropped.
+fn out_dir(name: &str) -> (Option<tempfile::TempDir>, PathBuf) {
+    match std::env::var_os("GYRO_PLOT_DIR") {
+        Some(d) => {
+            let dir = PathBuf::from(d);
+            std::fs::create_dir_all(&dir).unwrap();
+            (None, dir)
+        }
+        None => {
+            let scratch = tempfile::Builder::new()
+                .prefix(&format!("gyro-cli-plots-{name}-"))
+                .tempdir()
+                .unwrap();
+            let dir = scratch.path().to_path_buf();
+            (Some(scratch), dir)
+        }
+    }
 }
 
 fn bench_report(compensation: Compensation) -> RunReport {
@@ -168,7 +178,7 @@ fn assert_has(svg: &str, texts: &[&str]) {
 
 #[test]
 fn run_plot_svg_and_png() {
-    let dir = out_dir("run");
+    let (_scratch, dir) = out_dir("run");
     for (compensation, stem) in [
         (Compensation::Kalman, "run_kalman"),
         (Compensation::None, "run_none"),
@@ -215,7 +225,8 @@ fn run_plot_without_reference_drops_the_error_panel() {
         title: "no_reference.csv",
         report: &report,
     };
-    let svg = render_both(&figure, &out_dir("run-noref"), "run_no_reference");
+    let (_scratch, dir) = out_dir("run-noref");
+    let svg = render_both(&figure, &dir, "run_no_reference");
     assert_has(
         &svg,
         &[
@@ -231,7 +242,7 @@ fn run_plot_without_reference_drops_the_error_panel() {
 
 #[test]
 fn noise_plot_svg_and_png() {
-    let dir = out_dir("noise");
+    let (_scratch, dir) = out_dir("noise");
     let result = static_characterization();
     assert!(result.fit.arw_dps_per_rt_hz.significant);
     assert!(result.psd.is_some());
@@ -302,7 +313,7 @@ fn noise_plot_svg_and_png() {
 
 #[test]
 fn calibrate_plot_svg_and_png() {
-    let dir = out_dir("calibrate");
+    let (_scratch, dir) = out_dir("calibrate");
     let calibration = small_calibration();
     let figure = CalibrationPlot {
         calibration: &calibration,
@@ -328,7 +339,7 @@ fn calibrate_plot_svg_and_png() {
 
 #[test]
 fn cli_run_plot_writes_svg_and_png() {
-    let dir = out_dir("cli");
+    let (_scratch, dir) = out_dir("cli");
     let log = bench_log();
     let log = log.to_str().unwrap();
     let svg_path = dir.join("cli_run.svg");
@@ -353,7 +364,7 @@ fn cli_run_plot_writes_svg_and_png() {
 
 #[test]
 fn cli_plot_errors_name_the_file_and_do_not_panic() {
-    let dir = out_dir("cli-errors");
+    let (_scratch, dir) = out_dir("cli-errors");
     let log = bench_log();
     let log = log.to_str().unwrap();
 
@@ -385,7 +396,8 @@ fn library_errors_name_the_file() {
 
     let mut empty = report.clone();
     empty.series.clear();
-    let path = out_dir("lib-errors").join("empty.svg");
+    let (_scratch, dir) = out_dir("lib-errors");
+    let path = dir.join("empty.svg");
     let e = plot::run_plot(&path, "t", &empty).unwrap_err();
     let chain = format!("{e}: {}", std::error::Error::source(&e).unwrap());
     assert!(

@@ -12,7 +12,7 @@ use gyro_bridge::{self as bridge, Emulator, EmulatorConfig, Pacing, Sample};
 use gyro_log::{self as log, McapOptions};
 use std::ffi::OsStr;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
@@ -21,11 +21,13 @@ use std::time::{Duration, Instant};
 
 const BIN: &str = env!("CARGO_BIN_EXE_gyro-cli");
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gyro-record-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder for one test, named after it; removed with everything in it when the
+/// returned guard is dropped, so that test runs leave nothing in the temporary folder.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("gyro-record-cli-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// A real-time 1 kHz emulator on a fresh pty pair: the slave's name, the frames sent so
@@ -107,7 +109,8 @@ fn assert_prefix(rows: &[log::Row]) {
 /// `-o killed.mcap`): readable up to the kill, and never mistaken for a finished one.
 #[test]
 fn sigkill_loses_under_half_a_second() {
-    let dir = temp_dir("kill");
+    let scratch = temp_dir("kill");
+    let dir = scratch.path();
     let finished = dir.join("killed.mcap");
     let out = dir.join("killed.partial.mcap");
     let bridge = start_bridge(60);
@@ -160,12 +163,13 @@ fn sigkill_loses_under_half_a_second() {
     let again = log::read_mcap(recovered, &McapOptions::default()).unwrap();
     assert!(again.warnings.is_empty());
     assert_eq!(again.log.rows.len(), read.log.rows.len());
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
 fn sigint_finishes_the_file_and_prints_a_summary() {
-    let dir = temp_dir("int");
+    let scratch = temp_dir("int");
+    let dir = scratch.path();
     let out = dir.join("interrupted.mcap");
     let bridge = start_bridge(60);
     let child = spawn_record(&bridge.name, &out);
@@ -200,14 +204,15 @@ fn sigint_finishes_the_file_and_prints_a_summary() {
     );
     assert!(stderr.contains(&format!("frames {rows} ")), "{stderr}");
     assert_prefix(&read.log.rows);
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// The two subcommands together, as a user would run them: `emulate --create-pty` prints
 /// the port, `record` reads it until the line goes quiet; the counts match the fault log.
 #[test]
 fn emulate_and_record_commands_agree() {
-    let dir = temp_dir("cli");
+    let scratch = temp_dir("cli");
+    let dir = scratch.path();
     let out = dir.join("cli.mcap");
     let fault_log = dir.join("faults.json");
     let args = [
@@ -242,5 +247,5 @@ fn emulate_and_record_commands_agree() {
     );
     let read = log::read_mcap(&out, &McapOptions::default()).unwrap();
     assert_eq!(read.log.rows.len() as u64, intact);
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }

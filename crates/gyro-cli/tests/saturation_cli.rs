@@ -79,8 +79,9 @@ fn json_carries_saturated_on_every_movement() {
 
     // Clipped at ±120 deg/s: exactly the movements with a reading within 0.5% of it are
     // flagged (peaks 78 to 208 deg/s: three of six), and the range stands.
-    let dir = temp_dir("saturation-json");
-    let clipped = clipped_log(&dir);
+    let scratch = temp_dir("saturation-json");
+    let dir = scratch.path();
+    let clipped = clipped_log(dir);
     let report = json_of(&gyro(&[
         "run",
         &clipped,
@@ -125,7 +126,8 @@ fn a_model_from_a_faster_sensor_claims_no_range() {
         return;
     }
     let log = log.to_str().unwrap();
-    let dir = temp_dir("saturation-range-dropped");
+    let scratch = temp_dir("saturation-range-dropped");
+    let dir = scratch.path();
     let model = dir.join("m.json");
     let model = model.to_str().unwrap();
     let out = gyro(&["calibrate", log, "--objective", "movement-rms", "-o", model]);
@@ -169,8 +171,9 @@ fn a_model_from_a_faster_sensor_claims_no_range() {
 
 #[test]
 fn table_marks_and_warns_and_csv_has_a_column() {
-    let dir = temp_dir("saturation-table");
-    let log = clipped_log(&dir);
+    let scratch = temp_dir("saturation-table");
+    let dir = scratch.path();
+    let log = clipped_log(dir);
     let log = log.as_str();
     let table = ok(&gyro(&["run", log, "--range-dps", "120"]));
     assert!(table.contains("sensor range ±120 deg/s"), "{table}");
@@ -212,11 +215,12 @@ fn table_marks_and_warns_and_csv_has_a_column() {
 
 #[test]
 fn range_comes_from_the_model_unless_given() {
-    let dir = temp_dir("saturation-model");
-    let log = clipped_log(&dir);
+    let scratch = temp_dir("saturation-model");
+    let dir = scratch.path();
+    let log = clipped_log(dir);
     let log = log.as_str();
     let model = write(
-        &dir,
+        dir,
         "m.json",
         r#"{"format": "gyro-model", "version": 1, "sensor": {"range_dps": 120}}"#,
     );
@@ -248,7 +252,7 @@ fn range_comes_from_the_model_unless_given() {
     assert_eq!(overridden, (Some(300.0), 0));
     // A model without a sensor section: the section's default range, the CRM100's ±300.
     let bare = write(
-        &dir,
+        dir,
         "bare.json",
         r#"{"format": "gyro-model", "version": 1}"#,
     );

@@ -345,14 +345,15 @@ fn generated_logs(dir: &Path) -> Vec<PathBuf> {
 
 #[test]
 fn streaming_equals_materialising_on_fixtures_and_generated_logs() {
-    let dir = temp_dir("streaming");
+    let scratch = temp_dir("streaming");
+    let dir = scratch.path();
     let root = workspace_root();
     let mut logs = vec![
         bench_log(),
         root.join("fixtures/mcap/ros2_imu.mcap"),
         root.join("fixtures/noise/allan_input.csv"),
     ];
-    logs.extend(generated_logs(&dir));
+    logs.extend(generated_logs(dir));
     let mut outcomes = Vec::new();
     for path in &logs {
         let all = !path.ends_with("long_jittery.csv");
@@ -437,8 +438,9 @@ fn streaming_equals_materialising_on_real_logs() {
 /// with the series of `--out`.
 #[test]
 fn cli_output_equals_the_materialising_report() {
-    let dir = temp_dir("streaming-cli");
-    let path = PathBuf::from(write(&dir, "warts.csv", &wart_log(false)));
+    let scratch = temp_dir("streaming-cli");
+    let dir = scratch.path();
+    let path = PathBuf::from(write(dir, "warts.csv", &wart_log(false)));
     let series = dir.join("series.csv");
     let file = path.to_str().unwrap();
     let out = gyro(&[

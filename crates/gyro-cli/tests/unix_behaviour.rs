@@ -22,8 +22,11 @@ fn run_name(i: usize) -> String {
     format!("Drehwinkel_{}{i}.csv", "ö".repeat(20))
 }
 
-fn bench(name: &str) -> (PathBuf, Vec<PathBuf>) {
-    let dir = temp_dir(name).join("Prüfstand_Linie_3");
+/// Four simulated runs with non-ASCII names in a non-ASCII folder inside a fresh scratch
+/// folder (the guard, which removes it when dropped), the folder and the runs.
+fn bench(name: &str) -> (tempfile::TempDir, PathBuf, Vec<PathBuf>) {
+    let scratch = temp_dir(name);
+    let dir = scratch.path().join("Prüfstand_Linie_3");
     std::fs::create_dir_all(&dir).unwrap();
     let runs: Vec<PathBuf> = (1..=4).map(|i| dir.join(run_name(i))).collect();
     for (i, run) in runs.iter().enumerate() {
@@ -38,12 +41,12 @@ fn bench(name: &str) -> (PathBuf, Vec<PathBuf>) {
             "40",
         ]));
     }
-    (dir, runs)
+    (scratch, dir, runs)
 }
 
 #[test]
 fn run_noise_convert_take_non_ascii_paths() {
-    let (dir, runs) = bench("unicode-run");
+    let (_scratch, dir, runs) = bench("unicode-run");
     let log = s(&runs[0]);
     let series = dir.join("Reihe_ä.csv");
     let plot = dir.join("Bild_ü.svg");
@@ -74,7 +77,7 @@ fn run_noise_convert_take_non_ascii_paths() {
 
 #[test]
 fn calibrate_and_diagnose_take_non_ascii_paths() {
-    let (dir, runs) = bench("unicode-calibrate");
+    let (_scratch, dir, runs) = bench("unicode-calibrate");
     let model = dir.join("Modell_ö.json");
     let split = [
         s(&runs[0]),
@@ -119,7 +122,7 @@ fn calibrate_and_diagnose_take_non_ascii_paths() {
 
 #[test]
 fn emulate_and_record_take_non_ascii_paths() {
-    let (dir, runs) = bench("unicode-bridge");
+    let (_scratch, dir, runs) = bench("unicode-bridge");
     let recording = dir.join("Mitschnitt_ö.mcap");
     let fault_log = dir.join("Fehler_ä.json");
     let args: Vec<&OsStr> = vec![

@@ -863,20 +863,23 @@ mod tests {
     use super::*;
     use std::io::Write;
 
-    fn write_temp(name: &str, text: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("gyro-csv-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join(name);
+    /// `text` written to `name` in a fresh folder; the guard removes the folder when dropped.
+    fn write_temp(name: &str, text: &str) -> (tempfile::TempDir, std::path::PathBuf) {
+        let scratch = tempfile::Builder::new()
+            .prefix("gyro-csv-test-")
+            .tempdir()
+            .unwrap();
+        let path = scratch.path().join(name);
         std::fs::File::create(&path)
             .unwrap()
             .write_all(text.as_bytes())
             .unwrap();
-        path
+        (scratch, path)
     }
 
     #[test]
     fn reads_metadata_header_and_rows() {
-        let path = write_temp(
+        let (_scratch, path) = write_temp(
             "ok.csv",
             "# sensor: CRM100\n# sample_rate_hz: 1000\ntime_s,rate_dps,temperature_c,reference_deg,extra\n0.000,0.125,25.1,0.00,x\n0.001,,25.1,0.01,y\n0.002,nan,25.1,,z\n",
         );
@@ -1044,7 +1047,7 @@ mod tests {
                     });
                 }
             }
-            let path = write_temp("split.csv", &text);
+            let (_scratch, path) = write_temp("split.csv", &text);
             let fast = read_all(&path, true);
             let slow = read_all(&path, false);
             proptest::prop_assert_eq!(fast, slow, "{:?}", text);
@@ -1081,7 +1084,7 @@ mod tests {
             ),
         ];
         for (name, text, expected) in cases {
-            let path = write_temp(name, text);
+            let (_scratch, path) = write_temp(name, text);
             for split_lines in [true, false] {
                 let all = read_all(&path, split_lines);
                 assert!(all.contains(expected), "{name} {split_lines}: {all}");
@@ -1104,7 +1107,7 @@ mod tests {
                 text.push_str("40.0005,\"1.0\",0\r\n");
             }
         }
-        let path = write_temp("big.csv", &text);
+        let (_scratch, path) = write_temp("big.csv", &text);
         let fast = read_all(&path, true);
         assert!(
             !fast.contains("error"),
@@ -1117,7 +1120,7 @@ mod tests {
 
     #[test]
     fn units_are_converted() {
-        let path = write_temp("units.csv", "t_ms,w\n1000,3.141592653589793\n");
+        let (_scratch, path) = write_temp("units.csv", "t_ms,w\n1000,3.141592653589793\n");
         let columns = ColumnOptions {
             time_column: "t_ms".into(),
             time_unit: TimeUnit::Ms,
@@ -1132,7 +1135,8 @@ mod tests {
 
     #[test]
     fn errors_name_file_line_and_column() {
-        let path = write_temp("bad.csv", "# a: b\ntime_s,rate_dps\n0.0,1.0\n0.001,abc\n");
+        let (_scratch, path) =
+            write_temp("bad.csv", "# a: b\ntime_s,rate_dps\n0.0,1.0\n0.001,abc\n");
         let err = read_csv(&path, &ColumnOptions::default())
             .unwrap_err()
             .to_string();
@@ -1141,7 +1145,7 @@ mod tests {
             "{err}"
         );
 
-        let path = write_temp("nocol.csv", "time_s,gyro\n0.0,1.0\n");
+        let (_scratch, path) = write_temp("nocol.csv", "time_s,gyro\n0.0,1.0\n");
         let err = read_csv(&path, &ColumnOptions::default())
             .unwrap_err()
             .to_string();
@@ -1174,7 +1178,7 @@ mod tests {
             ),
             ("stamp,rate_dps", ")"),
         ] {
-            let path = write_temp("other_names.csv", &format!("{header}\n0,1\n"));
+            let (_scratch, path) = write_temp("other_names.csv", &format!("{header}\n0,1\n"));
             let err = read_csv(&path, &ColumnOptions::default())
                 .unwrap_err()
                 .to_string();
@@ -1182,7 +1186,7 @@ mod tests {
         }
 
         // Other separators are named, with a way to convert.
-        let path = write_temp("tabs.tsv", "# a: b\ntime_s\trate_dps\n0.0\t1.0\n");
+        let (_scratch, path) = write_temp("tabs.tsv", "# a: b\ntime_s\trate_dps\n0.0\t1.0\n");
         let err = read_csv(&path, &ColumnOptions::default())
             .unwrap_err()
             .to_string();
@@ -1190,7 +1194,7 @@ mod tests {
             err.contains("tabs.tsv:2: the header is separated by tabs, not commas"),
             "{err}"
         );
-        let path = write_temp("semicolons.csv", "time_s;rate_dps\n0,0;1,5\n");
+        let (_scratch, path) = write_temp("semicolons.csv", "time_s;rate_dps\n0,0;1,5\n");
         let err = read_csv(&path, &ColumnOptions::default())
             .unwrap_err()
             .to_string();
@@ -1200,7 +1204,7 @@ mod tests {
             "{err}"
         );
 
-        let path = write_temp("ragged.csv", "time_s,rate_dps\n0.0,1.0\n0.001,1.0,7\n");
+        let (_scratch, path) = write_temp("ragged.csv", "time_s,rate_dps\n0.0,1.0\n0.001,1.0,7\n");
         let err = read_csv(&path, &ColumnOptions::default())
             .unwrap_err()
             .to_string();
@@ -1209,7 +1213,7 @@ mod tests {
             "{err}"
         );
 
-        let path = write_temp("notime.csv", "time_s,rate_dps\n,1.0\n");
+        let (_scratch, path) = write_temp("notime.csv", "time_s,rate_dps\n,1.0\n");
         let err = read_csv(&path, &ColumnOptions::default())
             .unwrap_err()
             .to_string();
@@ -1226,11 +1230,11 @@ mod tests {
 
     #[test]
     fn write_then_read_round_trips() {
-        let path = write_temp("rt.csv", "# sample_rate_hz: 100\ntime_s,rate_dps,temperature_c,reference_deg\n0.000000,0.12500,25.100,1.00000\n0.010000,,25.200,\n");
+        let (_scratch, path) = write_temp("rt.csv", "# sample_rate_hz: 100\ntime_s,rate_dps,temperature_c,reference_deg\n0.000000,0.12500,25.100,1.00000\n0.010000,,25.200,\n");
         let log = read_csv(&path, &ColumnOptions::default()).unwrap();
         let mut out = Vec::new();
         write_csv(&mut out, &log).unwrap();
-        let again = write_temp("rt2.csv", std::str::from_utf8(&out).unwrap());
+        let (_scratch_again, again) = write_temp("rt2.csv", std::str::from_utf8(&out).unwrap());
         let back = read_csv(&again, &ColumnOptions::default()).unwrap();
         assert_eq!(back.rows.len(), 2);
         for (a, b) in log.rows.iter().zip(&back.rows) {
@@ -1255,7 +1259,7 @@ mod tests {
             ("twice", "# sample_rate_hz: 1000\n# sample_rate_hz: 500\n"),
         ] {
             let text = format!("# sensor: x\n{lines}time_s,rate_dps\n0,1\n0.001,1\n");
-            let path = write_temp(&format!("meta-{name}.csv"), &text);
+            let (_scratch, path) = write_temp(&format!("meta-{name}.csv"), &text);
             let err = read_csv(&path, &ColumnOptions::default())
                 .unwrap_err()
                 .to_string();
@@ -1266,7 +1270,7 @@ mod tests {
             );
         }
         // The same value twice, and a valid one, are read.
-        let path = write_temp(
+        let (_scratch, path) = write_temp(
             "meta-same.csv",
             "# sample_rate_hz: 1000\n# sample_rate_hz: 1e3\ntime_s,rate_dps\n0,1\n",
         );
@@ -1278,7 +1282,7 @@ mod tests {
     /// header line.
     #[test]
     fn duplicate_and_missing_named_columns_are_errors() {
-        let path = write_temp("dup.csv", "time_s,rate_dps,rate_dps\n0,1,2\n");
+        let (_scratch, path) = write_temp("dup.csv", "time_s,rate_dps,rate_dps\n0,1,2\n");
         let err = read_csv(&path, &ColumnOptions::default())
             .unwrap_err()
             .to_string();
@@ -1288,7 +1292,7 @@ mod tests {
             ),
             "{err}"
         );
-        let path = write_temp("named.csv", "time_s,rate_dps,reference_deg\n0,1,2\n");
+        let (_scratch, path) = write_temp("named.csv", "time_s,rate_dps,reference_deg\n0,1,2\n");
         let columns = ColumnOptions {
             reference_column: Some("ref_deg".into()),
             ..ColumnOptions::default()

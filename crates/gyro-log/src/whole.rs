@@ -144,17 +144,18 @@ mod tests {
     #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
     use super::*;
 
-    fn dir(name: &str) -> PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("gyro-log-whole-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    /// A fresh folder, removed when the guard is dropped.
+    fn dir(name: &str) -> tempfile::TempDir {
+        tempfile::Builder::new()
+            .prefix(&format!("gyro-log-whole-{name}-"))
+            .tempdir()
+            .unwrap()
     }
 
     #[test]
     fn partial_keeps_the_extension_and_never_takes_an_existing_name() {
-        let dir = dir("names");
+        let scratch = dir("names");
+        let dir = scratch.path();
         let target = dir.join("run.mcap");
         std::fs::write(dir.join("run.partial.mcap"), b"mine").unwrap();
         let partial = Partial::beside(&target).unwrap();
@@ -170,12 +171,13 @@ mod tests {
         assert_eq!(plain.path(), dir.join("model.partial"));
         plain.discard();
         assert!(!dir.join("model.partial").exists());
-        std::fs::remove_dir_all(&dir).unwrap();
+        std::fs::remove_dir_all(dir).unwrap();
     }
 
     #[test]
     fn a_failed_write_replaces_nothing() {
-        let dir = dir("failed");
+        let scratch = dir("failed");
+        let dir = scratch.path();
         let target = dir.join("out.csv");
         std::fs::write(&target, b"before").unwrap();
         let e = write(&target, |w| {
@@ -185,7 +187,7 @@ mod tests {
         .unwrap_err();
         assert_eq!(e.to_string(), "disk full");
         assert_eq!(std::fs::read(&target).unwrap(), b"before");
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        assert_eq!(std::fs::read_dir(dir).unwrap().count(), 1);
         write(&target, |w| w.write_all(b"after")).unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"after");
         // A folder that does not exist: an error, nothing made.
@@ -199,6 +201,6 @@ mod tests {
             write(null, |w| w.write_all(b"x")).unwrap();
             assert!(is_stream(null));
         }
-        std::fs::remove_dir_all(&dir).unwrap();
+        std::fs::remove_dir_all(dir).unwrap();
     }
 }

@@ -173,7 +173,8 @@ fn check(path: &Path, bytes: &[u8], grid: &GridOptions) -> Result<(), TestCaseEr
 
 #[test]
 fn the_unmutated_seeds_load() {
-    let dir = temp_dir("fuzz-csv-seeds");
+    let scratch = temp_dir("fuzz-csv-seeds");
+    let dir = scratch.path();
     for (i, seed) in seeds().iter().enumerate() {
         let path = dir.join(format!("seed{i}.csv"));
         std::fs::write(&path, seed).unwrap();
@@ -210,7 +211,8 @@ proptest! {
         lines.iter().for_each(|m| apply_line(&mut text, m));
         let mut data = encode(&(text.join("\n") + "\n"), encoding);
         bytes.iter().for_each(|m| m.apply(&mut data));
-        let path = temp_dir("fuzz-csv").join("case.csv");
+        let scratch = temp_dir("fuzz-csv");
+        let path = scratch.path().join("case.csv");
         check(&path, &data, &GridOptions { sample_rate_hz: None, max_gap_s })?;
     }
 }
@@ -230,7 +232,8 @@ proptest! {
         bytes in proptest::collection::vec(any::<u8>(), 0..600),
     ) {
         let data = if header { [b"time_s,rate_dps\n".as_slice(), &bytes].concat() } else { bytes };
-        let path = temp_dir("fuzz-csv-random").join("case.csv");
+        let scratch = temp_dir("fuzz-csv-random");
+        let path = scratch.path().join("case.csv");
         check(&path, &data, &GridOptions::default())?;
     }
 }
@@ -239,7 +242,8 @@ proptest! {
 /// header of junk listed every column whole, control characters included.
 #[test]
 fn corrupt_numbers_and_headers_make_short_messages() {
-    let dir = temp_dir("fuzz-csv-regressions");
+    let scratch = temp_dir("fuzz-csv-regressions");
+    let dir = scratch.path();
     let path = dir.join("back.csv");
     std::fs::write(&path, "time_s,rate_dps\n0,1\n0.001,1\n-1e300,1\n").unwrap();
     let err = gyro_log::load(

@@ -25,7 +25,8 @@ fn seeds() -> &'static [Vec<u8>] {
     SEEDS.get_or_init(|| {
         let root = workspace_root();
         // The first 300 rows of the bench log, written by the project's MCAP writer.
-        let dir = temp_dir("fuzz-mcap-seeds");
+        let scratch = temp_dir("fuzz-mcap-seeds");
+        let dir = scratch.path();
         let head: String = std::fs::read_to_string(root.join("fixtures/logs/bench_run.csv"))
             .unwrap()
             .lines()
@@ -75,7 +76,8 @@ fn options() -> impl Strategy<Value = LogOptions> {
 
 #[test]
 fn the_unmutated_seeds_load() {
-    let dir = temp_dir("fuzz-mcap-unmutated");
+    let scratch = temp_dir("fuzz-mcap-unmutated");
+    let dir = scratch.path();
     let options = LogOptions {
         mcap: McapOptions {
             topic: Some("/imu/data".into()),
@@ -114,7 +116,8 @@ proptest! {
     ) {
         let mut data = seeds()[seed].clone();
         mutations.iter().for_each(|m| m.apply(&mut data));
-        let path = temp_dir("fuzz-mcap").join("case.mcap");
+        let scratch = temp_dir("fuzz-mcap");
+        let path = scratch.path().join("case.mcap");
         check(&path, &data, &options)?;
     }
 }
@@ -137,7 +140,8 @@ proptest! {
         if closed {
             data.extend_from_slice(MAGIC);
         }
-        let path = temp_dir("fuzz-mcap-random").join("case.mcap");
+        let scratch = temp_dir("fuzz-mcap-random");
+        let path = scratch.path().join("case.mcap");
         check(&path, &data, &LogOptions::default())?;
     }
 }

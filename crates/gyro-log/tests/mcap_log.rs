@@ -55,9 +55,10 @@ fn err(path: &Path, options: &McapOptions) -> String {
 
 #[test]
 fn csv_to_mcap_to_csv_is_lossless() {
-    let dir = temp_dir("roundtrip");
+    let scratch = temp_dir("roundtrip");
+    let dir = scratch.path();
     let csv = bench();
-    let mcap = bench_mcap(&dir);
+    let mcap = bench_mcap(dir);
     let back = read(&mcap).unwrap();
     assert!(back.warnings.is_empty());
     assert_eq!(back.rate_topic, "/gyro");
@@ -75,7 +76,8 @@ fn csv_to_mcap_to_csv_is_lossless() {
 
 #[test]
 fn missing_values_columns_and_full_precision_survive() {
-    let dir = temp_dir("missing");
+    let scratch = temp_dir("missing");
+    let dir = scratch.path();
     let mut metadata = BTreeMap::new();
     metadata.insert("sample_rate_hz".to_string(), "100".to_string());
     let row = |line, time_s, rate_dps, reference_deg| Row {
@@ -137,8 +139,9 @@ fn missing_values_columns_and_full_precision_survive() {
 /// message definitions in CDR, lz4 chunks).
 #[test]
 fn written_file_has_ros_2_schemas_foxglove_plots() {
-    let dir = temp_dir("schemas");
-    let path = bench_mcap(&dir);
+    let scratch = temp_dir("schemas");
+    let dir = scratch.path();
+    let path = bench_mcap(dir);
     let bytes = std::fs::read(&path).unwrap();
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
     let mut topics: Vec<&str> = summary.channels.values().map(|c| &*c.topic).collect();
@@ -211,7 +214,8 @@ fn written_file_has_ros_2_schemas_foxglove_plots() {
 /// frames come out as written.
 #[test]
 fn incremental_writer_chunks_by_time_and_writes_extra_channels() {
-    let dir = temp_dir("incremental");
+    let scratch = temp_dir("incremental");
+    let dir = scratch.path();
     let path = dir.join("rec.mcap");
     let mut w = McapLogWriter::create(&path).unwrap();
     w.write_metadata(&[("sample_rate_hz".to_string(), "1000".to_string())].into())
@@ -286,7 +290,8 @@ fn incremental_writer_chunks_by_time_and_writes_extra_channels() {
 /// exact prefix), with a warning; or a clear error if too little is left. Never a panic.
 #[test]
 fn truncated_files_keep_every_complete_chunk() {
-    let dir = temp_dir("truncated");
+    let scratch = temp_dir("truncated");
+    let dir = scratch.path();
     let mut short = bench();
     short.rows.truncate(6000); // 12 chunks of 0.5 s
     let full_path = dir.join("short.mcap");
@@ -355,7 +360,8 @@ fn truncated_files_keep_every_complete_chunk() {
 
 #[test]
 fn empty_garbage_and_corrupt_files_are_clear_errors() {
-    let dir = temp_dir("corrupt");
+    let scratch = temp_dir("corrupt");
+    let dir = scratch.path();
     let path = dir.join("x.mcap");
     std::fs::write(&path, b"").unwrap();
     let e = err(&path, &McapOptions::default());
@@ -366,7 +372,7 @@ fn empty_garbage_and_corrupt_files_are_clear_errors() {
     assert!(e.contains("x.mcap: not an MCAP file (bad magic)"), "{e}");
 
     // A flipped byte inside a chunk of a finished file: the chunk CRC (or zstd) catches it.
-    let full = bench_mcap(&dir);
+    let full = bench_mcap(dir);
     let bytes = std::fs::read(&full).unwrap();
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
     let chunk = &summary.chunk_indexes[20];
@@ -440,7 +446,8 @@ const REF_SCHEMA: &str = r#"{"type":"object","properties":{"angle_deg":{"type":"
 
 #[test]
 fn wrong_schemas_and_bad_messages_name_channel_and_message() {
-    let dir = temp_dir("schema");
+    let scratch = temp_dir("schema");
+    let dir = scratch.path();
     let path = dir.join("s.mcap");
     let opts = McapOptions::default();
     let gyro = ("/gyro", "gyro.Sample", "jsonschema", GYRO_SCHEMA, "json");
@@ -639,7 +646,8 @@ fn wrong_schemas_and_bad_messages_name_channel_and_message() {
 
 #[test]
 fn reference_on_its_own_clock_is_interpolated() {
-    let dir = temp_dir("refclock");
+    let scratch = temp_dir("refclock");
+    let dir = scratch.path();
     let path = dir.join("r.mcap");
     let gyro = ("/gyro", "gyro.Sample", "jsonschema", GYRO_SCHEMA, "json");
     let reference = (
@@ -784,8 +792,9 @@ fn ros2_bag_with_two_imus_needs_a_topic() {
 
 #[test]
 fn read_log_picks_the_format_by_content() {
-    let dir = temp_dir("dispatch");
-    let mcap = bench_mcap(&dir);
+    let scratch = temp_dir("dispatch");
+    let dir = scratch.path();
+    let mcap = bench_mcap(dir);
     // An MCAP file named .csv is still read as MCAP.
     let disguised = dir.join("really_mcap.csv");
     std::fs::copy(&mcap, &disguised).unwrap();

@@ -60,7 +60,8 @@ fn assert_stream_equals_whole(path: &Path, whole: &Log, options: &LogOptions) {
 
 #[test]
 fn streaming_equals_whole_file_reading_on_the_fixtures() {
-    let dir = temp_dir("stream-fixtures");
+    let scratch = temp_dir("stream-fixtures");
+    let dir = scratch.path();
     let path = dir.join("bench.mcap");
     let csv = bench();
     gyro_log::write_mcap(&path, &csv).unwrap();
@@ -83,7 +84,8 @@ fn streaming_equals_whole_file_reading_on_the_fixtures() {
 /// whole, with a temperature and without one.
 #[test]
 fn the_summary_decides_the_columns_of_a_finished_file() {
-    let dir = temp_dir("stream-columns");
+    let scratch = temp_dir("stream-columns");
+    let dir = scratch.path();
     for with_temperature in [true, false] {
         let mut log = bench();
         if !with_temperature {
@@ -110,7 +112,8 @@ fn the_summary_decides_the_columns_of_a_finished_file() {
 
 #[test]
 fn a_truncated_file_warns_with_the_byte_offset_and_keeps_the_rows_before() {
-    let dir = temp_dir("stream-cut");
+    let scratch = temp_dir("stream-cut");
+    let dir = scratch.path();
     let full = dir.join("full.mcap");
     gyro_log::write_mcap(&full, &bench()).unwrap();
     let bytes = std::fs::read(&full).unwrap();
@@ -212,7 +215,8 @@ fn write_groups_as(
 /// chunks (mcap's linear reader) give the same rows, finished or cut after a few chunks.
 #[test]
 fn every_compression_and_loose_messages_read_alike() {
-    let dir = temp_dir("stream-compression");
+    let scratch = temp_dir("stream-compression");
+    let dir = scratch.path();
     let groups: Vec<Vec<u64>> = (0..6).map(|g| (g * 500..(g + 1) * 500).collect()).collect();
     let zstd = dir.join("zstd.mcap");
     write_groups(&zstd, &groups, true);
@@ -255,7 +259,8 @@ fn every_compression_and_loose_messages_read_alike() {
 
 #[test]
 fn chunks_out_of_time_order_are_read_in_time_order() {
-    let dir = temp_dir("stream-order");
+    let scratch = temp_dir("stream-order");
+    let dir = scratch.path();
     let times: Vec<u64> = (0..3000).collect();
     let in_order = dir.join("in_order.mcap");
     write_groups(&in_order, std::slice::from_ref(&times), true);
@@ -279,7 +284,8 @@ fn chunks_out_of_time_order_are_read_in_time_order() {
 
 #[test]
 fn rows_held_stay_within_a_chunk_whatever_the_length() {
-    let dir = temp_dir("stream-memory");
+    let scratch = temp_dir("stream-memory");
+    let dir = scratch.path();
     let mut log = bench();
     // 120 s at 1 kHz with a reference: 240 chunks of 0.5 s.
     let rows = log.rows.clone();

@@ -22,14 +22,13 @@ pub fn gyro(args: &[&str]) -> Output {
         .expect("gyro-cli runs")
 }
 
-/// A fresh folder for one test (each test binary is its own process: the pid separates them;
-/// what an earlier process of the same pid left there is removed, since outputs that exist
-/// are refused).
-pub fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gyro-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder for one test, named after it; removed with everything in it when the
+/// returned guard is dropped, so that test runs leave nothing in the temporary folder.
+pub fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("gyro-test-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// Write `text` to `dir/name`; returns the path as a string for the command line.

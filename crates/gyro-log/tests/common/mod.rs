@@ -8,11 +8,13 @@ pub fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// A fresh folder for one test (each test binary is its own process: the pid separates them).
-pub fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gyro-log-test-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder for one test, named after it; removed with everything in it when the
+/// returned guard is dropped, so that test runs leave nothing in the temporary folder.
+pub fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("gyro-log-test-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// Longest error message the fuzz tests accept: a message quotes at most ~80 characters of

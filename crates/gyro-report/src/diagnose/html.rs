@@ -1355,16 +1355,20 @@ mod tests {
         }
     }
 
-    fn temp(name: &str) -> PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("gyro-report-unit-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        dir
+    /// A report folder not yet made, inside a fresh folder that the guard removes when
+    /// dropped.
+    fn temp(name: &str) -> (tempfile::TempDir, PathBuf) {
+        let scratch = tempfile::Builder::new()
+            .prefix(&format!("gyro-report-unit-{name}-"))
+            .tempdir()
+            .unwrap();
+        let dir = scratch.path().join("report");
+        (scratch, dir)
     }
 
     #[test]
     fn page_without_runs_has_the_gap_map_and_the_angle_error_bars() {
-        let dir = temp("no-runs");
+        let (_scratch, dir) = temp("no-runs");
         write_report(&dir, &diagnosis(), None, &Options::default()).unwrap();
         let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
         assert_eq!(html.matches("<svg").count(), 2, "gap map and bars");
@@ -1387,7 +1391,7 @@ mod tests {
 
     #[test]
     fn errors_name_the_path() {
-        let dir = temp("blocked");
+        let (_scratch, dir) = temp("blocked");
         std::fs::create_dir_all(&dir).unwrap();
         let file = dir.join("not-a-dir");
         std::fs::write(&file, "x").unwrap();
@@ -1533,7 +1537,7 @@ mod tests {
         assert!(d
             .residual_caveat()
             .is_some_and(|c| c.starts_with("the reference is 107 ms ahead of the gyro")));
-        let dir = temp("turns");
+        let (_scratch, dir) = temp("turns");
         write_report(&dir, &d, None, &Options::default()).unwrap();
         let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
         assert!(html.contains("<h2>Turns, rest to rest</h2>"), "{html}");
