@@ -13,7 +13,7 @@ of 60 s at 100 Hz (the held-out windows move 1.7 times faster):
   random walk, a temperature bias over a warm-up, and nothing at all.
 
 Every gyro has a bias of 0.15 deg/s and white noise of 0.3 deg/s per sample (1.8
-deg/sqrt(h)); the reference is the exact angle. Prints one line per case: what was
+deg/sqrt(h)); the reference is the exact angle, printed to 0.001 deg. Prints one line per case: what was
 injected, what `diagnose` named with its 95% interval, whether the selected model fits
 the training runs, and G (training and held out, after selection) against its floor.
 

@@ -24,7 +24,7 @@ pub use effects::{
     EFFECTS, LOW_PASS_POLE_RATIO,
 };
 pub use low_pass::TwoPoleLowPass;
-pub use motion::{BenchProfile, Motion, Rotation};
+pub use motion::{rounding_noise_dps, BenchProfile, Motion, Rotation};
 pub use sensor::{
     check_size, sample_count, simulate, simulate_series, InvalidSensorModel, SensorModel,
     SimOptions, SimSeries, TooManySamples, BYTES_PER_SAMPLE, MAX_SAMPLES,

@@ -230,6 +230,10 @@ pub struct RunSummary {
     pub gap_before: f64,
     /// G of this run with the selected effects.
     pub gap_after: f64,
+    /// The grid its reference lies on, when quantised (an encoder's counts or a print's
+    /// decimals), and the smoothing its re-simulated rate takes; left out otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference_grid: Option<super::ReferenceGrid>,
     /// Its z-scores against the nominal ensemble, `(segment/statistic, z)` (for the
     /// report's gap map; not in the JSON).
     #[serde(skip)]

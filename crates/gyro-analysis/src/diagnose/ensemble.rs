@@ -13,8 +13,9 @@ use super::features::{
 use super::stats::{residuals, residuals_of, stats_of, Residuals, Stat, StatsError};
 use crate::seed::derive_seed;
 use gyro_log::RegularLog;
-use gyro_sim::{simulate_series, Effect, Motion, SensorModel, SimOptions};
+use gyro_sim::{rounding_noise_dps, simulate_series, Effect, Motion, SensorModel, SimOptions};
 use rayon::prelude::*;
+use serde::Serialize;
 
 /// A real run, ready to be compared with its simulations.
 #[derive(Clone, Debug)]
@@ -36,8 +37,8 @@ pub struct RealRun {
     pub motion: Motion,
     /// Temperatures per sample, if the log has them.
     pub temperature_c: Option<Vec<f64>>,
-    /// The reference's quantisation step (deg), if it is on a grid.
-    pub reference_step_deg: Option<f64>,
+    /// The reference's grid, if it is quantised ([`motion_from_reference`]).
+    pub reference_grid: Option<ReferenceGrid>,
     /// Rates of samples that were in the log (not filled), for the output grid.
     pub measured_rates_dps: Vec<f64>,
     /// Gaps in the log (dropout events) and slots filled by interpolation.
@@ -145,7 +146,7 @@ impl RealRun {
         stats.extend(feature_stats(&features));
         let fs = log.sample_rate_hz;
         let reference: Vec<f64> = filled_reference(&log);
-        let (motion, reference_step_deg) = motion_from_reference(&reference, fs);
+        let (motion, reference_grid) = motion_from_reference(&reference, fs);
         let temperature_c = log.has_temperature.then(|| {
             log.slots
                 .iter()
@@ -167,7 +168,7 @@ impl RealRun {
             residual_dps,
             motion,
             temperature_c,
-            reference_step_deg,
+            reference_grid,
             measured_rates_dps,
             gaps: log
                 .slots
@@ -192,27 +193,115 @@ impl RealRun {
     }
 }
 
+/// The grid a quantised reference lies on, as the re-simulation takes it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ReferenceGrid {
+    /// The grid's step (deg).
+    pub step_deg: f64,
+    /// What made it: an encoder's counts, or a print's decimals.
+    pub kind: GridKind,
+    /// Half width of the smoothing before the re-simulated rate is taken (s): an
+    /// encoder's moving average, a print's cubic smoothing.
+    pub smoothing_half_width_s: f64,
+}
+
+/// What quantised a reference.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GridKind {
+    /// An encoder's counts ([`reference_step`]).
+    Encoder,
+    /// Decimals of a print ([`print_step`]).
+    Print,
+}
+
 /// The motion a reference's samples `reference_deg` (at `fs` Hz) show, as a re-simulation
-/// takes it, and the reference's grid step (deg) when it is quantised
-/// ([`reference_step`]): smoothed over [`QUANTISED_SMOOTH_S`] when it is (an encoder's
-/// steps would otherwise be rate spikes in the simulated gyro), its rate a one-sided
-/// derivative beside each step of the acceleration
+/// takes it, and the reference's grid step (deg) when it is quantised. An encoder's
+/// ([`reference_step`]) is smoothed over [`QUANTISED_SMOOTH_S`] (its steps would otherwise
+/// be rate spikes in the simulated gyro) and rounded again by the re-simulation; a
+/// print's ([`print_step`]) keeps its angle and takes its rate through a cubic smoothing
+/// of [`print_half_width`] ([`Motion::from_rounded_reference`]: the real gyro does not
+/// see the rounding, and the re-simulated residual holds the real one's). Either rate is
+/// a one-sided derivative beside each step of the acceleration
 /// ([`Motion::from_reference_with_steps`]).
-pub fn motion_from_reference(reference_deg: &[f64], fs: f64) -> (Motion, Option<f64>) {
-    let step = reference_step(reference_deg);
-    let smooth = if step.is_some() {
-        ((QUANTISED_SMOOTH_S * fs).round() as usize).max(1)
-    } else {
-        1
+pub fn motion_from_reference(reference_deg: &[f64], fs: f64) -> (Motion, Option<ReferenceGrid>) {
+    let period_s = 1.0 / fs;
+    if let Some(step_deg) = reference_step(reference_deg) {
+        let smooth = ((QUANTISED_SMOOTH_S * fs).round() as usize).max(1);
+        let motion =
+            Motion::from_reference_with_steps(0.0, period_s, reference_deg, smooth, step_deg);
+        let grid = ReferenceGrid {
+            step_deg,
+            kind: GridKind::Encoder,
+            smoothing_half_width_s: (smooth / 2) as f64 / fs,
+        };
+        return (motion, Some(grid));
+    }
+    if let Some(step_deg) = print_step(reference_deg, fs) {
+        let half_width = print_half_width(step_deg, fs);
+        let motion =
+            Motion::from_rounded_reference(0.0, period_s, reference_deg, half_width, step_deg);
+        let grid = ReferenceGrid {
+            step_deg,
+            kind: GridKind::Print,
+            smoothing_half_width_s: half_width as f64 / fs,
+        };
+        return (motion, Some(grid));
+    }
+    (
+        Motion::from_reference_with_steps(0.0, period_s, reference_deg, 1, 0.0),
+        None,
+    )
+}
+
+/// Standard deviation of the rounding noise (deg/s) that a reference printed on a
+/// decimal grid puts into a re-simulated rate, below which the print is taken as exact:
+/// under the output step of common MEMS gyros (an MPU6050's 0.0076 °/s at ±250 °/s).
+const PRINT_ROUNDING_FLOOR_DPS: f64 = 0.005;
+
+/// Finest decimal grid [`print_step`] looks for (10⁻⁶°).
+const PRINT_MAX_DECIMALS: i32 = 6;
+
+/// The grid (deg) of a reference printed with few decimals, `10⁻ᵈ` for the fewest
+/// decimals `d` (at most [`PRINT_MAX_DECIMALS`]) that every value is written with, when
+/// its rounding matters at `fs` Hz. A reference printed to 0.001° rounds each angle by up
+/// to 0.0005°; differentiated at 1 kHz that is noise of 0.27 °/s, twice a CRM100's own
+/// per sample. The real gyro does not see it, but a re-simulated one would (its rate is
+/// the reference's derivative), and the residuals, gyro less the reference's rate, would
+/// then differ in spread and in their regression on the reference's jerk (which at 100 Hz
+/// the rounding dominates). Kept when the rounding noise of a five-point derivative,
+/// `0.274 · step · fs` ([`gyro_sim::rounding_noise_dps`]), reaches
+/// [`PRINT_ROUNDING_FLOOR_DPS`].
+pub fn print_step(values: &[f64], fs: f64) -> Option<f64> {
+    let finite = || values.iter().copied().filter(|v| v.is_finite());
+    finite().next()?;
+    let on_grid = |scale: f64| {
+        finite().all(|v| {
+            let x = v * scale;
+            (x - x.round()).abs() <= 1e-6 + 1e-12 * x.abs()
+        })
     };
-    let motion = Motion::from_reference_with_steps(
-        0.0,
-        1.0 / fs,
-        reference_deg,
-        smooth,
-        step.unwrap_or(0.0),
-    );
-    (motion, step)
+    let decimals = (0..=PRINT_MAX_DECIMALS).find(|&d| on_grid(10f64.powi(d)))?;
+    let step = 10f64.powi(-decimals);
+    (rounding_noise_dps(step, fs, 0) >= PRINT_ROUNDING_FLOOR_DPS).then_some(step)
+}
+
+/// Longest half width of a print's smoothing (s): a cubic smoothing of ±40 ms passes a
+/// wrench's turns (gain 0.998 at 3 Hz, 0.99 at 5 Hz, at 100 Hz as at 1 kHz); a print
+/// too coarse for it to bring the rounding under [`PRINT_ROUNDING_FLOOR_DPS`] keeps
+/// what it leaves (a 0.001° print at 1 kHz: 0.0067 °/s of the 0.27 °/s unsmoothed).
+const PRINT_MAX_HALF_WIDTH_S: f64 = 0.04;
+
+/// Half width (samples) of the cubic smoothing of a reference printed to `step` deg at
+/// `fs` Hz: the smallest that brings the rounding noise of the re-simulated rate under
+/// [`PRINT_ROUNDING_FLOOR_DPS`] ([`gyro_sim::rounding_noise_dps`]), at most
+/// [`PRINT_MAX_HALF_WIDTH_S`]. At 0.001°: the longest, 4 samples at 100 Hz and 40 at
+/// 1 kHz; at 0.0001° and 1 kHz, 7.
+pub fn print_half_width(step: f64, fs: f64) -> usize {
+    let longest = ((PRINT_MAX_HALF_WIDTH_S * fs).round() as usize).max(2);
+    (2..=longest)
+        .find(|&m| rounding_noise_dps(step, fs, m) < PRINT_ROUNDING_FLOOR_DPS)
+        .unwrap_or(longest)
 }
 
 /// The step of an encoder reference (deg), if its values lie on a grid coarser than
@@ -340,7 +429,7 @@ pub fn simulate_residuals(
 ) -> Result<Residuals, StatsError> {
     let options = SimOptions {
         seed,
-        reference_step_deg: run.reference_step_deg,
+        reference_step_deg: run.reference_grid.map(|g| g.step_deg),
         ..SimOptions::default()
     };
     let model = SensorModel {
@@ -540,6 +629,131 @@ mod tests {
                 .map(|k| (motion.angle_deg(k as f64 * 1e-3) * 1e6).round() / 1e6)
                 .collect();
             assert_eq!(reference_step(&reference), None, "seed {seed}");
+        }
+    }
+
+    #[test]
+    fn print_grid_is_found_when_its_rounding_matters() {
+        // A sweep printed with three decimals: the grid at 100 Hz and at 1 kHz.
+        let printed: Vec<f64> = (0..4000)
+            .map(|i| ((i as f64 * 0.01).sin() * 90.0 * 1000.0).round() / 1000.0)
+            .collect();
+        assert_eq!(print_step(&printed, 100.0), Some(0.001));
+        assert_eq!(print_step(&printed, 1000.0), Some(0.001));
+        // With six decimals its rounding is far below any gyro's output step.
+        let fine: Vec<f64> = printed
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v + ((i % 7) as f64) * 1e-6)
+            .collect();
+        assert_eq!(print_step(&fine, 1000.0), None);
+        // Full precision is on no grid; nor is an empty or all-NaN reference.
+        let exact: Vec<f64> = (0..4000).map(|i| (i as f64 * 0.01).sin() * 90.0).collect();
+        assert_eq!(print_step(&exact, 1000.0), None);
+        assert_eq!(print_step(&[f64::NAN, f64::NAN], 1000.0), None);
+        assert_eq!(print_step(&[], 1000.0), None);
+        // The motion taken from a printed reference carries the grid to the re-simulation.
+        let grid = motion_from_reference(&printed, 1000.0).1.unwrap();
+        assert_eq!((grid.step_deg, grid.kind), (0.001, GridKind::Print));
+        assert_eq!(grid.smoothing_half_width_s, 0.04);
+        assert_eq!(motion_from_reference(&exact, 1000.0).1, None);
+        // Smoothed as far as the rounding needs, no further than ±40 ms.
+        assert_eq!(print_half_width(0.001, 100.0), 4);
+        assert_eq!(print_half_width(0.001, 1000.0), 40);
+        assert_eq!(print_half_width(0.0001, 1000.0), 7);
+    }
+
+    #[test]
+    fn a_printed_reference_re_simulates_its_rounding_in_the_reference_alone() {
+        // A sweep at 1 kHz printed to 0.001°: the re-simulated rate holds the sweep's
+        // rate within the smoothing's loss and a few thousandths of rounding, where the
+        // plain five-point derivative of the printed angle holds 0.27 °/s of rounding.
+        let fs = 1000.0;
+        let rate = |t: f64| 60.0 * (2.0 * std::f64::consts::PI * 0.5 * t).cos();
+        let angle = |t: f64| 60.0 / std::f64::consts::PI * (std::f64::consts::PI * t).sin();
+        let printed: Vec<f64> = (0..20_000)
+            .map(|k| (angle(k as f64 / fs) * 1000.0).round() / 1000.0)
+            .collect();
+        let (motion, grid) = motion_from_reference(&printed, fs);
+        assert_eq!(grid.map(|g| g.step_deg), Some(0.001));
+        let errors: Vec<f64> = (100..19_900)
+            .map(|k| motion.rate_dps(k as f64 / fs) - rate(k as f64 / fs))
+            .collect();
+        let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+        assert!(rms < 0.01, "rms {rms}");
+        let plain = Motion::from_reference(0.0, 1.0 / fs, &printed, 1);
+        let plain_rms = ((100..19_900)
+            .map(|k| (plain.rate_dps(k as f64 / fs) - rate(k as f64 / fs)).powi(2))
+            .sum::<f64>()
+            / 19_800.0)
+            .sqrt();
+        assert!(plain_rms > 0.2, "plain rms {plain_rms}");
+        // The angle is the printed one, rounding and all.
+        assert!(
+            (motion.angle_deg(0.0123) - (printed[12] + 0.3 * (printed[13] - printed[12]))).abs()
+                < 1e-12
+        );
+    }
+
+    /// The moving residual's spread of a nominal CRM100 bench run at 1 kHz whose reference
+    /// is printed with `decimals`, and of its re-simulation under the same model.
+    fn moving_spread(decimals: i32) -> (f64, f64) {
+        let fs = 1000.0;
+        let model = SensorModel::default();
+        let profile = gyro_sim::BenchProfile {
+            duration_s: 20.0,
+            ..Default::default()
+        };
+        let motion = Motion::bench(&profile, 3);
+        let options = SimOptions {
+            seed: 4,
+            ..SimOptions::default()
+        };
+        let s = simulate_series(&model, &[], &motion, &options, None);
+        let scale = 10f64.powi(decimals);
+        let slots = (0..s.rate_dps.len())
+            .map(|k| Slot {
+                time_s: k as f64 / fs,
+                rate_dps: s.rate_dps[k],
+                reference_deg: Some((s.reference_deg[k] * scale).round() / scale),
+                temperature_c: None,
+                line: k as u64 + 2,
+                filled: false,
+            })
+            .collect();
+        let log = RegularLog {
+            slots,
+            sample_rate_hz: fs,
+            has_reference: true,
+            has_temperature: false,
+            quality: Quality::default(),
+        };
+        let run = RealRun::prepare("bench".into(), log).unwrap();
+        let real = residuals(&run.log).unwrap();
+        let sim = simulate_residuals(&run, &model, &[], 5).unwrap();
+        let spread = |r: &Residuals| {
+            let moving: Vec<f64> = (0..r.residual_dps.len())
+                .filter(|&i| !r.is_static[i] && r.residual_dps[i].is_finite())
+                .map(|i| r.residual_dps[i])
+                .collect();
+            let mean = moving.iter().sum::<f64>() / moving.len() as f64;
+            (moving.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / moving.len() as f64).sqrt()
+        };
+        (spread(&real), spread(&sim))
+    }
+
+    #[test]
+    fn a_reference_printed_to_a_thousandth_re_simulates_with_the_real_spread() {
+        // Differentiated unsmoothed, the rounding of a 0.001° print is 0.27 °/s of noise
+        // in the simulated gyro alone, about twice the CRM100's own: the simulated spread
+        // was 2.1 times the real one. Printed to 0.001° or exact, the two agree (1.03 and
+        // 1.04 here: two seeds of the same model).
+        for decimals in [3, 9] {
+            let (real, sim) = moving_spread(decimals);
+            assert!(
+                (sim / real - 1.0).abs() < 0.1,
+                "{decimals} decimals: real {real}, simulated {sim}"
+            );
         }
     }
 

@@ -55,7 +55,7 @@ pub use diagnosis::{
     CompensationRun, CompensationSummary, Diagnosis, EffectResult, GapSummary, InputEntry,
     ModelSummary, NotCorrected, RunSummary, Unexplained, UntestableEntry, Verdict, Where,
 };
-pub use ensemble::{motion_from_reference, split, RealRun};
+pub use ensemble::{motion_from_reference, split, GridKind, RealRun, ReferenceGrid};
 pub use features::MIN_TEMPERATURE_RANGE_C;
 pub use stats::stretches;
 

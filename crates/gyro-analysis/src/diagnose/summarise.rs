@@ -146,6 +146,7 @@ fn run_summaries(
             duration_s: r.duration_s,
             gap_before: gap(std::slice::from_ref(b)),
             gap_after: gap(std::slice::from_ref(a)),
+            reference_grid: r.reference_grid,
             z: b.z
                 .iter()
                 .map(|(s, z)| (format!("{}/{}", s.segment, s.statistic), *z))

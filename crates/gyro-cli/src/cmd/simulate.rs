@@ -25,7 +25,8 @@ pub struct Args {
     duration_s: f64,
     /// Re-simulate the motion of this log's `reference_deg` instead of generating motion
     /// (as `diagnose` re-simulates a run: smoothed over 20 ms when the reference is an
-    /// encoder's, one-sided beside a step of the acceleration).
+    /// encoder's, the rate through a cubic smoothing when it is printed with few decimals,
+    /// one-sided beside a step of the acceleration).
     #[arg(long)]
     motion_from: Option<PathBuf>,
     /// Add an effect: `id` or `id:name=value,...` (e.g. `scale_factor:k=0.01`); repeatable.

@@ -245,6 +245,7 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
             m.ratio
         ));
     }
+    lines.extend(reference_grid_lines(&d.runs));
     if let Some(line) = effective_noise_line(&d.effective_noise) {
         lines.push(match d.residual_caveat() {
             Some(caveat) => format!("{line}; but {caveat}"),
@@ -253,6 +254,48 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
     }
     lines.extend(d.warnings.iter().map(|w| format!("warning: {w}")));
     lines
+}
+
+/// How the re-simulation took the quantised references of `runs`, one line per kind of
+/// grid: an encoder's counts, or a print's decimals
+/// ([`gyro_analysis::diagnose::ReferenceGrid`]).
+pub fn reference_grid_lines(runs: &[gyro_analysis::diagnose::RunSummary]) -> Vec<String> {
+    use gyro_analysis::diagnose::GridKind;
+    let total = runs.len();
+    [GridKind::Encoder, GridKind::Print]
+        .into_iter()
+        .filter_map(|kind| {
+            let grids: Vec<_> = runs
+                .iter()
+                .filter_map(|r| r.reference_grid)
+                .filter(|g| g.kind == kind)
+                .collect();
+            let first = grids.first()?;
+            let (lo, hi) = grids.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), g| {
+                (lo.min(g.step_deg), hi.max(g.step_deg))
+            });
+            // A print's step is a power of ten, written as such; an encoder's is fitted.
+            let show = |x: f64| match kind {
+                GridKind::Print => format!("{x}"),
+                GridKind::Encoder => rounded(x, 1e-3 * x),
+            };
+            let step = if hi - lo > 1e-3 * hi {
+                format!("{} to {}", show(lo), show(hi))
+            } else {
+                show(hi)
+            };
+            let half_ms = 1e3 * first.smoothing_half_width_s;
+            let n = grids.len();
+            Some(match kind {
+                GridKind::Encoder => format!(
+                    "the reference of {n} of {total} runs lies on an encoder's grid of {step} deg: the re-simulation takes the motion's rate over a ±{half_ms:.0} ms moving average and rounds its own reference to the grid"
+                ),
+                GridKind::Print => format!(
+                    "the reference of {n} of {total} runs is printed to {step} deg: the re-simulation keeps that rounding in the reference and out of the gyro's rate (a cubic smoothing of ±{half_ms:.0} ms), as the real gyro never saw it"
+                ),
+            })
+        })
+        .collect()
 }
 
 /// True if the turns' evidence wrote a correction into the model file.
@@ -447,6 +490,45 @@ mod tests {
         assert_eq!(evidence(3.0), "positive");
         assert_eq!(evidence(1.0), "barely worth mentioning");
         assert_eq!(evidence(-4.0), "none");
+    }
+
+    #[test]
+    fn a_quantised_reference_is_said_once_per_kind_of_grid() {
+        use gyro_analysis::diagnose::{GridKind, ReferenceGrid, RunSummary};
+        let run = |grid: Option<(f64, GridKind, f64)>| RunSummary {
+            name: "r".into(),
+            role: "train",
+            duration_s: 60.0,
+            gap_before: 1.0,
+            gap_after: 1.0,
+            reference_grid: grid.map(|(step_deg, kind, smoothing_half_width_s)| ReferenceGrid {
+                step_deg,
+                kind,
+                smoothing_half_width_s,
+            }),
+            z: Vec::new(),
+        };
+        assert!(reference_grid_lines(&[run(None), run(None)]).is_empty());
+        let lines = reference_grid_lines(&[
+            run(Some((0.001, GridKind::Print, 0.04))),
+            run(Some((0.001, GridKind::Print, 0.04))),
+            run(None),
+            run(Some((0.08775, GridKind::Encoder, 0.01))),
+        ]);
+        assert_eq!(lines.len(), 2, "{lines:?}");
+        assert!(
+            lines[0].starts_with(
+                "the reference of 1 of 4 runs lies on an encoder's grid of 0.08775 deg"
+            ),
+            "{}",
+            lines[0]
+        );
+        assert!(
+            lines[1].starts_with("the reference of 2 of 4 runs is printed to 0.001 deg"),
+            "{}",
+            lines[1]
+        );
+        assert!(lines[1].contains("±40 ms"), "{}", lines[1]);
     }
 
     #[test]

@@ -1297,6 +1297,7 @@ mod tests {
             duration_s: 30.0,
             gap_before: z,
             gap_after: 1.0,
+            reference_grid: None,
             z: vec![
                 ("static/residual_mean".into(), z),
                 ("dynamic/slope_vs_rate".into(), -z),
