@@ -1042,26 +1042,13 @@ mod tests {
     /// A log that starts in motion: 1 kHz at a steady 300 °/s from its first row, the
     /// reference exact, or 12 ms ahead of the gyro and scored with that delay.
     fn turning_log(lead_s: f64) -> RegularLog {
-        let slots = (0..3000)
-            .map(|i| {
+        crate::test_log::with_reference(
+            1000.0,
+            (0..3000).map(|i| {
                 let time_s = i as f64 * 1e-3;
-                Slot {
-                    time_s,
-                    rate_dps: 300.0,
-                    reference_deg: Some(25.0 + 300.0 * (time_s + lead_s)),
-                    temperature_c: None,
-                    line: i as u64 + 2,
-                    filled: false,
-                }
-            })
-            .collect();
-        RegularLog {
-            slots,
-            sample_rate_hz: 1000.0,
-            has_reference: true,
-            has_temperature: false,
-            quality: gyro_log::Quality::default(),
-        }
+                (time_s, 300.0, 25.0 + 300.0 * (time_s + lead_s))
+            }),
+        )
     }
 
     /// Settled on a constant, the reference's low-pass made this log's error the rate

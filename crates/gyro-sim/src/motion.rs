@@ -177,20 +177,13 @@ impl Motion {
         smooth_samples: usize,
         resolution_deg: f64,
     ) -> Self {
-        let (angle_deg, mut rate_dps) = smoothed(period_s, reference_deg, smooth_samples);
-        one_sided_beside_steps(
-            &mut rate_dps,
+        let (angle_deg, rate_dps) = smoothed(period_s, reference_deg, smooth_samples);
+        let steps = Steps {
             reference_deg,
-            period_s,
-            smooth_samples / 2,
+            smooth_half: smooth_samples / 2,
             resolution_deg,
-        );
-        Motion::Trajectory {
-            start_s,
-            period_s,
-            angle_deg,
-            rate_dps,
-        }
+        };
+        steps.trajectory(start_s, period_s, angle_deg, rate_dps)
     }
 
     /// A trajectory from reference angles printed on a grid of `resolution_deg` (a log
@@ -214,22 +207,15 @@ impl Motion {
         let origin = reference_deg.first().copied().unwrap_or(0.0);
         let angle_deg: Vec<f64> = reference_deg.iter().map(|r| r - origin).collect();
         let smooth = cubic_smoothed(&angle_deg, half_width);
-        let mut rate_dps: Vec<f64> = (0..smooth.len())
+        let rate_dps: Vec<f64> = (0..smooth.len())
             .map(|k| centred_rate(&smooth, period_s, k))
             .collect();
-        one_sided_beside_steps(
-            &mut rate_dps,
+        let steps = Steps {
             reference_deg,
-            period_s,
-            half_width,
+            smooth_half: half_width,
             resolution_deg,
-        );
-        Motion::Trajectory {
-            start_s,
-            period_s,
-            angle_deg,
-            rate_dps,
-        }
+        };
+        steps.trajectory(start_s, period_s, angle_deg, rate_dps)
     }
 
     /// Duration (s).
@@ -310,6 +296,42 @@ impl Motion {
                 }
                 rate_dps[i] + w * (rate_dps[i + 1] - rate_dps[i])
             }
+        }
+    }
+}
+
+/// The steps of a reference's acceleration, and how far a rate taken from it reaches.
+struct Steps<'a> {
+    /// The reference's samples (deg).
+    reference_deg: &'a [f64],
+    /// Half width of the smoothing before the centred derivative (samples).
+    smooth_half: usize,
+    /// Its grid (deg; 0 when exact).
+    resolution_deg: f64,
+}
+
+impl Steps<'_> {
+    /// The trajectory of `angle_deg` and `rate_dps`, the rates beside each step of the
+    /// acceleration one-sided ([`one_sided_beside_steps`]).
+    fn trajectory(
+        &self,
+        start_s: f64,
+        period_s: f64,
+        angle_deg: Vec<f64>,
+        mut rate_dps: Vec<f64>,
+    ) -> Motion {
+        one_sided_beside_steps(
+            &mut rate_dps,
+            self.reference_deg,
+            period_s,
+            self.smooth_half,
+            self.resolution_deg,
+        );
+        Motion::Trajectory {
+            start_s,
+            period_s,
+            angle_deg,
+            rate_dps,
         }
     }
 }

@@ -591,7 +591,6 @@ pub fn ensembles(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use gyro_log::{Quality, Slot};
 
     #[test]
     fn fill_gaps_interpolates_and_holds_ends() {
@@ -711,23 +710,13 @@ mod tests {
         };
         let s = simulate_series(&model, &[], &motion, &options, None);
         let scale = 10f64.powi(decimals);
-        let slots = (0..s.rate_dps.len())
-            .map(|k| Slot {
-                time_s: k as f64 / fs,
-                rate_dps: s.rate_dps[k],
-                reference_deg: Some((s.reference_deg[k] * scale).round() / scale),
-                temperature_c: None,
-                line: k as u64 + 2,
-                filled: false,
-            })
-            .collect();
-        let log = RegularLog {
-            slots,
-            sample_rate_hz: fs,
-            has_reference: true,
-            has_temperature: false,
-            quality: Quality::default(),
-        };
+        let log = crate::test_log::with_reference(
+            fs,
+            (0..s.rate_dps.len()).map(|k| {
+                let reference_deg = (s.reference_deg[k] * scale).round() / scale;
+                (k as f64 / fs, s.rate_dps[k], reference_deg)
+            }),
+        );
         let run = RealRun::prepare("bench".into(), log).unwrap();
         let real = residuals(&run.log).unwrap();
         let sim = simulate_residuals(&run, &model, &[], 5).unwrap();
@@ -758,27 +747,19 @@ mod tests {
     }
 
     fn stamped(fs: f64, clock: f64, source: &'static str, jitter_s: f64) -> RegularLog {
-        let slots = (0..20_000)
-            .map(|k| Slot {
+        let mut log = crate::test_log::with_reference(
+            fs,
+            (0..20_000).map(|k| {
                 // A fixed pseudo-random jitter pattern (±jitter_s).
-                time_s: k as f64 / (fs * clock) + jitter_s * ((k * 7919 % 13) as f64 / 6.0 - 1.0),
-                rate_dps: 0.0,
-                reference_deg: Some(0.0),
-                temperature_c: None,
-                line: k as u64 + 2,
-                filled: k % 1000 == 5,
-            })
-            .collect();
-        RegularLog {
-            slots,
-            sample_rate_hz: fs,
-            has_reference: true,
-            has_temperature: false,
-            quality: Quality {
-                sample_rate_source: source,
-                ..Quality::default()
-            },
+                let jitter = jitter_s * ((k * 7919 % 13) as f64 / 6.0 - 1.0);
+                (k as f64 / (fs * clock) + jitter, 0.0, 0.0)
+            }),
+        );
+        for (k, slot) in log.slots.iter_mut().enumerate() {
+            slot.filled = k % 1000 == 5;
         }
+        log.quality.sample_rate_source = source;
+        log
     }
 
     #[test]

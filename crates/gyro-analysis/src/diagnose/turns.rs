@@ -335,7 +335,6 @@ fn untracked<'a>(
 mod tests {
     #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
     use super::*;
-    use gyro_log::{Quality, RegularLog, Slot};
 
     /// Rest, +120° about the reference's axis, rest, a 5° turn the reference does not see,
     /// rest, −90°, rest: the gyro reads `(1 + k)` times the turns, `lag_s` late, with a
@@ -348,29 +347,17 @@ mod tests {
         let seen = |t: f64| ramp(t, 2.0, 1.5, 120.0) + ramp(t, 8.0, 1.2, -90.0);
         let unseen = |t: f64| ramp(t, 5.0, 0.8, 5.0);
         let n = (11.0 * fs) as usize;
-        let slots = (0..n)
-            .map(|i| {
+        let log = crate::test_log::with_reference(
+            fs,
+            (0..n).map(|i| {
                 let t = i as f64 / fs;
                 let u = t - lag_s;
                 let d = |f: &dyn Fn(f64) -> f64| (f(u + 0.5 / fs) - f(u - 0.5 / fs)) * fs;
                 let wobble = 0.01 * (37.0 * t).sin();
-                Slot {
-                    time_s: t,
-                    rate_dps: (1.0 + k) * d(&seen) + d(&unseen) + bias_dps + wobble,
-                    reference_deg: Some(seen(t)),
-                    temperature_c: None,
-                    line: i as u64 + 1,
-                    filled: false,
-                }
-            })
-            .collect();
-        let log = RegularLog {
-            slots,
-            sample_rate_hz: fs,
-            has_reference: true,
-            has_temperature: false,
-            quality: Quality::default(),
-        };
+                let rate_dps = (1.0 + k) * d(&seen) + d(&unseen) + bias_dps + wobble;
+                (t, rate_dps, seen(t))
+            }),
+        );
         RealRun::prepare(name.into(), log).unwrap()
     }
 
