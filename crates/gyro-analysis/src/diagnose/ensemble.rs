@@ -264,7 +264,7 @@ const PRINT_MAX_DECIMALS: i32 = 6;
 
 /// The grid (deg) of a reference printed with few decimals, `10⁻ᵈ` for the fewest
 /// decimals `d` (at most [`PRINT_MAX_DECIMALS`]) that every value is written with, when
-/// its rounding matters at `fs` Hz. A reference printed to 0.001° rounds each angle by up
+/// the reference spans at least two steps of it and its rounding matters at `fs` Hz. A reference printed to 0.001° rounds each angle by up
 /// to 0.0005°; differentiated at 1 kHz that is noise of 0.27 °/s, twice a CRM100's own
 /// per sample. The real gyro does not see it, but a re-simulated one would (its rate is
 /// the reference's derivative), and the residuals, gyro less the reference's rate, would
@@ -283,7 +283,13 @@ pub fn print_step(values: &[f64], fs: f64) -> Option<f64> {
     };
     let decimals = (0..=PRINT_MAX_DECIMALS).find(|&d| on_grid(10f64.powi(d)))?;
     let step = 10f64.powi(-decimals);
-    (rounding_noise_dps(step, fs, 0) >= PRINT_ROUNDING_FLOOR_DPS).then_some(step)
+    // A reference that stays within two steps (one at rest lies on every grid) shows
+    // no print.
+    let (lo, hi) = finite().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    let moves = hi - lo >= 2.0 * step * (1.0 - 1e-9);
+    (moves && rounding_noise_dps(step, fs, 0) >= PRINT_ROUNDING_FLOOR_DPS).then_some(step)
 }
 
 /// Longest half width of a print's smoothing (s): a cubic smoothing of ±40 ms passes a
@@ -651,6 +657,10 @@ mod tests {
         assert_eq!(print_step(&exact, 1000.0), None);
         assert_eq!(print_step(&[f64::NAN, f64::NAN], 1000.0), None);
         assert_eq!(print_step(&[], 1000.0), None);
+        // A reference at rest lies on every grid, and shows no print.
+        assert_eq!(print_step(&[25.0; 1000], 1000.0), None);
+        assert_eq!(print_step(&[0.0, 0.001, 0.0, 0.001], 1000.0), None);
+        assert_eq!(print_step(&[0.0, 0.001, 0.002], 1000.0), Some(0.001));
         // The motion taken from a printed reference carries the grid to the re-simulation.
         let grid = motion_from_reference(&printed, 1000.0).1.unwrap();
         assert_eq!((grid.step_deg, grid.kind), (0.001, GridKind::Print));
