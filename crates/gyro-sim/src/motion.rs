@@ -178,12 +178,15 @@ impl Motion {
         resolution_deg: f64,
     ) -> Self {
         let (angle_deg, rate_dps) = smoothed(period_s, reference_deg, smooth_samples);
-        let steps = Steps {
+        trajectory_with_steps(
+            start_s,
+            period_s,
+            angle_deg,
+            rate_dps,
             reference_deg,
-            smooth_half: smooth_samples / 2,
+            smooth_samples / 2,
             resolution_deg,
-        };
-        steps.trajectory(start_s, period_s, angle_deg, rate_dps)
+        )
     }
 
     /// A trajectory from reference angles printed on a grid of `resolution_deg` (a log
@@ -210,12 +213,15 @@ impl Motion {
         let rate_dps: Vec<f64> = (0..smooth.len())
             .map(|k| centred_rate(&smooth, period_s, k))
             .collect();
-        let steps = Steps {
+        trajectory_with_steps(
+            start_s,
+            period_s,
+            angle_deg,
+            rate_dps,
             reference_deg,
-            smooth_half: half_width,
+            half_width,
             resolution_deg,
-        };
-        steps.trajectory(start_s, period_s, angle_deg, rate_dps)
+        )
     }
 
     /// Duration (s).
@@ -300,54 +306,21 @@ impl Motion {
     }
 }
 
-/// The steps of a reference's acceleration, and how far a rate taken from it reaches.
-struct Steps<'a> {
-    /// The reference's samples (deg).
-    reference_deg: &'a [f64],
-    /// Half width of the smoothing before the centred derivative (samples).
-    smooth_half: usize,
-    /// Its grid (deg; 0 when exact).
-    resolution_deg: f64,
-}
-
-impl Steps<'_> {
-    /// The trajectory of `angle_deg` and `rate_dps`, the rates beside each step of the
-    /// acceleration one-sided ([`one_sided_beside_steps`]).
-    fn trajectory(
-        &self,
-        start_s: f64,
-        period_s: f64,
-        angle_deg: Vec<f64>,
-        mut rate_dps: Vec<f64>,
-    ) -> Motion {
-        one_sided_beside_steps(
-            &mut rate_dps,
-            self.reference_deg,
-            period_s,
-            self.smooth_half,
-            self.resolution_deg,
-        );
-        Motion::Trajectory {
-            start_s,
-            period_s,
-            angle_deg,
-            rate_dps,
-        }
-    }
-}
-
-/// Replace, in `rate_dps`, the rate of each sample whose centred stencil (two samples)
-/// and smoothing (`smooth_half` samples) reach across a step of the acceleration of
-/// `reference_deg` (on a grid of `resolution_deg`; [`acceleration_steps`]) by a four-point
-/// one-sided derivative of the reference (third order) on its own side, when that side
-/// holds four samples clear of another step ([`Motion::from_reference_with_steps`]).
-fn one_sided_beside_steps(
-    rate_dps: &mut [f64],
-    reference_deg: &[f64],
+/// The trajectory of `angle_deg` and `rate_dps`, where the rate of each sample whose
+/// centred stencil (two samples) and smoothing (`smooth_half` samples) reach across a
+/// step of the acceleration of `reference_deg` (on a grid of `resolution_deg`;
+/// [`acceleration_steps`]) is replaced by a four-point one-sided derivative of the
+/// reference (third order) on its own side, when that side holds four samples clear of
+/// another step ([`Motion::from_reference_with_steps`]).
+fn trajectory_with_steps(
+    start_s: f64,
     period_s: f64,
+    angle_deg: Vec<f64>,
+    mut rate_dps: Vec<f64>,
+    reference_deg: &[f64],
     smooth_half: usize,
     resolution_deg: f64,
-) {
+) -> Motion {
     let n = reference_deg.len().min(rate_dps.len());
     let raw = &reference_deg[..n];
     let steps = acceleration_steps(raw, resolution_deg);
@@ -371,6 +344,12 @@ fn one_sided_beside_steps(
                     / (6.0 * period_s);
             }
         }
+    }
+    Motion::Trajectory {
+        start_s,
+        period_s,
+        angle_deg,
+        rate_dps,
     }
 }
 
