@@ -43,14 +43,16 @@ fn names_an_injected_scale_factor_and_compensates_it() {
     let train = runs(dir, "train", 4, &effect, 10);
     let holdout = runs(dir, "hold", 3, &effect, 50);
     let model = dir.join("model.json");
+    let report = dir.join("report");
+    let report_s = report.to_string_lossy().into_owned();
     let mut args = vec![
         "diagnose",
-        "--format",
-        "json",
         "--members",
         "20",
         "--candidate-members",
         "8",
+        "--report",
+        &report_s,
         "-o",
     ];
     let model_s = model.to_string_lossy().into_owned();
@@ -59,8 +61,30 @@ fn names_an_injected_scale_factor_and_compensates_it() {
     args.extend(train.iter().map(String::as_str));
     args.push("--holdout");
     args.extend(holdout.iter().map(String::as_str));
-    let out = gyro(&args);
-    let d = json_of(&out);
+    let table = ok(&gyro(&args));
+    // The answer in the first five lines, in degrees and plain words.
+    let head: Vec<&str> = table.lines().take(5).collect();
+    let head = head.join("\n");
+    assert!(
+        head.contains("The gyro reads 2.0 % more than the reference (scale factor)")
+            || head.contains("The gyro reads 1.9")
+            || head.contains("The gyro reads 2.1"),
+        "{table}"
+    );
+    assert!(
+        head.contains("Correcting the scale cuts the held-out angle error from")
+            && head.contains("°"),
+        "{table}"
+    );
+    // The report's page leads with the same verdict, before any table.
+    let html = std::fs::read_to_string(report.join("index.html")).unwrap();
+    let verdict = html.find("Correcting the scale cuts").unwrap();
+    assert!(verdict < html.find("<table").unwrap(), "{html}");
+    // The JSON contract, from the report's diagnosis.json (the object `--format json`
+    // prints).
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("diagnosis.json")).unwrap())
+            .unwrap();
     // The contract's keys.
     for key in [
         "train_before",
@@ -221,7 +245,14 @@ fn nothing_significant_without_an_effect() {
     let table = ok(&gyro(&args));
     assert!(table.contains("verdict: nothing significant"), "{table}");
     assert!(
-        !table.contains("does not fit") && !table.contains("unexplained by the selected model"),
+        table
+            .lines()
+            .nth(1)
+            .is_some_and(|l| l.contains("No effect of the vocabulary is named")),
+        "{table}"
+    );
+    assert!(
+        !table.contains("does not explain") && !table.contains("Not explained"),
         "the nominal model fits runs simulated with it: {table}"
     );
     assert!(

@@ -81,15 +81,19 @@ fn report_is_self_contained_with_every_figure_and_the_ranked_table() {
         assert!(html.contains(title), "no figure {title}");
     }
     let figures = if json["compensation"].is_null() {
-        assert!(html.contains("No correctable effect was selected"));
+        assert!(html.contains("No angle-error figure: "));
         5
     } else {
         6
     };
     assert_eq!(html.matches("<svg").count(), figures);
     assert_eq!(html.matches("</svg>").count(), figures);
-    // One "how to read this" per figure.
-    assert_eq!(html.matches("How to read this.").count(), figures);
+    // One "how to read this" per folded figure (the angle error's says what it shows in
+    // its title, beside the verdict).
+    assert_eq!(html.matches("How to read this.").count(), 5);
+    // The answer before every table and every folded section.
+    let verdict = html.find("<div class=\"verdict\">").unwrap();
+    assert!(verdict < html.find("<table").unwrap() && verdict < html.find("<details").unwrap());
     // The ranked table: scale_factor first, significant, with its interval.
     let row = html
         .split("<tr")
@@ -105,7 +109,7 @@ fn report_is_self_contained_with_every_figure_and_the_ranked_table() {
     }
     // Gap figures and the nominal model's provenance.
     assert!(html.contains("floor") && html.contains("regression intercept"));
-    assert!(html.contains("<b>Verdict:</b> unmodelled: <code>scale_factor</code>"));
+    assert!(html.contains("<b>In the statistics' terms:</b> unmodelled: <code>scale_factor</code>"));
 
     if std::env::var_os("GYRO_REPORT_DIR").is_none() {
         std::fs::remove_dir_all(dir).unwrap();

@@ -139,6 +139,15 @@ fn static_log_json_table_and_model_file() {
     let out = gyro(&["noise", &log]);
     assert!(out.status.success());
     let table = String::from_utf8_lossy(&out.stdout);
+    // The answer first, in the trade's units, before the Allan table.
+    let second = table.lines().nth(1).unwrap_or_default();
+    assert!(
+        second.contains("white noise (angle random walk)")
+            && second.contains("deg/√h")
+            && second.contains("deg (1 σ) after 1 minute"),
+        "{table}"
+    );
+    assert!(table.find("bias stability").unwrap() < table.find("Allan deviation (").unwrap());
     for needle in [
         "Allan deviation",
         "angle random walk N",

@@ -1,7 +1,7 @@
 //! The text of `calibrate`: fitted models and the per-run scores.
 
 use gyro_analysis::calibrate::delay::DelaySource;
-use gyro_analysis::calibrate::{Calibration, Candidate, ChoiceReason, RunScore};
+use gyro_analysis::calibrate::{Calibration, Candidate, ChoiceReason, Objective, RunScore};
 use gyro_core::{Compensation, Config};
 use serde::Serialize;
 
@@ -93,11 +93,126 @@ pub fn candidate_text(c: &Calibration, candidate: Candidate) -> String {
     }
 }
 
-/// The calibration as text: the fitted paper model with its leave-one-run-out spread, the
-/// Kalman form, the max abs angle error per run by candidate, and which candidate is
-/// written, chosen on the leave-one-run-out errors.
+/// What an objective measures, in words.
+pub fn objective_text(objective: Objective) -> &'static str {
+    match objective {
+        Objective::MeanMaxAbs => "the mean over the runs of each run's largest |angle error|",
+        Objective::MeanRms => "the mean over the runs of each run's RMS angle error",
+        Objective::WorstMaxAbs => "the largest |angle error| of any run",
+        Objective::MovementRms => "the RMS over every completed movement of its angle error",
+    }
+}
+
+/// The median of `scores` by `f` (NaN for none).
+fn median_of(scores: &[RunScore], f: fn(&RunScore) -> f64) -> f64 {
+    let v: Vec<f64> = scores.iter().map(f).collect();
+    gyro_analysis::median(&v).unwrap_or(f64::NAN)
+}
+
+/// A run score's max abs angle error for `candidate` (deg).
+fn score_of(r: &RunScore, candidate: Candidate) -> f64 {
+    match candidate {
+        Candidate::Default => r.default_max_abs_deg,
+        Candidate::None => r.none_max_abs_deg,
+        Candidate::Paper => r.paper_max_abs_deg,
+        Candidate::Kalman => r.kalman_max_abs_deg,
+    }
+}
+
+/// The answer in a few lines, in degrees and plain words, for the top of the table: what
+/// the written model holds, why, and what the hold-out runs say of it.
+pub fn answer(c: &Calibration) -> Vec<String> {
+    let written = c.choice.written;
+    let mut holds = vec![candidate_text(c, written)];
+    if let (Some(k), true) = (c.scale.k, c.scale.written) {
+        holds.push(format!("a scale correction of {:+.3} %", 100.0 * k));
+    }
+    let d = &c.reference_delay;
+    match d.source {
+        DelaySource::CrossCorrelation | DelaySource::Given => holds.push(format!(
+            "a reference delay of {:.1} ms (the gyro {} the reference)",
+            1e3 * d.delay_s.abs(),
+            if d.delay_s >= 0.0 { "lags" } else { "leads" }
+        )),
+        DelaySource::NotApplied => {}
+    }
+    let mut lines = vec![format!("the written model holds {}", holds.join(", "))];
+    let default = c
+        .choice
+        .scores
+        .iter()
+        .find(|score| score.candidate == Candidate::Default);
+    let chosen = c
+        .choice
+        .scores
+        .iter()
+        .find(|score| score.candidate == written);
+    let objective = objective_text(c.objective);
+    lines.push(match (c.choice.reason, default, chosen) {
+        (ChoiceReason::LowestHeldOut, Some(d), Some(w)) => {
+            let wins = w
+                .leave_one_out_runs_deg
+                .iter()
+                .zip(&d.leave_one_out_runs_deg)
+                .filter(|(v, d)| v < d)
+                .count();
+            format!(
+                "why: with each training run left out of the fit and scored, it errs {:.2} deg against {:.2} deg for the starting configuration ({objective}), better on {wins} of {} runs",
+                w.leave_one_out_deg.unwrap_or(f64::NAN),
+                d.leave_one_out_deg.unwrap_or(f64::NAN),
+                d.leave_one_out_runs_deg.len()
+            )
+        }
+        (ChoiceReason::DefaultNotBeaten, Some(d), _) => format!(
+            "why: with each training run left out of the fit and scored, no fitted candidate beats the starting configuration's {:.2} deg ({objective}) on most runs",
+            d.leave_one_out_deg.unwrap_or(f64::NAN)
+        ),
+        _ => format!("why: {}", choice_text(c)),
+    });
+    if let (true, Some((without, with))) = (
+        c.scale.written,
+        c.scale.holdout_deg.or(c.scale.leave_one_out_deg),
+    ) {
+        lines.push(format!(
+            "the scale correction takes the turns' RMS error (rest to rest) from {without:.2} deg to {with:.2} deg on runs it was not fitted on"
+        ));
+    }
+    if !c.holdout.is_empty() {
+        let before = median_of(&c.holdout, |r| r.default_max_abs_deg);
+        let v: Vec<f64> = c.holdout.iter().map(|r| score_of(r, written)).collect();
+        let after = gyro_analysis::median(&v).unwrap_or(f64::NAN);
+        lines.push(format!(
+            "on the {} hold-out run{}, each run's largest |angle error| (median): {before:.2} deg with the starting configuration, {after:.2} deg with {}{}",
+            c.holdout.len(),
+            if c.holdout.len() == 1 { "" } else { "s" },
+            candidate_text(c, written),
+            if c.scale.written {
+                " (without the scale correction: these scores are taken before it is fitted)"
+            } else {
+                ""
+            }
+        ));
+    }
+    lines
+}
+
+/// The calibration as text: the [`answer`] first, then the fitted paper model with its
+/// leave-one-run-out spread, the Kalman form, the max abs angle error per run by
+/// candidate, and which candidate is written, chosen on the leave-one-run-out errors.
 pub fn table(c: &Calibration) -> String {
-    let mut s = format!(
+    table_with_inputs(c, "")
+}
+
+/// [`table`] with the input-quality report `inputs` ([`crate::input::tables`]) at the top
+/// of the details, below the answer.
+pub fn table_with_inputs(c: &Calibration, inputs: &str) -> String {
+    let mut s = String::from("calibration:\n");
+    for line in answer(c) {
+        s += &format!("  {line}\n");
+    }
+    s += "\n---- details ----\n";
+    s += inputs;
+    s += &format!(
         "start: correlation time {:.1} s ({})\n",
         c.initial_tau.0, c.initial_tau.1
     );
@@ -110,15 +225,20 @@ pub fn table(c: &Calibration) -> String {
         );
     }
     s += &format!(
-        "paper error model: beta {:.5} 1/s (T {:.1} s), b0 {:.5} deg/s, o0 {:.5} deg\n  objective {:?} = {:.4} deg after {} evaluations ({})\n",
+        "paper error model: beta {:.5} 1/s (T {:.1} s), b0 {:.5} deg/s, o0 {:.5} deg\n  objective ({}) {:.4} deg after {} evaluations ({})\n",
         f.paper.beta_per_s,
         1.0 / f.paper.beta_per_s,
         f.paper.b0_dps,
         f.paper.o0_deg,
-        c.objective,
+        objective_text(c.objective),
         c.objective_deg,
         c.evaluations,
-        c.termination
+        match c.termination.as_str() {
+            "Converged" => "converged",
+            "MaxIterations" => "stopped at the iteration limit",
+            "MaxEvaluations" => "stopped at the evaluation limit",
+            other => other,
+        }
     );
     if let Some(sp) = &c.spread {
         s += &format!(
@@ -230,13 +350,13 @@ fn scale_text(c: &Calibration) -> String {
 fn choice_table(c: &Calibration) -> String {
     use std::fmt::Write as _;
     let mut s = format!(
-        "choice of the model written, on leave-one-run-out error (each training run scored with what was fitted on the other runs; objective {:?}, deg; training error not used)\n",
-        c.objective
+        "choice of the model written, on leave-one-run-out error (each training run scored with what was fitted on the other runs; {}, deg; training error not used)\n",
+        objective_text(c.objective)
     );
     let _ = writeln!(
         s,
-        "  {:<10} {:>11} {:>14} {:>11}",
-        "candidate", "held-out", "runs better", "training"
+        "  {:<10} {:>13} {:>14} {:>13}",
+        "candidate", "held-out deg", "runs better", "training deg"
     );
     let default = c
         .choice
@@ -264,7 +384,7 @@ fn choice_table(c: &Calibration) -> String {
         };
         let _ = writeln!(
             s,
-            "  {:<10} {:>11} {:>14} {:>11.4}",
+            "  {:<10} {:>13} {:>14} {:>13.4}",
             candidate_name(score.candidate),
             held_out,
             better,

@@ -1,6 +1,7 @@
 //! Rendering a [`Characterization`]: a human-readable table, the JSON of `noise`, and the
 //! PSD as CSV.
 
+use crate::plot::sig;
 use gyro_analysis::noise::{Characterization, FitTerm, NoiseLog, NoiseRun, NoiseType};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -14,7 +15,88 @@ fn mark(term: &FitTerm) -> &'static str {
     }
 }
 
-/// The Allan table, the fitted terms and the PSD summary of one data set, titled `label`.
+/// The answer for one data set in a few lines, in the trade's units: the bias, the white
+/// noise and what it does to the angle, the bias stability, and the terms the fit finds
+/// significant (and those it does not).
+pub fn answer(c: &Characterization) -> Vec<String> {
+    let f = &c.fit;
+    let mut lines = vec![format!(
+        "bias (mean rate at rest) {:.4} deg/s; white noise (angle random walk) {:.3} deg/√h: on its own it leaves an angle error of about {:.3} deg (1 σ) after 1 minute of integration",
+        c.mean_rate_dps,
+        f.arw_deg_per_rt_h,
+        f.arw_deg_per_rt_h * (1.0f64 / 60.0).sqrt()
+    )];
+    lines.push(format!(
+        "bias stability: the Allan deviation bottoms out at {} deg/s ({} deg/h) when averaged over {} s{}",
+        sig(f.floor.adev_dps, 3),
+        sig(3600.0 * f.floor.adev_dps, 3),
+        sig(f.floor.tau_s, 3),
+        if f.floor.at_longest_tau {
+            " (at the longest averaging time: it may fall further on a longer log)"
+        } else {
+            ""
+        }
+    ));
+    let mut found = Vec::new();
+    let mut not_found = Vec::new();
+    let mut term = |significant: bool, found_text: String, name: &str| {
+        if significant {
+            found.push(found_text);
+        } else {
+            not_found.push(name.to_string());
+        }
+    };
+    term(
+        f.quantization_deg.significant,
+        format!("quantisation {:.2e} deg", f.quantization_deg.value),
+        "quantisation",
+    );
+    term(
+        f.bias_instability_dps.significant,
+        format!(
+            "bias instability {} deg/s ({} deg/h)",
+            sig(f.bias_instability_dps.value, 3),
+            sig(3600.0 * f.bias_instability_dps.value, 3)
+        ),
+        "bias instability",
+    );
+    term(
+        f.rate_random_walk_dps_per_rt_s.significant,
+        format!(
+            "rate random walk {:.2e} deg/s/√s",
+            f.rate_random_walk_dps_per_rt_s.value
+        ),
+        "rate random walk",
+    );
+    let gm = &f.gauss_markov;
+    term(
+        gm.significant,
+        format!(
+            "a Gauss-Markov bias wander of σ {} deg/s{}",
+            sig(gm.sigma_dps, 3),
+            gm.corr_time_s
+                .map_or_else(String::new, |t| format!(" over {} s", sig(t, 3)))
+        ),
+        "Gauss-Markov bias wander",
+    );
+    lines.push(format!(
+        "beside the white noise the fit finds {}{}",
+        if found.is_empty() {
+            "nothing significant".to_string()
+        } else {
+            found.join(", ")
+        },
+        if not_found.is_empty() {
+            String::new()
+        } else {
+            format!("; not significant: {}", not_found.join(", "))
+        }
+    ));
+    lines
+}
+
+/// The Allan table, the fitted terms and the PSD summary of one data set, titled `label`:
+/// the [`answer`] first.
 pub fn table(label: &str, c: &Characterization) -> String {
     let mut s = String::new();
     let _ = writeln!(
@@ -30,9 +112,13 @@ pub fn table(label: &str, c: &Characterization) -> String {
         c.rate_step_dps
             .map_or(String::new(), |v| format!(", output step {v:.6} deg/s"))
     );
+    for line in answer(c) {
+        let _ = writeln!(s, "  {line}");
+    }
+    let _ = writeln!(s, "details:");
     let _ = writeln!(
         s,
-        "Allan deviation (overlapping; {:.1}% chi-squared bounds, EDF by the fitted model's noise type):",
+        "Allan deviation (overlapping; {:.1}% chi-squared bounds, EDF by the fitted model's noise type; noise: the type the fit takes at that τ):",
         100.0 * c.allan.confidence
     );
     let _ = writeln!(

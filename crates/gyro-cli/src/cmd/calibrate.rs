@@ -163,10 +163,9 @@ pub fn run(args: &Args) -> Result<()> {
         .collect();
     let text = match args.format {
         super::run::Format::Json => gyro_report::calibrate::json(&inputs, &result)? + "\n",
-        _ => format!(
-            "{}{}",
-            gyro_report::input::tables(inputs.iter().map(|i| (i.file, i.input))),
-            gyro_report::calibrate::table(&result)
+        _ => gyro_report::calibrate::table_with_inputs(
+            &result,
+            &gyro_report::input::tables(inputs.iter().map(|i| (i.file, i.input))),
         ),
     };
     super::to_stdout(|out| out.write_all(text.as_bytes()))?;

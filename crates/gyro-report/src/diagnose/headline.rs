@@ -43,93 +43,117 @@ pub fn rounded(x: f64, half: f64) -> String {
     format!("{x:.decimals$}")
 }
 
-/// Parameter `name` of `e` times `unit`, with its 95% interval, as "v [lo, hi]".
-fn value(e: &EffectResult, name: &str, unit: f64) -> Option<String> {
+/// Parameter `name` of `e` times `unit`, with its 95% interval as "v [lo, hi]" when
+/// `interval`, else alone (rounded to what the interval supports either way).
+fn value(e: &EffectResult, name: &str, unit: f64, interval: bool) -> Option<String> {
     let v = *e.params.get(name)? * unit;
     let ci = e.ci95.get(name).copied().unwrap_or([None, None]);
     Some(match ci {
         [Some(lo), Some(hi)] => {
             let (lo, hi) = ((lo * unit).min(hi * unit), (lo * unit).max(hi * unit));
             let half = 0.5 * (hi - lo).abs();
-            format!(
-                "{} [{}, {}]",
-                rounded(v, half),
-                rounded(lo, half),
-                rounded(hi, half)
-            )
+            if interval {
+                format!(
+                    "{} [{}, {}]",
+                    rounded(v, half),
+                    rounded(lo, half),
+                    rounded(hi, half)
+                )
+            } else {
+                // Alone, at most three significant digits.
+                rounded(v, half.max(0.05 * v.abs()))
+            }
         }
-        _ => rounded(v, f64::NAN),
+        _ if interval => rounded(v, f64::NAN),
+        _ => rounded(v, 0.05 * v.abs()),
     })
 }
 
-/// The sentence for a named effect.
-pub fn sentence(e: &EffectResult) -> String {
-    let v = |name: &str, unit: f64| value(e, name, unit).unwrap_or_else(|| "-".into());
+/// What a named effect does, as a clause whose subject is the gyro ("lags the reference
+/// by 12.6 ms"), with each value's 95% interval when `interval`.
+pub fn clause(e: &EffectResult, interval: bool) -> String {
+    let v = |name: &str, unit: f64| value(e, name, unit, interval).unwrap_or_else(|| "-".into());
+    let negative = |name: &str| e.params.get(name).is_some_and(|x| *x < 0.0);
     match e.id {
-        "latency" if e.params.get("delay_s").is_some_and(|d| *d < 0.0) => format!(
-            "the gyro leads the reference (the reference lags) by {} ms",
+        "latency" if negative("delay_s") => format!(
+            "leads the reference (the reference lags) by {} ms",
             v("delay_s", -1e3)
         ),
-        "latency" => format!("the gyro lags the reference by {} ms", v("delay_s", 1e3)),
+        "latency" => format!("lags the reference by {} ms", v("delay_s", 1e3)),
         "bandwidth" => format!(
-            "the gyro's response is low-passed (two poles) at {} Hz",
+            "responds as a two-pole low-pass at {} Hz",
             v("cutoff_hz", 1.0)
         ),
-        "scale_factor" if e.params.get("k").is_some_and(|k| *k < 0.0) => format!(
-            "scale {} % (the gyro reads that much less than the reference)",
-            v("k", 100.0)
+        "scale_factor" if negative("k") => format!(
+            "reads {} % less than the reference (scale factor)",
+            v("k", -100.0)
         ),
         "scale_factor" => format!(
-            "scale +{} % (the gyro reads that much more than the reference)",
+            "reads {} % more than the reference (scale factor)",
             v("k", 100.0)
         ),
         "scale_asymmetry" => format!(
-            "the scale differs by the sign of the rate: {} % (positive minus negative turns)",
+            "reads {} % more turning the positive way than the negative way (scale asymmetry)",
             v("k", 100.0)
         ),
         "nonlinearity" => format!(
-            "odd (cubic) nonlinearity {} per (deg/s)², i.e. {} % of the rate at 100 deg/s",
-            v("k3_per_dps2", 1.0),
-            v("k3_per_dps2", 1e6)
+            "reads {} % of the rate off at 100 deg/s, with the rate's sign (cubic nonlinearity {} per (deg/s)²)",
+            v("k3_per_dps2", 1e6),
+            v("k3_per_dps2", 1.0)
         ),
         "nonlinearity_even" => format!(
-            "even (quadratic) nonlinearity {} per deg/s, i.e. {} % of the rate at 100 deg/s, the same sign both ways",
-            v("k2_per_dps", 1.0),
-            v("k2_per_dps", 1e4)
+            "reads {} % of the rate off at 100 deg/s, the same sign both ways (quadratic nonlinearity {} per deg/s)",
+            v("k2_per_dps", 1e4),
+            v("k2_per_dps", 1.0)
+        ),
+        "clock_error_count_stamped" if negative("ppm") => format!(
+            "samples {} ppm slow and its rows are stamped by its sample count, so it runs ahead of the reference by {} ms more each minute",
+            v("ppm", -1.0),
+            v("ppm", -0.06)
         ),
         "clock_error_count_stamped" => format!(
-            "the sensor's clock is off by {} ppm and the rows are stamped by its sample count: the lag behind the reference grows by {} ms per minute",
+            "samples {} ppm fast and its rows are stamped by its sample count, so its lag behind the reference grows by {} ms each minute",
             v("ppm", 1.0),
             v("ppm", 0.06)
         ),
         "vibration" => format!(
-            "a vibration the reference does not see: {} deg/s at {} Hz",
+            "sees a vibration the reference does not: {} deg/s at {} Hz",
             v("amplitude_dps", 1.0),
             v("frequency_hz", 1.0)
         ),
-        "saturation" => format!("the output clips at ±{} deg/s", v("limit_dps", 1.0)),
-        "quantization" => format!("the output moves in steps of {} deg/s", v("lsb_dps", 1.0)),
+        "saturation" => format!("clips at ±{} deg/s", v("limit_dps", 1.0)),
+        "quantization" => format!("moves in steps of {} deg/s", v("lsb_dps", 1.0)),
+        "clock_error" if negative("ppm") => format!(
+            "samples {} ppm slow against the declared sample rate (its time stamps show it)",
+            v("ppm", -1.0)
+        ),
         "clock_error" => format!(
-            "the time stamps' clock is off by {} ppm against the declared sample rate",
+            "samples {} ppm fast against the declared sample rate (its time stamps show it)",
             v("ppm", 1.0)
         ),
         "dropouts" => format!(
-            "{} dropouts per s of {} samples each",
+            "drops samples {} times per s, {} at a time",
             v("rate_per_s", 1.0),
             v("mean_samples", 1.0)
         ),
-        "temperature_bias" => format!("the bias moves by {} deg/s per degC", v("dps_per_c", 1.0)),
-        "temperature_scale" => format!("the scale moves by {} % per degC", v("per_c", 100.0)),
+        "temperature_bias" => format!(
+            "has a bias that moves by {} deg/s per degC",
+            v("dps_per_c", 1.0)
+        ),
+        "temperature_scale" => format!(
+            "has a scale that moves by {} % per degC",
+            v("per_c", 100.0)
+        ),
         "bias_instability" => format!(
-            "the bias wanders by σ {} deg/s within a run",
+            "has a bias that wanders by σ {} deg/s within a run",
             v("sigma_dps", 1.0)
         ),
         "rate_random_walk" => format!(
-            "the bias random-walks by {} deg/s/√s",
+            "has a bias that random-walks by {} deg/s/√s",
             v("k_dps_per_rt_s", 1.0)
         ),
         "turn_on_bias" => format!(
-            "the bias differs from run to run by σ {} deg/s",
+            "has a bias that differs from run to run by σ {} deg/s",
             v("sigma_dps", 1.0)
         ),
         other => {
@@ -138,56 +162,233 @@ pub fn sentence(e: &EffectResult) -> String {
                 .keys()
                 .map(|k| format!("{k} = {}", v(k, 1.0)))
                 .collect();
-            format!("{other}: {}", params.join(", "))
+            format!("shows {other}: {}", params.join(", "))
         }
     }
 }
 
-/// The headline: a reference that does not measure the gyro's motion first (it makes the
-/// rest meaningless), then one line per named effect (in the order named), then what the
-/// written model corrects and what it does to the held-out angle error; or that nothing is
-/// named.
-pub fn headline(d: &Diagnosis) -> Vec<String> {
-    let mut lines: Vec<String> = d
+/// The sentence for a named effect, with its 95% intervals.
+pub fn sentence(e: &EffectResult) -> String {
+    format!("the gyro {}", clause(e, true))
+}
+
+/// What correcting effect `id` is, in words ("the lag", "the scale").
+fn correction_name(id: &str) -> String {
+    match id {
+        "latency" => "the lag".into(),
+        "bandwidth" => "the low-pass".into(),
+        "scale_factor" => "the scale".into(),
+        "scale_asymmetry" => "the scale asymmetry".into(),
+        "clock_error" | "clock_error_count_stamped" => "the clock".into(),
+        "temperature_bias" => "the bias's temperature slope".into(),
+        "temperature_scale" => "the scale's temperature slope".into(),
+        gyro_analysis::diagnose::BIAS_ID => "the bias".into(),
+        other => format!("the {}", other.replace('_', " ")),
+    }
+}
+
+/// `items` as "a", "a and b", "a, b and c".
+fn and_list(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.clone(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+    }
+}
+
+/// The held-out runs' median max |angle error| without and with the written corrections
+/// (deg), and how many runs the corrections made better.
+fn held_out_error(c: &gyro_analysis::diagnose::CompensationSummary) -> (f64, f64, usize) {
+    let median = |f: &dyn Fn(&gyro_analysis::diagnose::CompensationRun) -> f64| {
+        let v: Vec<f64> = c.runs.iter().map(f).filter(|x| x.is_finite()).collect();
+        gyro_analysis::median(&v).unwrap_or(f64::NAN)
+    };
+    let better = c
+        .runs
+        .iter()
+        .filter(|r| r.max_abs_error_after_deg < r.max_abs_error_before_deg)
+        .count();
+    (
+        median(&|r| r.max_abs_error_before_deg),
+        median(&|r| r.max_abs_error_after_deg),
+        better,
+    )
+}
+
+/// An angle in degrees for a sentence: two significant digits, at least one decimal
+/// below 10 ("7.2°", "0.45°", "38°").
+fn degrees(x: f64) -> String {
+    if !x.is_finite() {
+        "-".into()
+    } else if x.abs() >= 10.0 {
+        format!("{x:.0}°")
+    } else if x.abs() >= 1.0 {
+        format!("{x:.1}°")
+    } else {
+        format!("{}°", crate::plot::sig(x, 2))
+    }
+}
+
+/// The answer in a few sentences, in degrees and plain words, for the first lines of
+/// every output: what makes the diagnosis meaningless (a reference that does not measure
+/// the gyro's motion), if anything; what differs from the model, and by how much; what
+/// correcting it does to the held-out angle error; and what the model does not explain.
+pub fn verdict(d: &Diagnosis) -> Vec<String> {
+    let mut out: Vec<String> = d
         .reference_warnings
         .iter()
         .map(|w| format!("warning: {w}"))
         .collect();
-    let leading = lines.len();
-    lines.extend(d.effects.iter().filter(|e| e.significant).map(|e| {
-        format!(
-            "{}: {} (evidence on the held-out runs {})",
-            e.id,
-            sentence(e),
-            e.delta_bic.map_or(NOT_SCORED, evidence)
-        )
-    }));
-    if lines.len() == leading {
-        lines.push("no effect of the vocabulary is named: the nominal model holds on these runs, or what differs is not in the vocabulary (see the where-statistics)".into());
-    }
-    lines.extend(turn_lines(d));
+    let named: Vec<String> = d
+        .effects
+        .iter()
+        .filter(|e| e.significant)
+        .map(|e| clause(e, false))
+        .collect();
+    let turns = turn_clauses(d);
+    let mut differs = named.clone();
+    differs.extend(turns);
+    out.push(if differs.is_empty() {
+        "No effect of the vocabulary is named: on these runs the gyro behaves as the model predicts, or what differs is not in the vocabulary.".to_string()
+    } else {
+        format!("The gyro {}.", and_list(&differs))
+    });
     if let Some(c) = &d.compensation {
-        let median = |f: &dyn Fn(&gyro_analysis::diagnose::CompensationRun) -> f64| {
-            let v: Vec<f64> = c.runs.iter().map(f).filter(|x| x.is_finite()).collect();
-            gyro_analysis::median(&v).unwrap_or(f64::NAN)
-        };
-        let before = median(&|r| r.max_abs_error_before_deg);
-        let after = median(&|r| r.max_abs_error_after_deg);
+        let (before, after, better) = held_out_error(c);
+        let turns_wrote = turns_wrote(d);
+        if c.corrected.is_empty() {
+            out.push(format!(
+                "The written model corrects {}: no correction of {} lowered the held-out angle error ({} as it is, each run's largest error, median over {} runs).",
+                if turns_wrote { "only what the turns show" } else { "nothing" },
+                if named.len() == 1 { "it" } else { "them" },
+                degrees(before),
+                c.runs.len()
+            ));
+        } else {
+            let ids: Vec<String> = c.corrected.iter().map(|id| correction_name(id)).collect();
+            out.push(format!(
+                "Correcting {} cuts the held-out angle error from {} to {} (each run's largest error, median over {} runs; better on {better} of {}){}.",
+                and_list(&ids),
+                degrees(before),
+                degrees(after),
+                c.runs.len(),
+                c.runs.len(),
+                if turns_wrote { "; the turns' corrections come on top" } else { "" }
+            ));
+        }
+    } else if let Some(line) = turns_error_sentence(d) {
+        out.push(line);
+    } else if !named.is_empty() {
+        out.push("None of the named effects is one the model file corrects, so the held-out angle error is not changed by it.".into());
+    }
+    if !d.verdict.model_fits {
+        let first = d.unexplained.first().map(super::words::missed);
+        out.push(match first {
+            Some(m) => format!(
+                "Not explained by the model: {m}{}.",
+                if d.unexplained.len() > 1 {
+                    format!("; {} statistics in all, listed below", d.unexplained.len())
+                } else {
+                    String::new()
+                }
+            ),
+            None => "The model does not explain these runs.".into(),
+        });
+    }
+    out
+}
+
+/// What the turns show, as clauses of the verdict: a lag beyond the per-sample
+/// statistics, a turn scale that is named.
+fn turn_clauses(d: &Diagnosis) -> Vec<String> {
+    let Some(t) = &d.turns else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    if let Some(lag) = t.lag.as_ref().filter(|l| l.beyond_statistic) {
+        out.push(format!(
+            "{} the reference by {:.0} ms",
+            if lag.median_s >= 0.0 { "lags" } else { "leads" },
+            1e3 * lag.median_s.abs()
+        ));
+    }
+    if let Some(s) = t.scale.as_ref().filter(|s| s.named) {
+        out.push(format!(
+            "reads {:.2} % {} than the reference over whole turns",
+            100.0 * s.k.abs(),
+            if s.k < 0.0 { "less" } else { "more" }
+        ));
+    }
+    out
+}
+
+/// What the turns' written corrections do to the held-out angle error, when nothing else
+/// is compensated.
+fn turns_error_sentence(d: &Diagnosis) -> Option<String> {
+    let t = d.turns.as_ref()?;
+    let lag = t
+        .lag
+        .as_ref()
+        .filter(|l| l.written)
+        .and_then(|l| l.holdout_max_abs_error_deg);
+    let (b, a) = lag?;
+    Some(format!(
+        "Correcting the lag cuts the held-out angle error from {} to {} (each run's largest error, median).",
+        degrees(b),
+        degrees(a)
+    ))
+}
+
+/// The sections of the diagnosis below its [`verdict`], each a list of lines in plain
+/// words; every output shows all of them, in this order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Findings {
+    /// One line per named effect (value, 95% interval, evidence in words), then what the
+    /// turns show rest to rest, then what the written model corrects and what it does not.
+    pub named: Vec<String>,
+    /// What the model still misses, in words and units: the statistics it leaves
+    /// unexplained, the effective noise on moving data, lines in the motion.
+    pub missed: Vec<String>,
+    /// How the data were taken (a quantised reference) and what makes part of the
+    /// diagnosis unreliable.
+    pub notes: Vec<String>,
+}
+
+/// Most unexplained statistics listed in words in [`Findings::missed`] (the rest are in
+/// the details' table).
+pub const MISSED_LINES: usize = 5;
+
+/// The diagnosis's findings below the verdict ([`Findings`]).
+pub fn findings(d: &Diagnosis) -> Findings {
+    let mut named: Vec<String> = d
+        .effects
+        .iter()
+        .filter(|e| e.significant)
+        .map(|e| {
+            format!(
+                "{}: {} (evidence on the held-out runs: {})",
+                e.id,
+                sentence(e),
+                e.delta_bic.map_or(NOT_SCORED, evidence)
+            )
+        })
+        .collect();
+    if named.is_empty() {
+        named.push("no effect of the vocabulary is named: the nominal model holds on these runs, or what differs is not in the vocabulary (see what the model misses)".into());
+    }
+    named.extend(turn_lines(d));
+    if let Some(c) = &d.compensation {
+        let (before, after, better) = held_out_error(c);
         if c.corrected.is_empty() {
             let what = if turns_wrote(d) {
                 "no correction of the per-sample effects is written (the written model holds only the turns' corrections above)"
             } else {
                 "no correction is written"
             };
-            lines.push(format!(
+            named.push(format!(
                 "{what}: none lowered the held-out angle error (median max |error| {before:.2} deg)"
             ));
         } else {
-            let better = c
-                .runs
-                .iter()
-                .filter(|r| r.max_abs_error_after_deg < r.max_abs_error_before_deg)
-                .count();
             let ids: Vec<String> = c
                 .corrected
                 .iter()
@@ -202,7 +403,7 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
                     }
                 })
                 .collect();
-            lines.push(format!(
+            named.push(format!(
                 "the written model corrects {}: held-out median max |angle error| {before:.2} -> {after:.2} deg, better on {better} of {} runs",
                 ids.join(", "),
                 c.runs.len()
@@ -210,12 +411,12 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
         }
         for n in &c.not_corrected {
             if n.id == gyro_analysis::diagnose::BIAS_ID {
-                lines.push(format!(
+                named.push(format!(
                     "the bias ({:.3} deg/s, fitted on the training runs) is not written: it did not lower the held-out error",
                     d.model.sensor.bias_dps
                 ));
             } else {
-                lines.push(format!(
+                named.push(format!(
                     "{}: named, not corrected ({})",
                     n.id,
                     n.reason
@@ -224,8 +425,19 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
             }
         }
     }
+    let mut missed = Vec::new();
     if !d.verdict.model_fits {
-        lines.push(unexplained_line(d));
+        missed.push(unexplained_line(d));
+        missed.extend(super::words::missed_by_statistic(
+            &d.unexplained,
+            MISSED_LINES,
+        ));
+    }
+    if let Some(line) = effective_noise_line(&d.effective_noise) {
+        missed.push(match d.residual_caveat() {
+            Some(caveat) => format!("{line}; but {caveat}"),
+            None => line,
+        });
     }
     for m in &d.motion_lines {
         let response = if m.gyro_gain.is_finite() && m.gyro_lag_s.is_finite() {
@@ -237,7 +449,7 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
         } else {
             String::new()
         };
-        lines.push(format!(
+        missed.push(format!(
             "seen in the data, not a sensor effect: the motion of the {} runs has a line at {:.1} Hz ({} deg/s in the motion's rate, {:.0} times its local floor): the rig vibrates and both sensors see it{response}",
             m.runs,
             m.frequency_hz,
@@ -245,14 +457,28 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
             m.ratio
         ));
     }
-    lines.extend(reference_grid_lines(&d.runs));
-    if let Some(line) = effective_noise_line(&d.effective_noise) {
-        lines.push(match d.residual_caveat() {
-            Some(caveat) => format!("{line}; but {caveat}"),
-            None => line,
-        });
+    if missed.is_empty() {
+        missed.push(format!(
+            "nothing: every statistic of the training runs is within |z| < {} of its simulation with the selected model",
+            gyro_analysis::diagnose::locate::UNEXPLAINED_Z
+        ));
     }
-    lines.extend(d.warnings.iter().map(|w| format!("warning: {w}")));
+    let mut notes = reference_grid_lines(&d.runs);
+    notes.extend(d.warnings.iter().map(|w| format!("warning: {w}")));
+    Findings {
+        named,
+        missed,
+        notes,
+    }
+}
+
+/// Every line of the diagnosis in words: the [`verdict`], then the [`findings`].
+pub fn headline(d: &Diagnosis) -> Vec<String> {
+    let f = findings(d);
+    let mut lines = verdict(d);
+    lines.extend(f.named);
+    lines.extend(f.missed);
+    lines.extend(f.notes);
     lines
 }
 
@@ -407,30 +633,14 @@ pub fn sig3(x: f64) -> String {
     rounded(x, 0.005 * x.abs())
 }
 
-/// How many statistics the selected model leaves unexplained on the training runs, and
-/// the largest three with their real and simulated values.
+/// How many statistics the selected model leaves unexplained on the training runs, in
+/// words; [`super::words::missed`] says the largest ones.
 fn unexplained_line(d: &Diagnosis) -> String {
-    let largest: Vec<String> = d
-        .unexplained
-        .iter()
-        .take(3)
-        .map(|u| {
-            format!(
-                "{} ({}): real {}, simulated {} (z {})",
-                u.statistic,
-                u.segment,
-                sig3(u.real),
-                sig3(u.simulated),
-                sig3(u.z_train)
-            )
-        })
-        .collect();
     format!(
-        "the model does not fit the training runs: {} statistics remain unexplained (G {} against a floor of {}); no effect of the vocabulary, as selected, brings them to the simulation; largest: {}",
+        "the model does not explain the training runs: {} of the statistics compared stay outside its simulation (gap G {} where a model that explains the runs reaches about {}); no effect of the vocabulary, as selected, brings them in; the largest:",
         d.unexplained.len(),
         sig3(d.gap.train_after),
         sig3(d.gap.floor),
-        largest.join("; ")
     )
 }
 
@@ -475,11 +685,39 @@ mod tests {
         };
         assert_eq!(
             sentence(&scale(-0.015)),
-            "scale -1.50 [-1.53, -1.47] % (the gyro reads that much less than the reference)"
+            "the gyro reads 1.50 [1.47, 1.53] % less than the reference (scale factor)"
         );
         assert_eq!(
             sentence(&scale(0.0059)),
-            "scale +0.59 [0.56, 0.62] % (the gyro reads that much more than the reference)"
+            "the gyro reads 0.59 [0.56, 0.62] % more than the reference (scale factor)"
+        );
+    }
+
+    #[test]
+    fn a_clause_alone_keeps_at_most_three_digits() {
+        let e = latency(0.012_618, 0.012_31, 0.012_93);
+        assert_eq!(clause(&e, false), "lags the reference by 12.6 ms");
+        let clock = EffectResult {
+            id: "clock_error",
+            params: BTreeMap::from([("ppm", -1091.4)]),
+            ci95: BTreeMap::from([("ppm", [Some(-1093.0), Some(-1090.0)])]),
+            ..latency(0.0, 0.0, 0.0)
+        };
+        assert_eq!(
+            clause(&clock, false),
+            "samples 1091 ppm slow against the declared sample rate (its time stamps show it)"
+        );
+    }
+
+    #[test]
+    fn degrees_read_as_a_person_writes_them() {
+        assert_eq!(degrees(7.204), "7.2°");
+        assert_eq!(degrees(38.4), "38°");
+        assert_eq!(degrees(0.4512), "0.45°");
+        assert_eq!(degrees(f64::NAN), "-");
+        assert_eq!(
+            and_list(&["a".to_string(), "b".to_string(), "c".to_string()]),
+            "a, b and c"
         );
     }
 

@@ -561,7 +561,8 @@ fn subtitle(c: &gyro_analysis::diagnose::CompensationSummary) -> String {
 fn angle_error_plot(d: &Diagnosis) -> Option<AngleErrorPlot> {
     let c = d.compensation.as_ref()?;
     Some(AngleErrorPlot {
-        title: "Angle error of the held-out runs, without and with compensation".into(),
+        title: "Held-out angle error: each run's largest error, nominal and with the written model"
+            .into(),
         subtitle: subtitle(c),
         rows: c
             .runs
@@ -658,7 +659,10 @@ tr.sig td{background:#eef6ee}tr.sig td:first-child{font-weight:bold}
 .gap{font-size:1.05em}.verdict{font-size:1.15em;padding:.5em .8em;background:#f4f4f8;border-left:4px solid #0072b2}
 .figure svg{max-width:100%;height:auto;display:block}.read{background:#fafafa;border-left:3px solid #bbb;padding:.4em .8em;font-size:.92em}
 .warn{color:#a04000}code{font-size:.95em}
-.wide{overflow-x:auto}table.effects{font-size:.8em}td.test{min-width:12em}";
+.wide{overflow-x:auto}table.effects{font-size:.8em}
+.sub{color:#555;margin-top:-.6em}.verdict p{margin:.3em 0}
+details{margin:1em 0;border:1px solid #ddd;border-radius:4px;padding:.3em .8em}
+summary{cursor:pointer;font-weight:bold;padding:.3em 0}";
 
 fn effect_row(s: &mut String, e: &EffectResult) {
     let params: Vec<String> = e
@@ -674,7 +678,7 @@ fn effect_row(s: &mut String, e: &EffectResult) {
         .collect();
     let _ = writeln!(
         s,
-        "<tr{}><td><code>{}</code></td><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td><td class=\"test\">{}</td></tr>",
+        "<tr{}><td><code>{}</code></td><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td></tr>",
         if e.significant { " class=\"sig\"" } else { "" },
         esc(e.id),
         if e.significant {
@@ -704,8 +708,7 @@ fn effect_row(s: &mut String, e: &EffectResult) {
                 .map(|c| format!("<code>{}</code>", esc(c)))
                 .collect::<Vec<_>>()
                 .join(", ")
-        },
-        test_cell(e)
+        }
     );
 }
 
@@ -721,14 +724,67 @@ fn test_cell(e: &EffectResult) -> String {
     }
 }
 
+/// The answer first: the verdict sentences, the held-out angle error before and after the
+/// written corrections, what is named, what the model still misses and the notes, in
+/// plain words (the same lines as the text table's).
+fn summary(s: &mut String, d: &Diagnosis, page: &Path) -> Result<(), ReportError> {
+    let _ = writeln!(s, "<div class=\"verdict\">");
+    for line in super::verdict(d) {
+        let class = if line.starts_with("warning:") {
+            " class=\"warn\""
+        } else {
+            ""
+        };
+        let _ = writeln!(s, "<p{class}>{}</p>", esc(&line));
+    }
+    let _ = writeln!(s, "</div>");
+    match angle_error_plot(d) {
+        Some(plot) if !plot.rows.is_empty() => {
+            s.push_str(&inline_svg(&plot, "angle error before and after", page)?);
+        }
+        _ => {
+            let _ = writeln!(
+                s,
+                "<p>No angle-error figure: {}.</p>",
+                if d.verdict.unmodelled.is_empty() {
+                    "no effect was named, so there is no correction to compare"
+                } else {
+                    "none of the named effects is one the model file corrects"
+                }
+            );
+        }
+    }
+    let f = super::findings(d);
+    for (title, lines) in [
+        ("Named", f.named),
+        ("What the model still misses", f.missed),
+        ("Notes", f.notes),
+    ] {
+        if lines.is_empty() {
+            continue;
+        }
+        let _ = writeln!(s, "<h2>{title}</h2>\n<ul>");
+        for line in lines {
+            let class = if line.starts_with("warning:") {
+                " class=\"warn\""
+            } else {
+                ""
+            };
+            let _ = writeln!(s, "<li{class}>{}</li>", esc(&line));
+        }
+        let _ = writeln!(s, "</ul>");
+    }
+    Ok(())
+}
+
+/// The gap G with its explanation, the ensembles, the turns and the nominal model.
 fn header(s: &mut String, d: &Diagnosis, options: &Options) {
     let g = &d.gap;
-    let _ = writeln!(s, "<h1>Sim-to-real diagnosis</h1>");
     let verdict = if d.verdict.unmodelled.is_empty() {
         "nothing significant: no candidate effect closes the held-out gap".to_string()
     } else {
         format!(
-            "unmodelled: {}; they close {} of the held-out gap above the floor",
+            "unmodelled: {}; they close {} of the held-out gap G above the floor (G is not in degrees: the angle error is above)",
             d.verdict
                 .unmodelled
                 .iter()
@@ -738,11 +794,7 @@ fn header(s: &mut String, d: &Diagnosis, options: &Options) {
             percent(d.verdict.fraction_closed_holdout)
         )
     };
-    let _ = writeln!(s, "<div class=\"verdict\"><b>Diagnosis:</b><ul>");
-    for line in super::headline(d) {
-        let _ = writeln!(s, "<li>{}</li>", esc(&line));
-    }
-    let _ = writeln!(s, "</ul><b>Verdict:</b> {verdict}</div>");
+    let _ = writeln!(s, "<p><b>In the statistics' terms:</b> {verdict}.</p>");
     let _ = writeln!(
         s,
         "<table class=\"gap\"><tr><th>gap G</th><th>nominal model</th><th>with the selected effects</th></tr>\
@@ -980,12 +1032,17 @@ held-out z the same coefficient's test on the held-out runs, in the same directi
     );
     let _ = writeln!(
         s,
-        "<div class=\"wide\"><table class=\"effects\"><tr><th>effect</th><th>significant</th><th>parameters [95% interval]</th><th>z</th><th>held-out z</th><th>held-out evidence (ΔBIC)</th><th>held-out G before</th><th>after</th><th>closed</th><th>bootstrap p</th><th>confounded with</th><th>test</th></tr>"
+        "<div class=\"wide\"><table class=\"effects\"><tr><th>effect</th><th>significant</th><th>parameters [95% interval]</th><th>z</th><th>held-out z</th><th>held-out evidence (ΔBIC)</th><th>held-out G before</th><th>after</th><th>closed</th><th>bootstrap p</th><th>confounded with</th></tr>"
     );
     for e in &d.effects {
         effect_row(s, e);
     }
     let _ = writeln!(s, "</table></div>");
+    let _ = writeln!(s, "<p>How each candidate's parameter was tested:</p><ul>");
+    for e in &d.effects {
+        let _ = writeln!(s, "<li><code>{}</code>: {}</li>", esc(e.id), test_cell(e));
+    }
+    let _ = writeln!(s, "</ul>");
     if !d.untestable.is_empty() {
         let _ = writeln!(
             s,
@@ -1009,13 +1066,14 @@ combined over all runs (Σz/√n). Positive: the real value is above the simulat
     );
     let _ = writeln!(
         s,
-        "<table><tr><th>z</th><th>segment</th><th>statistic</th></tr>"
+        "<table><tr><th>z</th><th>what it is</th><th>segment</th><th>statistic</th></tr>"
     );
     for w in d.r#where.iter().take(WHERE_ROWS) {
         let _ = writeln!(
             s,
-            "<tr><td class=\"n\">{:.1}</td><td>{}</td><td>{}</td></tr>",
+            "<tr><td class=\"n\">{:.1}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             w.z,
+            esc(&super::described(&w.segment, &w.statistic)),
             esc(&w.segment),
             esc(&w.statistic)
         );
@@ -1066,12 +1124,13 @@ training runs; the held-out z is with the same model.</p>",
     );
     let _ = writeln!(
         s,
-        "<table><tr><th>statistic</th><th>segment</th><th>real</th><th>nominal model</th><th>selected model</th><th>z nominal</th><th>z selected</th><th>z held out</th></tr>"
+        "<table><tr><th>what it is</th><th>statistic</th><th>segment</th><th>real</th><th>nominal model</th><th>selected model</th><th>z nominal</th><th>z selected</th><th>z held out</th></tr>"
     );
     for u in &d.unexplained {
         let _ = writeln!(
             s,
-            "<tr><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td></tr>",
+            esc(&super::described(&u.segment, &u.statistic)),
             esc(&u.statistic),
             esc(&u.segment),
             sig3(u.real),
@@ -1083,6 +1142,31 @@ training runs; the held-out z is with the same model.</p>",
         );
     }
     let _ = writeln!(s, "</table>");
+}
+
+/// Draw `plot` into `s`, or, when none of its panels has anything to draw, one line
+/// saying why; true if drawn.
+fn drawn(
+    s: &mut String,
+    plot: &EnvelopePlot,
+    name: &'static str,
+    page: &Path,
+) -> Result<bool, ReportError> {
+    let reasons: Vec<&str> = plot
+        .panels
+        .iter()
+        .filter_map(|p| p.empty.as_deref())
+        .collect();
+    if !plot.panels.is_empty() && reasons.len() == plot.panels.len() {
+        let _ = writeln!(
+            s,
+            "<p>{name}: nothing to draw: {}.</p>",
+            esc(&reasons.join("; "))
+        );
+        return Ok(false);
+    }
+    s.push_str(&inline_svg(plot, name, page)?);
+    Ok(true)
 }
 
 fn read(s: &mut String, text: &str) {
@@ -1123,8 +1207,8 @@ fn figures(
                 let _ = writeln!(s, "<p class=\"warn\">left out: {}</p>", esc(e));
             }
             let _ = writeln!(s, "<h3>Allan deviation</h3>");
-            s.push_str(&inline_svg(&allan_plot(f), "Allan deviation", page)?);
-            read(
+            if drawn(s, &allan_plot(f), "Allan deviation", page)? {
+                read(
                 s,
                 &format!(
                     "White rate noise falls with slope −½; the nominal Gauss-Markov bias bends the curve \
@@ -1136,9 +1220,10 @@ model's noise is too large.",
                     signature("rate_random_walk")
                 ),
             );
+            }
             let _ = writeln!(s, "<h3>Power spectral density</h3>");
-            s.push_str(&inline_svg(&psd_plot(f), "PSD", page)?);
-            read(
+            if drawn(s, &psd_plot(f), "PSD", page)? {
+                read(
                 s,
                 &format!(
                     "The residual's spectrum over whole runs (still and moving). The flat level is the \
@@ -1150,6 +1235,7 @@ an error that scales with the motion — {}; {}.",
                     signature("scale_factor")
                 ),
             );
+            }
             let _ = writeln!(
                 s,
                 "<h3>Residual against rate, temperature and acceleration</h3>"
@@ -1214,45 +1300,27 @@ warm-up: {}.",
         );
     }
 
-    let _ = writeln!(s, "<h3>Angle error of the held-out runs</h3>");
-    match angle_error_plot(d) {
-        Some(plot) if !plot.rows.is_empty() => {
-            s.push_str(&inline_svg(&plot, "angle error before and after", page)?);
-            read(
-                s,
-                &format!(
-                    "The pipeline's max abs angle error on each held-out run with the nominal \
-configuration and with the correctable selected effects compensated (<code>run --model</code>). \
-Errors that grow with the total angle turned point to {}; angle lost in motion to {}.",
-                    signature("clock_error"),
-                    signature("dropouts")
-                ),
-            );
-        }
-        _ => {
-            let which = if d.verdict.unmodelled.is_empty() {
-                "no effect was selected".to_string()
-            } else {
-                format!(
-                    "the selected effects ({}) include none that <code>run --model</code> corrects",
-                    d.verdict
-                        .unmodelled
-                        .iter()
-                        .map(|u| format!("<code>{}</code>", esc(u)))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
-            };
-            let _ = writeln!(
-                s,
-                "<p>No correctable effect was selected, so there is no angle error to compare: {which}.</p>"
-            );
-        }
-    }
     Ok(())
 }
 
-/// The whole page.
+/// The files of the runs of `role`, each once, by name.
+fn files_of(d: &Diagnosis, role: &str) -> String {
+    let mut files: Vec<&str> = d
+        .runs
+        .iter()
+        .filter(|r| r.role == role)
+        .map(|r| r.name.split('#').next().unwrap_or(&r.name))
+        .collect();
+    files.dedup();
+    let names: Vec<String> = files.iter().map(|f| super::run_label(d, f)).collect();
+    if names.is_empty() {
+        "no run".into()
+    } else {
+        names.join(", ")
+    }
+}
+
+/// The whole page: the answer first, the details folded below it.
 fn page(
     d: &Diagnosis,
     envelopes: Option<&Envelopes>,
@@ -1269,9 +1337,31 @@ fn page(
             esc(&d.verdict.unmodelled.join(", "))
         }
     );
+    let _ = writeln!(
+        s,
+        "<h1>Sim-to-real diagnosis</h1>\n<p class=\"sub\">Trained on {}; held out: {}.</p>",
+        esc(&files_of(d, "train")),
+        esc(&files_of(d, "holdout"))
+    );
+    summary(&mut s, d, path)?;
+    let _ = writeln!(
+        s,
+        "<details><summary>How far the simulation is from the runs: the gap G, the ensembles, the turns, the nominal model</summary>"
+    );
     header(&mut s, d, options);
+    let _ = writeln!(s, "</details>");
+    let _ = writeln!(
+        s,
+        "<details><summary>Every candidate effect, the checks, what is unexplained and where the gap lies (tables)</summary>"
+    );
     tables(&mut s, d);
+    let _ = writeln!(s, "</details>");
+    let _ = writeln!(
+        s,
+        "<details><summary>Figures: the real runs against simulated ones (Allan deviation, spectrum, residual, cross-correlation, gap map)</summary>"
+    );
     figures(&mut s, d, envelopes, path)?;
+    let _ = writeln!(s, "</details>");
     let _ = writeln!(
         s,
         "<p><small>Written by gyro-cli diagnose {}; the machine-readable result is <code>diagnosis.json</code> beside this page.</small></p>\n</body>\n</html>",
@@ -1547,6 +1637,51 @@ mod tests {
             "{html}"
         );
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// The answer first: the verdict's sentences, then the held-out angle error figure,
+    /// both before every table and every folded section.
+    #[test]
+    fn the_verdict_and_the_angle_error_lead_the_page() {
+        let mut d = diagnosis();
+        d.effects = vec![EffectResult {
+            id: "clock_error",
+            params: BTreeMap::from([("ppm", 500.0)]),
+            delta_bic: Some(40.0),
+            holdout_gap_before: 4.0,
+            holdout_gap_after: Some(1.1),
+            fraction_closed: Some(0.9),
+            significant: true,
+            ci95: BTreeMap::from([("ppm", [Some(480.0), Some(520.0)])]),
+            z: Some(9.0),
+            holdout_z: None,
+            shape_loglik: None,
+            test: "z test".into(),
+            bootstrap_p: Some(0.0),
+            confounded_with: Vec::new(),
+            posterior_check: None,
+        }];
+        let (_scratch, dir) = temp("verdict_first");
+        write_report(&dir, &d, None, &Options::default()).unwrap();
+        let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+        let at = |needle: &str| {
+            html.find(needle)
+                .unwrap_or_else(|| panic!("{needle} not in the page:\n{html}"))
+        };
+        let verdict = at("<div class=\"verdict\">");
+        let said = at("The gyro samples 500 ppm fast against the declared sample rate");
+        let error = at("Correcting the clock cuts the held-out angle error from 1.5° to 0.20°");
+        let missed = at("Not explained by the model: in motion, the rate noise is 3.6 times");
+        let figure = at("aria-label=\"angle error before and after\"");
+        let first_table = at("<table");
+        let first_fold = at("<details");
+        assert!(verdict < said && said < error && error < missed, "{html}");
+        assert!(missed < figure, "the figure follows the verdict");
+        assert!(figure < first_table && figure < first_fold, "{html}");
+        assert!(
+            !html[..first_fold].contains("G ="),
+            "no G before the details"
+        );
     }
 
     #[test]

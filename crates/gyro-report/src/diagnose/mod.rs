@@ -4,8 +4,13 @@
 mod headline;
 mod html;
 mod text;
+mod words;
 
-pub use headline::{evidence, headline, rounded, sentence, sig3, NOT_SCORED};
+pub use headline::{
+    clause, evidence, findings, headline, rounded, sentence, sig3, verdict, Findings, MISSED_LINES,
+    NOT_SCORED,
+};
+pub use words::{described, missed, segment};
 
 pub use html::{
     write_report, ReportError, GAP_MAP_CLIP, GAP_MAP_COLUMNS, MIN_BIN_SAMPLES, REPORT_FILES,

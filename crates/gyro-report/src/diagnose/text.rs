@@ -146,17 +146,78 @@ fn holdout_names(d: &Diagnosis) -> String {
     names.join(", ")
 }
 
-/// The human-readable summary.
+/// The held-out runs' angle error without and with the written model, one line per run
+/// (none when nothing is compensated).
+fn angle_error_lines(d: &Diagnosis) -> (String, Vec<String>) {
+    let Some(c) = &d.compensation else {
+        return (String::new(), Vec::new());
+    };
+    let title = format!(
+        "held-out angle error, each run's largest |error| (deg): nominal -> with the written model ({})",
+        if c.corrected.is_empty() {
+            "which corrects nothing".to_string()
+        } else {
+            format!("corrects {}", c.corrected.join(", "))
+        }
+    );
+    let mut lines = Vec::new();
+    let width = c
+        .runs
+        .iter()
+        .map(|r| super::run_label(d, &r.name).chars().count())
+        .max()
+        .unwrap_or(0);
+    for r in &c.runs {
+        lines.push(format!(
+            "{:<width$}  {:>8.2} -> {:>8.2}",
+            super::run_label(d, &r.name),
+            r.max_abs_error_before_deg,
+            r.max_abs_error_after_deg
+        ));
+    }
+    (title, lines)
+}
+
+/// The human-readable summary: the verdict in its first lines, then the held-out angle
+/// error per run, what is named, what the model misses and the notes; then the details
+/// (what was read, the gap G, the where-statistics, the candidate table, the posterior
+/// checks, the nominal model), each with its explanation.
 pub fn table(d: &Diagnosis) -> String {
-    let mut s = crate::input::tables(d.inputs.iter().map(|i| (i.file.as_str(), &i.input)));
-    let g = &d.gap;
+    let mut s = String::new();
     let _ = writeln!(s, "diagnosis (held out: {}):", holdout_names(d));
-    for line in super::headline(d) {
+    for line in super::verdict(d) {
         let _ = writeln!(s, "  {line}");
+    }
+    let f = super::findings(d);
+    let sections = [
+        angle_error_lines(d),
+        ("named:".to_string(), f.named),
+        ("what the model still misses:".to_string(), f.missed),
+        ("notes:".to_string(), f.notes),
+    ];
+    for (title, lines) in sections {
+        if lines.is_empty() {
+            continue;
+        }
+        let _ = writeln!(s);
+        if !title.is_empty() {
+            let _ = writeln!(s, "{title}");
+        }
+        for line in lines {
+            let _ = writeln!(s, "  {line}");
+        }
     }
     let _ = writeln!(
         s,
-        "\ngap G (RMS z of the where-statistics; floor = two simulated ensembles)"
+        "\n---- details (the statistics behind the answer; docs/diagnose.md explains each) ----\n"
+    );
+    s.push_str(&crate::input::tables(
+        d.inputs.iter().map(|i| (i.file.as_str(), &i.input)),
+    ));
+    let g = &d.gap;
+    let _ = writeln!(
+        s,
+        "\ngap G: how far the runs' statistics lie from the model's simulations of the same runs, the RMS of their z-scores; the floor is G between two simulations of one model (what a model that explains the runs reaches)"
     );
     let _ = writeln!(
         s,
@@ -177,9 +238,16 @@ pub fn table(d: &Diagnosis) -> String {
         },
         num(d.verdict.fraction_closed_holdout)
     );
-    let _ = writeln!(s, "\nwhere (largest |z| of real vs the nominal ensembles):");
+    let _ = writeln!(s, "\nwhere the runs differ from the nominal model most (z: the real statistic's distance from its simulations, in their standard deviations; positive: real above):");
     for w in d.r#where.iter().take(10) {
-        let _ = writeln!(s, "  {:>8.1}  {:<28} {}", w.z, w.segment, w.statistic);
+        let _ = writeln!(
+            s,
+            "  {:>8.1}  {:<28} {:<28} {}",
+            w.z,
+            w.segment,
+            w.statistic,
+            super::described(&w.segment, &w.statistic)
+        );
     }
     if !d.unexplained.is_empty() {
         let _ = writeln!(
@@ -286,29 +354,6 @@ pub fn table(d: &Diagnosis) -> String {
                 n.runs_better,
                 n.runs,
                 n.bootstrap_p
-            );
-        }
-        let _ = writeln!(
-            s,
-            "\nrun --model with corrections for {}: max abs angle error per held-out run (deg){}",
-            if c.corrected.is_empty() {
-                "nothing (no correction lowered the held-out error)".to_string()
-            } else {
-                c.corrected.join(", ")
-            },
-            if super::headline::turns_wrote(d) {
-                "; the turns' corrections (headline) come on top of these"
-            } else {
-                ""
-            }
-        );
-        for r in &c.runs {
-            let _ = writeln!(
-                s,
-                "  {:<40} {:>9.4} -> {:>9.4}",
-                super::run_label(d, &r.name),
-                r.max_abs_error_before_deg,
-                r.max_abs_error_after_deg
             );
         }
     }

@@ -623,15 +623,16 @@ pub struct AngleErrorPlot {
     pub after_label: String,
 }
 
-/// Pixels per run of the bar chart.
-const BAR_ROW_PX: u32 = 46;
+/// Pixels per run of the bar chart: compact, so that the figure of 15 runs fits the
+/// report's first screen beside the verdict.
+const BAR_ROW_PX: u32 = 26;
 
 impl Figure for AngleErrorPlot {
     fn size(&self) -> (u32, u32) {
         let lines = self.subtitle.lines().filter(|l| !l.is_empty()).count() as u32;
         (
             WIDTH_PX,
-            (170 + 22 * lines + BAR_ROW_PX * self.rows.len() as u32).max(360),
+            (150 + 22 * lines + BAR_ROW_PX * self.rows.len() as u32).max(300),
         )
     }
 
@@ -645,7 +646,8 @@ impl Figure for AngleErrorPlot {
             .flat_map(|r| [r.before_deg, r.after_deg])
             .filter(|v| v.is_finite())
             .fold(0.0, f64::max);
-        let hi = if hi > 0.0 { hi * 1.25 } else { 1.0 };
+        // Room on the right for the values' labels and the legend.
+        let hi = if hi > 0.0 { hi * 1.45 } else { 1.0 };
         let n = self.rows.len();
         let names: Vec<String> = self.rows.iter().map(|r| short_name(&r.name)).collect();
         let name_px = (names.iter().map(|s| s.chars().count()).max().unwrap_or(0) as f64
@@ -689,7 +691,7 @@ impl Figure for AngleErrorPlot {
             .x_desc("max abs angle error over the run (deg)")
             .draw()
             .map_err(draw_err)?;
-        let value_style = TextStyle::from(("sans-serif", TICK_PX).into_font())
+        let value_style = TextStyle::from(("sans-serif", TICK_PX - 2).into_font())
             .color(&colour::INK)
             .pos(Pos::new(HPos::Left, VPos::Center));
         // Before above after within each run's row.
