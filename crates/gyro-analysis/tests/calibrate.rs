@@ -356,13 +356,22 @@ fn written_model_is_not_worse_than_the_default_on_other_runs() {
 
 /// A simulated bench run (nominal CRM100 model, 1 kHz) with `effects`.
 fn sim_run(effects: &str, seed: u64) -> BenchRun {
+    sim_run_of(effects, seed, BenchProfile::default().duration_s)
+}
+
+/// [`sim_run`] of `duration_s`.
+fn sim_run_of(effects: &str, seed: u64, duration_s: f64) -> BenchRun {
     let sensor = SensorModel::default();
     let effects: Vec<sim::Effect> = effects
         .split(' ')
         .filter(|e| !e.is_empty())
         .map(|e| sim::Effect::parse(e).unwrap())
         .collect();
-    let motion = Motion::bench(&BenchProfile::default(), seed);
+    let profile = BenchProfile {
+        duration_s,
+        ..BenchProfile::default()
+    };
+    let motion = Motion::bench(&profile, seed);
     let options = SimOptions {
         seed,
         ..SimOptions::default()
@@ -459,4 +468,106 @@ fn a_gyro_latency_is_measured_as_the_reference_delay() {
     let d = &result.reference_delay;
     assert_eq!(d.source, DelaySource::CrossCorrelation, "{d:?}");
     assert!((d.delay_s - 0.02).abs() < 0.002, "{d:?}");
+}
+
+/// Median over `runs` of the max abs angle error with `config`, scored against the
+/// reference `delay_s` back as `run --model` does with the model's `reference_delay_s`.
+fn median_max_abs_delayed(runs: &[BenchRun], config: &Config, delay_s: f64) -> f64 {
+    let scoring = gyro_analysis::replay::ReplayOptions {
+        reference_delay_s: delay_s,
+    };
+    let errors: Vec<f64> = runs
+        .iter()
+        .map(|run| {
+            gyro_analysis::replay::replay_with(&run.log, config, &scoring)
+                .unwrap()
+                .summary
+                .max_abs_error_deg
+                .unwrap()
+        })
+        .collect();
+    gyro_analysis::median(&errors).unwrap()
+}
+
+/// Length of the choice test's runs (s): long enough for several turns and rests.
+const RUN_S: f64 = 45.0;
+
+/// Held-out errors closer than this are the same for a wrench (deg): a 250th of the
+/// default tightening tolerance (±5°). The Kalman form with the built-in settings and with
+/// the fitted ones differ by about this much on these runs, and which is lower changes
+/// with the held-out runs drawn (here the worst is 0.063° against 0.045°, 1.41 times; on
+/// 90 s runs 1.35 times on 3 held-out runs, 1.15 on 6).
+const SAME_FOR_A_WRENCH_DEG: f64 = 0.02;
+
+/// The compensation is chosen with the corrections the file holds (the scale) applied to
+/// every candidate: on ten effect mixes the written model's held-out error is within 1.1
+/// times the best candidate's with the same corrections, or within
+/// [`SAME_FOR_A_WRENCH_DEG`] of it. The table of docs/figures.md
+/// ("calibrate's choice") is this test's output:
+/// `cargo test --release -p gyro-analysis --test calibrate choice -- --nocapture`.
+#[test]
+fn the_choice_is_made_with_the_written_corrections() {
+    let cases = [
+        "scale_factor:k=0.02 temperature_bias:dps_per_c=0.05 latency:delay_s=0.01",
+        "scale_factor:k=-0.015",
+        "scale_factor:k=0.01 turn_on_bias:sigma_dps=0.3",
+        "scale_factor:k=0.02 rate_random_walk:k_dps_per_rt_s=0.02",
+        "turn_on_bias:sigma_dps=0.3",
+        "rate_random_walk:k_dps_per_rt_s=0.02",
+        "bias_instability:sigma_dps=0.05",
+        "latency:delay_s=0.02 scale_factor:k=0.005",
+        "scale_asymmetry:k=0.01 temperature_bias:dps_per_c=0.05",
+        "",
+    ];
+    let mut worst: f64 = 0.0;
+    let mut failures = Vec::new();
+    println!("effects | written | held-out median max |error| (deg): written, default, none, paper, kalman | ratio to the best");
+    for (i, effects) in cases.iter().enumerate() {
+        let seed = 401 + 10 * i as u64;
+        let run = |s| sim_run_of(effects, s, RUN_S);
+        let train: Vec<BenchRun> = (seed..seed + 3).map(run).collect();
+        let holdout: Vec<BenchRun> = (seed + 3..seed + 8).map(run).collect();
+        let result = calibrate(
+            &train,
+            &holdout,
+            &Config::default(),
+            &default_options(),
+            &mut |_, _, _| {},
+        )
+        .unwrap();
+        let delay_s = result.reference_delay.delay_s;
+        let written = median_max_abs_delayed(&holdout, &result.config, delay_s);
+        let each: Vec<f64> = Candidate::ALL
+            .iter()
+            .map(|c| median_max_abs_delayed(&holdout, &result.candidate_config(*c), delay_s))
+            .collect();
+        let best = each.iter().copied().fold(f64::INFINITY, f64::min);
+        let ratio = written / best;
+        worst = worst.max(ratio);
+        println!(
+            "{} | {:?}{} | {written:.3}, {} | {ratio:.2}",
+            if effects.is_empty() {
+                "nominal"
+            } else {
+                effects
+            },
+            result.choice.written,
+            if result.scale.written {
+                format!(" + scale {:+.3}%", 100.0 * result.scale.k.unwrap())
+            } else {
+                String::new()
+            },
+            each.iter()
+                .map(|e| format!("{e:.3}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        if written > (1.1 * best).max(best + SAME_FOR_A_WRENCH_DEG) {
+            failures.push(format!(
+                "{effects}: written {written} against the best {best} ({each:?})"
+            ));
+        }
+    }
+    println!("worst ratio {worst:.2}");
+    assert!(failures.is_empty(), "{failures:#?}");
 }

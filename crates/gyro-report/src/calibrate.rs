@@ -84,8 +84,13 @@ fn compensation_text(compensation: Compensation) -> &'static str {
 pub fn candidate_text(c: &Calibration, candidate: Candidate) -> String {
     match candidate {
         Candidate::Default => format!(
-            "the starting configuration with {} compensation, nothing fitted",
-            compensation_text(c.start.compensation)
+            "the starting configuration with {} compensation{}",
+            compensation_text(c.start.compensation),
+            if c.scale.written {
+                ", nothing fitted but the scale"
+            } else {
+                ", nothing fitted"
+            }
         ),
         Candidate::None => "no compensation".to_string(),
         Candidate::Paper => "the fitted paper error model".to_string(),
@@ -181,17 +186,23 @@ pub fn answer(c: &Calibration) -> Vec<String> {
         let before = median_of(&c.holdout, |r| r.default_max_abs_deg);
         let v: Vec<f64> = c.holdout.iter().map(|r| score_of(r, written)).collect();
         let after = gyro_analysis::median(&v).unwrap_or(f64::NAN);
-        lines.push(format!(
-            "on the {} hold-out run{}, each run's largest |angle error| (median): {before:.2} deg with the starting configuration, {after:.2} deg with {}{}",
+        let runs = format!(
+            "on the {} hold-out run{}, each run's largest |angle error| (median)",
             c.holdout.len(),
-            if c.holdout.len() == 1 { "" } else { "s" },
-            candidate_text(c, written),
-            if c.scale.written {
-                " (without the scale correction: these scores are taken before it is fitted)"
-            } else {
-                ""
-            }
-        ));
+            if c.holdout.len() == 1 { "" } else { "s" }
+        );
+        let scale = if c.scale.written {
+            " (both with the scale correction)"
+        } else {
+            ""
+        };
+        lines.push(if written == Candidate::Default {
+            format!("{runs}: {after:.2} deg with the written model")
+        } else {
+            format!(
+                "{runs}: {after:.2} deg with the written model, {before:.2} deg with the starting configuration{scale}"
+            )
+        });
     }
     lines
 }
@@ -317,8 +328,7 @@ fn scale_text(c: &Calibration) -> String {
     );
     if let Some((without, with)) = sc.leave_one_out_deg {
         s += &format!(
-            "  RMS error of the turns (rest to rest) leaving each run out, {} with its refit: {without:.4} -> {with:.4} deg, better on {}/{} runs\n",
-            candidate_name(c.choice.written),
+            "  RMS error of the turns (rest to rest) on each run left out of the scale's fit, with the starting configuration: {without:.4} -> {with:.4} deg, better on {}/{} runs\n",
             sc.runs_better.0,
             sc.runs_better.1
         );
@@ -335,7 +345,7 @@ fn scale_text(c: &Calibration) -> String {
     }
     let significant = gyro_analysis::calibrate::scale::significant(k, sc.standard_error);
     s += if sc.written {
-        "  written (config.correction.scale_k): held out it lowers the turns' error and is better on most runs\n"
+        "  written (config.correction.scale_k): held out it lowers the turns' error and is better on most runs; every candidate above is fitted and scored with it\n"
     } else if !significant {
         "  not written: within its noise (under 1.96 standard errors from zero)\n"
     } else if sc.leave_one_out_deg.is_none() {

@@ -484,7 +484,8 @@ pub struct Calibration {
     pub termination: String,
     /// Objective evaluations.
     pub evaluations: usize,
-    /// The starting configuration: the default candidate.
+    /// The default candidate: the starting configuration, with the scale correction when
+    /// it is written (every candidate is fitted and scored with it).
     pub start: Config,
     /// Which candidate is written, chosen on leave-one-run-out error.
     pub choice: Choice,
@@ -933,61 +934,50 @@ fn fit(
     ))
 }
 
-/// What [`decide_scale`] needs from a calibration.
-struct ScaleInput<'a> {
-    train: &'a [BenchRun],
-    holdout: &'a [BenchRun],
-    base: &'a Config,
-    scoring: &'a ReplayOptions,
-    written: Candidate,
-    /// The written candidate fitted on all training runs.
-    written_config: &'a Config,
-    /// What was fitted leaving each training run out, in training order (empty without
-    /// refits).
-    fold_fitted: &'a [Fitted],
-    /// Each training run's errors under every candidate fitted on all runs.
-    train_errors: &'a [[RunErrors; 4]],
-    /// Each left-out run's errors under every candidate fitted on the others.
-    held_out: &'a [[RunErrors; 4]],
-    /// Each hold-out run's errors under every candidate fitted on all training runs.
-    holdout_errors: &'a [[RunErrors; 4]],
+/// The scale factor calibration fits, decided before anything else so that every
+/// candidate is fitted and scored with it when it is written.
+struct ScaleDecision {
+    /// What is reported.
+    fit: ScaleFit,
+    /// The scale fitted leaving each training run out, in training order, when written
+    /// (empty otherwise, or without refits): what each fold's candidates are scored with.
+    fold_k: Vec<Option<f64>>,
 }
 
-/// The scale factor from the training runs' movement totals, rest to rest (under the
-/// starting configuration, [`Candidate::Default`]), and whether it is written: only if it
-/// differs from zero beyond its noise ([`scale::significant`]) and, fitted leaving each
-/// run out and added to the written candidate's refit, it lowers the turns' RMS error on
-/// the left-out runs and is better on most of them.
-fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
-    let totals_of = |errors: &[RunErrors; 4]| errors[0].totals.clone();
-    let all: Vec<MovementTotal> = input.train_errors.iter().flat_map(totals_of).collect();
+/// The scale factor from the training runs' movement totals, rest to rest, under the
+/// starting configuration `base` (the bias compensation barely moves a turn's total), and
+/// whether it is written: only if it differs from zero beyond its noise
+/// ([`scale::significant`]) and, fitted leaving each run out and added to `base`, it
+/// lowers the turns' RMS error on the left-out runs and is better on most of them
+/// (`leave_one_out` refits only). `base_errors` are the training runs' errors under
+/// `base`, in training order.
+fn decide_scale(
+    train: &[BenchRun],
+    holdout: &[BenchRun],
+    base: &Config,
+    scoring: &ReplayOptions,
+    base_errors: &[RunErrors],
+    leave_one_out: bool,
+) -> Result<ScaleDecision, CalibrateError> {
+    let all: Vec<MovementTotal> = base_errors.iter().flat_map(|e| e.totals.clone()).collect();
     let fitted = scale::fit(&all);
-    // Where the written candidate's errors sit in each `[RunErrors; 4]`.
-    let slot = Candidate::ALL
-        .iter()
-        .position(|c| *c == input.written)
-        .unwrap_or(0);
     let mut without = Vec::new();
     let mut with = Vec::new();
-    if fitted.is_some() {
-        for (i, (run, fold)) in input.train.iter().zip(input.fold_fitted).enumerate() {
-            let others: Vec<MovementTotal> = input
-                .train_errors
+    let mut fold_k = Vec::new();
+    if fitted.is_some() && leave_one_out && train.len() >= 2 {
+        for (i, (run, errors)) in train.iter().zip(base_errors).enumerate() {
+            let others: Vec<MovementTotal> = base_errors
                 .iter()
                 .enumerate()
                 .filter(|(j, _)| *j != i)
-                .flat_map(|(_, e)| totals_of(e))
+                .flat_map(|(_, e)| e.totals.clone())
                 .collect();
-            let Some(errors) = input.held_out.get(i) else {
-                break;
-            };
-            let fold_config = fold.config(input.base, input.written);
-            // A fold without a turn to fit on keeps its candidate as it is.
-            let scaled = scale::fit(&others)
-                .and_then(|(k, _)| scale::with_scale(&fold_config, k))
-                .unwrap_or(fold_config);
-            with.push(replay_errors(run, &scaled, input.scoring)?);
-            without.push(errors[slot].clone());
+            let k = scale::fit(&others).map(|(k, _)| k);
+            // A fold without a turn to fit on keeps the configuration as it is.
+            let scaled = k.and_then(|k| scale::with_scale(base, k)).unwrap_or(*base);
+            with.push(replay_errors(run, &scaled, scoring)?);
+            without.push(errors.clone());
+            fold_k.push(k);
         }
     }
     let pooled = |runs: &[RunErrors]| scale::turn_rms(runs.iter().flat_map(|r| &r.totals));
@@ -1007,39 +997,39 @@ fn decide_scale(input: &ScaleInput<'_>) -> Result<ScaleFit, CalibrateError> {
             .iter()
             .flat_map(|r| &r.totals),
     );
-    let scaled = fitted.and_then(|(k, _)| scale::with_scale(input.written_config, k));
+    let scaled = fitted.and_then(|(k, _)| scale::with_scale(base, k));
     let holdout_deg = match scaled {
-        Some(config) if !input.holdout.is_empty() => {
-            let plain: Vec<RunErrors> = input
-                .holdout_errors
-                .iter()
-                .map(|e| e[slot].clone())
-                .collect();
-            let corrected = input
-                .holdout
-                .iter()
-                .map(|run| replay_errors(run, &config, input.scoring))
-                .collect::<Result<Vec<_>, _>>()?;
-            pooled(&plain).zip(pooled(&corrected))
+        Some(config) if !holdout.is_empty() => {
+            let errors = |config: &Config| {
+                holdout
+                    .iter()
+                    .map(|run| replay_errors(run, config, scoring))
+                    .collect::<Result<Vec<_>, _>>()
+            };
+            pooled(&errors(base)?).zip(pooled(&errors(&config)?))
         }
         _ => None,
     };
-    Ok(ScaleFit {
-        k: fitted.map(|(k, _)| k),
-        standard_error: fitted.and_then(|(_, se)| se),
-        movements: scale::turns(&all),
-        leave_one_out_deg,
-        runs_better: (runs_better, paired.len()),
-        holdout_deg,
-        residual_relative: residual.map(|(rms, _)| rms),
-        residual_relative_upper: residual.map(|(rms, n)| scale::upper_95(rms, n)),
-        written,
+    Ok(ScaleDecision {
+        fit: ScaleFit {
+            k: fitted.map(|(k, _)| k),
+            standard_error: fitted.and_then(|(_, se)| se),
+            movements: scale::turns(&all),
+            leave_one_out_deg,
+            runs_better: (runs_better, paired.len()),
+            holdout_deg,
+            residual_relative: residual.map(|(rms, _)| rms),
+            residual_relative_upper: residual.map(|(rms, n)| scale::upper_95(rms, n)),
+            written,
+        },
+        fold_k: if written { fold_k } else { Vec::new() },
     })
 }
 
-/// Calibrate `base` on `train`; score on `train` and `holdout`. The configuration
-/// written is the candidate with the lowest leave-one-run-out error ([`choose`]), the
-/// starting configuration unless one beats it.
+/// Calibrate `base` on `train`; score on `train` and `holdout`. The scale is decided
+/// first ([`decide_scale`]) and, when written, is part of every candidate; the
+/// configuration written is then the candidate with the lowest leave-one-run-out error
+/// ([`choose`]), the starting configuration (with the scale) unless one beats it.
 pub fn calibrate(
     train: &[BenchRun],
     holdout: &[BenchRun],
@@ -1071,6 +1061,28 @@ pub fn calibrate(
     let scoring = ReplayOptions {
         reference_delay_s: reference_delay.delay_s,
     };
+    // The scale first: when it is written, every candidate is fitted and scored with it
+    // (each fold with the scale fitted on its own runs), so that the compensation is
+    // chosen with the corrections the file holds.
+    let start_errors = train
+        .iter()
+        .map(|run| replay_errors(run, base, &scoring))
+        .collect::<Result<Vec<_>, _>>()?;
+    let scale = decide_scale(
+        train,
+        holdout,
+        base,
+        &scoring,
+        &start_errors,
+        options.leave_one_out,
+    )?;
+    let scaled = |k: Option<f64>| k.and_then(|k| scale::with_scale(base, k)).unwrap_or(*base);
+    let base = &if scale.fit.written {
+        scaled(scale.fit.k)
+    } else {
+        *base
+    };
+    let start = *base;
     let base_traces = traces_for(&runs, base, &scoring)?;
     if base_traces.iter().all(|t| t.spans.is_empty()) {
         return Err(CalibrateError::NoMovement);
@@ -1088,7 +1100,6 @@ pub fn calibrate(
     // Leave-one-run-out: refit everything on the other runs, from their own start, and
     // score the left-out run with each candidate.
     let mut fold_fits = Vec::new();
-    let mut fold_fitted = Vec::new();
     let mut held_out: Vec<[RunErrors; 4]> = Vec::new();
     if options.leave_one_out && train.len() >= 2 {
         for (i, run) in train.iter().enumerate() {
@@ -1097,25 +1108,33 @@ pub fn calibrate(
                 .enumerate()
                 .filter_map(|(j, r)| (j != i).then_some(*r))
                 .collect();
-            let traces: Vec<Trace> = base_traces
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != i)
-                .map(|(_, t)| t.clone())
-                .collect();
+            // The fold's own scale, when the scale is written.
+            let fold_base = match scale.fold_k.get(i) {
+                Some(k) => scaled(*k),
+                None => *base,
+            };
+            let traces: Vec<Trace> = if fold_base == *base {
+                base_traces
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| *j != i)
+                    .map(|(_, t)| t.clone())
+                    .collect()
+            } else {
+                traces_for(&others, &fold_base, &scoring)?
+            };
             let stage = format!("leave-one-out {}/{}", i + 1, train.len());
             let (fold, _) = fit(
                 &others,
                 traces,
-                base,
+                &fold_base,
                 options,
                 tau_for(&others).0,
                 &scoring,
                 &mut |_, n, best| progress(&stage, n, best),
             )?;
-            held_out.push(candidate_errors(run, base, &fold.fitted, &scoring)?);
+            held_out.push(candidate_errors(run, &fold_base, &fold.fitted, &scoring)?);
             fold_fits.push(fold.fitted.paper);
-            fold_fitted.push(fold.fitted);
         }
     }
     let spread = (fold_fits.len() >= 3).then(|| {
@@ -1171,23 +1190,7 @@ pub fn calibrate(
         &[]
     };
     let (written, reason) = choose_among(&scores, excluded);
-    let written_config = full.fitted.config(base, written);
-    let scale = decide_scale(&ScaleInput {
-        train,
-        holdout,
-        base,
-        scoring: &scoring,
-        written,
-        written_config: &written_config,
-        fold_fitted: &fold_fitted,
-        train_errors: &train_errors,
-        held_out: &held_out,
-        holdout_errors: &holdout_errors,
-    })?;
-    let config = match scale.k {
-        Some(k) if scale.written => scale::with_scale(&written_config, k).unwrap_or(written_config),
-        _ => written_config,
-    };
+    let config = full.fitted.config(base, written);
     Ok(Calibration {
         fitted: full.fitted,
         objective: options.objective,
@@ -1195,14 +1198,14 @@ pub fn calibrate(
         initial_tau,
         termination: format!("{:?}", full.termination),
         evaluations: full.evaluations,
-        start: *base,
+        start,
         choice: Choice {
             written,
             reason,
             scores,
             paper_at_bound,
         },
-        scale,
+        scale: scale.fit,
         reference_delay,
         config,
         train: train

@@ -178,13 +178,13 @@ pub struct ScaleFit {
     /// [`MIN_TURN_DEG`].
     pub movements: usize,
     /// The RMS error of the turns, rest to rest ([`turn_rms`]), on the left-out runs with
-    /// the written candidate, without and with the scale fitted on the other runs (deg;
+    /// the starting configuration, without and with the scale fitted on the other runs (deg;
     /// `None` without refits or turns). What a scale corrects is the turns' totals, so it
     /// is judged on them whatever the objective.
     pub leave_one_out_deg: Option<(f64, f64)>,
     /// Left-out runs with turns whose turn RMS is lower with the scale, of those runs.
     pub runs_better: (usize, usize),
-    /// The turn RMS on the hold-out runs with the written candidate, without and with
+    /// The turn RMS on the hold-out runs with the starting configuration, without and with
     /// the scale fitted on all training runs (deg; `None` without hold-out turns).
     pub holdout_deg: Option<(f64, f64)>,
     /// The scale uncertainty that remains, held out: the RMS of the left-out runs' turn
