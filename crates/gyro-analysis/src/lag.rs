@@ -78,8 +78,13 @@ pub struct LagMeter {
 impl LagMeter {
     /// A meter for output points every `period_s` seconds, searching ±[`SEARCH_S`].
     pub fn new(period_s: f64) -> Self {
-        let max_lag = if period_s.is_finite() && period_s > 0.0 {
-            ((SEARCH_S / period_s).round() as usize).clamp(1, 10_000)
+        Self::with_search(period_s, SEARCH_S)
+    }
+
+    /// A meter for output points every `period_s` seconds, searching ±`search_s`.
+    pub fn with_search(period_s: f64, search_s: f64) -> Self {
+        let max_lag = if period_s.is_finite() && period_s > 0.0 && search_s.is_finite() {
+            ((search_s / period_s).round() as usize).clamp(1, 10_000)
         } else {
             1
         };
@@ -154,6 +159,168 @@ impl LagMeter {
     }
 }
 
+/// Length of the blocks a lag's trend is read from (s): a clock 2% off moves the lag by
+/// 0.2 s within one, which its peak still finds.
+pub const TREND_BLOCK_S: f64 = 10.0;
+
+/// Half-width of each block's search (s): a clock that runs off its nominal rate carries
+/// the lag well beyond [`SEARCH_S`] over a run (2% over a minute: 1.2 s).
+pub const TREND_SEARCH_S: f64 = 2.0;
+
+/// Fewest blocks with a lag for a trend to be read.
+pub const TREND_MIN_BLOCKS: usize = 4;
+
+/// A trend's slope must be at least this many of its standard errors: block lags scatter
+/// by a few milliseconds, and a run hundreds of blocks long turns that into a slope.
+pub const TREND_MIN_Z: f64 = 4.0;
+
+/// A lag that changes through a run, as a clock that runs off its nominal rate makes it
+/// when rows are stamped by the sample count.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct LagTrend {
+    /// The fitted lag at the first and the last block's middle (s; positive: the gyro lags).
+    pub first_s: f64,
+    /// See `first_s`.
+    pub last_s: f64,
+    /// The middles of the first and last block with a lag (s, the log's time).
+    pub from_s: f64,
+    /// See `from_s`.
+    pub to_s: f64,
+    /// The lag's change per second of the run (s/s): the clock's relative rate error.
+    pub per_s: f64,
+}
+
+impl LagTrend {
+    /// The lag's change over the run (s).
+    pub fn change_s(&self) -> f64 {
+        self.last_s - self.first_s
+    }
+
+    /// Whether the change is one to say: at least [`NOTABLE_S`].
+    pub fn notable(&self) -> bool {
+        self.change_s().abs() >= NOTABLE_S
+    }
+}
+
+/// Reads the lag block by block ([`TREND_BLOCK_S`], each searched ±[`TREND_SEARCH_S`]) and
+/// fits a line through the block lags, in memory bounded by a block plus a number per
+/// block.
+#[derive(Clone, Debug)]
+pub struct LagTrendMeter {
+    period_s: f64,
+    block_points: usize,
+    block: LagMeter,
+    in_block: usize,
+    /// Time of the block's first point (s).
+    block_start_s: f64,
+    /// (middle of the block, its lag) for each block with a lag (s).
+    lags: Vec<(f64, f64)>,
+}
+
+impl LagTrendMeter {
+    /// A meter for output points every `period_s` seconds.
+    pub fn new(period_s: f64) -> Self {
+        let block_points = if period_s.is_finite() && period_s > 0.0 {
+            ((TREND_BLOCK_S / period_s).round() as usize).max(8)
+        } else {
+            usize::MAX
+        };
+        Self {
+            period_s,
+            block_points,
+            block: LagMeter::with_search(period_s, TREND_SEARCH_S),
+            in_block: 0,
+            block_start_s: 0.0,
+            lags: Vec::new(),
+        }
+    }
+
+    /// The next output point: its time (s), gyro rate (deg/s) and reference angle (deg).
+    pub fn push(&mut self, time_s: f64, rate_dps: f64, reference_deg: Option<f64>) {
+        if self.in_block == 0 {
+            self.block_start_s = time_s;
+        }
+        self.block.push(rate_dps, reference_deg);
+        self.in_block += 1;
+        if self.in_block == self.block_points {
+            let middle_s = 0.5 * (self.block_start_s + time_s);
+            if let Some(lag) = self.block.lag_s() {
+                self.lags.push((middle_s, lag));
+            }
+            self.in_block = 0;
+            self.block = LagMeter::with_search(self.period_s, TREND_SEARCH_S);
+        }
+    }
+
+    /// The least-squares line through the block lags, if at least [`TREND_MIN_BLOCKS`]
+    /// have one and its slope is at least [`TREND_MIN_Z`] standard errors from zero. A
+    /// block whose peak fell on another period of a repeating motion lies far off the
+    /// others: the lags more than [`TREND_OUTLIER_S`] (or five median deviations) from
+    /// the median line (Theil–Sen) are left out first.
+    pub fn trend(&self) -> Option<LagTrend> {
+        let lags = inliers(&self.lags)?;
+        let n = lags.len();
+        if n < TREND_MIN_BLOCKS {
+            return None;
+        }
+        let nf = n as f64;
+        let mean_t = lags.iter().map(|p| p.0).sum::<f64>() / nf;
+        let mean_l = lags.iter().map(|p| p.1).sum::<f64>() / nf;
+        let stt: f64 = lags.iter().map(|p| (p.0 - mean_t).powi(2)).sum();
+        let stl: f64 = lags.iter().map(|p| (p.0 - mean_t) * (p.1 - mean_l)).sum();
+        if stt <= 0.0 || !stt.is_finite() {
+            return None;
+        }
+        let slope = stl / stt;
+        let residual: f64 = lags
+            .iter()
+            .map(|p| (p.1 - mean_l - slope * (p.0 - mean_t)).powi(2))
+            .sum();
+        let se = (residual / (nf - 2.0) / stt).sqrt();
+        if slope.is_nan() || slope.abs() < TREND_MIN_Z * se {
+            return None;
+        }
+        let (from_s, to_s) = (lags[0].0, lags[n - 1].0);
+        Some(LagTrend {
+            first_s: mean_l + slope * (from_s - mean_t),
+            last_s: mean_l + slope * (to_s - mean_t),
+            from_s,
+            to_s,
+            per_s: slope,
+        })
+    }
+}
+
+/// A block lag this far (s) from the median line, and beyond five median deviations, is
+/// left out of the trend: a peak on another period of the motion, not the clock.
+pub const TREND_OUTLIER_S: f64 = 0.05;
+
+/// The median of `values` (NaN-free), `None` if empty.
+fn median_of(mut values: Vec<f64>) -> Option<f64> {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    (n > 0).then(|| 0.5 * (values[(n - 1) / 2] + values[n / 2]))
+}
+
+/// The points of `lags` near their Theil–Sen line (the median of the pairwise slopes,
+/// through the median point), in time order; `None` for fewer than two.
+fn inliers(lags: &[(f64, f64)]) -> Option<Vec<(f64, f64)>> {
+    let mut slopes = Vec::new();
+    for (i, a) in lags.iter().enumerate() {
+        for b in &lags[i + 1..] {
+            if b.0 != a.0 {
+                slopes.push((b.1 - a.1) / (b.0 - a.0));
+            }
+        }
+    }
+    let slope = median_of(slopes)?;
+    let intercept = median_of(lags.iter().map(|p| p.1 - slope * p.0).collect())?;
+    let off = |p: &(f64, f64)| (p.1 - intercept - slope * p.0).abs();
+    let spread = median_of(lags.iter().map(off).collect())?;
+    let limit = TREND_OUTLIER_S.max(5.0 * 1.4826 * spread);
+    Some(lags.iter().copied().filter(|p| off(p) <= limit).collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -200,6 +367,49 @@ mod tests {
             unreferenced.push(f64::from(i), None);
         }
         assert_eq!(unreferenced.lag_s(), None);
+    }
+
+    /// Turns that do not repeat (two sines of incommensurate periods), the gyro's samples
+    /// taken on a clock `1 + clock` times the nominal rate and stamped by their count: its
+    /// lag grows by `clock / (1 + clock)` per second; plus a constant `lag_s`.
+    fn trend_meter(clock: f64, lag_s: f64, duration_s: f64) -> LagTrendMeter {
+        use std::f64::consts::TAU;
+        let angle = |t: f64| 60.0 * (TAU * t / 3.0).sin() + 40.0 * (TAU * t / 7.7 + 1.0).sin();
+        let rate = |t: f64| {
+            60.0 * TAU / 3.0 * (TAU * t / 3.0).cos()
+                + 40.0 * TAU / 7.7 * (TAU * t / 7.7 + 1.0).cos()
+        };
+        let period = 0.02;
+        let mut m = LagTrendMeter::new(period);
+        for i in 0..(duration_s / period) as usize {
+            let t = i as f64 * period;
+            m.push(t, rate(t / (1.0 + clock) - lag_s), Some(angle(t)));
+        }
+        m
+    }
+
+    #[test]
+    fn a_lag_that_grows_is_read_as_a_trend() {
+        for clock in [0.02, 0.005, -0.009] {
+            let t = trend_meter(clock, 0.0, 90.0).trend().unwrap();
+            let expected = clock / (1.0 + clock);
+            assert!(
+                (t.per_s - expected).abs() < 0.1 * expected.abs(),
+                "{clock}: {t:?}"
+            );
+            assert!(t.notable(), "{t:?}");
+        }
+        // A constant lag, however long, has no trend to say.
+        for lag_s in [0.0, 0.109, -0.3] {
+            let m = trend_meter(0.0, lag_s, 90.0);
+            assert!(
+                m.trend().is_none_or(|t| !t.notable()),
+                "{lag_s}: {:?}",
+                m.trend()
+            );
+        }
+        // Too short a run: no trend read.
+        assert_eq!(trend_meter(0.02, 0.0, 30.0).trend(), None);
     }
 
     #[test]

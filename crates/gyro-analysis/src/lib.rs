@@ -13,6 +13,7 @@
 
 pub mod calibrate;
 pub mod diagnose;
+pub mod findings;
 pub mod lag;
 pub mod model;
 pub mod noise;

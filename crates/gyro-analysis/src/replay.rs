@@ -10,7 +10,7 @@
 //! reference ([`ReplayOptions::reference_delay_s`], the model file's `reference_delay_s`)
 //! is a matter of scoring only: the reference is shifted by it before the comparison.
 
-use crate::lag::LagMeter;
+use crate::lag::{LagMeter, LagTrendMeter};
 use crate::model::ModelFile;
 use gyro_core::{
     decide, Compensation, Config, Decimator, Event, MotionState, Pipeline, Sos, SosState,
@@ -78,8 +78,9 @@ pub struct MovementResult {
     /// Input samples interpolated during the movement (a gap in the log, or missing
     /// rates): the rotation across them is a guess.
     pub filled_samples: u32,
-    /// Standard deviation of `angle_deg` (deg), in Kalman mode, for a complete movement
-    /// ([`gyro_core::Movement::angle_std_deg`]).
+    /// Standard deviation of `angle_deg` (deg), in Kalman mode
+    /// ([`gyro_core::Movement::angle_std_deg`]); for a movement the log ends in, as if it
+    /// ended there ([`gyro_core::Pipeline::movement_std_deg`]).
     pub angle_std_deg: Option<f32>,
     /// The tightening decision ([`gyro_core::decide`]) when the configuration has a window;
     /// absent without one, or for a turn the other way (not a tightening). `invalid` when
@@ -127,6 +128,11 @@ pub struct Summary {
     /// from the output series' rates ([`crate::lag::LagMeter`]); `None` without a
     /// reference, without motion both show, or beyond ±[`crate::lag::SEARCH_S`].
     pub reference_lag_s: Option<f64>,
+    /// The lag's change through the run, when block by block it follows a line
+    /// ([`crate::lag::LagTrendMeter`]): a clock that runs off its nominal rate while the
+    /// rows are stamped by the sample count. `None` without a reference, on runs shorter
+    /// than a few blocks, or when the block lags do not trend.
+    pub reference_lag_trend: Option<crate::lag::LagTrend>,
     /// The largest |rate| among the input samples the pipeline accepted (deg/s).
     pub largest_abs_rate_dps: f64,
     /// A reading went beyond the configured range ([`Pipeline::range_contradicted`]): it
@@ -511,6 +517,7 @@ pub struct Replayer {
     errors: ErrorStats,
     raw_errors: ErrorStats,
     lag: LagMeter,
+    lag_trend: LagTrendMeter,
     movements: Vec<MovementResult>,
     open: Option<OpenMovement>,
     /// Filled input slots (gaps, missing rates) so far.
@@ -591,6 +598,7 @@ impl Replayer {
             errors: ErrorStats::default(),
             raw_errors: ErrorStats::default(),
             lag: LagMeter::new(1.0 / f64::from(output_rate_hz)),
+            lag_trend: LagTrendMeter::new(1.0 / f64::from(output_rate_hz)),
             movements: Vec::new(),
             open: None,
             filled_total: 0,
@@ -781,6 +789,8 @@ impl Replayer {
         }
         self.lag
             .push(f64::from(point.rate_dps), point.reference_deg);
+        self.lag_trend
+            .push(point.time_s, f64::from(point.rate_dps), point.reference_deg);
         self.first_time_s.get_or_insert(point.time_s);
         if self.held.len() >= self.max_held {
             self.held.pop_front();
@@ -836,7 +846,7 @@ impl Replayer {
                     complete: false,
                     saturated: self.pipeline.movement_saturated(),
                     filled_samples,
-                    angle_std_deg: None,
+                    angle_std_deg: self.pipeline.movement_std_deg(),
                 },
                 samples,
                 reference_change(start_reference, last.reference_deg),
@@ -864,6 +874,7 @@ impl Replayer {
             raw_rms_error_deg: raw_rms,
             raw_final_error_deg: raw_final,
             reference_lag_s: self.lag.lag_s(),
+            reference_lag_trend: self.lag_trend.trend(),
             largest_abs_rate_dps: self.largest_abs_rate_dps,
             range_contradicted: self.pipeline.range_contradicted(),
         };

@@ -564,7 +564,13 @@ fn a_lagging_reference_is_measured_and_said() {
     );
     let scored = json_of(&gyro(&["run", log, "--format", "json", "--model", &model]));
     assert!(scored["summary"]["reference_lag_s"].as_f64().unwrap().abs() < 0.004);
-    assert!(scored.get("warnings").is_none(), "{}", scored["warnings"]);
+    assert_eq!(
+        scored["warnings"],
+        serde_json::json!([]),
+        "{}",
+        scored["warnings"]
+    );
+    assert_eq!(scored["findings"], serde_json::json!([]));
     // The warning names the flag that scores it; the flag does, over the model's delay.
     assert!(warning.contains("--reference-delay-s 0.06"), "{warning}");
     let flagged = json_of(&gyro(&[
@@ -582,7 +588,12 @@ fn a_lagging_reference_is_measured_and_said() {
             .abs()
             < 0.004
     );
-    assert!(flagged.get("warnings").is_none(), "{}", flagged["warnings"]);
+    assert_eq!(
+        flagged["warnings"],
+        serde_json::json!([]),
+        "{}",
+        flagged["warnings"]
+    );
     assert_eq!(flagged["summary"], scored["summary"]);
     let over = json_of(&gyro(&[
         "run",
@@ -609,7 +620,7 @@ fn a_lagging_reference_is_measured_and_said() {
             .abs()
             < 0.002
     );
-    assert!(fixture.get("warnings").is_none());
+    assert_eq!(fixture["warnings"], serde_json::json!([]));
 }
 
 /// Verdicts without a σ (any compensation but the Kalman form) are said to be unguarded
@@ -645,7 +656,7 @@ fn verdicts_without_a_sigma_are_said_to_be_unguarded() {
     // The Kalman form with a scale uncertainty: guarded, nothing to say.
     let mut args = vec!["run", log, "--format", "json", "--scale-sigma", "0.001"];
     args.extend(window);
-    assert!(json_of(&gyro(&args)).get("warnings").is_none());
+    assert_eq!(json_of(&gyro(&args))["warnings"], serde_json::json!([]));
     // Without one, the guard band does not hold the scale error, and every output says so.
     let mut args = vec!["run", log, "--format", "json"];
     args.extend(window);

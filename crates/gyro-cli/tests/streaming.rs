@@ -59,11 +59,12 @@ fn describe(path: &Path, result: Result<RunReport, String>) -> String {
     match result {
         Ok(report) => {
             let file = path.display().to_string();
+            let findings = gyro_analysis::findings::of_run(&report, &[]);
             let mut series = Vec::new();
-            report::series_csv(&mut series, &report).unwrap();
+            report::series_csv(&mut series, &report, &findings).unwrap();
             let mut text = format!("{report:?}\n");
-            text.push_str(&report::table(&file, &report));
-            writeln!(text, "{}", report::json(&file, &report).unwrap()).unwrap();
+            text.push_str(&report::table(&file, &report, &findings));
+            writeln!(text, "{}", report::json(&file, &report, &findings).unwrap()).unwrap();
             text.push_str(&String::from_utf8(series).unwrap());
             text
         }
@@ -458,14 +459,26 @@ fn cli_output_equals_the_materialising_report() {
         &ReplayOptions::default(),
     )
     .unwrap();
+    // The log reader's notices, as `run` hears them, make the head of its findings.
+    let mut notices = Vec::new();
+    replay::replay_file(
+        &path,
+        &LogOptions::default(),
+        &GridOptions::default(),
+        &Config::default(),
+        &ReplayOptions::default(),
+        &mut |n| notices.push(n.to_string()),
+    )
+    .unwrap();
+    let findings = gyro_analysis::findings::of_run(&report, &notices);
     assert_eq!(
         ok(&out),
-        format!("{}\n", report::json(file, &report).unwrap())
+        format!("{}\n", report::json(file, &report, &findings).unwrap())
     );
     let mut expected = Vec::new();
-    report::series_csv(&mut expected, &report).unwrap();
+    report::series_csv(&mut expected, &report, &findings).unwrap();
     assert_eq!(std::fs::read(&series).unwrap(), expected);
 
     let out = gyro(&["run", file]);
-    assert_eq!(ok(&out), report::table(file, &report));
+    assert_eq!(ok(&out), report::table(file, &report, &findings));
 }

@@ -1140,6 +1140,19 @@ impl Pipeline {
         self.clip_flags & CLIP_BEYOND != 0
     }
 
+    /// The standard deviation (deg) of the angle the movement in progress has gained so
+    /// far, as [`Movement::angle_std_deg`] would give it were it to end now (Kalman form
+    /// only; `None` at rest or in another compensation). For a host whose log ends while
+    /// moving: the angle of a movement that never rests still has a σ, and it tells how far
+    /// the bias estimated at the last rest can have carried it.
+    pub fn movement_std_deg(&self) -> Option<f32> {
+        let track = self.track.as_ref()?;
+        (self.compensation == Compensation::Kalman).then(|| {
+            self.kalman
+                .movement_std_deg(self.index.saturating_sub(track.start_index))
+        })
+    }
+
     /// Whether the movement in progress (its confirming run included) is saturated so far;
     /// `false` at rest. For a host whose log ends while moving.
     pub fn movement_saturated(&self) -> bool {

@@ -10,9 +10,10 @@
 //!     &mut |_| {},
 //! )?;
 //! let report = gyro_analysis::replay::replay(&log, &gyro_core::Config::default())?;
-//! let text = gyro_report::run::table("bench_run.csv", &report);
+//! let findings = gyro_analysis::findings::of_run(&report, &[]);
+//! let text = gyro_report::run::table("bench_run.csv", &report, &findings);
 //! assert!(text.contains("bench_run.csv"));
-//! let json = gyro_report::run::json("bench_run.csv", &report)?;
+//! let json = gyro_report::run::json("bench_run.csv", &report, &findings)?;
 //! assert!(json.contains("max_abs_error_deg"));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```

@@ -1,5 +1,6 @@
 //! Rendering a [`RunReport`]: a human table, JSON, or CSV; and the 50 Hz series as CSV.
 
+use gyro_analysis::findings::Finding;
 use gyro_analysis::replay::{MovementResult, RunReport, SeriesPoint};
 use gyro_core::Verdict;
 use std::fmt::Write as _;
@@ -9,8 +10,9 @@ fn opt(value: Option<f64>, decimals: usize) -> String {
     value.map_or_else(|| "-".to_string(), |v| format!("{v:.decimals$}"))
 }
 
-/// A human-readable report.
-pub fn table(file: &str, report: &RunReport) -> String {
+/// A human-readable report, with the run's `findings` ([`gyro_analysis::findings::of_run`])
+/// after the summary, one `warning:` line each.
+pub fn table(file: &str, report: &RunReport, findings: &[Finding]) -> String {
     let mut s = String::new();
     let q = &report.input;
     let c = &report.config;
@@ -122,19 +124,6 @@ pub fn table(file: &str, report: &RunReport) -> String {
                 let _ = writeln!(s, "  {}", marks.join(" "));
             }
         }
-        for m in report.movements.iter().filter(|m| m.saturated) {
-            let _ = writeln!(s, "warning: {}", saturation_warning(m.index, c.range_dps));
-        }
-        if let Some(warning) = range_warning(report) {
-            let _ = writeln!(s, "warning: {warning}");
-        }
-        for m in report.movements.iter().filter(|m| m.filled_samples > 0) {
-            let _ = writeln!(
-                s,
-                "warning: movement {} spans {} interpolated input samples (a gap or missing rates in the log): its angle across them is a guess",
-                m.index, m.filled_samples
-            );
-        }
         if let Some(t) = &c.tightening {
             let count = |v: Verdict| {
                 report
@@ -169,12 +158,6 @@ pub fn table(file: &str, report: &RunReport) -> String {
                 count(Verdict::Invalid),
                 other_way
             );
-            for warning in unguarded_warning(report)
-                .into_iter()
-                .chain(scale_warning(report))
-            {
-                let _ = writeln!(s, "warning: {warning}");
-            }
         }
     }
     let sm = &report.summary;
@@ -198,108 +181,13 @@ pub fn table(file: &str, report: &RunReport) -> String {
             opt(sm.raw_rms_error_deg, 4),
             opt(sm.raw_final_error_deg, 4)
         );
-        if let Some(warning) = lag_warning(report) {
-            let _ = writeln!(s, "warning: {warning}");
-        }
     } else {
         let _ = writeln!(s, "  no reference_deg column: no error figures");
     }
+    for f in findings {
+        let _ = writeln!(s, "warning: {}", f.message);
+    }
     s
-}
-
-/// Every warning about what the figures and verdicts mean, in the order the table gives
-/// them: the JSON's `warnings`, and stderr for the CSV.
-pub fn warnings(report: &RunReport) -> Vec<String> {
-    rate_warning(report)
-        .into_iter()
-        .chain(range_warning(report))
-        .chain(unguarded_warning(report))
-        .chain(scale_warning(report))
-        .chain(lag_warning(report))
-        .collect()
-}
-
-/// The warning for a log slower than the configured output rate, run at its own rate
-/// ([`gyro_analysis::replay::config_for_rate`]): the low-pass is scaled with it, so the
-/// rate is smoothed more than the configuration says.
-pub fn rate_warning(report: &RunReport) -> Option<String> {
-    let configured_hz = report.output_rate_lowered_from_hz?;
-    Some(gyro_analysis::replay::lowered_rate_note(
-        report.sample_rate_hz,
-        configured_hz,
-        report.config.filter.cutoff_hz,
-    ))
-}
-
-/// The warning for readings beyond the sensor range in use: a sensor reads at most its
-/// range, so that range is not this one's (a model file's sensor section holds the
-/// CRM100's ±300 deg/s unless it says otherwise). From the first such reading the core
-/// flags saturation on clip plateaus only; a movement that ended before it may still be
-/// flagged for reaching the range.
-pub fn range_warning(report: &RunReport) -> Option<String> {
-    let range_dps = report.config.range_dps?;
-    report.summary.range_contradicted.then(|| {
-        format!(
-            "readings reach {:.1} deg/s, beyond the sensor range of ±{range_dps} deg/s in use: that range is not this sensor's, so from the first such reading only clip plateaus flag a movement saturated (one that ended before it may still be flagged for reaching the range); give --range-dps with the sensor's full scale",
-            report.summary.largest_abs_rate_dps
-        )
-    })
-}
-
-/// The warning for tightening verdicts without a σ: only the Kalman form gives a movement
-/// one, so in the other compensations the guard band holds only the scale term and an
-/// `ok` may sit on a bias error of any size.
-pub fn unguarded_warning(report: &RunReport) -> Option<String> {
-    let t = report.config.tightening.as_ref()?;
-    if report.config.compensation == gyro_core::Compensation::Kalman {
-        return None;
-    }
-    let mode = match report.config.compensation {
-        gyro_core::Compensation::None => "none",
-        _ => "paper",
-    };
-    Some(format!(
-        "the verdicts have no σ: only the Kalman form gives a movement one, and with compensation {mode} the guard band is {}, so an `ok` does not allow for the bias; run with --compensation kalman for a guarded decision",
-        if t.scale_sigma > 0.0 {
-            format!("only the scale term ({}% of the angle)", 100.0 * t.scale_sigma)
-        } else {
-            "zero".to_string()
-        }
-    ))
-}
-
-/// The warning for tightening verdicts without a scale uncertainty: σ holds the bias and
-/// the noise, not the scale factor, which on an uncalibrated MEMS gyro is off by 0.5–2%
-/// (1–3° on a 150° turn, the rasteiro recordings), far beyond σ (0.03–0.25° there).
-pub fn scale_warning(report: &RunReport) -> Option<String> {
-    let t = report.config.tightening.as_ref()?;
-    (t.scale_sigma == 0.0).then(|| {
-        "the guard band holds the bias and the noise (σ), not the gyro's scale error: uncalibrated, a MEMS gyro's scale is off by 0.5-2% (1-3 deg on a 150 deg turn), far beyond σ; give --scale-sigma (a datasheet's tolerance, e.g. 0.02) or a model from `calibrate` (its scale_sigma)".to_string()
-    })
-}
-
-/// The warning for a gyro that lags (or leads) the reference it is scored against by at
-/// least [`gyro_analysis::lag::NOTABLE_S`]: the errors during turns are then mostly the
-/// lag's, not the sensor's.
-pub fn lag_warning(report: &RunReport) -> Option<String> {
-    let lag_s = report.summary.reference_lag_s?;
-    if lag_s.abs() < gyro_analysis::lag::NOTABLE_S {
-        return None;
-    }
-    let how = if lag_s > 0.0 { "lags" } else { "leads" };
-    let scored = if report.reference_delay_s == 0.0 {
-        "the reference as logged".to_string()
-    } else {
-        format!(
-            "the reference (shifted by {:.1} ms)",
-            1e3 * report.reference_delay_s
-        )
-    };
-    Some(format!(
-        "the gyro {how} {scored} by {:.0} ms (cross-correlation of the rates): the errors against it during turns are the rate times that, not the sensor's; score with --reference-delay-s {:.3} (or a model file's reference_delay_s: `calibrate` measures and writes it)",
-        1e3 * lag_s.abs(),
-        report.reference_delay_s + lag_s,
-    ))
 }
 
 /// The JSON name of a verdict.
@@ -312,39 +200,25 @@ fn verdict_name(verdict: Verdict) -> &'static str {
     }
 }
 
-/// Why movement `index` is flagged saturated, and what that means for its angle.
-fn saturation_warning(index: usize, range_dps: Option<f32>) -> String {
-    let what = match range_dps {
-        Some(r) => format!("reached the sensor range ({r} deg/s) or clipped below it"),
-        None => format!(
-            "clipped ({} or more identical readings, and {} ms or more of them, at >= {} \
-             deg/s, {} deg/s ahead of the filtered rate or lasting {} ms; sensor range \
-             unknown)",
-            gyro_core::CLIP_PLATEAU_SAMPLES,
-            gyro_core::CLIP_PLATEAU_SHORT_S * 1000.0,
-            gyro_core::CLIP_PLATEAU_MIN_DPS,
-            gyro_core::CLIP_PLATEAU_LEAD_DPS,
-            gyro_core::CLIP_PLATEAU_LONG_S * 1000.0
-        ),
-    };
-    format!("movement {index} {what}: its angle is a lower bound")
-}
-
-/// JSON: `{"file", "input", "config", "summary", "movements", ...}`.
-pub fn json(file: &str, report: &RunReport) -> serde_json::Result<String> {
+/// JSON: `{"file", "input", "config", "summary", "movements", "warnings", "findings"}`:
+/// `warnings` the findings' sentences, `findings` the findings with their codes and where
+/// they lie; both always present (`[]` when there is none).
+pub fn json(file: &str, report: &RunReport, findings: &[Finding]) -> serde_json::Result<String> {
     #[derive(serde::Serialize)]
     struct WithFile<'a> {
         file: &'a str,
         #[serde(flatten)]
         report: &'a RunReport,
-        /// What makes the figures and verdicts mean less than they seem ([`warnings`]).
-        #[serde(skip_serializing_if = "Vec::is_empty")]
-        warnings: Vec<String>,
+        /// What makes the figures and verdicts mean less than they seem, one sentence each.
+        warnings: Vec<&'a str>,
+        /// The same, with codes and places.
+        findings: &'a [Finding],
     }
     serde_json::to_string_pretty(&WithFile {
         file,
         report,
-        warnings: warnings(report),
+        warnings: findings.iter().map(|f| f.message.as_str()).collect(),
+        findings,
     })
 }
 
@@ -377,12 +251,25 @@ pub fn movements_csv(out: &mut impl Write, movements: &[MovementResult]) -> io::
     Ok(())
 }
 
-/// CSV of the output series (the `--out` file): [`series_csv_header`], then
-/// [`series_csv_row`] for each point.
-pub fn series_csv(out: &mut impl Write, report: &RunReport) -> io::Result<()> {
+/// CSV of the output series (the `--out` file): the run's findings as comments
+/// ([`series_csv_findings`]), [`series_csv_header`], then [`series_csv_row`] for each point.
+pub fn series_csv(
+    out: &mut impl Write,
+    report: &RunReport,
+    findings: &[Finding],
+) -> io::Result<()> {
+    series_csv_findings(out, findings)?;
     series_csv_header(out, report.output_rate_hz)?;
     for p in &report.series {
         series_csv_row(out, p)?;
+    }
+    Ok(())
+}
+
+/// The run's findings as the series CSV's first comment lines, `# warning (code): …`.
+pub fn series_csv_findings(out: &mut impl Write, findings: &[Finding]) -> io::Result<()> {
+    for f in findings {
+        writeln!(out, "# warning ({}): {}", f.code, f.message)?;
     }
     Ok(())
 }

@@ -37,12 +37,8 @@ use crate::replay::{replay_with, ReplayOptions, RunReport};
 use rayon::prelude::*;
 use serde::Serialize;
 
-/// A movement the gyro makes while the reference turns less than this fraction of it is
-/// not followed by the reference.
-pub const UNTRACKED_FRACTION: f64 = 0.5;
-/// Smallest gyro angle (deg) of a movement listed as not followed by the reference: below
-/// it a bias wander over a long movement could make it.
-pub const UNTRACKED_MIN_DEG: f64 = 2.0;
+/// The rule for a movement the reference does not follow is `run`'s too: one home.
+pub use crate::findings::{not_followed, UNTRACKED_FRACTION, UNTRACKED_MIN_DEG};
 
 /// Smallest scale error named (1 = 100%): 0.1% is 0.09° on a 90° turn, below what the
 /// totals of real turns resolve, and what the pipeline's own filtering and grid leave on
@@ -320,9 +316,7 @@ fn untracked<'a>(
     runs.iter().zip(totals).flat_map(|(run, moves)| {
         moves.iter().filter_map(move |m| {
             let gyro_deg = m.reference_deg + m.error_deg;
-            (gyro_deg.abs() >= UNTRACKED_MIN_DEG
-                && m.reference_deg.abs() < UNTRACKED_FRACTION * gyro_deg.abs())
-            .then(|| Untracked {
+            not_followed(gyro_deg, m.reference_deg).then(|| Untracked {
                 run: run.name.clone(),
                 gyro_deg,
                 reference_deg: m.reference_deg,

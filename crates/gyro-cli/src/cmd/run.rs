@@ -2,6 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::ValueEnum;
+use gyro_analysis::findings::Finding;
 use gyro_analysis::model;
 use gyro_analysis::replay;
 use gyro_core::{Compensation, Config, Direction, Tightening};
@@ -172,13 +173,18 @@ pub fn run(args: &Args) -> Result<()> {
         (None, true) => &mut kept,
         (None, false) => &mut (),
     };
+    // The log reader's notices go to stderr as they come and into the run's findings.
+    let mut notices = Vec::new();
     let mut result = replay::replay_file_into(
         &args.log,
         &args.input,
         &args.grid,
         &config,
         &options,
-        &mut super::warn,
+        &mut |notice: &str| {
+            super::warn(notice);
+            notices.push(notice.to_string());
+        },
         series,
     )
     .map_err(|e| match e {
@@ -186,28 +192,34 @@ pub fn run(args: &Args) -> Result<()> {
         e @ replay::ReplayFileError::Config { .. } => anyhow::Error::new(e),
     })?;
     result.series = kept;
+    // One list of findings for every output: the table, the JSON, the series' header
+    // comments, and stderr (the log's notices went there as they came).
+    let findings = gyro_analysis::findings::of_run(&result, &notices);
     let file = args.log.display().to_string();
     let json = match args.format {
-        Format::Json => Some(report::json(&file, &result)?),
+        Format::Json => Some(report::json(&file, &result, &findings)?),
         _ => None,
     };
     super::to_stdout(|out| match args.format {
-        Format::Table => write!(out, "{}", report::table(&file, &result)),
+        Format::Table => write!(out, "{}", report::table(&file, &result, &findings)),
         Format::Json => writeln!(out, "{}", json.unwrap_or_default()),
         Format::Csv => report::movements_csv(&mut &mut *out, &result.movements),
     })?;
     if args.format != Format::Table {
-        // The table carries it; the JSON too, the movements' CSV cannot.
-        for warning in report::warnings(&result) {
-            super::warn(&warning);
+        // The table carries them on stdout; for the JSON and the CSV, stderr says them too.
+        for f in findings
+            .iter()
+            .filter(|f| f.code != gyro_analysis::findings::LOG)
+        {
+            super::warn(&f.message);
         }
     }
     if let Some(out) = &args.out {
         match series_file {
             Some(file) => file
-                .finish(result.output_rate_hz)
+                .finish(result.output_rate_hz, &findings)
                 .with_context(|| format!("cannot write {}", out.display()))?,
-            None => super::output::write(out, |w| report::series_csv(w, &result))?,
+            None => super::output::write(out, |w| report::series_csv(w, &result, &findings))?,
         }
     }
     if let Some(path) = &args.plot {
@@ -265,8 +277,10 @@ impl SeriesFile {
     }
 
     /// Complete the file (its header at `output_rate_hz` if no output came) and put it in
-    /// place of the target.
-    fn finish(mut self, output_rate_hz: f32) -> io::Result<()> {
+    /// place of the target, the run's `findings` as its first comment lines: they are known
+    /// only at the end, so the rows written so far are copied after them, a buffer at a
+    /// time.
+    fn finish(mut self, output_rate_hz: f32, findings: &[Finding]) -> io::Result<()> {
         if !self.started {
             self.write(|w| report::series_csv_header(w, output_rate_hz));
         }
@@ -274,10 +288,40 @@ impl SeriesFile {
         self.out = None;
         let partial = self.partial.take();
         match (self.error.take(), partial) {
-            (None, Some(partial)) => partial.finish(),
+            (None, Some(partial)) if findings.is_empty() => partial.finish(),
+            (None, Some(partial)) => {
+                let result = Self::prepend(&partial, findings);
+                match result {
+                    Ok(()) => partial.discard(),
+                    Err(e) => {
+                        partial.discard();
+                        return Err(e);
+                    }
+                }
+                Ok(())
+            }
             (error, partial) => {
                 partial.into_iter().for_each(Partial::discard);
                 Err(error.unwrap_or_else(|| io::Error::other("no partial file")))
+            }
+        }
+    }
+
+    /// Write `findings` then the rows of `rows` (a partial file) into the target, whole.
+    fn prepend(rows: &Partial, findings: &[Finding]) -> io::Result<()> {
+        let target = rows.target().to_path_buf();
+        let with = Partial::beside(&target)?;
+        let copy = || -> io::Result<()> {
+            let mut out = BufWriter::new(File::create(with.path())?);
+            report::series_csv_findings(&mut out, findings)?;
+            io::copy(&mut File::open(rows.path())?, &mut out)?;
+            out.flush()
+        };
+        match copy() {
+            Ok(()) => with.finish(),
+            Err(e) => {
+                with.discard();
+                Err(e)
             }
         }
     }

@@ -1,0 +1,177 @@
+//! `run`'s findings: one list per run, the same in the table, the JSON (`warnings` and
+//! `findings`, always present), the series CSV's header comments and stderr; and the
+//! findings a user met silently before: a lag that grows (a clock off its rate), a run that
+//! never rests (the bias unobservable), movements the reference does not follow.
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+mod common;
+use common::{gyro, json_of, ok, temp_dir, workspace_root};
+
+/// The codes of a JSON report's findings, in order.
+fn codes(report: &serde_json::Value) -> Vec<String> {
+    report["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["code"].as_str().unwrap().to_string())
+        .collect()
+}
+
+/// Every finding of the JSON is a `warning:` line of the table, in the same order, and the
+/// table has no other; the JSON's `warnings` are the findings' sentences.
+fn same_in_table_and_json(log: &str) -> serde_json::Value {
+    let report = json_of(&gyro(&["run", log, "--format", "json"]));
+    let table = ok(&gyro(&["run", log]));
+    let said: Vec<&str> = table
+        .lines()
+        .filter_map(|l| l.strip_prefix("warning: "))
+        .collect();
+    let messages: Vec<&str> = report["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["message"].as_str().unwrap())
+        .collect();
+    assert_eq!(said, messages, "{table}");
+    let warnings: Vec<&str> = report["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    assert_eq!(warnings, messages);
+    report
+}
+
+/// A gyro whose clock runs 2% fast, its rows stamped by its sample count: the lag grows
+/// through the run, said with its rate in every output.
+#[test]
+fn a_lag_that_grows_is_said_everywhere() {
+    let scratch = temp_dir("findings-clock");
+    let dir = scratch.path();
+    let log = dir.join("clock.csv");
+    let log_s = log.to_str().unwrap();
+    ok(&gyro(&[
+        "simulate",
+        "-o",
+        log_s,
+        "--seed",
+        "3",
+        "--duration-s",
+        "60",
+        "--effect",
+        "clock_error_count_stamped:ppm=20000",
+    ]));
+    let report = same_in_table_and_json(log_s);
+    assert!(
+        codes(&report).contains(&"lag_drift".to_string()),
+        "{report}"
+    );
+    let trend = &report["summary"]["reference_lag_trend"];
+    let per_s = trend["per_s"].as_f64().unwrap();
+    assert!((per_s - 0.0196).abs() < 0.002, "{trend}");
+    let drift = report["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["code"] == "lag_drift")
+        .unwrap();
+    assert!(drift["time_s"].is_number(), "{drift}");
+    let message = drift["message"].as_str().unwrap();
+    assert!(
+        message.contains("ms per minute") && message.contains("1.9"),
+        "{message}"
+    );
+
+    // The series CSV opens with the findings; the CSV format says them on stderr.
+    let series = dir.join("series.csv");
+    let out = gyro(&[
+        "run",
+        log_s,
+        "--format",
+        "csv",
+        "--out",
+        series.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains(message));
+    let text = std::fs::read_to_string(&series).unwrap();
+    let head: Vec<&str> = text.lines().take_while(|l| l.starts_with('#')).collect();
+    assert!(
+        head.iter()
+            .any(|l| l.starts_with("# warning (lag_drift): ") && l.ends_with(message)),
+        "{head:?}"
+    );
+    assert!(
+        head.last().unwrap().starts_with("# output_rate_hz"),
+        "{head:?}"
+    );
+
+    // A steady clock: no drift, and `warnings` is still there, empty.
+    let steady = dir.join("steady.csv");
+    ok(&gyro(&[
+        "simulate",
+        "-o",
+        steady.to_str().unwrap(),
+        "--seed",
+        "3",
+        "--duration-s",
+        "60",
+    ]));
+    let report = json_of(&gyro(&[
+        "run",
+        steady.to_str().unwrap(),
+        "--format",
+        "json",
+    ]));
+    assert_eq!(report["warnings"], serde_json::json!([]), "{report}");
+    assert_eq!(report["findings"], serde_json::json!([]));
+}
+
+/// On the shared real recordings (when beside the workspace): the shaft that never rests
+/// says its bias is unobservable and how fast the error may grow, with σ on its movement;
+/// the robot's turns about the other axes are flagged.
+#[test]
+fn real_recordings_say_what_their_figures_do_not() {
+    let real = workspace_root().join("../shared/data/real");
+    let ssong = real.join("ssong_x_slow.csv");
+    let rasteiro = real.join("rasteiro/rasteiro_MPU6050RM3100_V_300_x.csv");
+    if !ssong.exists() || !rasteiro.exists() {
+        eprintln!("skipped: no real logs in {}", real.display());
+        return;
+    }
+    let report = same_in_table_and_json(ssong.to_str().unwrap());
+    assert!(
+        codes(&report).contains(&"bias_unobservable".to_string()),
+        "{}",
+        report["findings"]
+    );
+    let movement = &report["movements"][0];
+    assert!(
+        movement["angle_std_deg"].as_f64().unwrap() > 100.0,
+        "{movement}"
+    );
+    let unobservable = report["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["code"] == "bias_unobservable")
+        .unwrap()["message"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert!(
+        unobservable.starts_with("no rest for 1500 s") && unobservable.contains("deg/s"),
+        "{unobservable}"
+    );
+
+    let report = same_in_table_and_json(rasteiro.to_str().unwrap());
+    let flagged: Vec<u64> = report["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["code"] == "reference_does_not_follow")
+        .map(|f| f["movement"].as_u64().unwrap())
+        .collect();
+    assert_eq!(flagged, [1, 2, 3, 4], "{}", report["findings"]);
+}
