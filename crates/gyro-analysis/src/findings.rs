@@ -3,7 +3,8 @@
 //! output of `run` shows the same list (the table, the JSON's `warnings` and `findings`,
 //! the series CSV's header comments, stderr), so nothing found is said in one place only.
 //!
-//! The rules are here, once: the log reader's notices ([`LOG`]), a log run slower than the
+//! The rules are here, once: the log reader's notices ([`LOG`]), a log too short to say
+//! anything ([`SHORT_LOG`]), a log run slower than the
 //! configured rate ([`OUTPUT_RATE_LOWERED`]), saturated movements ([`SATURATED`]), movements
 //! across interpolated samples ([`GAP`]), movements longer than the bias can be trusted
 //! ([`BIAS_UNOBSERVABLE`]), movements the reference does not follow ([`NOT_FOLLOWED`],
@@ -19,6 +20,12 @@ use serde::Serialize;
 /// A notice of the log reader (a reference that jumps, a sense that turns the other way,
 /// irregular time stamps…), passed on as it was given.
 pub const LOG: &str = "log";
+/// The log is shorter than [`SHORT_LOG_S`]: no rest can estimate the bias, no movement
+/// can be told from a start-up transient.
+pub const SHORT_LOG: &str = "short_log";
+/// Shortest log (s of output) whose figures mean anything: the motion detector needs
+/// quiet blocks before it trusts a rest, and a movement needs a rest on each side.
+pub const SHORT_LOG_S: f64 = 1.0;
 /// The log is slower than the configured output rate and ran at its own rate.
 pub const OUTPUT_RATE_LOWERED: &str = "output_rate_lowered";
 /// A movement reached the sensor's range or a clip plateau: its angle is a lower bound.
@@ -94,6 +101,16 @@ pub fn of_run(report: &RunReport, notices: &[String]) -> Vec<Finding> {
         .iter()
         .map(|n| Finding::new(LOG, n.clone()))
         .collect();
+    let covered_s = report.summary.outputs as f64 / f64::from(report.output_rate_hz);
+    if covered_s < SHORT_LOG_S {
+        out.push(Finding::new(
+            SHORT_LOG,
+            format!(
+                "the log gives {} output samples ({covered_s:.2} s at {} Hz), under {SHORT_LOG_S} s: too short for a rest to estimate the bias or a movement to be told from the start, so its figures say nothing; log at least a few seconds with a rest at the start",
+                report.summary.outputs, report.output_rate_hz
+            ),
+        ));
+    }
     if let Some(configured_hz) = report.output_rate_lowered_from_hz {
         out.push(Finding::new(
             OUTPUT_RATE_LOWERED,

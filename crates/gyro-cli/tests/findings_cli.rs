@@ -79,7 +79,7 @@ fn a_lag_that_grows_is_said_everywhere() {
     assert!(drift["time_s"].is_number(), "{drift}");
     let message = drift["message"].as_str().unwrap();
     assert!(
-        message.contains("ms per minute") && message.contains("1.9"),
+        message.contains("ms per minute") && message.contains("% above its nominal rate"),
         "{message}"
     );
 
@@ -174,4 +174,17 @@ fn real_recordings_say_what_their_figures_do_not() {
         .map(|f| f["movement"].as_u64().unwrap())
         .collect();
     assert_eq!(flagged, [1, 2, 3, 4], "{}", report["findings"]);
+}
+
+/// A log of three rows runs, and says its figures say nothing.
+#[test]
+fn a_log_too_short_says_so() {
+    let scratch = temp_dir("findings-short");
+    let log = common::write(
+        scratch.path(),
+        "three.csv",
+        "time_s,rate_dps,reference_deg\n0,0.1,0\n0.001,0.1,0\n0.002,0.1,0\n",
+    );
+    let report = same_in_table_and_json(&log);
+    assert_eq!(codes(&report), ["short_log"], "{}", report["findings"]);
 }
