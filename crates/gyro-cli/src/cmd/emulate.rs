@@ -121,10 +121,13 @@ pub fn run(args: &Args) -> Result<()> {
         Pacing::RealTime
     };
     say!(
-        "emulating a CRM100 bridge: {} samples from the {what}, range {}, {:?}",
+        "emulating a CRM100 bridge: {} samples from the {what}, range {}, {}",
         samples.len(),
         args.range,
-        pacing
+        match pacing {
+            Pacing::RealTime => "each frame at its time stamp, as a bridge sends it",
+            Pacing::AsFastAsPossible => "as fast as the receiver takes the bytes",
+        }
     );
     let mut emulator = Emulator::new(samples.into_iter(), config);
     let write_timeout = Duration::try_from_secs_f64(args.write_timeout_s).ok();
