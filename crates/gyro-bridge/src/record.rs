@@ -29,18 +29,19 @@
 //! `/crm100/raw` but not written to `/gyro` a second time.
 //!
 //! # Durability
-//! The MCAP writer closes a chunk every 0.5 s of bridge time, and [`record`] also closes
-//! it and flushes every [`RecordOptions::flush_interval`] (0.25 s) of wall time, so a
-//! killed recorder loses at most about that much (under 0.5 s); Ctrl-C (the `stop` flag)
-//! finishes the file with its summary. A killed file has no summary: every reader in
-//! `gyro_log` reads it up to its unfinished last chunk, with a warning.
+//! The MCAP writer (chunks compressed as [`RecordOptions::compression`] says) closes a
+//! chunk every 0.5 s of bridge time, and [`record`] also closes it and flushes every
+//! [`RecordOptions::flush_interval`] (0.25 s) of wall time, so a killed recorder loses at
+//! most about that much (under 0.5 s); Ctrl-C (the `stop` flag) finishes the file with its
+//! summary. A killed file has no summary: every reader in `gyro_log` reads it up to its
+//! unfinished last chunk, with a warning.
 
 use crm100_driver::{
     BridgeFrame, BridgeReader, Checks, Range, ReadEvent, ReaderStats, Received, Response, SeqEvent,
     BRIDGE_FRAME_LEN, FORMAT_V1,
 };
 use gyro_log::mcap::RAW_TOPIC;
-use gyro_log::{JsonChannel, LogError, McapLogWriter};
+use gyro_log::{JsonChannel, LogError, McapCompression, McapLogWriter, McapWriteOptions};
 use serde::Serialize;
 use serde_json::json;
 use std::collections::BTreeMap;
@@ -75,6 +76,9 @@ pub struct RecordOptions {
     pub status_interval: Duration,
     /// Description of the source for the metadata (`source`), e.g. the port and baud rate.
     pub source: String,
+    /// How [`McapSink`] compresses its chunks (a CSV has none). Default zstd, as every
+    /// MCAP writer of gyro-cli.
+    pub compression: McapCompression,
 }
 
 impl Default for RecordOptions {
@@ -88,6 +92,7 @@ impl Default for RecordOptions {
             flush_interval: Duration::from_millis(250),
             status_interval: Duration::from_millis(250),
             source: String::new(),
+            compression: McapCompression::default(),
         }
     }
 }
@@ -412,7 +417,13 @@ fn stats_schema() -> serde_json::Value {
 impl McapSink {
     /// Creates `path` with the channels and the metadata of `options`.
     pub fn create(path: &Path, options: &RecordOptions) -> Result<Self, LogError> {
-        let mut writer = McapLogWriter::create(path)?;
+        let mut writer = McapLogWriter::create_with(
+            path,
+            McapWriteOptions {
+                compression: options.compression,
+                ..McapWriteOptions::default()
+            },
+        )?;
         writer.write_metadata(&options.metadata())?;
         let schema = |text: &str| -> Result<serde_json::Value, LogError> {
             serde_json::from_str(text).map_err(|e| LogError::Mcap {

@@ -39,8 +39,8 @@ enum Command {
     Run(cmd::run::Args),
     /// Fit the error model on bench runs with an encoder reference; write a model file.
     Calibrate(cmd::calibrate::Args),
-    /// Simulate a sensor log: the nominal model plus optional effects, on bench-like
-    /// motion or on the motion recorded in a log's reference.
+    /// Simulate a sensor log (CSV, or MCAP for a `.mcap` name): the nominal model plus
+    /// effects, on bench-like motion, a log's recorded motion, or at rest (--static).
     Simulate(cmd::simulate::Args),
     /// Noise characterisation of static logs: Allan deviation with bounds, fitted noise
     /// terms (ARW, bias instability, rate random walk, Gauss-Markov), Welch PSD.
@@ -48,10 +48,11 @@ enum Command {
     /// Sim-to-real diagnosis: where real runs differ from their simulation, which
     /// unmodelled effect causes it, how far adding it closes the gap on held-out runs.
     Diagnose(cmd::diagnose::Args),
-    /// Convert a log between CSV and MCAP (also from a ROS 2 bag in MCAP).
+    /// Convert a log between CSV and MCAP (also from a ROS 2 bag in MCAP): the output's
+    /// format by its extension, MCAP chunks compressed with zstd unless --compression.
     Convert(cmd::convert::Args),
-    /// Record the CRM100 serial bridge to MCAP (or CSV) as it comes: every loss counted,
-    /// a live status line, a clean finish on Ctrl-C.
+    /// Record the CRM100 serial bridge to MCAP (or CSV, for a `.csv` name) as it comes:
+    /// every loss counted, a live status line, a clean finish on Ctrl-C.
     Record(cmd::record::Args),
     /// Play a log or a simulated run as a CRM100 serial bridge on a port, with seeded
     /// faults (byte loss, bit flips, bad checksums, status faults, dropped frames, stalls).

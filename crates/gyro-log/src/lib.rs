@@ -4,7 +4,8 @@
 //! [`load`] is the one way in for a command: read either format (by content, else by
 //! extension), pass on the warnings, place the rows on the grid; [`stream`] does the same
 //! slot by slot. [`read_log`] reads without placing; [`write_log`] writes either format by
-//! extension, whole ([`whole`]: a partial file beside the target, renamed when complete).
+//! extension (MCAP compressed as [`McapCompression`] says), whole ([`whole`]: a partial
+//! file beside the target, renamed when complete).
 //!
 //! ```
 //! let regular = gyro_log::load(
@@ -40,9 +41,10 @@ pub use csv_log::{
 };
 pub use load::{load, stream};
 pub use mcap::{
-    decode_reference, decode_sample, encode_reference, encode_sample, read_mcap, write_mcap, Axis,
-    GyroSample, JsonChannel, McapLogWriter, McapOptions, McapRead, McapRows, McapWriteOptions,
-    TimeSource, HAS_TEMPERATURE_KEY, REFERENCE_SCHEMA_NAME, SAMPLE_SCHEMA_NAME,
+    decode_reference, decode_sample, encode_reference, encode_sample, read_mcap, write_mcap,
+    write_mcap_with, Axis, GyroSample, JsonChannel, McapCompression, McapLogWriter, McapOptions,
+    McapRead, McapRows, McapWriteOptions, TimeSource, HAS_TEMPERATURE_KEY, REFERENCE_SCHEMA_NAME,
+    SAMPLE_SCHEMA_NAME,
 };
 pub use regular::{
     place, regularize, GridOptions, LogInfo, Quality, RegularLog, Slot, SlotSink,
@@ -175,8 +177,19 @@ pub fn read_log(path: &Path, options: &LogOptions) -> Result<Log, LogError> {
     read_log_with_warnings(path, options).map(|(log, _)| log)
 }
 
-/// Write `log` to `path` as `format`, or by the path's extension (`.csv`, `.mcap`).
+/// Write `log` to `path` as `format`, or by the path's extension (`.csv`, `.mcap`); MCAP
+/// with the default [`McapCompression`] (zstd).
 pub fn write_log(path: &Path, log: &Log, format: Option<LogFormat>) -> Result<(), LogError> {
+    write_log_with(path, log, format, McapCompression::default())
+}
+
+/// [`write_log`], an MCAP file's chunks compressed with `compression` (a CSV ignores it).
+pub fn write_log_with(
+    path: &Path,
+    log: &Log,
+    format: Option<LogFormat>,
+    compression: McapCompression,
+) -> Result<(), LogError> {
     let format = format
         .or_else(|| LogFormat::from_extension(path))
         .ok_or_else(|| LogError::Format {
@@ -190,7 +203,7 @@ pub fn write_log(path: &Path, log: &Log, format: Option<LogFormat>) -> Result<()
         cause,
     };
     let partial = whole::Partial::beside(path).map_err(io_err)?;
-    match write_log_as(partial.path(), log, format) {
+    match write_log_as(partial.path(), log, format, compression) {
         Ok(()) => partial.finish().map_err(io_err),
         Err(e) => {
             partial.discard();
@@ -200,9 +213,14 @@ pub fn write_log(path: &Path, log: &Log, format: Option<LogFormat>) -> Result<()
 }
 
 /// [`write_log`]'s writing, straight to `path`.
-fn write_log_as(path: &Path, log: &Log, format: LogFormat) -> Result<(), LogError> {
+fn write_log_as(
+    path: &Path,
+    log: &Log,
+    format: LogFormat,
+    compression: McapCompression,
+) -> Result<(), LogError> {
     match format {
-        LogFormat::Mcap => write_mcap(path, log),
+        LogFormat::Mcap => write_mcap_with(path, log, compression),
         LogFormat::Csv => {
             let io_err = |cause| LogError::Io {
                 path: path.to_path_buf(),

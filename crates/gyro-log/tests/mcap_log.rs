@@ -178,7 +178,7 @@ fn written_file_has_ros_2_schemas_foxglove_plots() {
         assert_eq!(declared, fields, "{}", channel.topic);
     }
     for chunk in &summary.chunk_indexes {
-        assert_eq!(chunk.compression, "lz4");
+        assert_eq!(chunk.compression, "zstd");
     }
     let stats = summary.stats.as_ref().unwrap();
     assert_eq!(stats.message_count, 80_000);
@@ -250,7 +250,7 @@ fn incremental_writer_chunks_by_time_and_writes_extra_channels() {
         summary.chunk_indexes.len()
     );
     for chunk in &summary.chunk_indexes {
-        assert_eq!(chunk.compression, "lz4");
+        assert_eq!(chunk.compression, "zstd");
         let span = chunk.message_end_time - chunk.message_start_time;
         assert!(span < 500_000_000, "chunk spans {span} ns");
     }

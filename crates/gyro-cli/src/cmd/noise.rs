@@ -29,7 +29,8 @@ pub enum Grid {
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Static logs (CSV: `time_s,rate_dps,...`). Several: each, then all pooled.
+    /// Static logs, CSV (`time_s,rate_dps,...`) or MCAP, e.g. from `simulate --static`.
+    /// Several: each, then all pooled.
     #[arg(required = true)]
     logs: Vec<PathBuf>,
     /// Output format on stdout.

@@ -17,11 +17,14 @@ pub struct Args {
     /// Baud rate (24-byte frames at 1 kHz need at least 460800).
     #[arg(long, default_value_t = serial::DEFAULT_BAUD, value_parser = clap::value_parser!(u32).range(1..))]
     baud: u32,
-    /// Output log: MCAP (default) or, with --csv, CSV. An existing file is kept unless
-    /// --force: a recording is not replaced by accident. It is written as OUT's name with
-    /// `.partial` before the extension and renamed to OUT when the recording ends.
+    /// Output log: CSV for a `.csv` name (or with --csv), else MCAP. An existing file is
+    /// kept unless --force: a recording is not replaced by accident. It is written as
+    /// OUT's name with `.partial` before the extension and renamed to OUT when the
+    /// recording ends.
     #[arg(short, long)]
     out: PathBuf,
+    #[command(flatten)]
+    compression: super::output::Compression,
     #[command(flatten)]
     force: super::output::Force,
     /// Stop after this many seconds (default: until Ctrl-C or the port closes).
@@ -36,7 +39,8 @@ pub struct Args {
     /// Nominal frame rate of the bridge (Hz), for the metadata.
     #[arg(long, default_value_t = 1000.0, value_parser = gyro_log::value::positive::<f64>)]
     sample_rate_hz: f64,
-    /// Write CSV (time_s, rate_dps, temperature_c, status, sequence, raw) instead of MCAP.
+    /// Write CSV (time_s, rate_dps, temperature_c, status, sequence, raw) instead of MCAP,
+    /// whatever OUT's name (a `.csv` name does without it).
     #[arg(long)]
     csv: bool,
     /// Do not verify the CRM100 response checksum (the rule is assumed, not documented).
@@ -85,6 +89,18 @@ fn status_line(s: &LiveStatus) -> String {
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
     args.force.check([args.out.as_path()], [])?;
+    // CSV with --csv or for a `.csv` name (as every command writes by the extension),
+    // else MCAP; --csv with a `.mcap` name is a contradiction, refused.
+    let by_name = gyro_log::LogFormat::from_extension(&args.out);
+    let format = match (args.csv, by_name) {
+        (true, Some(gyro_log::LogFormat::Mcap)) => anyhow::bail!(
+            "--csv: {} is named .mcap; name it .csv, or leave --csv out for MCAP",
+            args.out.display()
+        ),
+        (true, _) | (false, Some(gyro_log::LogFormat::Csv)) => gyro_log::LogFormat::Csv,
+        (false, _) => gyro_log::LogFormat::Mcap,
+    };
+    let compression = args.compression.for_output(&args.out, format)?;
     let stop = super::stop_flag()?;
     let options = RecordOptions {
         range: args.range,
@@ -93,6 +109,7 @@ pub fn run(args: &Args) -> Result<()> {
         duration: seconds(args.duration, "duration")?,
         idle_stop: seconds(args.idle_stop, "idle-stop")?,
         source: format!("{} at {} Bd", args.port, args.baud),
+        compression,
         ..RecordOptions::default()
     };
     let mut reader = serial::open_reader(
@@ -104,7 +121,7 @@ pub fn run(args: &Args) -> Result<()> {
     // Recorded beside OUT, which an earlier recording (--force) keeps until the end.
     let partial = whole::Partial::beside(&args.out)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
-    let sink: Result<Box<dyn RecordSink>, _> = if args.csv {
+    let sink: Result<Box<dyn RecordSink>, _> = if format == gyro_log::LogFormat::Csv {
         CsvSink::create(partial.path(), &options).map(|s| Box::new(s) as _)
     } else {
         McapSink::create(partial.path(), &options).map(|s| Box::new(s) as _)

@@ -1,4 +1,5 @@
-//! `gyro-cli simulate`: the sensor simulator.
+//! `gyro-cli simulate`: the sensor simulator, writing a log (CSV or MCAP by the output's
+//! extension) of bench-like motion, of the motion in a log's reference, or at rest.
 
 use anyhow::{Context, Result};
 use gyro_analysis::model;
@@ -10,7 +11,8 @@ use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Output log (CSV).
+    /// Output log: MCAP for a `.mcap` name, else CSV (`time_s, rate_dps, temperature_c,
+    /// reference_deg`).
     #[arg(short, long, required_unless_present = "list_effects")]
     out: Option<PathBuf>,
     /// Model file whose `sensor` section gives the nominal model; default: a CRM100
@@ -20,9 +22,14 @@ pub struct Args {
     /// Seed of all random streams (same seed, same log).
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Duration of the generated bench-like motion (s).
+    /// Duration of the generated bench-like motion, or of the rest with --static (s).
     #[arg(long, default_value_t = 90.0, value_parser = value::positive::<f64>)]
     duration_s: f64,
+    /// No motion: the sensor at rest for --duration-s, the reference at 0 throughout, the
+    /// sensor model and any --effect applied as in motion. A static log for `noise`
+    /// (e.g. `--static --duration-s 3600`).
+    #[arg(long = "static", conflicts_with = "motion_from")]
+    at_rest: bool,
     /// Re-simulate the motion of this log's `reference_deg` instead of generating motion
     /// (as `diagnose` re-simulates a run: smoothed over 20 ms when the reference is an
     /// encoder's, the rate through a cubic smoothing when it is printed with few decimals,
@@ -42,6 +49,8 @@ pub struct Args {
     /// Temperature rise during the run (°C, warm-up with a 120 s time constant).
     #[arg(long, default_value_t = 5.0, value_parser = value::finite::<f64>)]
     temperature_rise_c: f64,
+    #[command(flatten)]
+    compression: super::output::Compression,
     #[command(flatten)]
     force: super::output::Force,
     /// Quantise the reference like an encoder with this many counts per revolution.
@@ -82,6 +91,12 @@ pub fn run(args: &Args) -> Result<()> {
         super::to_stdout(|out| list_effects(out))?;
         return Ok(());
     }
+    let Some(out) = &args.out else {
+        anyhow::bail!("--out is required");
+    };
+    // MCAP for a `.mcap` name, else CSV (the format the command always wrote).
+    let format = log::LogFormat::from_extension(out).unwrap_or(log::LogFormat::Csv);
+    let compression = args.compression.for_output(out, format)?;
     let mut sensor = match &args.model {
         Some(path) => model::load(path)?.sensor,
         None => SensorModel::default(),
@@ -135,13 +150,18 @@ pub fn run(args: &Args) -> Result<()> {
             if !(args.duration_s > 0.0 && args.duration_s <= 86_400.0) {
                 anyhow::bail!("--duration-s must be in (0, 86400]");
             }
-            Motion::bench(
-                &BenchProfile {
-                    duration_s: args.duration_s,
-                    ..BenchProfile::default()
-                },
-                args.seed,
-            )
+            if args.at_rest {
+                // No rotation at all: the angle and the rate are 0 throughout.
+                Motion::from_rotations(Vec::new(), args.duration_s)
+            } else {
+                Motion::bench(
+                    &BenchProfile {
+                        duration_s: args.duration_s,
+                        ..BenchProfile::default()
+                    },
+                    args.seed,
+                )
+            }
         }
     };
     let options = SimOptions {
@@ -149,9 +169,6 @@ pub fn run(args: &Args) -> Result<()> {
         temperature_rise_c: args.temperature_rise_c,
         encoder_counts: args.encoder_counts,
         ..SimOptions::default()
-    };
-    let Some(out) = &args.out else {
-        anyhow::bail!("--out is required");
     };
     sim::check_size(&sensor, &motion).with_context(|| match &args.motion_from {
         Some(path) => format!(
@@ -161,15 +178,17 @@ pub fn run(args: &Args) -> Result<()> {
         None => "cannot simulate the run (--duration-s, --sample-rate-hz)".into(),
     })?;
     let log = sim::simulate(&sensor, &effects, &motion, &options);
-    // MCAP for a `.mcap` name, else CSV (the format the command always wrote).
-    let format = log::LogFormat::from_extension(out).unwrap_or(log::LogFormat::Csv);
-    log::write_log(out, &log, Some(format))?;
+    log::write_log_with(out, &log, Some(format), compression)?;
     say!(
-        "wrote {} samples ({:.1} s at {} Hz, {} rotations, effects: {}) to {}",
+        "wrote {} samples ({:.1} s at {} Hz, {}, effects: {}) to {}",
         log.rows.len(),
         motion.duration_s(),
         sensor.sample_rate_hz,
-        motion.rotations().len(),
+        if args.at_rest {
+            "at rest".to_string()
+        } else {
+            format!("{} rotations", motion.rotations().len())
+        },
         if effects.is_empty() {
             "none".to_string()
         } else {

@@ -1,6 +1,6 @@
 //! MCAP logs (docs/log-formats.md, "MCAP"): the samples as ROS 2 messages in CDR, which
-//! Foxglove plots, written incrementally in small lz4 chunks, read chunk by chunk in
-//! constant memory; earlier files with JSON samples, and ROS 2 bags
+//! Foxglove plots, written incrementally in small zstd (or lz4, or uncompressed) chunks,
+//! read chunk by chunk in constant memory; earlier files with JSON samples, and ROS 2 bags
 //! (`sensor_msgs/msg/Imu` in CDR), are read too.
 //!
 //! # Layout written
@@ -16,8 +16,9 @@
 //! `has_temperature` says whether the log has a temperature column. The log's
 //! `# key: value` metadata is one MCAP metadata record named `gyro`.
 //!
-//! Chunks are lz4-compressed and closed every 0.5 s of log time (see [`McapWriteOptions`]),
-//! with message indexes (Foxglove's indexed reader needs them; they are half the size:
+//! Chunks are compressed as [`McapCompression`] says (zstd unless asked otherwise) and
+//! closed every 0.5 s of log time (see [`McapWriteOptions`]), with message indexes
+//! (Foxglove's indexed reader needs them; uncompressed, they are most of a zstd file:
 //! 32 bytes per 1 kHz sample with a reference, 115 MB per hour, against 126 MB of CSV).
 //!
 //! Times are whole nanoseconds (u64): a CSV time with up to 9 decimals survives the trip
@@ -39,7 +40,9 @@ pub use binary::{
 };
 pub use read::{read_mcap, McapOptions, McapRead, McapRows, REFERENCE_MAX_SPAN_S, TIME_ORIGIN_KEY};
 pub use ros2::{Axis, TimeSource, IMU_SCHEMA_NAME};
-pub use write::{write_mcap, JsonChannel, McapLogWriter, McapWriteOptions};
+pub use write::{
+    write_mcap, write_mcap_with, JsonChannel, McapCompression, McapLogWriter, McapWriteOptions,
+};
 
 /// Channel of the gyro samples.
 pub const GYRO_TOPIC: &str = "/gyro";
