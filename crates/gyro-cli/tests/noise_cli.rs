@@ -338,3 +338,27 @@ fn bad_input_is_a_one_line_error_naming_the_file() {
     // No log at all: clap's usage error.
     assert!(!gyro(&["noise"]).status.success());
 }
+
+/// The nominal sensor at rest for 600 s: its own Gauss-Markov bias (T = 100 s) reads as a
+/// rate random walk over the averaging times such a log has; the table says the two are
+/// look-alikes here rather than that the sensor model lacks it.
+#[test]
+fn a_short_static_log_says_its_random_walk_may_be_the_models_own_bias() {
+    let scratch = temp_dir("noise-look-alike");
+    let log = scratch.path().join("rest.csv");
+    let log = log.to_str().unwrap();
+    let out = gyro(&["simulate", "--static", "--duration-s", "600", "-o", log]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = gyro(&["noise", log]);
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(
+        table.contains("this log is too short to tell them apart")
+            && table.contains("may also be the sensor model's own Gauss-Markov bias"),
+        "{table}"
+    );
+}

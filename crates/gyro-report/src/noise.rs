@@ -63,8 +63,14 @@ pub fn answer(c: &Characterization) -> Vec<String> {
     term(
         f.rate_random_walk_dps_per_rt_s.significant,
         format!(
-            "rate random walk {:.2e} deg/s/√s",
-            f.rate_random_walk_dps_per_rt_s.value
+            "rate random walk {:.2e} deg/s/√s{}",
+            f.rate_random_walk_dps_per_rt_s.value,
+            gyro_analysis::noise::rate_random_walk_look_alike(c).map_or(String::new(), |(t, _)| {
+                format!(
+                    " (or a Gauss-Markov bias of correlation time near or beyond {} s: this log is too short to tell them apart)",
+                    sig(t, 3)
+                )
+            })
         ),
         "rate random walk",
     );
@@ -267,9 +273,17 @@ pub fn table(label: &str, c: &Characterization) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "Not in the sensor model; to simulate: {}",
+            "Not in the sensor model's form; to simulate: {}",
             specs.join(" ")
         );
+        if let Some((t, sigma)) = gyro_analysis::noise::rate_random_walk_look_alike(c) {
+            let _ = writeln!(
+                s,
+                "  it may also be the sensor model's own Gauss-Markov bias seen on too short a log: one of correlation time T near or beyond the longest averaging time here ({} s) and σ = K·√(T/2) ({} deg/s at that T) gives the same Allan deviation; a log several T long tells them apart",
+                sig(t, 3),
+                sig(sigma, 3)
+            );
+        }
     }
     s
 }

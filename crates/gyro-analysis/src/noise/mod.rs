@@ -265,6 +265,22 @@ pub fn characterize(
     })
 }
 
+/// The Gauss-Markov bias a significant rate random walk of `c` may be on this log: over
+/// averaging times up to about its correlation time T, a Gauss-Markov bias of σ has the
+/// Allan variance of a rate random walk K = σ·√(2/T), so a log not several T long cannot
+/// tell them apart (the nominal CRM100's own bias, σ 0.05 deg/s over T = 100 s, reads as
+/// K 0.0069 deg/s/√s on 600 s at rest, its longest averaging time 126 s). Returns (the
+/// longest averaging time in s, the σ in deg/s of a Gauss-Markov bias with T equal to
+/// it); `None` without a significant rate random walk.
+pub fn rate_random_walk_look_alike(c: &Characterization) -> Option<(f64, f64)> {
+    let k = &c.fit.rate_random_walk_dps_per_rt_s;
+    if !k.significant {
+        return None;
+    }
+    let t = c.allan.points.last()?.tau_s;
+    Some((t, k.value * (t / 2.0).sqrt()))
+}
+
 impl Characterization {
     /// The simulator's sensor model from this characterisation: rate, bias (the mean
     /// rate), ARW (fitted N), Gauss-Markov σ and T (σ = 0 if the term is not significant;
