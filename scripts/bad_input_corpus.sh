@@ -95,6 +95,20 @@ cp in/good.mcap in/corrupt_index.mcap
 printf 'XXXXXXXXXXXXXXXX' | dd of=in/corrupt_index.mcap bs=1 seek=$((size * 6 / 10)) conv=notrunc status=none
 { printf 'NOTMCAP!'; tail -c +9 in/good.mcap; } >in/bad_magic.mcap
 head -c 20 in/good.mcap >in/header_only.mcap
+# Absurd values (issue 46's classes): a stamp of 1e300 s mid-file, every stamp 0, a field
+# of a million digits, a rate too large for a double, inf and nan rates (missing values by
+# the contract: counted and named), two data rows.
+{ echo "$hdr"; data 3000; echo '1e300,0.1,25,0'; data 6000 | tail -n 3000; } >in/huge_time_mid.csv
+{ echo '# sample_rate_hz: 1000'; echo "$hdr"; data 3000 | awk -F, -v OFS=, '{$1=0; print}'; } >in/all_stamps_zero.csv
+{ echo '# sample_rate_hz: 1000'; echo "$hdr"; data 3000 | tac; } >in/reverse_order.csv
+{ echo "$hdr"; data 1500; printf '1.500000,1'; head -c 1000000 /dev/zero | tr '\0' '0'; echo ',25,0'; data 3000 | tail -n 1499; } >in/million_digit_field.csv
+{ echo "$hdr"; data 3000 | awk -F, -v OFS=, 'NR==1500{$2="1e400"} {print}'; } >in/rate_1e400.csv
+{ echo "$hdr"; data 10004 | awk -F, -v OFS=, 'NR%7==0{$2="inf"} NR%11==0{$2="nan"} {print}'; } >in/inf_nan_rates.csv
+{ echo "$hdr"; data 2; } >in/two_rows.csv
+# MCAP files whose messages run backwards in time, or sit at one log time (made from
+# reversed and constant-stamp CSVs before the writer refused them).
+cp "$ROOT/fixtures/mcap/reverse_time.mcap" in/reverse_time.mcap
+cp "$ROOT/fixtures/mcap/one_log_time.mcap" in/one_log_time.mcap
 echo '{"format": "gyro-model", "version": 1}' >in/model.json
 printf '\xef\xbb\xbf{"format": "gyro-model", "version": 1}\n' >in/model_bom.json
 echo '{"format": "gyro-model", "version": 2}' >in/model_v2.json
@@ -151,6 +165,34 @@ for f in empty utf16 not_a_number; do
     c "emulate --log $f.csv" refuse "$f.csv" "\$G emulate --log in/$f.csv --port out/nowhere"
 done
 
+# Absurd values: refused naming the file (and the line), or said
+for f in huge_time_mid all_stamps_zero reverse_order million_digit_field rate_1e400; do
+    c "run $f.csv" refuse "$f.csv" "\$G run in/$f.csv"
+    c "noise $f.csv" refuse "$f.csv" "\$G noise in/$f.csv"
+    c "convert $f.csv" refuse "$f.csv" "\$G convert in/$f.csv out/c.mcap"
+done
+for f in million_digit_field rate_1e400 all_stamps_zero; do
+    c "calibrate $f.csv" refuse "$f.csv" "\$G calibrate in/$f.csv -o out/m.json"
+    c "diagnose --train $f.csv" refuse "$f.csv" "\$G diagnose --train in/$f.csv in/good.csv --holdout in/other.csv"
+    c "simulate --motion-from $f.csv" refuse "$f.csv" "\$G simulate --motion-from in/$f.csv -o out/s.csv"
+done
+for f in reverse_time one_log_time; do
+    c "run $f.mcap" refuse "$f.mcap" "\$G run in/$f.mcap"
+    c "noise $f.mcap" refuse "$f.mcap" "\$G noise in/$f.mcap"
+    c "convert $f.mcap" refuse "$f.mcap" "\$G convert in/$f.mcap out/c.csv"
+done
+c "run inf_nan_rates.csv (missing values: counted, lines named)" ok "" "\$G run in/inf_nan_rates.csv | grep -q 'missing rates, .* interpolated'"
+c "noise inf_nan_rates.csv (interpolated samples said)" ok "" "\$G noise in/inf_nan_rates.csv | grep -q 'samples interpolated'"
+c "simulate --motion-from inf_nan_rates.csv (said)" ok "" "\$G simulate --motion-from in/inf_nan_rates.csv -o out/s.csv 2>&1 | grep -q 'missing rates'"
+c "run two_rows.csv (short_log said)" ok "" "\$G run in/two_rows.csv --format json | grep -q short_log"
+c "simulate --motion-from two_rows.csv (said)" ok "" "\$G simulate --motion-from in/two_rows.csv -o out/s.csv 2>&1 | grep -q 'under 1 s'"
+for f in one_row two_rows; do
+    c "noise $f.csv" refuse "$f.csv" "\$G noise in/$f.csv"
+    c "calibrate $f.csv" refuse "" "\$G calibrate in/$f.csv -o out/m.json"
+done
+c "diagnose --train one_row.csv" refuse "one_row.csv" "\$G diagnose --train in/one_row.csv in/good.csv --holdout in/other.csv"
+c "simulate --motion-from one_row.csv" refuse "one_row.csv" "\$G simulate --motion-from in/one_row.csv -o out/s.csv"
+
 # MCAP damage
 for f in empty corrupt bad_magic header_only csv_named; do
     c "run $f.mcap" refuse "$f.mcap" "\$G run in/$f.mcap"
@@ -189,6 +231,20 @@ c "run a directory" refuse "a_directory" "\$G run in/a_directory"
 c "noise missing.mcap" refuse "missing.mcap" "\$G noise in/missing.mcap"
 c "run --model missing.json" refuse "missing.json" "\$G run in/good.csv --model in/missing.json"
 
+# Outputs that are directories: one line naming the path
+D=in/a_directory
+c "run --out a directory" refuse "a_directory: is a directory" "\$G run in/good.csv --out $D"
+c "run --out a directory --force" refuse "a_directory: is a directory" "\$G run in/good.csv --out $D --force"
+c "calibrate -o a directory" refuse "a_directory: is a directory" "\$G calibrate in/good.csv -o $D"
+c "noise --psd-out a directory" refuse "a_directory: is a directory" "\$G noise in/good.csv --psd-out $D"
+c "noise --model-out a directory" refuse "a_directory: is a directory" "\$G noise in/good.csv --model-out $D"
+c "noise --noise-yaml a directory" refuse "a_directory: is a directory" "\$G noise in/good.csv --noise-yaml $D"
+c "diagnose -o a directory" refuse "a_directory: is a directory" "\$G diagnose --train in/good.csv --holdout in/other.csv -o $D"
+c "simulate -o a directory" refuse "a_directory: is a directory" "\$G simulate --duration-s 2 -o $D"
+c "convert to a directory" refuse "a_directory: is a directory" "\$G convert in/good.csv $D"
+c "emulate --fault-log a directory" refuse "a_directory: is a directory" "\$G emulate --port out/nowhere --fault-log $D"
+c "record -o a directory" refuse "a_directory: is a directory" "\$G record --port /dev/null -o $D"
+
 # Model files
 for f in model_v2 model_bad_setting model_unknown_key model_truncated model_delay model_scale_sigma model_empty model_utf16; do
     c "run --model $f.json" refuse "$f.json" "\$G run in/good.csv --model in/$f.json"
@@ -203,6 +259,17 @@ done
 for v in -1 nan inf; do
     c "run --max-gap-s $v" refuse "--max-gap-s" "\$G run in/good.csv --max-gap-s=$v"
 done
+# A negative number after a flag, with a space: the value, judged by its parser
+c "run --sample-rate-hz -1000" refuse "expected a positive" "\$G run in/good.csv --sample-rate-hz -1000"
+c "run --max-gap-s -1" refuse "--max-gap-s" "\$G run in/good.csv --max-gap-s -1"
+c "noise --margin-s -1" refuse "--margin-s" "\$G noise in/good.csv --margin-s -1"
+c "calibrate --tau-s -1" refuse "--tau-s" "\$G calibrate in/good.csv --tau-s -1 -o out/m.json"
+c "simulate --duration-s -5" refuse "--duration-s" "\$G simulate --duration-s -5 -o out/s.csv"
+c "emulate --rate-hz -5" refuse "--rate-hz" "\$G emulate --port out/nowhere --rate-hz -5"
+c "record --duration -1" refuse "--duration" "\$G record --port /dev/null --duration -1 -o out/r.mcap"
+c "simulate --temperature-rise-c -1e308" refuse "--temperature-rise-c" "\$G simulate --temperature-rise-c -1e308 -o out/s.csv"
+c "simulate --temperature-rise-c 1e6" refuse "--temperature-rise-c" "\$G simulate --temperature-rise-c 1e6 -o out/s.csv"
+c "simulate --temperature-rise-c -5 (a cooling run)" ok "" "\$G simulate --temperature-rise-c -5 --duration-s 2 -o out/s.csv"
 c "run --sample-rate-hz 100 on a 1 kHz log" refuse "--sample-rate-hz" "\$G run in/good.csv --sample-rate-hz 100"
 c "run --sample-rate-hz 1e9" refuse "--sample-rate-hz" "\$G run in/good.csv --sample-rate-hz 1e9"
 c "run --range-dps 0" refuse "--range-dps" "\$G run in/good.csv --range-dps 0"
@@ -317,6 +384,7 @@ c "run --out /dev/stdout (a device: written, not refused)" ok "" "\$G run in/goo
 c "record --port missing" refuse "/dev/no-such-port" "\$G record --port /dev/no-such-port -o out/r.mcap"
 c "emulate --port missing folder" refuse "no-such-dir" "\$G emulate --port /no-such-dir/tty --duration-s 1"
 c "emulate --create-pty, nobody reads" refuse "" "\$G emulate --create-pty --duration-s 2 --write-timeout-s 1"
+c "emulate --create-pty, nobody reads: the stalled port said" refuse "is anything reading it?" "\$G emulate --create-pty --duration-s 30 --write-timeout-s 2"
 c "run > /dev/full" refuse "stdout" "\$G run in/good.csv >/dev/full"
 c "calibrate > /dev/full" late "stdout" "\$G calibrate in/good.csv --no-leave-one-out -o out/m.json >/dev/full"
 c "noise > /dev/full" refuse "stdout" "\$G noise in/good.csv >/dev/full"

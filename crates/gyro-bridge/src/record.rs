@@ -184,6 +184,8 @@ pub struct RecordStats {
     /// Good frames stamped earlier than the good frame before them (the bridge clock
     /// stepped back: a restart, a wrap).
     pub clock_steps_back: u64,
+    /// The largest of those steps back (µs).
+    pub largest_clock_step_back_us: u64,
     /// Bridge time covered (µs): the sum of the forward steps between consecutive good
     /// frames' timestamps (a step back adds nothing).
     pub bridge_time_us: u64,
@@ -324,6 +326,16 @@ pub enum RecordEvent {
         /// This one.
         to: u32,
     },
+    /// The bridge clock stepped back: the frame is stamped before the good frame ahead of
+    /// it (a restart, a wrap, a corrupt stamp).
+    ClockBack {
+        /// The frame's sequence number.
+        sequence: u32,
+        /// The previous good frame's timestamp (µs).
+        from_us: u64,
+        /// This frame's (µs).
+        to_us: u64,
+    },
     /// The frame's command byte selects another range than the one decoding it.
     CommandMismatch {
         /// The frame's sequence number.
@@ -374,11 +386,12 @@ const EVENT_SCHEMA: &str = r#"{
   "description": "A loss or fault seen while recording; log_time is the bridge time of the last good frame (ns)",
   "type": "object",
   "properties": {
-    "event": {"type": "string", "enum": ["gap", "crc_error", "skipped_bytes", "checksum_error", "status_fault", "saturated", "duplicate", "backwards", "command_mismatch"]},
+    "event": {"type": "string", "enum": ["gap", "crc_error", "skipped_bytes", "checksum_error", "status_fault", "saturated", "duplicate", "backwards", "clock_back", "command_mismatch"]},
     "from": {"type": "integer"}, "to": {"type": "integer"}, "lost": {"type": "integer"},
     "expected": {"type": "integer"}, "found": {"type": "integer"},
     "bytes": {"type": "integer"}, "sequence": {"type": "integer"},
-    "status": {"type": "integer"}, "command": {"type": "integer"}
+    "status": {"type": "integer"}, "command": {"type": "integer"},
+    "from_us": {"type": "integer"}, "to_us": {"type": "integer"}
   },
   "required": ["event"]
 }"#;
@@ -406,6 +419,7 @@ fn stats_schema() -> serde_json::Value {
             "command_mismatches": counter("command byte of another range"),
             "timeouts": counter("read timeouts"),
             "clock_steps_back": counter("good frames stamped before the previous good frame"),
+            "largest_clock_step_back_us": counter("the largest of those steps back (us)"),
             "bridge_time_us": counter("forward steps of the bridge clock, summed (us)"),
             "first_timestamp_us": {"type": ["integer", "null"]},
             "last_timestamp_us": {"type": ["integer", "null"]}
@@ -650,8 +664,9 @@ impl std::fmt::Display for RecordSummary {
         if s.clock_steps_back > 0 {
             write!(
                 f,
-                "\nwarning: the bridge clock stepped back {} times (a restart?): bridge time counts its forward steps only, and the log's times go back there",
-                s.clock_steps_back
+                "\nwarning: the bridge clock stepped back {} times, by up to {:.6} s (a restart?): every frame is kept at its own stamp (each step back in /crm100/events, `clock_back`); bridge time counts the forward steps only, and the log's times go back there: readers refuse a step back of more than 0.5 s",
+                s.clock_steps_back,
+                s.largest_clock_step_back_us as f64 * 1e-6
             )?;
         }
         Ok(())
@@ -793,7 +808,21 @@ fn handle_frame(
     if let Some(last) = stats.last_timestamp_us {
         match frame.timestamp_us.checked_sub(last) {
             Some(step) => stats.bridge_time_us = stats.bridge_time_us.saturating_add(step),
-            None => stats.clock_steps_back += 1,
+            None => {
+                // Said in `/crm100/events` and the summary; the frame is kept, at its own
+                // stamp (a reader refuses or re-times what goes back, and says so).
+                let back_us = last - frame.timestamp_us;
+                stats.clock_steps_back += 1;
+                stats.largest_clock_step_back_us = stats.largest_clock_step_back_us.max(back_us);
+                sink.event(
+                    time_ns,
+                    &RecordEvent::ClockBack {
+                        sequence: frame.sequence,
+                        from_us: last,
+                        to_us: frame.timestamp_us,
+                    },
+                )?;
+            }
         }
     }
     stats.last_timestamp_us = Some(frame.timestamp_us);

@@ -374,7 +374,18 @@ fn a_bridge_clock_stepping_back_is_counted_not_wrapped() {
     let text = summary.to_string();
     assert!(
         text.contains("(1.999 s of bridge time)")
-            && text.contains("warning: the bridge clock stepped back 1 times"),
+            && text.contains("warning: the bridge clock stepped back 1 times, by up to 0.499000 s")
+            && text.contains("every frame is kept"),
         "{text}"
     );
+    assert_eq!(summary.stats.largest_clock_step_back_us, 499_000);
+    // Every frame kept, the ones after the step at their own stamps.
+    let written = std::fs::read_to_string(&path).unwrap();
+    assert_eq!(
+        written.lines().filter(|l| !l.starts_with('#')).count() as u64,
+        summary.stats.samples + 1,
+        "{}",
+        &written[..200]
+    );
+    assert_eq!(summary.stats.samples, planned.len() as u64);
 }

@@ -816,3 +816,120 @@ fn temperature_and_reference_columns_that_are_not_used_are_refused() {
     ]));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// Absurd stamps and fields (issue 46): refused where they enter, one line naming the file
+/// (and the line) and what to do, by every command that reads the log.
+#[test]
+fn absurd_stamps_and_fields_are_refused_where_they_enter() {
+    let scratch = temp_dir("absurd");
+    let dir = scratch.path();
+    let good = log_text("# sample_rate_hz: 1000\n", 3000, 0.001);
+    let lines: Vec<&str> = good.lines().collect();
+    // lines[0] metadata, lines[1] header, data from lines[2] (file line 3).
+    let mut huge = lines[..1502].join("\n");
+    huge.push_str("\n1e300,0.1,0.0\n");
+    huge.push_str(&lines[1502..].join("\n"));
+    let huge = write(dir, "huge.csv", &(huge + "\n"));
+    let zero: String = log_text("# sample_rate_hz: 1000\n", 3000, 0.0);
+    let zero = write(dir, "zero.csv", &zero);
+    let mut reversed: Vec<&str> = lines[2..].to_vec();
+    reversed.reverse();
+    let reversed = write(
+        dir,
+        "reversed.csv",
+        &format!("{}\n{}\n{}\n", lines[0], lines[1], reversed.join("\n")),
+    );
+    // Row 1000 (file line 1003) with its rate replaced.
+    let with_rate = |rate: &str| {
+        let mut rows: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+        rows[1002] = format!("1.000000,{rate},0.0");
+        rows.join("\n") + "\n"
+    };
+    let long = write(
+        dir,
+        "long.csv",
+        &with_rate(&format!("1{}", "0".repeat(1_000_000))),
+    );
+    let overflow = write(dir, "overflow.csv", &with_rate("1e400"));
+    let out = dir.join("o.mcap");
+    let cases: [(&str, &str); 5] = [
+        (&huge, "huge.csv:150"),
+        (&zero, "zero.csv: all 3000 rows (3 to 3002, by CSV line or MCAP message) are stamped 0.000000 s"),
+        (&reversed, "reversed.csv:4: time runs backwards: 2999 of 2999 steps"),
+        (&long, "long.csv:1003: column `rate_dps`: `1000"),
+        (&overflow, "overflow.csv:1003: column `rate_dps`: `1e400` is too large for any number"),
+    ];
+    for (log, needle) in cases {
+        refused(&gyro(&["run", log]), 1, needle);
+        refused(&gyro(&["noise", log]), 1, needle);
+        refused(&gyro(&["convert", log, s(&out)]), 1, needle);
+        assert!(!out.exists(), "{log}: nothing written");
+    }
+    // MCAP messages backwards in time, or all at one log time.
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/mcap");
+    let reverse = fixtures.join("reverse_time.mcap");
+    let one_time = fixtures.join("one_log_time.mcap");
+    refused(
+        &gyro(&["run", s(&reverse)]),
+        1,
+        "reverse_time.mcap:2: time runs backwards",
+    );
+    refused(&gyro(&["run", s(&one_time)]), 1, "are stamped 5.000000 s");
+}
+
+/// An output path that is a directory: one line naming it, for every command that writes.
+#[test]
+fn an_output_that_is_a_directory_is_named() {
+    let scratch = temp_dir("outdir");
+    let dir = scratch.path();
+    let log = bench_log();
+    let log: &str = s(&log);
+    let folder = dir.join("folder");
+    std::fs::create_dir(&folder).unwrap();
+    let d = s(&folder);
+    let needle = format!("{d}: is a directory; give a file name");
+    for args in [
+        vec!["run", log, "--out", d],
+        vec!["run", log, "--out", d, "--force"],
+        vec!["calibrate", log, "-o", d],
+        vec!["noise", log, "--psd-out", d],
+        vec!["simulate", "--duration-s", "2", "-o", d],
+        vec!["convert", log, d],
+        vec!["record", "--port", "/dev/null", "-o", d],
+    ] {
+        refused(&gyro(&args), 1, &needle);
+    }
+}
+
+/// A negative number after a flag is the flag's value, judged by its parser; a
+/// temperature rise out of any gyro's range is refused.
+#[test]
+fn negative_numbers_after_a_flag_are_values() {
+    let log = bench_log();
+    refused(
+        &gyro(&["run", s(&log), "--sample-rate-hz", "-1000"]),
+        2,
+        "expected a positive finite number, got `-1000`",
+    );
+    refused(
+        &gyro(&["simulate", "--duration-s", "-5", "-o", "x.csv"]),
+        2,
+        "--duration-s",
+    );
+    refused(
+        &gyro(&["simulate", "--temperature-rise-c", "-1e308", "-o", "x.csv"]),
+        2,
+        "expected a number from -125 to 125",
+    );
+    let scratch = temp_dir("cooling");
+    let out = scratch.path().join("s.csv");
+    ok(&gyro(&[
+        "simulate",
+        "--temperature-rise-c",
+        "-5",
+        "--duration-s",
+        "2",
+        "-o",
+        s(&out),
+    ]));
+}

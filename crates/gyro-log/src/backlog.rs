@@ -75,10 +75,19 @@ impl Retimer {
     /// Take the next row; push the rows released, in order, onto `out`.
     pub(crate) fn push(&mut self, row: Row, out: &mut Vec<Row>) {
         if let Some((anchor_s, period_s, gap_s)) = self.anchor {
+            // A backlog's rows arrive in order, give or take a jitter: a row stamped a gap
+            // before the one held ahead of it makes that one a stamp out of line (a
+            // corrupt 1e300 s), not the end of a stall, and nothing is re-timed.
+            let out_of_line = self
+                .held
+                .last()
+                .is_some_and(|last| last.time_s - row.time_s > self.gap_step_s);
             self.held.push(row);
             let count = self.held.len();
             let span_s = row.time_s.max(anchor_s) - anchor_s;
-            if span_s <= count as f64 * period_s {
+            if out_of_line {
+                // released as stamped below
+            } else if span_s <= count as f64 * period_s {
                 for (k, held) in self.held.iter_mut().enumerate() {
                     held.time_s = anchor_s + span_s * (k + 1) as f64 / count as f64;
                 }
@@ -204,6 +213,17 @@ mod tests {
         // A gap at the end of the rows, or before enough steps: left as it is.
         let (out, r) = retimed(&[0.0, 0.01, 0.2, 0.201, 0.202], 0.015);
         assert_eq!((r.backlogs, out[2]), (0, 0.2));
+    }
+
+    #[test]
+    fn a_stamp_out_of_line_is_not_a_backlog() {
+        // One row stamped 1e300 s, the next back on time: no stall, nothing re-timed (the
+        // grid then refuses the gap, naming the line).
+        let mut stamps: Vec<f64> = (0..10).map(|k| f64::from(k) * 0.01).collect();
+        stamps.extend([1e300, 0.10, 0.11]);
+        let (out, r) = retimed(&stamps, 0.015);
+        assert_eq!(r.backlogs, 0);
+        assert_eq!(out, stamps);
     }
 
     #[test]

@@ -103,17 +103,42 @@ impl Default for ColumnOptions {
     }
 }
 
-/// Parse a field: `Ok(None)` if empty, NaN or infinite (a missing value), an error if it
-/// is not a number at all.
-fn parse_field(field: &[u8]) -> Result<Option<f64>, ()> {
+/// The longest field read as a number (characters): `%.17g` of any double is 24, `%f` of
+/// 1e100 is 108; a longer field is a corrupt line, not a value a logger wrote.
+pub const MAX_NUMBER_CHARS: usize = 128;
+
+/// Why a field is not a value.
+#[derive(Debug, PartialEq)]
+enum FieldError {
+    /// Not a number at all.
+    NotANumber,
+    /// A number written out that is too large for a double (`1e400`, a thousand digits):
+    /// read as infinite it would pass for a missing value.
+    Overflows,
+    /// Longer than [`MAX_NUMBER_CHARS`].
+    TooLong(usize),
+}
+
+/// Parse a field: `Ok(None)` if empty, `nan` or `inf` as written (a missing value), an
+/// error if it is not a number at all, is a number too large for a double, or is longer
+/// than [`MAX_NUMBER_CHARS`].
+fn parse_field(field: &[u8]) -> Result<Option<f64>, FieldError> {
     if let Some(value) = parse_plain_decimal(field) {
         return Ok(Some(value));
     }
-    let text = std::str::from_utf8(field).map_err(|_| ())?.trim();
+    let text = std::str::from_utf8(field)
+        .map_err(|_| FieldError::NotANumber)?
+        .trim();
     if text.is_empty() {
         return Ok(None);
     }
-    let value: f64 = text.parse().map_err(|_| ())?;
+    if text.len() > MAX_NUMBER_CHARS {
+        return Err(FieldError::TooLong(text.chars().count()));
+    }
+    let value: f64 = text.parse().map_err(|_| FieldError::NotANumber)?;
+    if value.is_infinite() && !text.to_ascii_lowercase().contains("inf") {
+        return Err(FieldError::Overflows);
+    }
     Ok(value.is_finite().then_some(value))
 }
 
@@ -559,11 +584,32 @@ impl Columns {
     fn row<'a>(&self, line: u64, field: impl Fn(usize) -> &'a [u8]) -> Result<Row, LogError> {
         let value = |idx: usize, column: &str| -> Result<Option<f64>, LogError> {
             let raw = field(idx);
-            parse_field(raw).map_err(|()| LogError::NotANumber {
-                path: self.path.clone(),
-                line,
-                column: column.to_string(),
-                value: excerpt(raw),
+            parse_field(raw).map_err(|e| {
+                let (path, column, value) = (self.path.clone(), column.to_string(), excerpt(raw));
+                match e {
+                    FieldError::NotANumber => LogError::NotANumber {
+                        path,
+                        line,
+                        column,
+                        value,
+                    },
+                    FieldError::Overflows => LogError::NumberOutOfRange {
+                        path,
+                        line,
+                        column,
+                        value,
+                        what: "is too large for any number (it overflows a double)".into(),
+                    },
+                    FieldError::TooLong(chars) => LogError::NumberOutOfRange {
+                        path,
+                        line,
+                        column,
+                        value,
+                        what: format!(
+                            "is a field of {chars} characters, longer than any number a logger writes ({MAX_NUMBER_CHARS})"
+                        ),
+                    },
+                }
             })
         };
         let names = &self.names;

@@ -222,6 +222,8 @@ fn write_log_as(
     match format {
         LogFormat::Mcap => write_mcap_with(path, log, compression),
         LogFormat::Csv => {
+            let window = log.rows.len().min(RATE_WINDOW_STEPS + 1);
+            regular::check_time_order(&log.path, &log.rows[..window])?;
             let io_err = |cause| LogError::Io {
                 path: path.to_path_buf(),
                 cause,
@@ -415,6 +417,23 @@ pub enum LogError {
         /// The field as written.
         value: String,
     },
+    /// A field is a number no logger writes: too large for a double (`1e400`, a thousand
+    /// digits) or too long to be one (a corrupt line).
+    #[error(
+        "{path}:{line}: column `{column}`: `{value}` {what}; a corrupt line? fix or delete it"
+    )]
+    NumberOutOfRange {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: u64,
+        /// Column name.
+        column: String,
+        /// The field as written (an excerpt).
+        value: String,
+        /// What is wrong with it.
+        what: String,
+    },
     /// A time stamp is missing or not finite.
     #[error("{path}:{line}: missing or non-finite time stamp in column `{column}`")]
     BadTime {
@@ -516,6 +535,38 @@ pub enum LogError {
     SampleRateUnknown {
         /// File.
         path: PathBuf,
+    },
+    /// Every row is stamped alike: the stamps give no time.
+    #[error(
+        "{path}: all {rows} rows ({first_line} to {last_line}, by CSV line or MCAP message) are stamped {} s: the stamps give no time order; fix the time stamps",
+        fixed(*time_s, 6)
+    )]
+    TimeConstant {
+        /// File.
+        path: PathBuf,
+        /// Rows looked at.
+        rows: u64,
+        /// First row's line (CSV) or message index (MCAP).
+        first_line: u64,
+        /// Last row's line.
+        last_line: u64,
+        /// The one stamp (s).
+        time_s: f64,
+    },
+    /// More steps back in time than forward: rows in reverse order.
+    #[error(
+        "{path}:{line}: time runs backwards: {back} of {steps} steps between rows go back; rows in reverse order? sort them by time"
+    )]
+    TimeReversed {
+        /// File.
+        path: PathBuf,
+        /// Line (CSV) or message index (MCAP) of the first row stamped before the one
+        /// ahead of it.
+        line: u64,
+        /// Steps back.
+        back: u64,
+        /// Steps looked at.
+        steps: u64,
     },
     /// Time runs backwards by more than the tolerated amount.
     #[error(

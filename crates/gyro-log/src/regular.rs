@@ -463,7 +463,9 @@ pub fn place<S: SlotSink + ?Sized>(
         (None, Some(b)) => Ok((1.0 / b.mean_step_s, "mean_step")),
         (None, None) => single_step_rate(info.path, &ahead),
     };
-    let rate = check_max_gap(info.path, options).and(rate);
+    let rate = check_max_gap(info.path, options)
+        .and(check_time_order(info.path, &ahead))
+        .and(rate);
     let rate = rate.and_then(|(rate_hz, source)| {
         let warning = check_given_rate(info.path, &ahead, arrival, rate_hz, source)?;
         check_bridged_slots(info.path, options, rate_hz)?;
@@ -493,6 +495,48 @@ pub fn place<S: SlotSink + ?Sized>(
     let mut quality = placer.finish()?;
     note_wraps(&mut quality, &unwrapper);
     Ok(quality)
+}
+
+/// Refuse rows whose time stamps give no order: every one of them stamped alike (a time
+/// column of zeros, MCAP messages all at one log time), or more steps back in time than
+/// forward (rows in reverse order). Either placed on the grid would be a log of another
+/// length and order than the one recorded. `rows` are the first rows of a log (the
+/// window the rate is estimated on, or the whole log).
+pub(crate) fn check_time_order(path: &Path, rows: &[Row]) -> Result<(), LogError> {
+    let (Some(first), Some(last)) = (rows.first(), rows.last()) else {
+        return Ok(());
+    };
+    if rows.len() < 2 {
+        return Ok(());
+    }
+    if rows.iter().all(|r| r.time_s == first.time_s) {
+        return Err(LogError::TimeConstant {
+            path: path.to_path_buf(),
+            rows: rows.len() as u64,
+            first_line: first.line,
+            last_line: last.line,
+            time_s: first.time_s,
+        });
+    }
+    let (mut back, mut forward, mut first_back) = (0_u64, 0_u64, None);
+    for pair in rows.windows(2) {
+        let dt = pair[1].time_s - pair[0].time_s;
+        if dt < 0.0 {
+            back += 1;
+            first_back.get_or_insert(pair[1].line);
+        } else if dt > 0.0 {
+            forward += 1;
+        }
+    }
+    match first_back {
+        Some(line) if back > forward => Err(LogError::TimeReversed {
+            path: path.to_path_buf(),
+            line,
+            back,
+            steps: rows.len() as u64 - 1,
+        }),
+        _ => Ok(()),
+    }
 }
 
 /// The error for `row` stamped more than `max_back_s` before `previous` (a concatenated or
@@ -1060,6 +1104,9 @@ mod tests {
                     let gap_s = rows[i].time_s - last_s;
                     let mut j = i;
                     while j < rows.len() {
+                        if j > i && rows[j - 1].time_s - rows[j].time_s > gap_step_s {
+                            break;
+                        }
                         let span_s = rows[j].time_s.max(last_s) - last_s;
                         let count = j - i + 1;
                         if span_s <= count as f64 * period_s {
@@ -1104,6 +1151,8 @@ mod tests {
             }
             let arrival = crate::bursts::classify(&log.rows, 100_000);
             super::super::check_max_gap(&log.path, options)?;
+            let window = log.rows.len().min(super::super::RATE_WINDOW_STEPS + 1);
+            super::super::check_time_order(&log.path, &log.rows[..window])?;
             let (rate_hz, source) = sample_rate(log, options, arrival)?;
             let warning =
                 super::super::check_given_rate(&log.path, &log.rows, arrival, rate_hz, source)?;

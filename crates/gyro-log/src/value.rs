@@ -6,7 +6,7 @@
 
 use std::str::FromStr;
 
-fn checked<T>(text: &str, ok: fn(f64) -> bool, expected: &str) -> Result<T, String>
+fn checked<T>(text: &str, ok: impl Fn(f64) -> bool, expected: &str) -> Result<T, String>
 where
     T: FromStr + Copy + Into<f64>,
 {
@@ -36,6 +36,22 @@ pub fn non_negative<T: FromStr + Copy + Into<f64>>(text: &str) -> Result<T, Stri
     checked(text, |v| v.is_finite() && v >= 0.0, "a finite number >= 0")
 }
 
+/// A parser of a finite number from `lo` to `hi` (`what` says what the bounds are, e.g.
+/// "°C; ...").
+pub fn within(
+    lo: f64,
+    hi: f64,
+    what: &'static str,
+) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync + 'static {
+    move |text| {
+        checked(
+            text,
+            |v| v.is_finite() && (lo..=hi).contains(&v),
+            &format!("a number from {lo} to {hi} ({what})"),
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -53,6 +69,15 @@ mod tests {
         }
         // Overflows f32: infinite.
         assert!(finite::<f32>("1e40").is_err());
+        let rise = within(-125.0, 125.0, "°C");
+        assert_eq!(rise("-5"), Ok(-5.0));
+        for bad in ["-1e308", "126", "nan", "inf", "x"] {
+            assert!(rise(bad).is_err(), "{bad}");
+        }
+        assert_eq!(
+            rise("-1e308").unwrap_err(),
+            "expected a number from -125 to 125 (°C), got `-1e308`"
+        );
         assert_eq!(
             positive::<f64>("-1").unwrap_err(),
             "expected a positive finite number, got `-1`"

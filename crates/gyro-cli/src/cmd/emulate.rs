@@ -121,13 +121,14 @@ pub fn run(args: &Args) -> Result<()> {
         Pacing::RealTime
     };
     say!(
-        "emulating a CRM100 bridge: {} samples from the {what}, range {}, {}",
+        "emulating a CRM100 bridge: {} samples from the {what}, range {}, {}; a port that takes no byte for {} s (nobody reading it) is an error (--write-timeout-s)",
         samples.len(),
         args.range,
         match pacing {
             Pacing::RealTime => "each frame at its time stamp, as a bridge sends it",
             Pacing::AsFastAsPossible => "as fast as the receiver takes the bytes",
-        }
+        },
+        args.write_timeout_s
     );
     let mut emulator = Emulator::new(samples.into_iter(), config);
     let write_timeout = Duration::try_from_secs_f64(args.write_timeout_s).ok();

@@ -27,6 +27,9 @@ impl Force {
     ) -> Result<()> {
         let mut seen: Vec<(&Path, Option<PathBuf>)> = Vec::new();
         for output in outputs {
+            if output.is_dir() {
+                anyhow::bail!("{}: is a directory; give a file name", output.display());
+            }
             refuse_to_overwrite(output, inputs.clone())?;
             // A device or a pipe (`/dev/stdout`, `/dev/null`) is written to, not replaced.
             if gyro_log::whole::is_stream(output) {

@@ -46,8 +46,10 @@ pub struct Args {
     /// Sample rate (Hz), overriding the model's.
     #[arg(long, value_parser = value::positive::<f64>)]
     sample_rate_hz: Option<f64>,
-    /// Temperature rise during the run (°C, warm-up with a 120 s time constant).
-    #[arg(long, default_value_t = 5.0, value_parser = value::finite::<f64>)]
+    /// Temperature rise during the run (°C, warm-up with a 120 s time constant), from
+    /// -125 to 125 (a MEMS gyro's operating range, -40 to 85 °C, spans 125 °C).
+    #[arg(long, default_value_t = 5.0,
+          value_parser = value::within(-125.0, 125.0, "°C: a MEMS gyro's operating range, -40 to 85 °C, spans 125"))]
     temperature_rise_c: f64,
     #[command(flatten)]
     compression: super::output::Compression,
@@ -142,6 +144,17 @@ pub fn run(args: &Args) -> Result<()> {
                         path.display()
                     )
                 })?;
+            // A log of a row or two gives a motion of no length: said, as `run` says it
+            // of such a log (finding `short_log`), not written as if it were a run.
+            let span_s = reference.len().saturating_sub(1) as f64 / regular.sample_rate_hz;
+            if span_s < gyro_analysis::findings::SHORT_LOG_S {
+                super::warn(&format!(
+                    "{}: its reference spans {span_s:.3} s ({} samples), under {} s: the simulated log is as short, too short for any figure; give a log of at least a few seconds",
+                    path.display(),
+                    reference.len(),
+                    gyro_analysis::findings::SHORT_LOG_S
+                ));
+            }
             // As `diagnose` re-simulates a run: smoothed when the reference is an
             // encoder's, one-sided beside a step of the acceleration.
             gyro_analysis::diagnose::motion_from_reference(&reference, regular.sample_rate_hz).0

@@ -484,6 +484,8 @@ pub fn write_mcap_with(
     log: &Log,
     compression: McapCompression,
 ) -> Result<(), LogError> {
+    let window = log.rows.len().min(crate::RATE_WINDOW_STEPS + 1);
+    crate::regular::check_time_order(&log.path, &log.rows[..window])?;
     let max_back_s = crate::GridOptions::default().max_gap_s;
     if let Some(e) = log
         .rows
