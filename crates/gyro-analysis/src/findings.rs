@@ -178,15 +178,16 @@ fn of_movement(report: &RunReport, m: &MovementResult) -> Vec<Finding> {
             .at(m),
         );
     }
-    if let (true, Some(reference_deg)) = (m.complete, m.reference_deg) {
+    if let Some(reference_deg) = m.reference_deg {
         let gyro_deg = f64::from(m.angle_deg);
         if not_followed(gyro_deg, reference_deg) {
             out.push(
                 Finding::new(
                     NOT_FOLLOWED,
                     format!(
-                        "movement {}: the gyro turns {gyro_deg:.2} deg while the reference turns {reference_deg:.2} deg: a turn about another axis seen through a mount off the reference's axis (cross-axis sensitivity), or motion the reference misses; its error is not the gyro's",
-                        m.index
+                        "movement {}{}: the gyro turns {gyro_deg:.2} deg while the reference turns {reference_deg:.2} deg: a turn about another axis seen through a mount off the reference's axis (cross-axis sensitivity), or motion the reference misses; its error is not the gyro's",
+                        m.index,
+                        if m.complete { "" } else { " (to the log's end)" }
                     ),
                 )
                 .at(m),

@@ -295,13 +295,6 @@ impl LagTrendMeter {
 /// left out of the trend: a peak on another period of the motion, not the clock.
 pub const TREND_OUTLIER_S: f64 = 0.05;
 
-/// The median of `values` (NaN-free), `None` if empty.
-fn median_of(mut values: Vec<f64>) -> Option<f64> {
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    (n > 0).then(|| 0.5 * (values[(n - 1) / 2] + values[n / 2]))
-}
-
 /// The points of `lags` near their Theil–Sen line (the median of the pairwise slopes,
 /// through the median point), in time order; `None` for fewer than two.
 fn inliers(lags: &[(f64, f64)]) -> Option<Vec<(f64, f64)>> {
@@ -313,10 +306,10 @@ fn inliers(lags: &[(f64, f64)]) -> Option<Vec<(f64, f64)>> {
             }
         }
     }
-    let slope = median_of(slopes)?;
-    let intercept = median_of(lags.iter().map(|p| p.1 - slope * p.0).collect())?;
+    let slope = crate::median(&slopes)?;
+    let intercept = crate::median(&lags.iter().map(|p| p.1 - slope * p.0).collect::<Vec<_>>())?;
     let off = |p: &(f64, f64)| (p.1 - intercept - slope * p.0).abs();
-    let spread = median_of(lags.iter().map(off).collect())?;
+    let spread = crate::median(&lags.iter().map(off).collect::<Vec<_>>())?;
     let limit = TREND_OUTLIER_S.max(5.0 * 1.4826 * spread);
     Some(lags.iter().copied().filter(|p| off(p) <= limit).collect())
 }

@@ -188,3 +188,24 @@ fn a_log_too_short_says_so() {
     let report = same_in_table_and_json(&log);
     assert_eq!(codes(&report), ["short_log"], "{}", report["findings"]);
 }
+
+/// A log that ends while the gyro turns and the reference stays still: said as well.
+#[test]
+fn a_turn_the_reference_misses_to_the_log_end_is_said() {
+    let scratch = temp_dir("findings-midturn");
+    let mut text = String::from("time_s,rate_dps,reference_deg\n");
+    for i in 0..6000 {
+        let t = f64::from(i) / 1000.0;
+        let rate = if t < 3.0 { 0.0 } else { 36.0 };
+        text.push_str(&format!("{t:.3},{rate},0\n"));
+    }
+    let log = common::write(scratch.path(), "midturn.csv", &text);
+    let report = same_in_table_and_json(&log);
+    assert!(
+        codes(&report).contains(&"reference_does_not_follow".to_string()),
+        "{}",
+        report["findings"]
+    );
+    assert_eq!(report["movements"][0]["complete"], false);
+    assert!(report["movements"][0]["angle_std_deg"].is_number());
+}

@@ -1,7 +1,9 @@
 //! The text of `calibrate`: fitted models and the per-run scores.
 
 use gyro_analysis::calibrate::delay::DelaySource;
-use gyro_analysis::calibrate::{Calibration, Candidate, ChoiceReason, Objective, RunScore};
+use gyro_analysis::calibrate::{
+    Calibration, Candidate, CandidateScore, ChoiceReason, Objective, RunScore,
+};
 use gyro_core::{Compensation, Config};
 use serde::Serialize;
 
@@ -108,6 +110,16 @@ pub fn objective_text(objective: Objective) -> &'static str {
     }
 }
 
+/// The left-out runs on which `score` errs less than `default`.
+fn runs_better(score: &CandidateScore, default: &CandidateScore) -> usize {
+    score
+        .leave_one_out_runs_deg
+        .iter()
+        .zip(&default.leave_one_out_runs_deg)
+        .filter(|(v, d)| v < d)
+        .count()
+}
+
 /// The median of `scores` by `f` (NaN for none).
 fn median_of(scores: &[RunScore], f: fn(&RunScore) -> f64) -> f64 {
     let v: Vec<f64> = scores.iter().map(f).collect();
@@ -155,12 +167,7 @@ pub fn answer(c: &Calibration) -> Vec<String> {
     let objective = objective_text(c.objective);
     lines.push(match (c.choice.reason, default, chosen) {
         (ChoiceReason::LowestHeldOut, Some(d), Some(w)) => {
-            let wins = w
-                .leave_one_out_runs_deg
-                .iter()
-                .zip(&d.leave_one_out_runs_deg)
-                .filter(|(v, d)| v < d)
-                .count();
+            let wins = runs_better(w, d);
             format!(
                 "why: with each training run left out of the fit and scored, it errs {:.2} deg against {:.2} deg for the starting configuration ({objective}), better on {wins} of {} runs",
                 w.leave_one_out_deg.unwrap_or(f64::NAN),
@@ -382,13 +389,11 @@ fn choice_table(c: &Calibration) -> String {
             Some(d)
                 if score.candidate != Candidate::Default && score.leave_one_out_deg.is_some() =>
             {
-                let wins = score
-                    .leave_one_out_runs_deg
-                    .iter()
-                    .zip(&d.leave_one_out_runs_deg)
-                    .filter(|(v, d)| v < d)
-                    .count();
-                format!("{wins}/{}", d.leave_one_out_runs_deg.len())
+                format!(
+                    "{}/{}",
+                    runs_better(score, d),
+                    d.leave_one_out_runs_deg.len()
+                )
             }
             _ => "-".to_string(),
         };
