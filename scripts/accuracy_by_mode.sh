@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Accuracy by compensation mode on hold-out runs (README table).
+# Accuracy by compensation mode on hold-out runs (docs/figures.md, "Accuracy by compensation mode").
 #
 # 20 simulated CRM100 bench runs of 90 s (the nominal sensor model of `gyro-cli simulate`
 # plus a turn-on bias of sigma 0.3 deg/s: each power cycle starts with another bias),

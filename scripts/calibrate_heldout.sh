@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The model `calibrate` writes against the default configuration, on runs it was not
-# fitted on (README figure).
+# fitted on (docs/figures.md, "Calibration").
 #
 # 20 simulated 90 s CRM100 bench runs (the nominal sensor model of `gyro-cli simulate`
 # plus EFFECTS; default: a rate random walk of the bias, 0.02 deg/s/sqrt(s)), seeds

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Writes a 24-hour simulated log at 1 kHz (86 400 001 rows, about 3.2 GB) for the log
-# throughput figures (README, "Log throughput"): `simulate` holds a run in memory and
+# throughput figures (docs/figures.md, "Log throughput"): `simulate` holds a run in memory and
 # refuses one over 2^26 samples, so the day is 24 one-hour runs (seeds SEED..SEED+23),
 # each shifted to follow the previous one in time (1 ms later) and in reference angle.
 #

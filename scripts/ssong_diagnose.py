@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The README's table of `gyro-cli diagnose` on the bundled ssong recordings: per axis,
+"""The table (docs/diagnose.md, "Results") of `gyro-cli diagnose` on the bundled ssong recordings: per axis,
 trained on one speed and held out on the other (each recording cut into 100 s windows),
 both directions:
 
