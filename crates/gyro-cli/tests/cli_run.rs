@@ -166,7 +166,7 @@ fn bad_input_is_a_clear_error_naming_file_and_line() {
         (
             "one_stamp.csv",
             "time_s,rate_dps\n0.000,1.0\n0.000,1.0\n",
-            "fewer than two distinct time stamps); give the sample rate with --sample-rate-hz",
+            "are stamped 0.000000 s: the stamps give no time order; fix the time stamps",
         ),
         (
             "backwards.csv",
