@@ -200,7 +200,10 @@ pub fn run(args: &Args) -> Result<()> {
         if args.at_rest {
             "at rest".to_string()
         } else {
-            format!("{} rotations", motion.rotations().len())
+            match motion.rotations().len() {
+                1 => "1 rotation".to_string(),
+                n => format!("{n} rotations"),
+            }
         },
         if effects.is_empty() {
             "none".to_string()
