@@ -167,6 +167,11 @@ pub const TREND_BLOCK_S: f64 = 10.0;
 /// the lag well beyond [`SEARCH_S`] over a run (2% over a minute: 1.2 s).
 pub const TREND_SEARCH_S: f64 = 2.0;
 
+/// The trend reads every this many output points: its wide search costs four times the
+/// whole run's lag ([`SEARCH_S`]) per point, and a trend of tens of milliseconds needs no
+/// finer step than 40 ms at the usual 50 Hz (the peak is refined between steps).
+pub const TREND_STRIDE: usize = 2;
+
 /// Fewest blocks with a lag for a trend to be read.
 pub const TREND_MIN_BLOCKS: usize = 4;
 
@@ -207,7 +212,10 @@ impl LagTrend {
 /// block.
 #[derive(Clone, Debug)]
 pub struct LagTrendMeter {
+    /// The period of the points read ([`TREND_STRIDE`] output periods).
     period_s: f64,
+    /// Output points pushed.
+    pushed: usize,
     block_points: usize,
     block: LagMeter,
     in_block: usize,
@@ -218,8 +226,9 @@ pub struct LagTrendMeter {
 }
 
 impl LagTrendMeter {
-    /// A meter for output points every `period_s` seconds.
-    pub fn new(period_s: f64) -> Self {
+    /// A meter for output points every `output_period_s` seconds.
+    pub fn new(output_period_s: f64) -> Self {
+        let period_s = output_period_s * TREND_STRIDE as f64;
         let block_points = if period_s.is_finite() && period_s > 0.0 {
             ((TREND_BLOCK_S / period_s).round() as usize).max(8)
         } else {
@@ -227,6 +236,7 @@ impl LagTrendMeter {
         };
         Self {
             period_s,
+            pushed: 0,
             block_points,
             block: LagMeter::with_search(period_s, TREND_SEARCH_S),
             in_block: 0,
@@ -237,6 +247,10 @@ impl LagTrendMeter {
 
     /// The next output point: its time (s), gyro rate (deg/s) and reference angle (deg).
     pub fn push(&mut self, time_s: f64, rate_dps: f64, reference_deg: Option<f64>) {
+        self.pushed += 1;
+        if (self.pushed - 1) % TREND_STRIDE != 0 {
+            return;
+        }
         if self.in_block == 0 {
             self.block_start_s = time_s;
         }
