@@ -1303,23 +1303,6 @@ warm-up: {}.",
     Ok(())
 }
 
-/// The files of the runs of `role`, each once, by name.
-fn files_of(d: &Diagnosis, role: &str) -> String {
-    let mut files: Vec<&str> = d
-        .runs
-        .iter()
-        .filter(|r| r.role == role)
-        .map(|r| r.name.split('#').next().unwrap_or(&r.name))
-        .collect();
-    files.dedup();
-    let names: Vec<String> = files.iter().map(|f| super::run_label(d, f)).collect();
-    if names.is_empty() {
-        "no run".into()
-    } else {
-        names.join(", ")
-    }
-}
-
 /// The whole page: the answer first, the details folded below it.
 fn page(
     d: &Diagnosis,
@@ -1340,8 +1323,8 @@ fn page(
     let _ = writeln!(
         s,
         "<h1>Sim-to-real diagnosis</h1>\n<p class=\"sub\">Trained on {}; held out: {}.</p>",
-        esc(&files_of(d, "train")),
-        esc(&files_of(d, "holdout"))
+        esc(&super::run_files(d, "train")),
+        esc(&super::run_files(d, "holdout"))
     );
     summary(&mut s, d, path)?;
     let _ = writeln!(

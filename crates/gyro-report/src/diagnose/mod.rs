@@ -37,3 +37,22 @@ pub fn run_label(d: &Diagnosis, name: &str) -> String {
     }
     name.strip_prefix(common).unwrap_or(name).to_string()
 }
+
+/// The files of `d`'s runs of `role` (`train`, `holdout`), each once, named as
+/// [`run_label`] names them ("no run" for none): the windows of one file (`#1`, `#2`, …)
+/// are one file.
+pub fn run_files(d: &Diagnosis, role: &str) -> String {
+    let mut files: Vec<&str> = d
+        .runs
+        .iter()
+        .filter(|r| r.role == role)
+        .map(|r| r.name.split('#').next().unwrap_or(&r.name))
+        .collect();
+    files.dedup();
+    let names: Vec<String> = files.iter().map(|f| run_label(d, f)).collect();
+    if names.is_empty() {
+        "no run".into()
+    } else {
+        names.join(", ")
+    }
+}

@@ -130,22 +130,6 @@ pub(super) fn fails_posterior(e: &gyro_analysis::diagnose::EffectResult) -> bool
     e.posterior_check.as_ref().is_some_and(|c| !c.passes)
 }
 
-/// The held-out runs' files, each once, by name.
-fn holdout_names(d: &Diagnosis) -> String {
-    let mut files: Vec<&str> = d
-        .runs
-        .iter()
-        .filter(|r| r.role == "holdout")
-        .map(|r| r.name.split('#').next().unwrap_or(&r.name))
-        .collect();
-    files.dedup();
-    let names: Vec<&str> = files
-        .iter()
-        .map(|f| f.rsplit(['/', '\\']).next().unwrap_or(f))
-        .collect();
-    names.join(", ")
-}
-
 /// The held-out runs' angle error without and with the written model, one line per run
 /// (none when nothing is compensated).
 fn angle_error_lines(d: &Diagnosis) -> (String, Vec<String>) {
@@ -184,7 +168,11 @@ fn angle_error_lines(d: &Diagnosis) -> (String, Vec<String>) {
 /// checks, the nominal model), each with its explanation.
 pub fn table(d: &Diagnosis) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "diagnosis (held out: {}):", holdout_names(d));
+    let _ = writeln!(
+        s,
+        "diagnosis (held out: {}):",
+        super::run_files(d, "holdout")
+    );
     for line in super::verdict(d) {
         let _ = writeln!(s, "  {line}");
     }
