@@ -4,7 +4,7 @@
 
 use gyro_analysis::calibrate::delay::DelaySource;
 use gyro_analysis::calibrate::{
-    calibrate, BenchRun, CalibrateOptions, Candidate, Objective, RunScore, Trace,
+    calibrate, BenchRun, CalibrateOptions, Candidate, Objective, Trace,
 };
 use gyro_analysis::replay::replay;
 use gyro_core::{Compensation, Config, GaussMarkov};
@@ -334,24 +334,11 @@ fn written_model_is_not_worse_than_the_default_on_other_runs() {
     let result = calibrate(&train, &[], &base, &options, &mut |_, _, _| {}).unwrap();
     let written = median_max_abs(&other, &result.config);
     let default = median_max_abs(&other, &base);
-    // The rule calibrate used to write by: the lower mean max abs error on the training runs
-    // of the paper model and the Kalman form.
-    let mean = |f: fn(&RunScore) -> f64| result.train.iter().map(f).sum::<f64>() / 10.0;
-    let by_training = if mean(|s| s.kalman_max_abs_deg) < mean(|s| s.paper_max_abs_deg) {
-        Candidate::Kalman
-    } else {
-        Candidate::Paper
-    };
-    let training_choice = median_max_abs(&other, &result.candidate_config(by_training));
     println!(
-        "{:?}: {:?}\nmedian max abs error on 20 other runs: written {written:.3} deg, default {default:.3} deg, {by_training:?} (best on training) {training_choice:.3} deg",
+        "{:?}: {:?}\nmedian max abs error on 20 other runs: written {written:.3} deg, default {default:.3} deg",
         result.choice.written, result.choice.scores
     );
     assert!(written <= default, "{written} vs default {default}");
-    assert!(
-        training_choice > default,
-        "the training-error choice {by_training:?} is not worse here: {training_choice} vs {default}"
-    );
 }
 
 /// A simulated bench run (nominal CRM100 model, 1 kHz) with `effects`.
@@ -492,11 +479,15 @@ fn median_max_abs_delayed(runs: &[BenchRun], config: &Config, delay_s: f64) -> f
 /// Length of the choice test's runs (s): long enough for several turns and rests.
 const RUN_S: f64 = 45.0;
 
+/// Held-out runs per case: the median of each run's largest error over 5 runs moves by
+/// 0.02–0.03° with the runs drawn, as much as the candidates differ.
+const HELD_OUT_RUNS: u64 = 40;
+
 /// Held-out errors closer than this are the same for a wrench (deg): a 250th of the
-/// default tightening tolerance (±5°). The Kalman form with the built-in settings and with
-/// the fitted ones differ by about this much on these runs, and which is lower changes
-/// with the held-out runs drawn (here the worst is 0.063° against 0.045°, 1.41 times; on
-/// 90 s runs 1.35 times on 3 held-out runs, 1.15 on 6).
+/// default tightening tolerance (±5°). Candidates this close are not told apart by three
+/// training runs: on the nominal mix the fitted Kalman form is lower on 40 held-out runs
+/// (0.046° against 0.054°) while the built-in settings are lower on the training runs
+/// themselves, held out or not.
 const SAME_FOR_A_WRENCH_DEG: f64 = 0.02;
 
 /// The compensation is chosen with the corrections the file holds (the scale) applied to
@@ -526,7 +517,7 @@ fn the_choice_is_made_with_the_written_corrections() {
         let seed = 401 + 10 * i as u64;
         let run = |s| sim_run_of(effects, s, RUN_S);
         let train: Vec<BenchRun> = (seed..seed + 3).map(run).collect();
-        let holdout: Vec<BenchRun> = (seed + 3..seed + 8).map(run).collect();
+        let holdout: Vec<BenchRun> = (seed + 3..seed + 3 + HELD_OUT_RUNS).map(run).collect();
         let result = calibrate(
             &train,
             &holdout,

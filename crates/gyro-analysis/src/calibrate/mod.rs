@@ -106,6 +106,8 @@ pub struct Trace {
     spans: Vec<Span>,
     /// Mean rate of each rest of at least 1 s (deg/s).
     pub rest_means_dps: Vec<f64>,
+    /// The middle of each of those rests (s from the first output).
+    pub rest_times_s: Vec<f64>,
     /// Standard deviation of the rate about its rest mean, pooled over rests (deg/s).
     pub rest_noise_dps: Option<f64>,
 }
@@ -161,6 +163,7 @@ impl Trace {
         // Rest statistics from stretches of static samples of at least 1 s.
         let min_len = (1.0 / output_period_s).ceil() as usize;
         let (mut rest_means_dps, mut sum_sq, mut count) = (Vec::new(), 0.0, 0_usize);
+        let mut rest_times_s = Vec::new();
         let mut k = 0;
         while k < series.len() {
             if series[k].motion != MotionState::Static {
@@ -185,6 +188,7 @@ impl Trace {
                     .sum::<f64>();
                 count += rest.len() - 1;
                 rest_means_dps.push(mean);
+                rest_times_s.push(0.5 * (lo + hi) as f64 * output_period_s);
             }
         }
         Self {
@@ -193,6 +197,7 @@ impl Trace {
             reference_deg: series.iter().map(|p| p.reference_deg).collect(),
             spans,
             rest_means_dps,
+            rest_times_s,
             rest_noise_dps: (count > 0).then(|| (sum_sq / count as f64).sqrt()),
         }
     }
@@ -521,9 +526,11 @@ pub enum CalibrateError {
     /// No runs.
     #[error("no training runs")]
     NoRuns,
-    /// No movement in any run.
-    #[error("no movement found in any training run: nothing to fit")]
-    NoMovement,
+    /// No movement in any run (the runs' names).
+    #[error(
+        "no movement found in any training run ({0}): nothing to fit; give runs that turn between rests"
+    )]
+    NoMovement(String),
     /// The configuration does not fit a run.
     #[error("{name}: {source}")]
     Config {
@@ -845,7 +852,12 @@ fn fit_motion(
 /// differs between runs (turn-on: the initial uncertainty). Mixing the two would make the
 /// filter chase noise. White noise: of the filtered rate at rest. `rest_means`: the bias
 /// mean's source (the rests under the starting motion thresholds).
-fn kalman_from_rests(base: KalmanConfig, rest_means: &[f64], traces: &[Trace]) -> KalmanConfig {
+fn kalman_from_rests(
+    base: KalmanConfig,
+    rest_means: &[f64],
+    traces: &[Trace],
+    dof: SpreadDof,
+) -> KalmanConfig {
     let mut kalman = base;
     if let Some(mean) = crate::median(rest_means) {
         kalman.bias_mean_dps = mean as f32;
@@ -867,11 +879,36 @@ fn kalman_from_rests(base: KalmanConfig, rest_means: &[f64], traces: &[Trace]) -
             });
         }
     }
+    // The wander between successive rests, as a Gauss-Markov sigma: over a gap dt much
+    // shorter than the correlation time the bias moves by a variance of 2·beta·sigma²·dt.
+    let (mut step_sq, mut step_weight, mut steps) = (0.0, 0.0, 0_usize);
+    for t in traces {
+        for (m, w) in t.rest_means_dps.windows(2).zip(t.rest_times_s.windows(2)) {
+            let dt_s = w[1] - w[0];
+            if dt_s > 0.0 {
+                step_sq += (m[1] - m[0]).powi(2);
+                step_weight += 2.0 * f64::from(base.beta_per_s) * dt_s;
+                steps += 1;
+            }
+        }
+    }
     if within_n > 0 {
-        kalman.bias_sigma_dps = (within_sq / within_n as f64).sqrt().max(0.005) as f32;
+        let spread_sd = (within_sq / within_n as f64).sqrt();
+        let wander_sd = if steps > 0 && step_weight > 0.0 {
+            (step_sq / step_weight).sqrt()
+        } else {
+            0.0
+        };
+        let sd = spread_sd.max(wander_sd) * spread_upper_factor(dof.within);
+        kalman.bias_sigma_dps = sd.max(0.005) as f32;
     }
     if run_means.len() >= 2 {
-        kalman.initial_bias_sigma_dps = (stats(&run_means)[1] as f32).max(kalman.bias_sigma_dps);
+        let n = run_means.len();
+        // A new run's bias: the spread between runs, bounded above, and the error of the
+        // mean it is drawn about.
+        let sd =
+            stats(&run_means)[1] * spread_upper_factor(dof.between) * (1.0 + 1.0 / n as f64).sqrt();
+        kalman.initial_bias_sigma_dps = (sd as f32).max(kalman.bias_sigma_dps);
     }
     let noises: Vec<f64> = traces.iter().filter_map(|t| t.rest_noise_dps).collect();
     if let Some(noise) = crate::median(&noises) {
@@ -879,6 +916,38 @@ fn kalman_from_rests(base: KalmanConfig, rest_means: &[f64], traces: &[Trace]) -
     }
     kalman
 }
+
+/// How much larger than a spread measured with `dof` degrees of freedom the true spread
+/// can be ([`SPREAD_CONFIDENCE`] one-sided, chi-squared): a filter told too small a bias
+/// spread trusts its prior over the data, and a few runs measure a spread poorly.
+fn spread_upper_factor(dof: usize) -> f64 {
+    let dof = dof as f64;
+    (dof / crate::noise::chi2_quantile(1.0 - SPREAD_CONFIDENCE, dof)).sqrt()
+}
+
+/// The degrees of freedom the Kalman candidate's bias spreads are bounded with: those of all
+/// training runs, in the leave-one-out folds too, so that a fold scores the settings as
+/// they are written (from every run), not settings made wider by the fold's fewer runs.
+#[derive(Clone, Copy, Debug)]
+struct SpreadDof {
+    /// Rests less one per run (the spread within runs).
+    within: usize,
+    /// Runs with a rest, less one (the spread between runs).
+    between: usize,
+}
+
+impl SpreadDof {
+    fn of(traces: &[Trace]) -> Self {
+        let with_rest = traces.iter().filter(|t| !t.rest_means_dps.is_empty());
+        Self {
+            within: with_rest.clone().map(|t| t.rest_means_dps.len() - 1).sum(),
+            between: with_rest.count().saturating_sub(1),
+        }
+    }
+}
+
+/// The one-sided confidence of the bias spreads the Kalman candidate is given.
+pub const SPREAD_CONFIDENCE: f64 = 0.9;
 
 /// A fit on a set of runs.
 struct Fit {
@@ -897,6 +966,7 @@ fn fit(
     options: &CalibrateOptions,
     tau_s: f64,
     scoring: &ReplayOptions,
+    dof: SpreadDof,
     progress: &mut dyn FnMut(&str, usize, f64),
 ) -> Result<(Fit, Vec<Trace>), CalibrateError> {
     let rest_means: Vec<f64> = traces
@@ -921,7 +991,7 @@ fn fit(
     let fitted = Fitted {
         motion,
         paper,
-        kalman: kalman_from_rests(base.kalman, &rest_means, &traces),
+        kalman: kalman_from_rests(base.kalman, &rest_means, &traces, dof),
     };
     Ok((
         Fit {
@@ -1085,8 +1155,10 @@ pub fn calibrate(
     let start = *base;
     let base_traces = traces_for(&runs, base, &scoring)?;
     if base_traces.iter().all(|t| t.spans.is_empty()) {
-        return Err(CalibrateError::NoMovement);
+        let names: Vec<&str> = runs.iter().map(|r| r.name.as_str()).collect();
+        return Err(CalibrateError::NoMovement(names.join(", ")));
     }
+    let dof = SpreadDof::of(&base_traces);
     let (full, _) = fit(
         &runs,
         base_traces.clone(),
@@ -1094,6 +1166,7 @@ pub fn calibrate(
         options,
         initial_tau.0,
         &scoring,
+        dof,
         progress,
     )?;
 
@@ -1131,6 +1204,7 @@ pub fn calibrate(
                 options,
                 tau_for(&others).0,
                 &scoring,
+                dof,
                 &mut |_, n, best| progress(&stage, n, best),
             )?;
             held_out.push(candidate_errors(run, &fold_base, &fold.fitted, &scoring)?);
@@ -1220,7 +1294,24 @@ pub fn calibrate(
 
 #[cfg(test)]
 mod tests {
-    use super::{choose, Candidate, CandidateScore, ChoiceReason};
+    use super::{choose, spread_upper_factor, Candidate, CandidateScore, ChoiceReason};
+
+    /// Against `(d / scipy.stats.chi2.ppf(0.1, d)) ** 0.5`.
+    #[test]
+    fn the_spread_bound_is_the_chi_squared_one() {
+        for (dof, scipy) in [
+            (1, 7.957_896_56),
+            (2, 3.080_782_62),
+            (5, 1.762_099_91),
+            (20, 1.267_824_87),
+        ] {
+            let ours = spread_upper_factor(dof);
+            assert!(
+                (ours - scipy).abs() < 1e-3 * scipy,
+                "dof {dof}: {ours} against {scipy}"
+            );
+        }
+    }
 
     fn score(candidate: Candidate, runs: &[f64], training_deg: f64) -> CandidateScore {
         CandidateScore {
