@@ -957,16 +957,24 @@ struct Fit {
     evaluations: usize,
 }
 
+/// Where a fit starts from and what it bounds its spreads with.
+#[derive(Clone, Copy, Debug)]
+struct FitStart {
+    /// The starting bias correlation time (s).
+    tau_s: f64,
+    /// The degrees of freedom of the Kalman candidate's spread bounds.
+    dof: SpreadDof,
+}
+
 /// Fit everything calibration fits on `runs`, whose traces under `base` are `traces`,
-/// starting from correlation time `tau_s`.
+/// from `start`.
 fn fit(
     runs: &[&BenchRun],
     traces: Vec<Trace>,
     base: &Config,
     options: &CalibrateOptions,
-    tau_s: f64,
+    start_at: FitStart,
     scoring: &ReplayOptions,
-    dof: SpreadDof,
     progress: &mut dyn FnMut(&str, usize, f64),
 ) -> Result<(Fit, Vec<Trace>), CalibrateError> {
     let rest_means: Vec<f64> = traces
@@ -974,7 +982,7 @@ fn fit(
         .flat_map(|t| t.rest_means_dps.iter().copied())
         .collect();
     let start = GaussMarkov {
-        beta_per_s: (1.0 / tau_s) as f32,
+        beta_per_s: (1.0 / start_at.tau_s) as f32,
         b0_dps: crate::median(&rest_means).unwrap_or(0.0) as f32,
         o0_deg: 0.0,
     };
@@ -991,7 +999,7 @@ fn fit(
     let fitted = Fitted {
         motion,
         paper,
-        kalman: kalman_from_rests(base.kalman, &rest_means, &traces, dof),
+        kalman: kalman_from_rests(base.kalman, &rest_means, &traces, start_at.dof),
     };
     Ok((
         Fit {
@@ -1164,9 +1172,11 @@ pub fn calibrate(
         base_traces.clone(),
         base,
         options,
-        initial_tau.0,
+        FitStart {
+            tau_s: initial_tau.0,
+            dof,
+        },
         &scoring,
-        dof,
         progress,
     )?;
 
@@ -1202,9 +1212,11 @@ pub fn calibrate(
                 traces,
                 &fold_base,
                 options,
-                tau_for(&others).0,
+                FitStart {
+                    tau_s: tau_for(&others).0,
+                    dof,
+                },
                 &scoring,
-                dof,
                 &mut |_, n, best| progress(&stage, n, best),
             )?;
             held_out.push(candidate_errors(run, &fold_base, &fold.fitted, &scoring)?);
