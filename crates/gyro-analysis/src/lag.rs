@@ -7,7 +7,9 @@
 //! path, then looks like a bad sensor. `run` measures the lag on every log with a
 //! reference and says so when it is at least [`NOTABLE_S`].
 
-use crate::diagnose::stats::{is_at_edge_of, residuals, xcorr_peak_lag_within, Overlap};
+use crate::xcorr::{
+    centred_difference, is_at_edge_of, xcorr_peak_lag_within, Overlap, MIN_SAMPLES,
+};
 use gyro_log::RegularLog;
 use std::collections::VecDeque;
 
@@ -29,15 +31,27 @@ pub const MIN_CORRELATION: f64 = 0.5;
 /// `None` without a reference or a peak, or with the peak on the edge of the search: a
 /// bound, not a measurement (a reference that turns against the gyro puts it there).
 pub fn log_lag_s(log: &RegularLog) -> Option<f64> {
-    let r = residuals(log).ok()?;
-    xcorr_peak_lag_within(
-        &r.rate_dps,
-        &r.reference_rate_dps,
-        r.sample_rate_hz,
-        SEARCH_S,
-        Overlap::Whole,
-    )
-    .filter(|lag| lag.is_finite() && !is_at_edge_of(*lag, r.sample_rate_hz, SEARCH_S))
+    if !log.has_reference {
+        return None;
+    }
+    let fs = log.sample_rate_hz;
+    let reference_deg: Vec<f64> = log
+        .slots
+        .iter()
+        .map(|s| s.reference_deg.unwrap_or(f64::NAN))
+        .collect();
+    let rate_dps: Vec<f64> = log.slots.iter().map(|s| s.rate_dps).collect();
+    let reference_rate_dps = centred_difference(&reference_deg, fs);
+    let read = rate_dps
+        .iter()
+        .zip(&reference_rate_dps)
+        .filter(|(g, r)| (*g - *r).is_finite())
+        .count();
+    if read < MIN_SAMPLES {
+        return None;
+    }
+    xcorr_peak_lag_within(&rate_dps, &reference_rate_dps, fs, SEARCH_S, Overlap::Whole)
+        .filter(|lag| lag.is_finite() && !is_at_edge_of(*lag, fs, SEARCH_S))
 }
 
 /// The offset (in lags, within ±½) of the vertex of the parabola through the correlation

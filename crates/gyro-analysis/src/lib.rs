@@ -22,6 +22,7 @@ pub mod rest_mean;
 pub mod seed;
 #[cfg(test)]
 pub(crate) mod test_log;
+pub mod xcorr;
 
 /// The median of `values` as the upper of the two middle values for an even count (an
 /// observed value, never an average of two); `None` when empty. Callers drop what they

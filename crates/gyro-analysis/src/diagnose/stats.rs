@@ -3,7 +3,8 @@
 //!
 //! Definitions (every number below is a constant of this module):
 //! - **Reference rate**: the centred difference `(θ[i+h] − θ[i−h]) / (2h·dt)` of the
-//!   reference angle with `h = max(1, round(fs · SMOOTH_WINDOW_S / 2))`. This is exactly
+//!   reference angle with `h = max(1, round(fs · W / 2))`, W =
+//!   [`crate::xcorr::SMOOTH_WINDOW_S`] ([`crate::xcorr::centred_difference`]). This is exactly
 //!   the derivative of the reference angle averaged over a boxcar of `2h` samples
 //!   (≈ 20 ms), centred, so it adds no lag. Samples whose `i ± h` neighbours lack a
 //!   reference (or lie outside the log) get no reference rate and are left out of every
@@ -55,13 +56,15 @@
 //!   run); windows with a sample lacking a residual are skipped: `all`.
 
 use crate::noise::{AllanDeviation, ONE_SIGMA};
+pub use crate::xcorr::{
+    centred_difference, is_at_edge_of, smooth_half_width, xcorr_peak_lag_within, Overlap,
+    MIN_SAMPLES,
+};
 use gyro_log::RegularLog;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt;
 
-/// Width of the boxcar over which the reference angle is differentiated (s).
-pub const SMOOTH_WINDOW_S: f64 = 0.02;
 /// A sample is still when |reference rate| is below this (deg/s).
 pub const STATIC_RATE_DPS: f64 = 1.0;
 /// Shortest still run counted as static (s).
@@ -157,12 +160,6 @@ pub struct Residuals {
     pub low_reference_rate_dps: Vec<f64>,
 }
 
-/// The half-width `h` (samples) of the reference rate's centred difference at
-/// `sample_rate_hz`: `max(1, round(fs · SMOOTH_WINDOW_S / 2))`.
-pub fn smooth_half_width(sample_rate_hz: f64) -> usize {
-    ((sample_rate_hz * SMOOTH_WINDOW_S / 2.0).round() as usize).max(1)
-}
-
 /// The gain of the reference rate's centred difference at `frequency_hz` (a boxcar of
 /// `2h` samples: `sin(π f 2h / fs) / (π f 2h / fs)`, no phase). At 100 Hz (h = 1) it
 /// passes 0.90 of a 12.8 Hz line and 0.22 of a 40 Hz one: a response read against the
@@ -176,9 +173,6 @@ pub fn reference_rate_gain(sample_rate_hz: f64, frequency_hz: f64) -> f64 {
         x.sin() / x
     }
 }
-
-/// Fewest samples with a residual accepted by [`residuals`].
-const MIN_SAMPLES: usize = 10;
 
 /// Residual rate and static/dynamic segmentation of `log` (see the module documentation).
 pub fn residuals(log: &RegularLog) -> Result<Residuals, StatsError> {
@@ -210,20 +204,8 @@ pub fn residuals_of(
     temperature_c: Vec<f64>,
 ) -> Result<Residuals, StatsError> {
     let n = rate_dps.len();
-    let h = smooth_half_width(fs);
-    let mut reference_rate_dps = vec![f64::NAN; n];
-    for (i, r) in reference_rate_dps.iter_mut().enumerate() {
-        if i < h || i + h >= n {
-            continue;
-        }
-        *r = (reference_deg[i + h] - reference_deg[i - h]) * fs / (2 * h) as f64;
-    }
-    let mut reference_acceleration_dps2 = vec![f64::NAN; n];
-    for (i, a) in reference_acceleration_dps2.iter_mut().enumerate() {
-        if i >= h && i + h < n {
-            *a = (reference_rate_dps[i + h] - reference_rate_dps[i - h]) * fs / (2 * h) as f64;
-        }
-    }
+    let reference_rate_dps = centred_difference(reference_deg, fs);
+    let reference_acceleration_dps2 = centred_difference(&reference_rate_dps, fs);
     let residual_dps: Vec<f64> = rate_dps
         .iter()
         .zip(&reference_rate_dps)
@@ -484,118 +466,9 @@ pub fn is_at_search_edge(lag_s: f64, fs: f64) -> bool {
     is_at_edge_of(lag_s, fs, MAX_LAG_S)
 }
 
-/// True if a cross-correlation peak lag `lag_s` (at sample rate `fs`) sits on the edge of
-/// a search of ±`max_lag_s` rounded to whole samples.
-pub(crate) fn is_at_edge_of(lag_s: f64, fs: f64, max_lag_s: f64) -> bool {
-    let edge_s = ((max_lag_s * fs).round()).max(1.0) / fs;
-    lag_s.abs() >= edge_s * (1.0 - 1e-9)
-}
-
-/// Cross-correlation peak lag (s) of `gyro` against `reference` within ±`max_lag` samples.
-///
-/// Samples where either is undefined count as zero after mean removal. The correlation of
-/// rates is smooth in the lag, so it is searched every few lags and then refined around
-/// the best one (the same peak as an exhaustive search unless two peaks lie within a few
-/// samples of each other).
+/// [`xcorr_peak_lag_within`] ±[`MAX_LAG_S`], normalised by the overlap.
 fn xcorr_peak_lag(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
     xcorr_peak_lag_within(gyro, reference, fs, MAX_LAG_S, Overlap::Divide)
-}
-
-/// How the cross-correlation at a lag is normalised.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Overlap {
-    /// By the overlap's length (`n − |lag|`): the diagnosis's statistic, compared with
-    /// simulations computed alike. It leans towards longer lags when the motion sits
-    /// inside the run (the sum stays, the divisor shrinks).
-    Divide,
-    /// By the run's length: no lean, the peak of motion inside the run is where the
-    /// signals align (a measured delay).
-    Whole,
-}
-
-/// [`xcorr_peak_lag`] within ±`max_lag_s` (s) instead of ±[`MAX_LAG_S`], normalised as
-/// `overlap` says.
-pub(crate) fn xcorr_peak_lag_within(
-    gyro: &[f64],
-    reference: &[f64],
-    fs: f64,
-    max_lag_s: f64,
-    overlap: Overlap,
-) -> Option<f64> {
-    let n = gyro.len();
-    let max_lag = ((max_lag_s * fs).round() as usize).max(1);
-    let both = |i: usize| gyro[i].is_finite() && reference[i].is_finite();
-    let count = (0..n).filter(|&i| both(i)).count();
-    if count < 3 {
-        return None;
-    }
-    let mg = (0..n).filter(|&i| both(i)).map(|i| gyro[i]).sum::<f64>() / count as f64;
-    let mr = (0..n)
-        .filter(|&i| both(i))
-        .map(|i| reference[i])
-        .sum::<f64>()
-        / count as f64;
-    let g: Vec<f64> = (0..n)
-        .map(|i| if both(i) { gyro[i] - mg } else { 0.0 })
-        .collect();
-    let r: Vec<f64> = (0..n)
-        .map(|i| if both(i) { reference[i] - mr } else { 0.0 })
-        .collect();
-    // c(lag) = Σ g[i + lag] r[i] / overlap.
-    let corr = |lag: i64| -> f64 {
-        let l = lag.unsigned_abs() as usize;
-        if l >= n {
-            return f64::NEG_INFINITY;
-        }
-        let (a, b) = if lag >= 0 {
-            (&g[l..], &r[..n - l])
-        } else {
-            (&g[..n - l], &r[l..])
-        };
-        let mut acc = [0.0f64; 4];
-        let chunks = a.len() / 4;
-        for k in 0..chunks {
-            for j in 0..4 {
-                acc[j] += a[4 * k + j] * b[4 * k + j];
-            }
-        }
-        let mut sum = acc.iter().sum::<f64>();
-        for k in 4 * chunks..a.len() {
-            sum += a[k] * b[k];
-        }
-        match overlap {
-            Overlap::Divide => sum / (n - l) as f64,
-            Overlap::Whole => sum / n as f64,
-        }
-    };
-    let max_lag = max_lag as i64;
-    let step = (max_lag / 10).clamp(1, 8);
-    let mut best = (0i64, f64::NEG_INFINITY);
-    let mut lag = -max_lag;
-    while lag <= max_lag {
-        let c = corr(lag);
-        if c > best.1 {
-            best = (lag, c);
-        }
-        lag += step;
-    }
-    let (lo, hi) = ((best.0 - step).max(-max_lag), (best.0 + step).min(max_lag));
-    for lag in lo..=hi {
-        let c = corr(lag);
-        if c > best.1 {
-            best = (lag, c);
-        }
-    }
-    if !best.1.is_finite() {
-        return None;
-    }
-    let k = best.0;
-    let offset = if k > -max_lag && k < max_lag {
-        crate::lag::parabola_offset(corr(k - 1), best.1, corr(k + 1))
-    } else {
-        0.0
-    };
-    Some((k as f64 + offset) / fs)
 }
 
 /// Averaging factors for the Allan bands at `fs`.
