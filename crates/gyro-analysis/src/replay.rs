@@ -684,7 +684,15 @@ impl Replayer {
 
     /// The replayer in `mode`.
     pub fn with_mode(self, mode: Mode) -> Self {
-        Self { mode, ..self }
+        let smoother = offline::Smoother::new(
+            1.0 / f64::from(self.output_rate_hz),
+            f64::from(self.config.kalman.rate_noise_dps),
+        );
+        Self {
+            mode,
+            smoother,
+            ..self
+        }
     }
 
     /// Give `point`, an output of [`Replayer::push`], to `series`: as it is when causal;

@@ -62,15 +62,67 @@ pub(super) struct Smoother {
     ready: Vec<SeriesPoint>,
     /// The most outputs held at once.
     most_held: usize,
+    /// The filter's prior for the white rate noise integrated over one output step (deg²).
+    prior_step_variance: f64,
+    /// The white rate noise integrated over one output step as the rests show it (deg²):
+    /// half the mean square of the difference of consecutive rest blocks' mean rates,
+    /// times the block's length and the step squared.
+    block_pairs: (f64, usize),
+    /// The rest block being summed: (sum of rates, samples), and the last complete one's mean.
+    block: (f64, usize),
+    last_block_mean: Option<f64>,
+    /// Output step (s).
+    step_s: f64,
 }
+
+/// Rest outputs per noise block (0.2 s at 50 Hz): a block mean against the next measures
+/// the white noise the movement's angle integrates.
+const NOISE_BLOCK: usize = 10;
 
 fn variance_of(point: &SeriesPoint) -> Option<f64> {
     point.angle_std_deg.map(|s| f64::from(s) * f64::from(s))
 }
 
 impl Smoother {
+    /// A smoother for outputs `step_s` apart from a filter whose white rate noise prior is
+    /// `rate_noise_dps` per output.
+    pub fn new(step_s: f64, rate_noise_dps: f64) -> Self {
+        Self {
+            prior_step_variance: (rate_noise_dps * step_s).powi(2),
+            step_s,
+            ..Self::default()
+        }
+    }
+
+    /// The white noise integrated per step as measured at rest, else the prior (deg²).
+    fn step_variance(&self) -> f64 {
+        match self.block_pairs {
+            (sum, n) if n >= 8 => sum / n as f64 * NOISE_BLOCK as f64 * self.step_s * self.step_s,
+            _ => self.prior_step_variance,
+        }
+    }
+
     /// The next causal output.
     pub fn push(&mut self, point: SeriesPoint) {
+        if point.motion == gyro_core::MotionState::Static && self.pending_is_settled() {
+            self.block.0 += f64::from(point.rate_dps);
+            self.block.1 += 1;
+            if self.block.1 == NOISE_BLOCK {
+                let mean = self.block.0 / NOISE_BLOCK as f64;
+                if let Some(last) = self.last_block_mean {
+                    let d = mean - last;
+                    if d.is_finite() {
+                        self.block_pairs.0 += 0.5 * d * d;
+                        self.block_pairs.1 += 1;
+                    }
+                }
+                self.last_block_mean = Some(mean);
+                self.block = (0.0, 0);
+            }
+        } else {
+            self.block = (0.0, 0);
+            self.last_block_mean = None;
+        }
         self.held.push_back(point);
         self.most_held = self.most_held.max(self.held.len());
     }
@@ -78,6 +130,11 @@ impl Smoother {
     /// The most outputs held at once so far.
     pub fn most_held(&self) -> usize {
         self.most_held
+    }
+
+    /// No movement is open (the pending one, if any, has ended).
+    fn pending_is_settled(&self) -> bool {
+        self.pending.is_none_or(|p| p.end_index.is_some())
     }
 
     /// The causal output with index `index`, if held.
@@ -170,8 +227,12 @@ impl Smoother {
                 // The angle the rest after added: the correction of the movement's bias.
                 let correction = f64::from(end.angle_deg - moved_end.angle_deg);
                 let angle = f64::from(end.angle_deg - start.angle_deg);
+                // The filter's variance gained, its white-noise part as the rests measure it.
+                let steps = (end_index - p.start_index) as f64;
+                let white = steps * self.step_variance();
+                let white_prior = steps * self.prior_step_variance;
                 let variance = match (variance_of(&start), variance_of(&end)) {
-                    (Some(a), Some(b)) => Some((b - a).max(0.0)),
+                    (Some(a), Some(b)) => Some((b - a - white_prior).max(0.0) + white),
                     _ => None,
                 };
                 let (t0, t1) = (start.time_s, moved_end.time_s);
