@@ -6,8 +6,10 @@
 //! rest that follows) beside the per-rest mean's per movement; and how often the offline 95% interval (1.96 σ) covers the true angle, with
 //! the quantiles of |error|/σ.
 //!
-//! `cargo run --release -p gyro-analysis --example offline_bench [RUNS [FIRST_SEED]]`
-//! (default 20 runs of 90 s at 1 kHz per kind, seeds FIRST_SEED.. (1..) on).
+//! `cargo run --release -p gyro-analysis --example offline_bench [RUNS [FIRST_SEED
+//! [GM_SIGMA_DPS]]]` (default 20 runs of 90 s at 1 kHz per kind, seeds FIRST_SEED.. (1..) on;
+//! GM_SIGMA_DPS replaces the sensor's Gauss-Markov bias wander, 0.05 deg/s by default: 0.005
+//! or 0 is a sensor whose bias holds still between power-ups).
 use gyro_analysis::replay::{replay_with_mode, Mode, ReplayOptions};
 use gyro_analysis::rest_mean::{score_report, simulate_bench_run};
 use gyro_core::Config;
@@ -21,6 +23,13 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let runs: u64 = std::env::args().nth(1).map_or(Ok(20), |a| a.parse())?;
     let first_seed: u64 = std::env::args().nth(2).map_or(Ok(1), |a| a.parse())?;
+    let defaults = SensorModel::default();
+    let sensor = SensorModel {
+        gm_sigma_dps: std::env::args()
+            .nth(3)
+            .map_or(Ok(defaults.gm_sigma_dps), |a| a.parse())?,
+        ..defaults
+    };
     let kinds: [(&str, &[&str]); 9] = [
         ("nominal model", &[]),
         ("turn-on bias 0.05 deg/s", &["turn_on_bias:sigma_dps=0.05"]),
@@ -60,7 +69,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut ratios = vec![];
         let mut covered = (0_usize, 0_usize);
         for seed in first_seed..first_seed + runs {
-            let run = simulate_bench_run(&SensorModel::default(), &effects, seed)?;
+            let run = simulate_bench_run(&sensor, &effects, seed)?;
             let options = ReplayOptions::default();
             let causal = replay_with_mode(&run.log, &Config::default(), &options, Mode::Causal)?;
             let offline = replay_with_mode(&run.log, &Config::default(), &options, Mode::Offline)?;
