@@ -21,6 +21,27 @@ use serde::Serialize;
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
+mod offline;
+
+/// How a replay estimates each movement's angle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// As the wrench does: each movement at its end, from the rests before it.
+    #[default]
+    Causal,
+    /// For a log analysed after the fact: each movement after the rest that follows it, so
+    /// that its bias comes from the rests on both sides ([`offline`]).
+    Offline,
+}
+
+impl Mode {
+    /// The causal mode (left out of the JSON, which then reads as before the mode existed).
+    pub fn is_causal(&self) -> bool {
+        *self == Mode::Causal
+    }
+}
+
 /// One output sample of the run, with the reference where present.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct SeriesPoint {
@@ -162,6 +183,9 @@ impl ReplayOptions {
 /// The result of replaying one log.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RunReport {
+    /// How the movements' angles were estimated; in the JSON only when offline.
+    #[serde(skip_serializing_if = "Mode::is_causal")]
+    pub mode: Mode,
     /// Input grid rate (Hz).
     pub sample_rate_hz: f64,
     /// Decimation factor.
@@ -255,7 +279,18 @@ pub fn replay_with(
     config: &Config,
     options: &ReplayOptions,
 ) -> Result<RunReport, gyro_core::Error> {
-    let mut replayer = Replayer::new(log.sample_rate_hz, config, options, log.has_temperature)?;
+    replay_with_mode(log, config, options, Mode::Causal)
+}
+
+/// [`replay_with`] in `mode`.
+pub fn replay_with_mode(
+    log: &RegularLog,
+    config: &Config,
+    options: &ReplayOptions,
+    mode: Mode,
+) -> Result<RunReport, gyro_core::Error> {
+    let mut replayer =
+        Replayer::new(log.sample_rate_hz, config, options, log.has_temperature)?.with_mode(mode);
     // The reference's shift in grid slots (a non-finite delay is treated as none).
     let shift_slots = if options.reference_delay_s.is_finite() {
         options.reference_delay_s * log.sample_rate_hz
@@ -265,17 +300,22 @@ pub fn replay_with(
     let mut series = Vec::new();
     if shift_slots == 0.0 {
         for slot in &log.slots {
-            series.extend(replayer.push(slot));
+            if let Some(point) = replayer.push(slot) {
+                replayer.emit(point, &mut series);
+            }
         }
     } else {
         // The reference at other slots, ahead or behind: the whole log is at hand.
         replayer.reference_origin = log.slots.iter().find_map(|s| s.reference_deg);
         for (i, slot) in log.slots.iter().enumerate() {
-            series
-                .extend(replayer.push_scored(slot, shifted_reference(&log.slots, i, shift_slots)));
+            if let Some(point) =
+                replayer.push_scored(slot, shifted_reference(&log.slots, i, shift_slots))
+            {
+                replayer.emit(point, &mut series);
+            }
         }
     }
-    let mut report = replayer.finish(log.quality.clone());
+    let mut report = replayer.finish_into(log.quality.clone(), &mut series);
     report.series = series;
     Ok(report)
 }
@@ -396,6 +436,31 @@ pub fn replay_file_into(
     warn: &mut dyn FnMut(&str),
     series: &mut dyn SeriesSink,
 ) -> Result<RunReport, ReplayFileError> {
+    replay_file_into_mode(
+        path,
+        options,
+        grid,
+        config,
+        replay_options,
+        Mode::Causal,
+        warn,
+        series,
+    )
+}
+
+/// [`replay_file_into`] in `mode`. Offline, memory holds the outputs from a movement's
+/// start to the next one's ([`offline`]) besides what the causal replay holds.
+#[allow(clippy::too_many_arguments)]
+pub fn replay_file_into_mode(
+    path: &Path,
+    options: &LogOptions,
+    grid: &GridOptions,
+    config: &Config,
+    replay_options: &ReplayOptions,
+    mode: Mode,
+    warn: &mut dyn FnMut(&str),
+    series: &mut dyn SeriesSink,
+) -> Result<RunReport, ReplayFileError> {
     let config_error = |cause, sample_rate_hz| ReplayFileError::Config {
         path: path.to_path_buf(),
         cause,
@@ -405,7 +470,7 @@ pub fn replay_file_into(
     let delay = replay_options.reference_delay_s;
     if delay.is_finite() && delay != 0.0 {
         let regular = gyro_log::load(path, options, grid, warn)?;
-        let mut report = replay_with(&regular, config, replay_options)
+        let mut report = replay_with_mode(&regular, config, replay_options, mode)
             .map_err(|cause| config_error(cause, regular.sample_rate_hz))?;
         series.start(report.output_rate_hz);
         for point in std::mem::take(&mut report.series) {
@@ -416,6 +481,7 @@ pub fn replay_file_into(
     let mut sink = ReplaySink {
         config,
         options: replay_options,
+        mode,
         has_temperature: false,
         replayer: None,
         series,
@@ -423,7 +489,7 @@ pub fn replay_file_into(
     let quality = gyro_log::stream(path, options, grid, &mut sink, warn)?;
     let sample_rate_hz = quality.sample_rate_hz;
     match sink.replayer {
-        Some(Ok(replayer)) => Ok(replayer.finish(quality)),
+        Some(Ok(replayer)) => Ok(replayer.finish_into(quality, sink.series)),
         Some(Err(cause)) => Err(config_error(cause, sample_rate_hz)),
         // `place` succeeded, so it gave the rate: not reached.
         None => Replayer::new(
@@ -446,6 +512,7 @@ pub fn replay_file_into(
 struct ReplaySink<'c> {
     config: &'c Config,
     options: &'c ReplayOptions,
+    mode: Mode,
     has_temperature: bool,
     replayer: Option<Result<Replayer, gyro_core::Error>>,
     series: &'c mut dyn SeriesSink,
@@ -457,12 +524,14 @@ impl SlotSink for ReplaySink<'_> {
     }
 
     fn start(&mut self, sample_rate_hz: f64) {
+        let mode = self.mode;
         let replayer = Replayer::new(
             sample_rate_hz,
             self.config,
             self.options,
             self.has_temperature,
-        );
+        )
+        .map(|r| r.with_mode(mode));
         if let Ok(replayer) = &replayer {
             self.series.start(replayer.output_rate_hz);
         }
@@ -472,7 +541,7 @@ impl SlotSink for ReplaySink<'_> {
     fn slot(&mut self, slot: &Slot) {
         if let Some(Ok(replayer)) = &mut self.replayer {
             if let Some(point) = replayer.push(slot) {
-                self.series.point(&point);
+                replayer.emit(point, self.series);
             }
         }
     }
@@ -522,6 +591,11 @@ pub struct Replayer {
     open: Option<OpenMovement>,
     /// Filled input slots (gaps, missing rates) so far.
     filled_total: u32,
+    /// Causal, or offline with its smoother.
+    mode: Mode,
+    smoother: offline::Smoother,
+    /// The last smoothed output (offline).
+    last_smoothed: Option<SeriesPoint>,
 }
 
 /// What the replay keeps of a recent output: what a movement's ends read.
@@ -602,7 +676,70 @@ impl Replayer {
             movements: Vec::new(),
             open: None,
             filled_total: 0,
+            mode: Mode::Causal,
+            smoother: offline::Smoother::default(),
+            last_smoothed: None,
         })
+    }
+
+    /// The replayer in `mode`.
+    pub fn with_mode(self, mode: Mode) -> Self {
+        let smoother = offline::Smoother::new(
+            1.0 / f64::from(self.output_rate_hz),
+            f64::from(self.config.kalman.rate_noise_dps),
+        );
+        Self {
+            mode,
+            smoother,
+            ..self
+        }
+    }
+
+    /// Give `point`, an output of [`Replayer::push`], to `series`: as it is when causal;
+    /// offline, the smoothed outputs it has made ready instead, scored as they go.
+    pub fn emit(&mut self, point: SeriesPoint, series: &mut dyn SeriesSink) {
+        match self.mode {
+            Mode::Causal => series.point(&point),
+            Mode::Offline => self.emit_smoothed(series),
+        }
+    }
+
+    /// Score the smoothed outputs made ready and give them to `series`.
+    fn emit_smoothed(&mut self, series: &mut dyn SeriesSink) {
+        let ready: Vec<SeriesPoint> = self.smoother.take_ready().collect();
+        for point in ready {
+            if let Some(e) = point.error_deg() {
+                self.errors.add(e);
+            }
+            series.point(&point);
+            self.last_smoothed = Some(point);
+        }
+    }
+
+    /// The most outputs the offline smoother has held at once (0 when causal).
+    pub fn most_smoothed_held(&self) -> usize {
+        self.smoother.most_held()
+    }
+
+    /// Put a movement's offline angle and σ in its result.
+    fn apply(&mut self, smoothed: Option<offline::Smoothed>) {
+        let Some(smoothed) = smoothed else { return };
+        let tightening = self.config.tightening;
+        let Some(m) = self.movements.get_mut(smoothed.movement) else {
+            return;
+        };
+        m.angle_deg = smoothed.angle_deg;
+        m.angle_std_deg = smoothed.angle_std_deg;
+        m.error_deg = m.reference_deg.map(|r| f64::from(m.angle_deg) - r);
+        let untrusted = m.saturated || !m.complete || m.filled_samples > 0;
+        m.verdict = tightening.as_ref().and_then(|window| {
+            decide(
+                window,
+                m.angle_deg,
+                m.angle_std_deg.unwrap_or(0.0),
+                untrusted,
+            )
+        });
     }
 
     /// The output rate (Hz).
@@ -718,6 +855,9 @@ impl Replayer {
             reference_deg,
         };
         self.hold(&point);
+        if self.mode == Mode::Offline {
+            self.smoother.push(point);
+        }
         match out.event {
             Some(Event::MovementStarted {
                 start_time_s,
@@ -734,6 +874,10 @@ impl Replayer {
                     open.reference_at_start = Some(self.reference_near(start_time_s));
                 }
                 self.open = Some(open);
+                if self.mode == Mode::Offline {
+                    let smoothed = self.smoother.movement_started(start_index);
+                    self.apply(smoothed);
+                }
             }
             Some(Event::MovementEnded(m)) => {
                 let open = self.open.take();
@@ -772,6 +916,10 @@ impl Replayer {
                     reference_change(start_reference, end_reference),
                     self.config.tightening.as_ref(),
                 ));
+                if self.mode == Mode::Offline {
+                    self.smoother
+                        .movement_ended(self.movements.len() - 1, samples.1);
+                }
             }
             None => {}
         }
@@ -781,7 +929,8 @@ impl Replayer {
     /// Count `point` into the summary and hold it (dropping the oldest held output past
     /// `max_held`); resolve the open movement's start once an output reaches its time.
     fn hold(&mut self, point: &SeriesPoint) {
-        if let Some(e) = point.error_deg() {
+        // Offline, the smoothed outputs are scored as they are made.
+        if let (Some(e), Mode::Causal) = (point.error_deg(), self.mode) {
             self.errors.add(e);
         }
         if let Some(r) = point.reference_deg {
@@ -827,7 +976,22 @@ impl Replayer {
     /// The report, with `input` the quality of the grid the slots came from; its series is
     /// empty (the caller has had every point from [`Replayer::push`]).
     pub fn finish(self, input: Quality) -> RunReport {
+        self.finish_into(input, &mut ())
+    }
+
+    /// [`Replayer::finish`], the outputs still held for smoothing (offline) given to
+    /// `series` first.
+    pub fn finish_into(mut self, input: Quality, series: &mut dyn SeriesSink) -> RunReport {
+        if self.mode == Mode::Offline {
+            let smoothed = self.smoother.finish();
+            self.apply(smoothed);
+            self.emit_smoothed(series);
+        }
         let last = self.held.back().copied();
+        let last_angle_deg = match (self.mode, self.last_smoothed) {
+            (Mode::Offline, Some(p)) => Some(p.angle_deg),
+            _ => last.map(|p| p.angle_deg),
+        };
         let mut movements = self.movements;
         if let (Some(open), Some(last)) = (self.open, last) {
             let samples = (open.start_index, self.outputs - 1);
@@ -865,7 +1029,7 @@ impl Replayer {
             },
             movements: movements.len(),
             rejected_samples: self.pipeline.rejected_samples(),
-            final_angle_deg: last.map_or(0.0, |p| p.angle_deg),
+            final_angle_deg: last_angle_deg.unwrap_or(0.0),
             final_raw_angle_deg: last.map_or(0.0, |p| p.raw_angle_deg),
             max_abs_error_deg: max_abs,
             rms_error_deg: rms,
@@ -879,6 +1043,7 @@ impl Replayer {
             range_contradicted: self.pipeline.range_contradicted(),
         };
         RunReport {
+            mode: self.mode,
             sample_rate_hz: self.sample_rate_hz,
             decimation_factor: self.factor,
             output_rate_hz: self.output_rate_hz,

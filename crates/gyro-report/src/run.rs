@@ -38,6 +38,12 @@ pub fn table(file: &str, report: &RunReport, findings: &[Finding]) -> String {
         c.range_dps
             .map_or(String::new(), |r| format!(", sensor range ±{r} deg/s"))
     );
+    if report.mode == gyro_analysis::replay::Mode::Offline {
+        let _ = writeln!(
+            s,
+            "mode: offline (each movement's angle and σ from the rests before and after it)"
+        );
+    }
     let k = &c.correction;
     if !k.is_identity() {
         let temperature = match report.temperature_reference_c {

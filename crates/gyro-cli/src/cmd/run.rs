@@ -82,6 +82,12 @@ pub struct Args {
     /// measures a lag of 20 ms or more, and names the delay that would score it.
     #[arg(long, value_name = "S", value_parser = value::finite::<f64>, allow_negative_numbers = true)]
     reference_delay_s: Option<f64>,
+    /// Analyse the log after the fact: each movement's angle and σ from the rests on both
+    /// sides (the Kalman form smoothed over the rest after it), not only the rest before as
+    /// the wrench must. Needs the Kalman compensation. Memory holds a movement and the rest
+    /// after it.
+    #[arg(long)]
+    offline: bool,
     /// Output format on stdout (csv: the movements).
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -157,6 +163,21 @@ pub fn run(args: &Args) -> Result<()> {
             CompensationArg::Kalman => Compensation::Kalman,
         };
     }
+    if args.offline && config.compensation != Compensation::Kalman {
+        anyhow::bail!(
+            "--offline smooths the Kalman form's bias: it needs --compensation kalman (the model's compensation is {})",
+            match config.compensation {
+                Compensation::None => "none",
+                Compensation::Paper => "paper",
+                Compensation::Kalman => "kalman",
+            }
+        );
+    }
+    let mode = if args.offline {
+        replay::Mode::Offline
+    } else {
+        replay::Mode::Causal
+    };
     // One pass: rows are read, placed on the grid and replayed as they come. The output
     // series is kept only for the plot, which needs it whole, or for an `--out` that is a
     // stream (`/dev/stdout`: written after the report, as the report may share it);
@@ -175,12 +196,13 @@ pub fn run(args: &Args) -> Result<()> {
     };
     // The log reader's notices go to stderr as they come and into the run's findings.
     let mut notices = Vec::new();
-    let mut result = replay::replay_file_into(
+    let mut result = replay::replay_file_into_mode(
         &args.log,
         &args.input,
         &args.grid,
         &config,
         &options,
+        mode,
         &mut |notice: &str| {
             super::warn(notice);
             notices.push(notice.to_string());

@@ -1,0 +1,298 @@
+//! The offline mode of a replay (`run --offline`): each movement's angle read after the rest
+//! that follows it, so that its bias comes from the rests on both sides.
+//!
+//! The Kalman form's state is `[θ, b]`. While a movement integrates, θ's error and the bias
+//! error become correlated; the zero-rate updates of the rest after the movement correct the
+//! bias and, through that correlation, the angle the movement added (the core's
+//! `update_at_rest` returns that angle correction). The causal filter reports a movement at
+//! its end, before those updates; the angle it holds at the end of the rest after is the
+//! fixed-interval smoothed estimate of the movement's angle given the rest before (the
+//! filter's prior at the movement's start) and the rest after (its updates), which is what a
+//! Rauch–Tung–Striebel pass over the movement's span gives for the angle gained over it.
+//! So a movement's offline angle is the causal angle at the start of the next movement less
+//! the causal angle at the start of this one, and its variance the growth of the angle's
+//! variance between them.
+//!
+//! The series is smoothed alike: within a movement the correction its rest after made is
+//! spread in proportion to the time elapsed (a bias error integrates linearly), and over a
+//! rest the angle is the smoothed one at its end. That needs the outputs from a movement's
+//! start to the next movement's start: memory holds one movement and the rest after it, not
+//! the log.
+
+use super::SeriesPoint;
+use std::collections::VecDeque;
+
+/// A movement waiting for the rest after it.
+#[derive(Clone, Copy, Debug)]
+struct Pending {
+    /// Its place in the report's movements, once it has ended.
+    movement: Option<usize>,
+    /// Output index of its start (last quiet sample before).
+    start_index: usize,
+    /// Output index of its end (first quiet sample after), once ended.
+    end_index: Option<usize>,
+}
+
+/// A movement's angle and variance from the rests on both sides.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Smoothed {
+    /// The movement's place in the report's movements.
+    pub movement: usize,
+    /// Its angle (deg).
+    pub angle_deg: f32,
+    /// Its standard deviation (deg), when the causal series has one.
+    pub angle_std_deg: Option<f32>,
+}
+
+/// The offline smoothing of one replay's output series, fed the causal outputs in order.
+#[derive(Debug, Default)]
+pub(super) struct Smoother {
+    /// Causal outputs not yet smoothed: output indices `first..first + held.len()`.
+    held: VecDeque<SeriesPoint>,
+    first: usize,
+    /// The movement whose rest after is being read.
+    pending: Option<Pending>,
+    /// Smoothed angle (deg) and variance (deg²) at the start of the pending movement, less the
+    /// causal ones there: what a smoothed output adds to its causal angle.
+    offset_deg: f64,
+    variance_offset: f64,
+    /// The smoothed angle and variance are set (a movement has started).
+    anchored: bool,
+    /// Smoothed points ready for the caller.
+    ready: Vec<SeriesPoint>,
+    /// The most outputs held at once.
+    most_held: usize,
+    /// The filter's prior for the white rate noise integrated over one output step (deg²).
+    prior_step_variance: f64,
+    /// The white rate noise integrated over one output step as the rests show it (deg²):
+    /// half the mean square of the difference of consecutive rest blocks' mean rates,
+    /// times the block's length and the step squared.
+    block_pairs: (f64, usize),
+    /// The rest block being summed: (sum of rates, samples), and the last complete one's mean.
+    block: (f64, usize),
+    last_block_mean: Option<f64>,
+    /// Output step (s).
+    step_s: f64,
+}
+
+/// Rest outputs per noise block (0.2 s at 50 Hz): a block mean against the next measures
+/// the white noise the movement's angle integrates.
+const NOISE_BLOCK: usize = 10;
+
+fn variance_of(point: &SeriesPoint) -> Option<f64> {
+    point.angle_std_deg.map(|s| f64::from(s) * f64::from(s))
+}
+
+impl Smoother {
+    /// A smoother for outputs `step_s` apart from a filter whose white rate noise prior is
+    /// `rate_noise_dps` per output.
+    pub fn new(step_s: f64, rate_noise_dps: f64) -> Self {
+        Self {
+            prior_step_variance: (rate_noise_dps * step_s).powi(2),
+            step_s,
+            ..Self::default()
+        }
+    }
+
+    /// The white noise integrated per step as measured at rest, else the prior (deg²).
+    fn step_variance(&self) -> f64 {
+        match self.block_pairs {
+            (sum, n) if n >= 8 => sum / n as f64 * NOISE_BLOCK as f64 * self.step_s * self.step_s,
+            _ => self.prior_step_variance,
+        }
+    }
+
+    /// The next causal output.
+    pub fn push(&mut self, point: SeriesPoint) {
+        if point.motion == gyro_core::MotionState::Static && self.pending_is_settled() {
+            self.block.0 += f64::from(point.rate_dps);
+            self.block.1 += 1;
+            if self.block.1 == NOISE_BLOCK {
+                let mean = self.block.0 / NOISE_BLOCK as f64;
+                if let Some(last) = self.last_block_mean {
+                    let d = mean - last;
+                    if d.is_finite() {
+                        self.block_pairs.0 += 0.5 * d * d;
+                        self.block_pairs.1 += 1;
+                    }
+                }
+                self.last_block_mean = Some(mean);
+                self.block = (0.0, 0);
+            }
+        } else {
+            self.block = (0.0, 0);
+            self.last_block_mean = None;
+        }
+        self.held.push_back(point);
+        self.most_held = self.most_held.max(self.held.len());
+    }
+
+    /// The most outputs held at once so far.
+    pub fn most_held(&self) -> usize {
+        self.most_held
+    }
+
+    /// No movement is open (the pending one, if any, has ended).
+    fn pending_is_settled(&self) -> bool {
+        self.pending.is_none_or(|p| p.end_index.is_some())
+    }
+
+    /// The causal output with index `index`, if held.
+    fn at(&self, index: usize) -> Option<&SeriesPoint> {
+        self.held.get(index.checked_sub(self.first)?)
+    }
+
+    /// A movement started at output `start_index` (already pushed): the pending one, if any,
+    /// is smoothed with the rest up to there.
+    pub fn movement_started(&mut self, start_index: usize) -> Option<Smoothed> {
+        let smoothed = self.close(start_index);
+        self.pending = Some(Pending {
+            movement: None,
+            start_index,
+            end_index: None,
+        });
+        smoothed
+    }
+
+    /// The pending movement ended at output `end_index`; `movement` is its place in the
+    /// report's movements.
+    pub fn movement_ended(&mut self, movement: usize, end_index: usize) {
+        if let Some(p) = &mut self.pending {
+            p.movement = Some(movement);
+            p.end_index = Some(end_index);
+        }
+    }
+
+    /// The log has ended: smooth what is pending with the rest up to the last output.
+    pub fn finish(&mut self) -> Option<Smoothed> {
+        let last = (self.first + self.held.len()).checked_sub(1)?;
+        let smoothed = match self.pending {
+            Some(Pending {
+                end_index: Some(_), ..
+            }) => self.close(last),
+            _ => None,
+        };
+        // What is left (a movement the log ends in, or a log without movements) keeps the
+        // causal angles, shifted by the smoothing so far.
+        let (offset, variance_offset) = (self.offset_deg, self.variance_offset);
+        while let Some(p) = self.held.pop_front() {
+            self.ready.push(shifted(&p, offset, variance_offset));
+            self.first += 1;
+        }
+        smoothed
+    }
+
+    /// The smoothed points made since the last call.
+    pub fn take_ready(&mut self) -> std::vec::Drain<'_, SeriesPoint> {
+        self.ready.drain(..)
+    }
+
+    /// Smooth the pending movement with the rest that ends at output `until` (held), and
+    /// release the outputs before `until`.
+    fn close(&mut self, until: usize) -> Option<Smoothed> {
+        let end = *self.at(until)?;
+        let pending = self.pending.take();
+        let mut smoothed = None;
+        match pending {
+            None => {
+                // The rest before the first movement: its smoothed angle is the one at its
+                // end.
+                self.offset_deg = 0.0;
+                self.variance_offset = 0.0;
+                let (angle, variance) = (f64::from(end.angle_deg), variance_of(&end));
+                while self.first < until {
+                    let Some(p) = self.held.pop_front() else {
+                        break;
+                    };
+                    let mut q = p;
+                    q.angle_deg = angle as f32;
+                    if let Some(v) = variance {
+                        q.angle_std_deg = Some(v.max(0.0).sqrt() as f32);
+                    }
+                    self.ready.push(q);
+                    self.first += 1;
+                }
+                // From here the smoothed angle is the causal one.
+                self.anchored = true;
+            }
+            Some(p) => {
+                let start = *self.at(p.start_index)?;
+                let (end_index, movement) = match (p.end_index, p.movement) {
+                    (Some(e), Some(m)) if e <= until => (e, Some(m)),
+                    // Not ended (cannot happen: the core ends a movement before it starts
+                    // another): the causal angles, shifted.
+                    _ => (until, None),
+                };
+                let moved_end = *self.at(end_index)?;
+                // The angle the rest after added: the correction of the movement's bias.
+                let correction = f64::from(end.angle_deg - moved_end.angle_deg);
+                let angle = f64::from(end.angle_deg - start.angle_deg);
+                // The filter's variance gained, its white-noise part as the rests measure it.
+                let steps = (end_index - p.start_index) as f64;
+                let white = steps * self.step_variance();
+                let white_prior = steps * self.prior_step_variance;
+                let variance = match (variance_of(&start), variance_of(&end)) {
+                    (Some(a), Some(b)) => Some((b - a - white_prior).max(0.0) + white),
+                    _ => None,
+                };
+                let (t0, t1) = (start.time_s, moved_end.time_s);
+                let (offset, variance_offset) = (self.offset_deg, self.variance_offset);
+                let base_angle = f64::from(start.angle_deg);
+                let base_variance = variance_of(&start).unwrap_or(0.0);
+                while self.first < until {
+                    let Some(q) = self.held.pop_front() else {
+                        break;
+                    };
+                    let index = self.first;
+                    self.first += 1;
+                    let share = if index >= end_index {
+                        1.0
+                    } else if t1 > t0 {
+                        ((q.time_s - t0) / (t1 - t0)).clamp(0.0, 1.0)
+                    } else {
+                        1.0
+                    };
+                    let mut s = q;
+                    if index > end_index {
+                        // The rest after: the smoothed angle at its end.
+                        s.angle_deg = (offset + base_angle + angle) as f32;
+                    } else {
+                        s.angle_deg = (offset + f64::from(q.angle_deg) + share * correction) as f32;
+                    }
+                    if let Some(v) = variance {
+                        s.angle_std_deg = Some(
+                            (variance_offset + base_variance + share * v)
+                                .max(0.0)
+                                .sqrt() as f32,
+                        );
+                    }
+                    self.ready.push(s);
+                }
+                // From `until` on the smoothed angle is the causal one plus this offset.
+                self.offset_deg = offset + base_angle + angle - f64::from(end.angle_deg);
+                if let Some(v) = variance {
+                    self.variance_offset =
+                        variance_offset + base_variance + v - variance_of(&end).unwrap_or(0.0);
+                }
+                if let Some(movement) = movement {
+                    smoothed = Some(Smoothed {
+                        movement,
+                        angle_deg: angle as f32,
+                        angle_std_deg: variance.map(|v| v.sqrt() as f32),
+                    });
+                }
+            }
+        }
+        smoothed
+    }
+}
+
+/// `p` with `offset` (deg) added to its angle and `variance_offset` (deg²) to its variance.
+fn shifted(p: &SeriesPoint, offset: f64, variance_offset: f64) -> SeriesPoint {
+    let mut s = *p;
+    s.angle_deg = (offset + f64::from(p.angle_deg)) as f32;
+    if let Some(v) = variance_of(p) {
+        s.angle_std_deg = Some((v + variance_offset).max(0.0).sqrt() as f32);
+    }
+    s
+}
