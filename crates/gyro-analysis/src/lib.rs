@@ -1,6 +1,6 @@
 //! Analysis of gyro logs: replay through exactly the `gyro-core` pipeline the firmware runs,
-//! the model file, noise characterisation, calibration on bench runs and the sim-to-real
-//! diagnosis.
+//! the model file, noise characterisation and calibration on bench runs. The sim-to-real
+//! diagnosis builds on it in `gyro-diagnose`.
 //!
 //! ```no_run
 //! use gyro_analysis::replay;
@@ -12,7 +12,6 @@
 //! ```
 
 pub mod calibrate;
-pub mod diagnose;
 pub mod findings;
 pub mod lag;
 pub mod model;
@@ -20,8 +19,6 @@ pub mod noise;
 pub mod replay;
 pub mod rest_mean;
 pub mod seed;
-#[cfg(test)]
-pub(crate) mod test_log;
 pub mod xcorr;
 
 /// The median of `values` as the upper of the two middle values for an even count (an

@@ -1218,7 +1218,7 @@ mod tests {
     /// A log that starts in motion: 1 kHz at a steady 300 °/s from its first row, the
     /// reference exact, or 12 ms ahead of the gyro and scored with that delay.
     fn turning_log(lead_s: f64) -> RegularLog {
-        crate::test_log::with_reference(
+        gyro_log::RegularLog::with_reference(
             1000.0,
             (0..3000).map(|i| {
                 let time_s = i as f64 * 1e-3;

@@ -168,6 +168,36 @@ pub struct RegularLog {
     pub quality: Quality,
 }
 
+impl RegularLog {
+    /// A log at `sample_rate_hz` of `(time_s, rate_dps, reference_deg)` samples as a reader
+    /// makes of a clean log: every slot read (none filled), no temperature, a clean input
+    /// report. For tests and for callers that hold samples already on a grid.
+    pub fn with_reference(
+        sample_rate_hz: f64,
+        samples: impl IntoIterator<Item = (f64, f64, f64)>,
+    ) -> Self {
+        let slots = samples
+            .into_iter()
+            .enumerate()
+            .map(|(i, (time_s, rate_dps, reference_deg))| Slot {
+                time_s,
+                rate_dps,
+                reference_deg: Some(reference_deg),
+                temperature_c: None,
+                line: i as u64 + 2,
+                filled: false,
+            })
+            .collect();
+        Self {
+            slots,
+            sample_rate_hz,
+            has_reference: true,
+            has_temperature: false,
+            quality: Quality::default(),
+        }
+    }
+}
+
 /// The grid rate is estimated from the median positive step among the first this many
 /// steps, so a log without a rate holds this many rows back before placing any.
 pub const RATE_WINDOW_STEPS: usize = 100_000;

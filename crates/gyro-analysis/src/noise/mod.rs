@@ -33,7 +33,7 @@
 pub mod allan;
 mod chi2;
 pub mod export;
-pub(crate) mod fft;
+pub mod fft;
 pub mod fit;
 mod logs;
 pub mod psd;

@@ -78,7 +78,7 @@ pub fn default_segment_len(longest: usize) -> usize {
 }
 
 /// The periodic Hann window of `len` samples (Welch's segments).
-pub(crate) fn hann(len: usize) -> Vec<f64> {
+pub fn hann(len: usize) -> Vec<f64> {
     (0..len)
         .map(|n| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * n as f64 / len as f64).cos())
         .collect()

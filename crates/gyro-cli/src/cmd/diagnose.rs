@@ -3,9 +3,9 @@
 
 use anyhow::{bail, Result};
 use clap::ValueEnum;
-use gyro_analysis::diagnose::{self, selftest, DiagnoseError, Diagnosis, Options, Progress};
-use gyro_analysis::diagnose::{split, InputEntry, RealRun};
 use gyro_analysis::model;
+use gyro_diagnose::{self as diagnose, selftest, DiagnoseError, Diagnosis, Options, Progress};
+use gyro_diagnose::{split, InputEntry, RealRun};
 use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};

@@ -157,7 +157,7 @@ pub fn run(args: &Args) -> Result<()> {
             }
             // As `diagnose` re-simulates a run: smoothed when the reference is an
             // encoder's, one-sided beside a step of the acceleration.
-            gyro_analysis::diagnose::motion_from_reference(&reference, regular.sample_rate_hz).0
+            gyro_diagnose::motion_from_reference(&reference, regular.sample_rate_hz).0
         }
         None => {
             if !(args.duration_s > 0.0 && args.duration_s <= 86_400.0) {

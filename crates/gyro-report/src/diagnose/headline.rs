@@ -2,7 +2,7 @@
 //! of the trade, rounded to what the interval supports, then what the written model
 //! corrects; and the words for a ΔBIC (Kass & Raftery's scale).
 
-use gyro_analysis::diagnose::{Diagnosis, EffectResult};
+use gyro_diagnose::{Diagnosis, EffectResult};
 
 /// What the held-out columns of an effect not scored on the held-out runs say: its
 /// parameter test does not pass on the training runs, so it can never be named.
@@ -182,7 +182,7 @@ fn correction_name(id: &str) -> String {
         "clock_error" | "clock_error_count_stamped" => "the clock".into(),
         "temperature_bias" => "the bias's temperature slope".into(),
         "temperature_scale" => "the scale's temperature slope".into(),
-        gyro_analysis::diagnose::BIAS_ID => "the bias".into(),
+        gyro_diagnose::BIAS_ID => "the bias".into(),
         other => format!("the {}", other.replace('_', " ")),
     }
 }
@@ -198,8 +198,8 @@ fn and_list(items: &[String]) -> String {
 
 /// The held-out runs' median max |angle error| without and with the written corrections
 /// (deg), and how many runs the corrections made better.
-fn held_out_error(c: &gyro_analysis::diagnose::CompensationSummary) -> (f64, f64, usize) {
-    let median = |f: &dyn Fn(&gyro_analysis::diagnose::CompensationRun) -> f64| {
+fn held_out_error(c: &gyro_diagnose::CompensationSummary) -> (f64, f64, usize) {
+    let median = |f: &dyn Fn(&gyro_diagnose::CompensationRun) -> f64| {
         let v: Vec<f64> = c.runs.iter().map(f).filter(|x| x.is_finite()).collect();
         gyro_analysis::median(&v).unwrap_or(f64::NAN)
     };
@@ -393,7 +393,7 @@ pub fn findings(d: &Diagnosis) -> Findings {
                 .corrected
                 .iter()
                 .map(|id| {
-                    if *id == gyro_analysis::diagnose::BIAS_ID {
+                    if *id == gyro_diagnose::BIAS_ID {
                         format!(
                             "the bias ({:.3} deg/s, fitted on the training runs)",
                             d.model.sensor.bias_dps
@@ -410,7 +410,7 @@ pub fn findings(d: &Diagnosis) -> Findings {
             ));
         }
         for n in &c.not_corrected {
-            if n.id == gyro_analysis::diagnose::BIAS_ID {
+            if n.id == gyro_diagnose::BIAS_ID {
                 named.push(format!(
                     "the bias ({:.3} deg/s, fitted on the training runs) is not written: it did not lower the held-out error",
                     d.model.sensor.bias_dps
@@ -460,7 +460,7 @@ pub fn findings(d: &Diagnosis) -> Findings {
     if missed.is_empty() {
         missed.push(format!(
             "nothing: every statistic of the training runs is within |z| < {} of its simulation with the selected model",
-            gyro_analysis::diagnose::locate::UNEXPLAINED_Z
+            gyro_diagnose::locate::UNEXPLAINED_Z
         ));
     }
     let mut notes = reference_grid_lines(&d.runs);
@@ -484,9 +484,9 @@ pub fn headline(d: &Diagnosis) -> Vec<String> {
 
 /// How the re-simulation took the quantised references of `runs`, one line per kind of
 /// grid: an encoder's counts, or a print's decimals
-/// ([`gyro_analysis::diagnose::ReferenceGrid`]).
-pub fn reference_grid_lines(runs: &[gyro_analysis::diagnose::RunSummary]) -> Vec<String> {
-    use gyro_analysis::diagnose::GridKind;
+/// ([`gyro_diagnose::ReferenceGrid`]).
+pub fn reference_grid_lines(runs: &[gyro_diagnose::RunSummary]) -> Vec<String> {
+    use gyro_diagnose::GridKind;
     let total = runs.len();
     [GridKind::Encoder, GridKind::Print]
         .into_iter()
@@ -531,7 +531,7 @@ pub(super) fn turns_wrote(d: &Diagnosis) -> bool {
     })
 }
 
-/// What the movements show rest to rest ([`gyro_analysis::diagnose::turns`]), one line
+/// What the movements show rest to rest ([`gyro_diagnose::turns`]), one line
 /// each: a lag too long for the per-sample statistics, the turns' scale, and the
 /// movements the reference does not follow.
 pub fn turn_lines(d: &Diagnosis) -> Vec<String> {
@@ -559,7 +559,7 @@ pub fn turn_lines(d: &Diagnosis) -> Vec<String> {
             1e3 * lag.median_s.abs(),
             1e3 * lo,
             1e3 * hi,
-            1e3 * gyro_analysis::diagnose::turns::STATISTIC_LAG_S
+            1e3 * gyro_diagnose::turns::STATISTIC_LAG_S
         ));
     }
     if let Some(s) = &t.scale {
@@ -610,7 +610,7 @@ pub fn turn_lines(d: &Diagnosis) -> Vec<String> {
 }
 
 /// The effective noise on moving data, training runs beside held-out ones.
-fn effective_noise_line(e: &gyro_analysis::diagnose::effective::EffectiveNoise) -> Option<String> {
+fn effective_noise_line(e: &gyro_diagnose::effective::EffectiveNoise) -> Option<String> {
     let t = e.training.as_ref()?;
     let held_out = e.holdout.as_ref().map_or(String::new(), |h| {
         format!(
@@ -732,7 +732,7 @@ mod tests {
 
     #[test]
     fn a_quantised_reference_is_said_once_per_kind_of_grid() {
-        use gyro_analysis::diagnose::{GridKind, ReferenceGrid, RunSummary};
+        use gyro_diagnose::{GridKind, ReferenceGrid, RunSummary};
         let run = |grid: Option<(f64, GridKind, f64)>| RunSummary {
             name: "r".into(),
             role: "train",

@@ -7,7 +7,7 @@
 //! data against simulated envelopes, each with a note on how to read it.
 //!
 //! **Envelopes.** The figures draw [`Envelopes`], which the analysis computes
-//! ([`gyro_analysis::diagnose::envelopes`]): real data against the same statistics of
+//! ([`gyro_diagnose::envelopes`]): real data against the same statistics of
 //! simulated runs, a band spanning the members' minimum to maximum with their median
 //! dashed (the cross-correlation's: a 95% band, mean ± 1.96 sd of the members). The gap
 //! map and the tables use every run. The page renders; it computes nothing.
@@ -17,11 +17,11 @@ use crate::plot::diagnose_plot::{
     AngleErrorPlot, AngleErrorRow, Band, EnvelopePlot, GapMapPlot, Measured, Panel,
 };
 use crate::plot::{render, sig, Figure, ImageFormat, RenderError};
-use gyro_analysis::diagnose::envelopes::{
+use gyro_diagnose::envelopes::{
     quantile, Bins, Envelopes, Measures, Moments, SimModel, PSD_BANDS_PER_DECADE,
 };
-use gyro_analysis::diagnose::MIN_TEMPERATURE_RANGE_C;
-use gyro_analysis::diagnose::{Diagnosis, EffectResult, Options};
+use gyro_diagnose::MIN_TEMPERATURE_RANGE_C;
+use gyro_diagnose::{Diagnosis, EffectResult, Options};
 use gyro_sim::EFFECTS;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -545,7 +545,7 @@ fn gap_map(d: &Diagnosis) -> GapMapPlot {
 }
 
 /// What is corrected, and what is named but not corrected.
-fn subtitle(c: &gyro_analysis::diagnose::CompensationSummary) -> String {
+fn subtitle(c: &gyro_diagnose::CompensationSummary) -> String {
     let mut s = if c.corrected.is_empty() {
         "corrected: none (no correction lowered the held-out error)".to_string()
     } else {
@@ -1106,7 +1106,7 @@ fn unexplained_table(s: &mut String, d: &Diagnosis) {
         let _ = writeln!(
             s,
             "<p>Every statistic of the training runs is within |z| &lt; {} of its simulated ensemble with the selected model: it fits the sensor at hand.</p>",
-            gyro_analysis::diagnose::locate::UNEXPLAINED_Z
+            gyro_diagnose::locate::UNEXPLAINED_Z
         );
         return;
     }
@@ -1118,7 +1118,7 @@ vocabulary, as selected, brings them to the simulation; they are what the sensor
 the reference) does that the model cannot say. Real and simulated values are means over the \
 training runs; the held-out z is with the same model.</p>",
         d.unexplained.len(),
-        gyro_analysis::diagnose::locate::UNEXPLAINED_Z,
+        gyro_diagnose::locate::UNEXPLAINED_Z,
         sig3(d.gap.train_after),
         sig3(d.gap.floor)
     );
@@ -1359,7 +1359,7 @@ mod tests {
 
     use gyro_sim::{Effect, SensorModel};
 
-    use gyro_analysis::diagnose::{
+    use gyro_diagnose::{
         CompensationRun, CompensationSummary, GapSummary, ModelSummary, RunSummary, Verdict,
     };
 
@@ -1391,7 +1391,7 @@ mod tests {
                 fraction_closed_holdout: 0.9,
                 model_fits: false,
             },
-            unexplained: vec![gyro_analysis::diagnose::Unexplained {
+            unexplained: vec![gyro_diagnose::Unexplained {
                 segment: "dynamic".into(),
                 statistic: "residual_std".into(),
                 real: 3.2,
@@ -1488,7 +1488,7 @@ mod tests {
     #[test]
     fn an_unmeasured_signature_is_shown_failing() {
         let mut d = diagnosis();
-        d.effects.push(gyro_analysis::diagnose::EffectResult {
+        d.effects.push(gyro_diagnose::EffectResult {
             id: "clock_error_count_stamped",
             params: std::collections::BTreeMap::from([("ppm", 5737.0)]),
             delta_bic: Some(360.0),
@@ -1503,7 +1503,7 @@ mod tests {
             test: String::new(),
             bootstrap_p: Some(0.0),
             confounded_with: Vec::new(),
-            posterior_check: Some(gyro_analysis::diagnose::posterior::PosteriorCheck {
+            posterior_check: Some(gyro_diagnose::posterior::PosteriorCheck {
                 passes: false,
                 statistics: Vec::new(),
                 unmeasured: true,
@@ -1565,7 +1565,7 @@ mod tests {
 
     #[test]
     fn the_headline_says_what_the_turns_show() {
-        use gyro_analysis::diagnose::turns::{TurnEvidence, TurnScale, Untracked, WideLag};
+        use gyro_diagnose::turns::{TurnEvidence, TurnScale, Untracked, WideLag};
         let mut d = diagnosis();
         d.turns = Some(TurnEvidence {
             train_turns: 12,

@@ -18,7 +18,7 @@ pub use html::{
 };
 pub use text::{self_test_table, table};
 
-use gyro_analysis::diagnose::Diagnosis;
+use gyro_diagnose::Diagnosis;
 
 /// `name` (a run's log path, as given) without the directory all of `d`'s runs share:
 /// the report names runs relative to their input, and long absolute paths that differ

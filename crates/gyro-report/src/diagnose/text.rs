@@ -1,6 +1,6 @@
 //! The diagnosis and the self-check as text (`gyro-cli diagnose`'s table).
 
-use gyro_analysis::diagnose::{selftest, Diagnosis};
+use gyro_diagnose::{selftest, Diagnosis};
 use std::fmt::Write as _;
 
 fn pct(x: f64) -> String {
@@ -119,14 +119,14 @@ fn num(x: f64) -> String {
 /// A posterior check worth listing: it checked something (or could not), for an effect
 /// named or left out by it.
 pub(super) fn shows_posterior(
-    e: &gyro_analysis::diagnose::EffectResult,
-    c: &gyro_analysis::diagnose::posterior::PosteriorCheck,
+    e: &gyro_diagnose::EffectResult,
+    c: &gyro_diagnose::posterior::PosteriorCheck,
 ) -> bool {
     (!c.statistics.is_empty() || c.unmeasured) && (e.significant || !c.passes)
 }
 
 /// Not named because its simulation does not reproduce its signature statistics.
-pub(super) fn fails_posterior(e: &gyro_analysis::diagnose::EffectResult) -> bool {
+pub(super) fn fails_posterior(e: &gyro_diagnose::EffectResult) -> bool {
     e.posterior_check.as_ref().is_some_and(|c| !c.passes)
 }
 
@@ -241,7 +241,7 @@ pub fn table(d: &Diagnosis) -> String {
         let _ = writeln!(
             s,
             "\nunexplained by the selected model (training runs, |z| >= {}; real vs simulated, means over the runs):",
-            gyro_analysis::diagnose::locate::UNEXPLAINED_Z
+            gyro_diagnose::locate::UNEXPLAINED_Z
         );
         let _ = writeln!(
             s,

@@ -5,7 +5,7 @@
 //! all call [`missed`].
 
 use crate::plot::sig;
-use gyro_analysis::diagnose::Unexplained;
+use gyro_diagnose::Unexplained;
 
 /// How a statistic's real and simulated values are compared in words.
 #[derive(Clone, Copy, Debug, PartialEq)]

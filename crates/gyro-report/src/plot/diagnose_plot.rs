@@ -14,7 +14,7 @@ use super::{
     colour, draw_err, legend_corner, legend_size, padded, sig, tick, titled, DrawResult, Figure,
     RenderError, LABEL_PX, TICK_PX,
 };
-use gyro_analysis::diagnose::stretches;
+use gyro_diagnose::stretches;
 use plotters::coord::combinators::BindKeyPoints;
 use plotters::coord::ranged1d::Ranged;
 use plotters::coord::types::RangedCoordf64;

@@ -17,7 +17,7 @@
 
 use super::ensemble::RealRun;
 use super::{diagnose, Diagnosis, Options, Silent};
-use crate::seed::derive_seed;
+use gyro_analysis::seed::derive_seed;
 use gyro_log::{regularize, GridOptions};
 use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions, EFFECTS};
 use serde::Serialize;

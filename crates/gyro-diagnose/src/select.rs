@@ -7,7 +7,7 @@ use super::fit::{self, Fit, Joint};
 use super::posterior::{self, PosteriorCheck};
 use super::score::{bootstrap_p, gap, RunScore};
 use super::{Options, Progress, CONFOUND_COSINE, MAX_EFFECTS};
-use crate::seed::derive_seed;
+use gyro_analysis::seed::derive_seed;
 use gyro_sim::{Effect, SensorModel};
 use std::collections::BTreeMap;
 

@@ -4,7 +4,7 @@
 //! Definitions (every number below is a constant of this module):
 //! - **Reference rate**: the centred difference `(θ[i+h] − θ[i−h]) / (2h·dt)` of the
 //!   reference angle with `h = max(1, round(fs · W / 2))`, W =
-//!   [`crate::xcorr::SMOOTH_WINDOW_S`] ([`crate::xcorr::centred_difference`]). This is exactly
+//!   [`gyro_analysis::xcorr::SMOOTH_WINDOW_S`] ([`gyro_analysis::xcorr::centred_difference`]). This is exactly
 //!   the derivative of the reference angle averaged over a boxcar of `2h` samples
 //!   (≈ 20 ms), centred, so it adds no lag. Samples whose `i ± h` neighbours lack a
 //!   reference (or lie outside the log) get no reference rate and are left out of every
@@ -55,8 +55,8 @@
 //!   static residual mean (the bias; the mean over all samples when there is no static
 //!   run); windows with a sample lacking a residual are skipped: `all`.
 
-use crate::noise::{AllanDeviation, ONE_SIGMA};
-pub use crate::xcorr::{
+use gyro_analysis::noise::{AllanDeviation, ONE_SIGMA};
+pub use gyro_analysis::xcorr::{
     centred_difference, is_at_edge_of, smooth_half_width, xcorr_peak_lag_within, Overlap,
     MIN_SAMPLES,
 };

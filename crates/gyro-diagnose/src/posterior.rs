@@ -284,7 +284,7 @@ fn pooled(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::stats::Stat;
+    use crate::stats::Stat;
     use gyro_sim::EFFECTS;
 
     /// A fit of effect `id` at its typical value, with a 95% interval of ±1.96 times

@@ -14,7 +14,7 @@
 //! rate (the rests' noise coloured). Small ensembles keep it quick.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use gyro_analysis::diagnose::{diagnose, split, Options, RealRun, Silent};
+use gyro_diagnose::{diagnose, split, Options, RealRun, Silent};
 use gyro_log::{load, GridOptions, LogOptions};
 use std::path::PathBuf;
 
@@ -46,14 +46,14 @@ fn quick() -> Options {
 }
 
 /// The diagnosis trained on `train` and held out on `holdout` (fixture files).
-fn diagnosed(train: &str, holdout: &str) -> gyro_analysis::diagnose::Diagnosis {
+fn diagnosed(train: &str, holdout: &str) -> gyro_diagnose::Diagnosis {
     let (train, holdout) = (windows(train), windows(holdout));
     assert_eq!((train.len(), holdout.len()), (4, 4));
     diagnose(&train, &holdout, &quick(), &Silent).unwrap()
 }
 
 /// The effect `id`'s 95% interval of `key` holds `truth`.
-fn covers(d: &gyro_analysis::diagnose::Diagnosis, id: &str, key: &str, truth: f64) {
+fn covers(d: &gyro_diagnose::Diagnosis, id: &str, key: &str, truth: f64) {
     let e = d.effects.iter().find(|e| e.id == id).unwrap();
     let [lo, hi] = e.ci95[key];
     assert!(
@@ -87,9 +87,8 @@ fn a_moving_sensor_from_another_generator_gets_its_own_noise_and_effects() {
     assert!(d.verdict.fraction_closed_holdout > 0.8, "{:?}", d.verdict);
     let c = d.compensation.as_ref().unwrap();
     assert!(c.corrected.contains(&"latency"), "{:?}", c.corrected);
-    let total = |f: &dyn Fn(&gyro_analysis::diagnose::CompensationRun) -> f64| -> f64 {
-        c.runs.iter().map(f).sum()
-    };
+    let total =
+        |f: &dyn Fn(&gyro_diagnose::CompensationRun) -> f64| -> f64 { c.runs.iter().map(f).sum() };
     let (before, after) = (
         total(&|r| r.max_abs_error_before_deg),
         total(&|r| r.max_abs_error_after_deg),

@@ -29,6 +29,33 @@
 //! [`diagnose`] runs this as stages, one module each: `baseline` (1), `locate` (2),
 //! `fit` and `select` (3), `compensate` (the correctable effects replayed through
 //! the core) and `summarise` (4, and the [`Diagnosis`]).
+//!
+//! ```no_run
+//! use gyro_diagnose::{diagnose, split, Options, RealRun, Silent};
+//! use gyro_log::{load, GridOptions, LogOptions};
+//!
+//! let log = load(
+//!     "fixtures/logs/bench_run.csv".as_ref(),
+//!     &LogOptions::default(),
+//!     &GridOptions::default(),
+//!     &mut |_| {},
+//! )?;
+//! // 30 s windows: the first two train, the rest are held out.
+//! let mut runs = split(&log, 30.0)
+//!     .into_iter()
+//!     .enumerate()
+//!     .map(|(i, w)| RealRun::prepare(format!("window {i}"), w))
+//!     .collect::<Result<Vec<_>, _>>()?;
+//! let holdout = runs.split_off(2);
+//! let result = diagnose(&runs, &holdout, &Options::default(), &Silent)?;
+//! println!(
+//!     "named: {:?}, held-out gap closed: {:.0}%, model fits: {}",
+//!     result.verdict.unmodelled,
+//!     100.0 * result.verdict.fraction_closed_holdout,
+//!     result.verdict.model_fits
+//! );
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 mod baseline;
 pub(crate) mod compensate;
@@ -63,7 +90,7 @@ use baseline::Runs;
 use fit::FitInput;
 use select::Scorer;
 
-use crate::model::ModelFile;
+use gyro_analysis::model::ModelFile;
 use gyro_sim::SensorModel;
 
 /// Most effects the forward selection adds.

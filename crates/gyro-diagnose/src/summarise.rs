@@ -9,7 +9,7 @@ use super::{
     CompensationSummary, Diagnosis, EffectResult, GapSummary, ModelSummary, Options, Progress,
     RealRun, RunSummary, UntestableEntry, Verdict, Where,
 };
-use crate::model::ModelFile;
+use gyro_analysis::model::ModelFile;
 use gyro_sim::{Effect, SensorModel};
 
 /// The training runs with the selected effects: their scores and G.
@@ -329,7 +329,7 @@ fn lag_warnings(runs: &Runs) -> Vec<String> {
     // What the lag is, searched wider on those runs.
     let measured: Vec<f64> = cut
         .iter()
-        .filter_map(|(r, _)| crate::lag::log_lag_s(&r.log))
+        .filter_map(|(r, _)| gyro_analysis::lag::log_lag_s(&r.log))
         .collect();
     let wider = match (
         measured.iter().copied().reduce(f64::min),
@@ -337,7 +337,7 @@ fn lag_warnings(runs: &Runs) -> Vec<String> {
     ) {
         (Some(lo), Some(hi)) => format!(
             "; searched within ±{:.0} ms, those runs give {:+.0} to {:+.0} ms (+: the gyro lags)",
-            1e3 * crate::lag::SEARCH_S,
+            1e3 * gyro_analysis::lag::SEARCH_S,
             1e3 * lo,
             1e3 * hi
         ),

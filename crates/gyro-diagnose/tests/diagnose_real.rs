@@ -9,10 +9,11 @@
 //! README's figures come from the full recordings.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+#[path = "../../gyro-analysis/tests/common/mod.rs"]
 mod common;
 
 use common::real_log;
-use gyro_analysis::diagnose::{diagnose, split, Options, RealRun, Silent};
+use gyro_diagnose::{diagnose, split, Options, RealRun, Silent};
 use gyro_log::GridOptions;
 
 /// Small ensembles and `bootstrap` resamples: quick enough for a test.
@@ -90,9 +91,8 @@ fn latency_is_named_on_real_yaw_and_its_correction_does_not_hurt() {
     }
     // What is written lowers the held-out error; what would not is named, not corrected.
     let c = d.compensation.as_ref().unwrap();
-    let total = |f: &dyn Fn(&gyro_analysis::diagnose::CompensationRun) -> f64| -> f64 {
-        c.runs.iter().map(f).sum()
-    };
+    let total =
+        |f: &dyn Fn(&gyro_diagnose::CompensationRun) -> f64| -> f64 { c.runs.iter().map(f).sum() };
     let before = total(&|r| r.max_abs_error_before_deg);
     let after = total(&|r| r.max_abs_error_after_deg);
     assert!(after <= before, "{before} -> {after}");
@@ -249,7 +249,7 @@ fn a_lag_beyond_the_statistic_leaves_the_scale_to_the_turns() {
     let d = diagnose(&train, &holdout, &quick(500), &Silent).unwrap();
     let c = d.compensation.as_ref().unwrap();
     assert!(!c.corrected.contains(&"scale_factor"), "{c:?}");
-    let from_turns = gyro_analysis::diagnose::SCALE_FROM_TURNS;
+    let from_turns = gyro_diagnose::SCALE_FROM_TURNS;
     assert!(
         c.not_corrected
             .iter()

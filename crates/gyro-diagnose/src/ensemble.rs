@@ -11,7 +11,7 @@ use super::features::{
     WANDER_TAUS_S,
 };
 use super::stats::{residuals, residuals_of, stats_of, Residuals, Stat, StatsError};
-use crate::seed::derive_seed;
+use gyro_analysis::seed::derive_seed;
 use gyro_log::RegularLog;
 use gyro_sim::{rounding_noise_dps, simulate_series, Effect, Motion, SensorModel, SimOptions};
 use rayon::prelude::*;
@@ -720,7 +720,7 @@ mod tests {
         };
         let s = simulate_series(&model, &[], &motion, &options, None);
         let scale = 10f64.powi(decimals);
-        let log = crate::test_log::with_reference(
+        let log = gyro_log::RegularLog::with_reference(
             fs,
             (0..s.rate_dps.len()).map(|k| {
                 let reference_deg = (s.reference_deg[k] * scale).round() / scale;
@@ -757,7 +757,7 @@ mod tests {
     }
 
     fn stamped(fs: f64, clock: f64, source: &'static str, jitter_s: f64) -> RegularLog {
-        let mut log = crate::test_log::with_reference(
+        let mut log = gyro_log::RegularLog::with_reference(
             fs,
             (0..20_000).map(|k| {
                 // A fixed pseudo-random jitter pattern (±jitter_s).

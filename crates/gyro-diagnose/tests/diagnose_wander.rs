@@ -11,9 +11,9 @@
 //! test.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use gyro_analysis::diagnose::selftest::{case_runs, magnitudes};
-use gyro_analysis::diagnose::{diagnose, Options, Silent};
 use gyro_analysis::seed::derive_seed;
+use gyro_diagnose::selftest::{case_runs, magnitudes};
+use gyro_diagnose::{diagnose, Options, Silent};
 
 #[test]
 fn a_random_walk_is_named_on_its_replicated_allan_excess() {

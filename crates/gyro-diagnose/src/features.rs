@@ -42,8 +42,8 @@
 
 use super::low_band;
 use super::stats::{smooth_half_width, stretches, Residuals};
-use crate::noise::fft::fft_in_place;
-use crate::noise::AllanDeviation;
+use gyro_analysis::noise::fft::fft_in_place;
+use gyro_analysis::noise::AllanDeviation;
 
 /// Number of regressors.
 pub const N_REG: usize = 10;
@@ -220,7 +220,7 @@ type Spectra = (Vec<f64>, Vec<f64>, Vec<(f64, f64)>);
 fn line_spectra(r: &Residuals) -> Spectra {
     let len = line_segment_len(r.sample_rate_hz);
     let both = |i: usize| r.rate_dps[i].is_finite() && r.reference_rate_dps[i].is_finite();
-    let window = crate::noise::psd::hann(len);
+    let window = gyro_analysis::noise::psd::hann(len);
     let bins = len / 2 + 1;
     let (mut sgg, mut srr) = (vec![0.0; bins], vec![0.0; bins]);
     let (mut sgr_re, mut sgr_im) = (vec![0.0; bins], vec![0.0; bins]);
@@ -771,7 +771,7 @@ fn solve_spd(a: &[[f64; N_REG]; N_REG], b: &[f64; N_REG], n: usize) -> Option<[f
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::stats::residuals_of;
+    use crate::stats::residuals_of;
     use gyro_sim::{
         simulate_series, BenchProfile, Effect, Motion, Rotation, SensorModel, SimOptions,
     };

@@ -156,7 +156,7 @@ pub(crate) fn unexplained(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::stats::Stat;
+    use crate::stats::Stat;
 
     fn run(entries: &[(&str, f64, f64, f64)]) -> RunScore {
         // (statistic, real value, ensemble mean, z)

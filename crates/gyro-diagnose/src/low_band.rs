@@ -119,7 +119,7 @@ mod tests {
     /// (`fixtures/filters/low_band.py`).
     #[test]
     fn matches_scipy_sosfiltfilt() {
-        let text = include_str!("../../../../fixtures/filters/low_band.csv");
+        let text = include_str!("../../../fixtures/filters/low_band.csv");
         let rows: Vec<(f64, f64)> = text
             .lines()
             .filter(|l| !l.starts_with('#') && !l.starts_with("x"))

@@ -25,8 +25,8 @@ use super::ensemble::{simulate_residuals, RealRun};
 use super::features::regression_residual;
 use super::fit::WHITE_CHECK_Z;
 use super::stats::stretches;
-use crate::noise::export::{band_white_variance, WHITE_TAUS_S};
-use crate::seed::derive_seed;
+use gyro_analysis::noise::export::{band_white_variance, WHITE_TAUS_S};
+use gyro_analysis::seed::derive_seed;
 use gyro_sim::SensorModel;
 use serde::Serialize;
 

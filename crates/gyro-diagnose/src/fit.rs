@@ -12,8 +12,8 @@
 
 use super::ensemble::{simulate_features, simulate_member, Member, RealRun, StampedClock};
 use super::features::{reg, CUBIC_SCALE_DPS, N_REG, WANDER_TAUS_S};
-use crate::noise::fit::gauss_markov_avar_continuous;
-use crate::noise::{chi2_quantile, rate_step};
+use gyro_analysis::noise::fit::gauss_markov_avar_continuous;
+use gyro_analysis::noise::{chi2_quantile, rate_step};
 use gyro_sim::{
     Effect, EffectInfo, FitProcedure, Reading, Regressor, SensorModel, WanderShape, EFFECTS,
 };
@@ -471,8 +471,10 @@ pub fn nominal_model(
         model.gm_sigma_dps, model.gm_tau_s, model.lsb_dps, model.range_dps
     );
     if let Some(m) = moving {
-        let k_prior =
-            crate::noise::export::gauss_markov_random_walk(model.gm_sigma_dps, model.gm_tau_s);
+        let k_prior = gyro_analysis::noise::export::gauss_markov_random_walk(
+            model.gm_sigma_dps,
+            model.gm_tau_s,
+        );
         let k = m.rate_random_walk_dps_per_rt_s;
         let verdict = match (m.rate_random_walk_resolved, k_prior <= k) {
             (true, _) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, against {k:.3e} fitted to the training residual (a larger wander is the vocabulary's to name)"),

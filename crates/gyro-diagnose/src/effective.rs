@@ -9,13 +9,13 @@
 //! residual (`features::real_features`: the smoothed gyro minus the reference rate,
 //! minus the full-band regression on rate, acceleration, jerk, … — the deterministic
 //! terms), characterised as `gyro-cli noise` characterises a static log
-//! ([`crate::noise::characterize`]), from τ = 0.1 s. On periodic motion that Allan
+//! ([`gyro_analysis::noise::characterize`]), from τ = 0.1 s. On periodic motion that Allan
 //! deviation is seldom a clean −½ line: the rig's lines and the motion's period leave
 //! bounded errors whose Allan deviation falls as 1/τ (on the ssong medium trial the
 //! residual's power is 96% at the 40 Hz stepper line). So the angle random walk N is the
 //! largest white noise the curve allows at every τ from 1 s (where the convention reads
 //! N) to 10 s (a long movement), the fitted rate random walk taken off
-//! ([`crate::noise::export::white_bound`]): what accumulates into angle over a movement.
+//! ([`gyro_analysis::noise::export::white_bound`]): what accumulates into angle over a movement.
 //! The rate random walk K and the bias instability B are the fit's, where it resolves
 //! them. The residual's own smoothing (the reference derivative's ±h samples) only
 //! touches τ of a few samples; the reference's differentiation noise falls off as 1/τ and
@@ -27,8 +27,8 @@
 
 use super::ensemble::RealRun;
 use super::stats::stretches;
-use crate::noise::export::{residual_random_walk, white_bound, white_level};
-use crate::noise::{characterize, Characterization, NoiseOptions, TauGrid};
+use gyro_analysis::noise::export::{residual_random_walk, white_bound, white_level};
+use gyro_analysis::noise::{characterize, Characterization, NoiseOptions, TauGrid};
 use serde::Serialize;
 
 /// Shortest stretch of residual used (s): shorter ones add no τ worth reading.
@@ -53,7 +53,7 @@ pub struct MeasuredNoise {
     pub arw_deg_per_rt_h: f64,
     /// The white noise the residual reads (deg/√h): 60 × the level its Allan deviation
     /// gives from τ = 1 s to 10 s, an estimate rather than a bound
-    /// ([`crate::noise::export::white_level`]); what the baseline of runs that never
+    /// ([`gyro_analysis::noise::export::white_level`]); what the baseline of runs that never
     /// rest simulates.
     pub white_level_deg_per_rt_h: f64,
     /// Rate random walk K (deg/s/√s), as the filter YAML writes it: the fitted +1/2 line

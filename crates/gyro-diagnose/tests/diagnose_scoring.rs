@@ -7,7 +7,7 @@
 //! ensembles keep it quick.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use gyro_analysis::diagnose::{diagnose, Options, RealRun, Silent};
+use gyro_diagnose::{diagnose, Options, RealRun, Silent};
 use gyro_log::{regularize, GridOptions};
 use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
 

@@ -9,7 +9,7 @@
 //! still (the middle of the rests around it, [`scale::rest_to_rest`]), do not depend on
 //! the reference's timing at all. From them, on top of the model the diagnosis wrote:
 //! - **lag**: each run's gyro–reference cross-correlation peak searched within
-//!   ±[`crate::lag::SEARCH_S`] ([`crate::lag::log_lag_s`]), median over the training runs;
+//!   ±[`gyro_analysis::lag::SEARCH_S`] ([`gyro_analysis::lag::log_lag_s`]), median over the training runs;
 //! - **scale**: the least-squares slope of the training turns' errors on their reference
 //!   turns ([`scale::fit`]), named when it is [`Z_CRITICAL`] standard errors from zero, at
 //!   least [`MIN_K`], and the held-out runs' own turns show it too (their slope, before
@@ -31,14 +31,14 @@ use super::stats::MAX_LAG_S;
 
 /// Largest lag the per-sample cross-correlation statistic searches (s).
 pub const STATISTIC_LAG_S: f64 = MAX_LAG_S;
-use crate::calibrate::scale::{self, MovementTotal};
-use crate::model::ModelFile;
-use crate::replay::{replay_with, ReplayOptions, RunReport};
+use gyro_analysis::calibrate::scale::{self, MovementTotal};
+use gyro_analysis::model::ModelFile;
+use gyro_analysis::replay::{replay_with, ReplayOptions, RunReport};
 use rayon::prelude::*;
 use serde::Serialize;
 
 /// The rule for a movement the reference does not follow is `run`'s too: one home.
-pub use crate::findings::{not_followed, UNTRACKED_FRACTION, UNTRACKED_MIN_DEG};
+pub use gyro_analysis::findings::{not_followed, UNTRACKED_FRACTION, UNTRACKED_MIN_DEG};
 
 /// Smallest scale error named (1 = 100%): 0.1% is 0.09° on a 90° turn, below what the
 /// totals of real turns resolve, and what the pipeline's own filtering and grid leave on
@@ -62,7 +62,7 @@ pub struct TurnEvidence {
 }
 
 /// The gyro's lag behind the reference, each run's cross-correlation peak within
-/// ±[`crate::lag::SEARCH_S`].
+/// ±[`gyro_analysis::lag::SEARCH_S`].
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct WideLag {
     /// Median over the training runs (s; positive: the gyro lags).
@@ -195,10 +195,10 @@ pub(crate) fn turn_evidence(
 }
 
 /// Each run's gyro–reference lag searched wide (s), where it is measured
-/// ([`crate::lag::log_lag_s`]).
+/// ([`gyro_analysis::lag::log_lag_s`]).
 pub(crate) fn run_lags_s(runs: &[RealRun]) -> Vec<f64> {
     runs.par_iter()
-        .filter_map(|r| crate::lag::log_lag_s(&r.log))
+        .filter_map(|r| gyro_analysis::lag::log_lag_s(&r.log))
         .collect()
 }
 
@@ -240,7 +240,7 @@ fn wide_lag(
         let before = max_abs_errors(holdout, model);
         let after = max_abs_errors(holdout, &trial);
         let paired = paired_gains(&before, &after);
-        let seed = crate::seed::derive_seed(options.seed, "turns-lag", 0);
+        let seed = gyro_analysis::seed::derive_seed(options.seed, "turns-lag", 0);
         let p = bootstrap_p(&paired, options.bootstrap.max(1), seed);
         out.holdout_max_abs_error_deg = median(&before).zip(median(&after));
         out.bootstrap_p = Some(p);
@@ -285,7 +285,7 @@ fn turn_scale(
         .filter(|d| d.is_finite())
         .collect();
     let better = paired.iter().filter(|d| **d > 0.0).count();
-    let seed = crate::seed::derive_seed(options.seed, "turns-scale", 0);
+    let seed = gyro_analysis::seed::derive_seed(options.seed, "turns-scale", 0);
     let p = bootstrap_p(&paired, options.bootstrap.max(1), seed);
 
     let z = k / se;
@@ -341,7 +341,7 @@ mod tests {
         let seen = |t: f64| ramp(t, 2.0, 1.5, 120.0) + ramp(t, 8.0, 1.2, -90.0);
         let unseen = |t: f64| ramp(t, 5.0, 0.8, 5.0);
         let n = (11.0 * fs) as usize;
-        let log = crate::test_log::with_reference(
+        let log = gyro_log::RegularLog::with_reference(
             fs,
             (0..n).map(|i| {
                 let t = i as f64 / fs;

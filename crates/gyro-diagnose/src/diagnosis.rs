@@ -1,7 +1,7 @@
 //! The diagnosis: the JSON contract of `diagnose --format json`, plus what the report
 //! and `--out` need (not serialised).
 
-use crate::model::ModelFile;
+use gyro_analysis::model::ModelFile;
 use gyro_sim::{Effect, SensorModel};
 use serde::Serialize;
 use std::collections::BTreeMap;

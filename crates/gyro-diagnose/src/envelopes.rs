@@ -5,7 +5,7 @@
 //! (`member_seed` of run and member), [`REPORT_MEMBERS`] members each, so the nominal
 //! band is drawn from the very ensemble the z-scores were computed against. Every real
 //! and simulated run goes through the same residuals (`residuals`) and [`Measures`],
-//! pooled over the runs (like [`crate::noise`] pools segments) for the real runs and,
+//! pooled over the runs (like [`gyro_analysis::noise`] pools segments) for the real runs and,
 //! member by member, for the simulated ones. When the runs hold more than
 //! [`SAMPLE_BUDGET`] samples, an evenly spaced subset of training and held-out runs is
 //! used (real and simulated alike).
@@ -14,7 +14,7 @@ use super::ensemble::{member_seed, simulate_residuals, RealRun};
 use super::features::MIN_TEMPERATURE_RANGE_C;
 use super::stats::{residuals, stretches, Residuals, MAX_LAG_S};
 use super::{Diagnosis, Options};
-use crate::noise::{welch, AllanDeviation, PsdOptions, TauGrid, ONE_SIGMA};
+use gyro_analysis::noise::{welch, AllanDeviation, PsdOptions, TauGrid, ONE_SIGMA};
 use gyro_sim::{Effect, SensorModel};
 use rayon::prelude::*;
 use std::collections::BTreeMap;

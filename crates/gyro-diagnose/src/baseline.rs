@@ -134,14 +134,16 @@ pub(crate) fn baseline(runs: &Runs, options: &Options, progress: &dyn Progress) 
         } = fit::nominal_model(&runs.train, &options.prior, moving.as_ref(), short.as_ref());
         // The prior's range is the CRM100's: any run, trained on or held out, that reads
         // beyond it shows it is not this sensor's (it is not fitted, only refused).
-        let largest = crate::model::largest_plausible_abs_rate(
+        let largest = gyro_analysis::model::largest_plausible_abs_rate(
             runs.train
                 .iter()
                 .chain(&runs.holdout)
                 .map(|r| r.features.max_abs_rate_dps),
             options.base_model.config.max_abs_rate_dps,
         );
-        if let Some(note) = crate::model::contradicted_range_note(nominal.range_dps, largest) {
+        if let Some(note) =
+            gyro_analysis::model::contradicted_range_note(nominal.range_dps, largest)
+        {
             nominal.range_dps = f64::from(gyro_core::Config::default().max_abs_rate_dps);
             notes.push(note);
         }

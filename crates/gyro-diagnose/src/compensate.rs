@@ -10,8 +10,8 @@
 
 use super::ensemble::RealRun;
 use super::{CompensationRun, CompensationSummary, NotCorrected};
-use crate::model::ModelFile;
-use crate::replay::{replay_with, ReplayOptions};
+use gyro_analysis::model::ModelFile;
+use gyro_analysis::replay::{replay_with, ReplayOptions};
 use gyro_core::Compensation;
 use gyro_sim::{CoreCorrection, Effect};
 use rayon::prelude::*;
@@ -151,7 +151,7 @@ pub(crate) fn compensate(
         let (model, _) = with_tries(base, &trial);
         let after = max_abs_errors(holdout, &model);
         let paired = paired_gains(&current, &after);
-        let seed = crate::seed::derive_seed(options.seed, "correction", k as u64);
+        let seed = gyro_analysis::seed::derive_seed(options.seed, "correction", k as u64);
         let p = super::score::bootstrap_p(&paired, options.bootstrap.max(1), seed);
         let reason = match t {
             Try::Effect(e) if scale_from_turns && is_scale(e) => Some(SCALE_FROM_TURNS),
@@ -207,7 +207,7 @@ pub(super) fn paired_gains(without: &[f64], with: &[f64]) -> Vec<f64> {
 /// Median of the finite values (NaN when none).
 pub(super) fn median(values: &[f64]) -> f64 {
     let finite: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-    crate::median(&finite).unwrap_or(f64::NAN)
+    gyro_analysis::median(&finite).unwrap_or(f64::NAN)
 }
 
 /// Max abs angle error of every held-out run replayed with `model` (NaN when a run

@@ -20,7 +20,7 @@
 use super::ensemble::{Member, RealRun};
 use super::features::{line_resolution_hz, Features};
 use super::fit::mean_sd;
-use crate::median;
+use gyro_analysis::median;
 
 /// A line must also stand this many times above its local floor (on the training runs to
 /// be found, on the held-out runs to replicate): the null replicas' spectra are smooth,
@@ -289,7 +289,7 @@ mod tests {
 
     #[test]
     fn a_sinusoid_is_measured_by_frequency_and_amplitude() {
-        use crate::noise::psd::{welch, PsdOptions};
+        use gyro_analysis::noise::psd::{welch, PsdOptions};
         let fs = 1000.0;
         let n = 60_000;
         // White noise from a fixed LCG, plus 0.2 deg/s at 37 Hz.
