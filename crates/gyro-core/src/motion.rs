@@ -40,15 +40,16 @@ pub struct MotionConfig {
 }
 
 impl Default for MotionConfig {
-    /// Tuned for a CRM100 at 1 kHz, decimated to 50 Hz and low-passed at 10 Hz (the
+    /// Tuned for a CRM100 at 1 kHz, decimated to 50 Hz and low-passed at 12.5 Hz (the
     /// default [`crate::Config`]; white noise of 0.05–0.1 deg/s rms per input sample leaves
-    /// at most about 0.019 deg/s rms):
+    /// 0.008–0.016 deg/s rms at the output, measured with `gyro-cli run --out` on a static
+    /// log of that noise):
     ///
     /// - `exit_dps` 0.08 (above 4 σ of that noise): a smooth rotation starts and ends where
     ///   its rate crosses this level, so a lower level finds its ends closer to the truth.
     ///   A 90° rotation in 4 s with a raised-cosine rate is still below 0.1 deg/s for
     ///   60 ms after it started; at the former 0.3 deg/s the ends of such rotations were
-    ///   missed by up to 0.11 s (the pipeline tests now see at most 55 ms).
+    ///   missed by up to 0.11 s (the pipeline tests see at most 55 ms).
     /// - `enter_dps` 2.0: above the sensor's bias (up to ±1 deg/s) with margin. At
     ///   power-up, before a rest has measured the bias, the reference is
     ///   `initial_bias_dps`; with the former 1.0 a bias of 1 deg/s was taken for a
