@@ -30,20 +30,7 @@ const TRIM_S: f64 = 0.25;
 type Turn = (f64, f64, f64);
 
 fn recordings() -> Vec<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/real/rasteiro");
-    let mut found: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .map(|entries| {
-            entries
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.extension().is_some_and(|x| x == "csv"))
-                .collect()
-        })
-        .unwrap_or_default();
-    found.sort();
-    if found.is_empty() {
-        eprintln!("skipped: no recordings in {}", dir.display());
-    }
-    found
+    gyro_log::real_data::csv_files("rasteiro")
 }
 
 /// Angles folded into [−180, 180).

@@ -5,7 +5,7 @@
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 mod common;
-use common::{gyro, json_of, ok, temp_dir, workspace_root};
+use common::{gyro, json_of, ok, temp_dir};
 
 /// The codes of a JSON report's findings, in order.
 fn codes(report: &serde_json::Value) -> Vec<String> {
@@ -133,11 +133,11 @@ fn a_lag_that_grows_is_said_everywhere() {
 /// the robot's turns about the other axes are flagged.
 #[test]
 fn real_recordings_say_what_their_figures_do_not() {
-    let real = workspace_root().join("../shared/data/real");
+    let real = gyro_log::real_data::dir();
     let ssong = real.join("ssong_x_slow.csv");
     let rasteiro = real.join("rasteiro/rasteiro_MPU6050RM3100_V_300_x.csv");
     if !ssong.exists() || !rasteiro.exists() {
-        eprintln!("skipped: no real logs in {}", real.display());
+        gyro_log::real_data::skipped(&format!("{} or {}", ssong.display(), rasteiro.display()));
         return;
     }
     let report = same_in_table_and_json(ssong.to_str().unwrap());

@@ -119,10 +119,10 @@ fn json_carries_saturated_on_every_movement() {
 /// none either.
 #[test]
 fn a_model_from_a_faster_sensor_claims_no_range() {
-    let real = common::workspace_root().join("../shared/data/real/rasteiro");
+    let real = gyro_log::real_data::dir().join("rasteiro");
     let log = real.join("rasteiro_MPU6500RM3100_V1500_z.csv");
     if !log.exists() {
-        eprintln!("skipped: {} is not here", log.display());
+        gyro_log::real_data::skipped(&log.display().to_string());
         return;
     }
     let log = log.to_str().unwrap();

@@ -415,14 +415,14 @@ fn streaming_equals_materialising_on_fixtures_and_generated_logs() {
 /// The real logs (shared/data/real beside the workspace), when present.
 #[test]
 fn streaming_equals_materialising_on_real_logs() {
-    let real = workspace_root().join("../shared/data/real");
+    let real = gyro_log::real_data::dir();
     let logs: Vec<PathBuf> = ["x", "y", "z"]
         .iter()
         .map(|axis| real.join(format!("ssong_{axis}_slow.csv")))
         .filter(|p| p.exists())
         .collect();
     if logs.is_empty() {
-        eprintln!("skipped: no real logs in {}", real.display());
+        gyro_log::real_data::skipped(&format!("ssong_*_slow.csv in {}", real.display()));
         return;
     }
     for path in &logs {

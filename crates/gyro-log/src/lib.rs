@@ -26,6 +26,7 @@ mod csv_log;
 pub mod jumps;
 mod load;
 pub mod mcap;
+pub mod real_data;
 mod regular;
 pub mod sense;
 pub mod value;

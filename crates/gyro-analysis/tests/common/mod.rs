@@ -3,17 +3,10 @@
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use gyro_log::{load, GridOptions, LogOptions, RegularLog};
-use std::path::PathBuf;
 
 /// `relative` (to ../shared/data/real) placed on the grid `grid` says, or `None` (and a
 /// note) when the recordings are not beside the workspace.
 pub fn real_log(relative: &str, grid: &GridOptions) -> Option<RegularLog> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/real")
-        .join(relative);
-    if !path.exists() {
-        eprintln!("skipped: {} not present", path.display());
-        return None;
-    }
+    let path = gyro_log::real_data::path(relative)?;
     Some(load(&path, &LogOptions::default(), grid, &mut |_| {}).unwrap())
 }
