@@ -384,6 +384,7 @@ c "run --out /dev/stdout (a device: written, not refused)" ok "" "\$G run in/goo
 c "record --port missing" refuse "/dev/no-such-port" "\$G record --port /dev/no-such-port -o out/r.mcap"
 c "emulate --port missing folder" refuse "no-such-dir" "\$G emulate --port /no-such-dir/tty --duration-s 1"
 c "emulate --create-pty, nobody reads" refuse "" "\$G emulate --create-pty --duration-s 2 --write-timeout-s 1"
+c "emulate --create-pty, nobody reads, default timeout" refuse "is anything reading it?" "\$G emulate --create-pty --duration-s 30"
 c "emulate --create-pty, nobody reads: the stalled port said" refuse "is anything reading it?" "\$G emulate --create-pty --duration-s 30 --write-timeout-s 2"
 c "run > /dev/full" refuse "stdout" "\$G run in/good.csv >/dev/full"
 c "calibrate > /dev/full" late "stdout" "\$G calibrate in/good.csv --no-leave-one-out -o out/m.json >/dev/full"

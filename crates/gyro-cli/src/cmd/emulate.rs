@@ -54,8 +54,9 @@ pub struct Args {
     /// `typical,seed=7` or `drop=1e-3,bit_flip=5e-4`.
     #[arg(long, default_value = "none", value_parser = FaultSpec::parse)]
     faults: FaultSpec,
-    /// Give up when the port takes no byte for this many seconds (nobody reading it).
-    #[arg(long, default_value_t = 30.0, value_parser = gyro_log::value::positive::<f64>)]
+    /// Give up when the port takes no byte for this many seconds (nobody reading it): at
+    /// 1 kHz the bridge sends 6 kB a second, so a reader away this long has lost its data.
+    #[arg(long, default_value_t = 5.0, value_parser = gyro_log::value::positive::<f64>)]
     write_timeout_s: f64,
     /// Write the fault log (the report, with every lost sequence number) as JSON here.
     #[arg(long)]
