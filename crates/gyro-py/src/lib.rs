@@ -620,6 +620,155 @@ impl Stream {
     }
 }
 
+/// The options of `gyro-cli noise` that do not write files (each named after its flag).
+#[derive(Clone, Debug)]
+pub struct NoiseOptions {
+    /// `--static-only`.
+    pub static_only: bool,
+    /// `--margin-s`.
+    pub margin_s: f64,
+    /// `--min-rest-s`.
+    pub min_rest_s: f64,
+    /// `--model`.
+    pub model: Option<PathBuf>,
+    /// `--tau-grid` (`log`, `octave`, `decade`).
+    pub tau_grid: String,
+    /// `--per-decade`.
+    pub per_decade: u32,
+    /// `--confidence`.
+    pub confidence: f64,
+    /// `--psd-segment`.
+    pub psd_segment: Option<usize>,
+    /// `--sample-rate-hz`, `--max-gap-s`.
+    pub grid: GridOptions,
+    /// The CSV and MCAP input options (time and rate only).
+    pub input: LogOptions,
+}
+
+impl Default for NoiseOptions {
+    fn default() -> Self {
+        Self {
+            static_only: false,
+            margin_s: 0.5,
+            min_rest_s: 1.0,
+            model: None,
+            tau_grid: "log".into(),
+            per_decade: 10,
+            confidence: gyro_analysis::noise::ONE_SIGMA,
+            psd_segment: None,
+            grid: GridOptions::default(),
+            input: LogOptions::default(),
+        }
+    }
+}
+
+/// `gyro-cli noise LOG... --format json` (`files`: the logs as given): its JSON text.
+pub fn noise_files(paths: &[PathBuf], files: &[String], o: &NoiseOptions) -> Result<String, Error> {
+    use gyro_analysis::noise::{self, NoiseLog, PsdOptions, TauGrid};
+    if paths.is_empty() {
+        return Err(Error("noise needs at least one log".into()));
+    }
+    if !(o.confidence > 0.0 && o.confidence < 1.0) {
+        return Err(Error("--confidence must be in (0, 1)".into()));
+    }
+    if !(o.margin_s >= 0.0 && o.min_rest_s >= 0.0) {
+        return Err(Error("--margin-s and --min-rest-s must be >= 0".into()));
+    }
+    if o.per_decade < 1 {
+        return Err(Error(
+            "invalid value 0 for per_decade: expected at least 1".into(),
+        ));
+    }
+    if let Some(len) = o.psd_segment {
+        if len < 2 || !len.is_power_of_two() {
+            return Err(Error("--psd-segment must be a power of two >= 2".into()));
+        }
+    }
+    let taus = match o.tau_grid.as_str() {
+        "log" => TauGrid::PerDecade(o.per_decade),
+        "octave" => TauGrid::Octave,
+        "decade" => TauGrid::Decade,
+        other => {
+            return Err(Error(format!(
+                "invalid value '{other}' for tau_grid: expected one of log, octave, decade"
+            )))
+        }
+    };
+    let config = match &o.model {
+        Some(path) => model::load(path).map_err(|e| error(&e))?.config,
+        None => Config::default(),
+    };
+    let options = noise::NoiseOptions {
+        taus,
+        confidence: o.confidence,
+        psd: PsdOptions {
+            segment_len: o.psd_segment,
+            ..PsdOptions::default()
+        },
+        ..noise::NoiseOptions::default()
+    };
+    let mut loaded = Vec::new();
+    for (path, file) in paths.iter().zip(files) {
+        let regular =
+            gyro_log::load(path, &o.input, &o.grid, &mut |_| {}).map_err(|e| error(&e))?;
+        let rate: Vec<f64> = regular.slots.iter().map(|s| s.rate_dps).collect();
+        let rests = |margin_s: f64, min_rest_s: f64| {
+            noise::rest_segments(&regular, &config, margin_s, min_rest_s).map_err(|e| {
+                Error(format!(
+                    "{}: cannot configure the pipeline for this log: {}",
+                    path.display(),
+                    error(&e)
+                ))
+            })
+        };
+        let mut moving_share = None;
+        let segments = if o.static_only {
+            let segments = rests(o.margin_s, o.min_rest_s)?;
+            if segments.is_empty() {
+                return Err(Error(format!(
+                    "{}: no rest stretch of at least {} s found (--static-only)",
+                    path.display(),
+                    o.min_rest_s
+                )));
+            }
+            segments
+        } else {
+            let at_rest: usize = rests(0.0, 0.0)?.iter().map(ExactSizeIterator::len).sum();
+            moving_share = Some(1.0 - at_rest as f64 / rate.len().max(1) as f64);
+            std::iter::once(0..rate.len()).collect()
+        };
+        loaded.push(NoiseLog {
+            file: file.clone(),
+            rate_dps: rate,
+            sample_rate_hz: regular.sample_rate_hz,
+            segments,
+            input: regular.quality,
+            moving_share,
+        });
+    }
+    let run = noise::characterize_logs(&loaded, &options).map_err(|e| error(&e))?;
+    gyro_report::noise::json(&loaded, &run, o.static_only, None).map_err(|e| error(&e))
+}
+
+/// The tightening decision on one angle ([`gyro_core::decide`]): `None` for a turn the
+/// other way. The window is checked as a model file's is.
+pub fn decide(
+    window: &Tightening,
+    angle_deg: f32,
+    angle_std_deg: f32,
+    untrusted: bool,
+) -> Result<Option<gyro_core::Verdict>, Error> {
+    window
+        .validate()
+        .map_err(|e| Error(format!("the tightening window: {e}")))?;
+    Ok(gyro_core::decide(
+        window,
+        angle_deg,
+        angle_std_deg,
+        untrusted,
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]

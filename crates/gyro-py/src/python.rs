@@ -2,10 +2,10 @@
 //! while it works. The package `gyro` (python/gyro) wraps it: the JSON text becomes Python
 //! objects there, the options arrive here as a dict.
 
-use crate::{Arrays, Error, RunOptions, RunOutput, Stream};
+use crate::{Arrays, Error, NoiseOptions, RunOptions, RunOutput, Stream};
 use clap::ValueEnum;
 use gyro_analysis::replay::SeriesPoint;
-use gyro_core::{Compensation, Direction, MotionState};
+use gyro_core::{Compensation, Direction, MotionState, Tightening, Verdict};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -210,6 +210,91 @@ fn run_arrays<'py>(
     result(py, out)
 }
 
+/// `gyro-cli noise LOG... --format json`: the JSON text.
+#[pyfunction]
+#[pyo3(signature = (paths, options=None))]
+fn noise_files(
+    py: Python<'_>,
+    paths: Vec<PathBuf>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<String> {
+    let mut o = NoiseOptions::default();
+    if let Some(options) = options {
+        for (key, value) in options.iter() {
+            let key: String = key.extract()?;
+            if value.is_none() {
+                continue;
+            }
+            let columns = &mut o.input.columns;
+            let mcap = &mut o.input.mcap;
+            match key.as_str() {
+                "static_only" => o.static_only = value.extract()?,
+                "margin_s" => o.margin_s = value.extract()?,
+                "min_rest_s" => o.min_rest_s = value.extract()?,
+                "model" => o.model = Some(value.extract()?),
+                "tau_grid" => o.tau_grid = value.extract()?,
+                "per_decade" => o.per_decade = value.extract()?,
+                "confidence" => o.confidence = value.extract()?,
+                "psd_segment" => o.psd_segment = Some(value.extract()?),
+                "sample_rate_hz" => o.grid.sample_rate_hz = Some(value.extract()?),
+                "max_gap_s" => o.grid.max_gap_s = value.extract()?,
+                "time_column" => columns.time_column = value.extract()?,
+                "time_unit" => columns.time_unit = choice(&key, &value)?,
+                "rate_column" => columns.rate_column = value.extract()?,
+                "rate_unit" => columns.rate_unit = choice(&key, &value)?,
+                "topic" => mcap.topic = Some(value.extract()?),
+                "axis" => mcap.axis = choice(&key, &value)?,
+                "flip" => mcap.flip = value.extract()?,
+                "time_source" => mcap.time_source = choice(&key, &value)?,
+                _ => {
+                    return Err(PyTypeError::new_err(format!(
+                        "unexpected keyword argument '{key}'"
+                    )))
+                }
+            }
+        }
+    }
+    let files: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    Ok(py.detach(|| crate::noise_files(&paths, &files, &o))?)
+}
+
+/// The tightening decision on one angle: "ok", "nok", "recheck", "invalid", or None.
+#[pyfunction]
+#[pyo3(signature = (angle_deg, angle_std_deg, target_deg, tolerance_deg, k_sigma=2.0, tightening_direction="positive", scale_sigma=0.0, untrusted=false))]
+#[allow(clippy::too_many_arguments)]
+fn decide(
+    angle_deg: f64,
+    angle_std_deg: f64,
+    target_deg: f64,
+    tolerance_deg: f64,
+    k_sigma: f64,
+    tightening_direction: &str,
+    scale_sigma: f64,
+    untrusted: bool,
+) -> PyResult<Option<&'static str>> {
+    let direction = match tightening_direction {
+        "positive" => Direction::Positive,
+        "negative" => Direction::Negative,
+        other => return Err(GyroError::new_err(format!(
+            "invalid value '{other}' for tightening_direction: expected one of positive, negative"
+        ))),
+    };
+    let window = Tightening {
+        target_deg: target_deg as f32,
+        tolerance_deg: tolerance_deg as f32,
+        k_sigma: k_sigma as f32,
+        direction,
+        scale_sigma: scale_sigma as f32,
+    };
+    let verdict = crate::decide(&window, angle_deg as f32, angle_std_deg as f32, untrusted)?;
+    Ok(verdict.map(|v| match v {
+        Verdict::Ok => "ok",
+        Verdict::Nok => "nok",
+        Verdict::Recheck => "recheck",
+        Verdict::Invalid => "invalid",
+    }))
+}
+
 /// The streaming pipeline (the Rust [`Stream`]); `gyro.Pipeline` wraps it.
 #[pyclass(name = "_Stream", module = "gyro._gyro")]
 struct PyStream {
@@ -279,6 +364,8 @@ fn _gyro(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(run_file, m)?)?;
     m.add_function(wrap_pyfunction!(run_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(noise_files, m)?)?;
+    m.add_function(wrap_pyfunction!(decide, m)?)?;
     m.add_class::<PyStream>()?;
     Ok(())
 }

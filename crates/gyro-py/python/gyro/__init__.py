@@ -6,7 +6,9 @@ The pipeline and the host tools of the gyro workspace on numpy arrays and log fi
   the output series as numpy arrays under ``"series"``;
 - ``run_arrays(time_s, rate_dps, reference_deg=None, temperature_c=None, **options)``:
   the same on arrays, as if they were a CSV log's columns;
-- ``Pipeline(sample_rate_hz, **options)``: the pipeline fed block by block.
+- ``Pipeline(sample_rate_hz, **options)``: the pipeline fed block by block;
+- ``noise(paths, **options)``: ``gyro-cli noise LOG... --format json`` as Python objects;
+- ``decide(angle_deg, angle_std_deg, target_deg, tolerance_deg, ...)``: one verdict.
 
 Options are ``gyro-cli run``'s flags with ``_`` for ``-`` (``target_deg=90``,
 ``tolerance_deg=0.5``, ``model="x.model.json"``, ``offline=True``). Errors raise
@@ -24,7 +26,7 @@ import numpy as np
 from . import _gyro
 from ._gyro import GyroError
 
-__all__ = ["GyroError", "Pipeline", "run", "run_arrays", "__version__"]
+__all__ = ["GyroError", "Pipeline", "decide", "noise", "run", "run_arrays", "__version__"]
 __version__: str = _gyro.__version__
 
 SERIES_KEYS = (
@@ -138,6 +140,39 @@ class Pipeline:
     def finish(self, name: str = "<stream>") -> Dict[str, Any]:
         """The report of everything pushed, as ``run`` gives it (without ``"series"``)."""
         return _report(self._stream.finish(name), None)
+
+
+def noise(paths: Any, **options: Any) -> Dict[str, Any]:
+    """``gyro-cli noise LOG... --format json`` (Allan deviation, fitted noise terms, PSD).
+
+    ``paths``: one log or several (pooled when they share a sample rate). Options are the
+    command's flags that do not write files: ``static_only``, ``margin_s``, ``min_rest_s``,
+    ``model``, ``tau_grid``, ``per_decade``, ``confidence``, ``psd_segment``,
+    ``sample_rate_hz``, ``max_gap_s`` and the time and rate input options.
+    """
+    if isinstance(paths, (str, os.PathLike)):
+        paths = [paths]
+    return json.loads(_gyro.noise_files([os.fspath(p) for p in paths], options))
+
+
+def decide(
+    angle_deg: float,
+    angle_std_deg: float,
+    target_deg: float,
+    tolerance_deg: float,
+    k_sigma: float = 2.0,
+    tightening_direction: str = "positive",
+    scale_sigma: float = 0.0,
+    untrusted: bool = False,
+) -> Optional[str]:
+    """The tightening verdict on one angle, as ``run`` gives each movement's.
+
+    ``"ok"`` (inside the window by more than k·σ), ``"nok"`` (outside by more than k·σ),
+    ``"recheck"``, ``"invalid"`` (``untrusted``: saturated, cut off, filled samples), or
+    ``None`` for a turn the other way. σ includes ``scale_sigma`` times the angle.
+    """
+    return _gyro.decide(angle_deg, angle_std_deg, target_deg, tolerance_deg, k_sigma,
+                        tightening_direction, scale_sigma, untrusted)
 
 
 def concat_series(blocks: List[Dict[str, np.ndarray]]) -> Dict[str, np.ndarray]:

@@ -29,6 +29,21 @@ def run_arrays(
 ) -> Tuple[str, Series]:
     """``gyro-cli run`` on arrays: (JSON text, series arrays)."""
 
+def noise_files(paths: List[str], options: Optional[Dict[str, Any]] = None) -> str:
+    """``gyro-cli noise LOG... --format json``: the JSON text."""
+
+def decide(
+    angle_deg: float,
+    angle_std_deg: float,
+    target_deg: float,
+    tolerance_deg: float,
+    k_sigma: float = 2.0,
+    tightening_direction: str = "positive",
+    scale_sigma: float = 0.0,
+    untrusted: bool = False,
+) -> Optional[str]:
+    """The tightening decision on one angle: "ok", "nok", "recheck", "invalid", or None."""
+
 class _Stream:
     """The streaming pipeline; ``gyro.Pipeline`` wraps it."""
 
