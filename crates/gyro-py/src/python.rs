@@ -275,9 +275,11 @@ fn decide(
     let direction = match tightening_direction {
         "positive" => Direction::Positive,
         "negative" => Direction::Negative,
-        other => return Err(GyroError::new_err(format!(
+        other => {
+            return Err(GyroError::new_err(format!(
             "invalid value '{other}' for tightening_direction: expected one of positive, negative"
-        ))),
+        )))
+        }
     };
     let window = Tightening {
         target_deg: target_deg as f32,
