@@ -750,6 +750,117 @@ pub fn noise_files(paths: &[PathBuf], files: &[String], o: &NoiseOptions) -> Res
     gyro_report::noise::json(&loaded, &run, o.static_only, None).map_err(|e| error(&e))
 }
 
+/// The options of `gyro-cli calibrate` (each named after its flag; `out` may be left out).
+#[derive(Clone, Debug, Default)]
+pub struct CalibrateArgs {
+    /// The training runs.
+    pub logs: Vec<PathBuf>,
+    /// `--holdout`.
+    pub holdout: Vec<PathBuf>,
+    /// `--objective`.
+    pub objective: gyro_analysis::calibrate::Objective,
+    /// `--model`.
+    pub model: Option<PathBuf>,
+    /// `--tau-s`.
+    pub tau_s: Option<f64>,
+    /// `--fit-motion`.
+    pub fit_motion: bool,
+    /// `--reference-delay-s`.
+    pub reference_delay_s: Option<f64>,
+    /// Not `--no-leave-one-out`.
+    pub leave_one_out: bool,
+    /// `-o`: where to write the model file, if anywhere.
+    pub out: Option<PathBuf>,
+    /// `--sample-rate-hz`, `--max-gap-s`.
+    pub grid: GridOptions,
+    /// The CSV and MCAP input options.
+    pub input: LogOptions,
+}
+
+/// `gyro-cli calibrate LOG... --format json`: its JSON text and the model file's (the file
+/// written to `out` when given, as `-o` writes it).
+pub fn calibrate_files(a: &CalibrateArgs) -> Result<(String, String), Error> {
+    use gyro_analysis::calibrate::{calibrate, BenchRun, CalibrateOptions};
+    if let Some(t) = a.tau_s.filter(|t| !(t.is_finite() && *t > 0.0)) {
+        return Err(Error(format!(
+            "invalid value {t} for tau_s: expected a positive finite number"
+        )));
+    }
+    if let Some(d) = a.reference_delay_s {
+        if !d.is_finite() || d.abs() > model::MAX_REFERENCE_DELAY_S {
+            return Err(Error(format!(
+                "--reference-delay-s {d}: expected at most {} s either way",
+                model::MAX_REFERENCE_DELAY_S
+            )));
+        }
+    }
+    let base = match &a.model {
+        Some(path) => model::load(path).map_err(|e| error(&e))?,
+        None => model::ModelFile::new(Config::default()),
+    };
+    let load = |paths: &[PathBuf]| -> Result<Vec<BenchRun>, Error> {
+        paths
+            .iter()
+            .map(|path| {
+                let log =
+                    gyro_log::load(path, &a.input, &a.grid, &mut |_| {}).map_err(|e| error(&e))?;
+                Ok(BenchRun {
+                    name: path.display().to_string(),
+                    log,
+                })
+            })
+            .collect()
+    };
+    let train = load(&a.logs)?;
+    let holdout = load(&a.holdout)?;
+    let options = CalibrateOptions {
+        objective: a.objective,
+        leave_one_out: a.leave_one_out,
+        initial_tau_s: a.tau_s,
+        fit_motion: a.fit_motion,
+        reference_delay_s: a
+            .reference_delay_s
+            .or((base.reference_delay_s != 0.0).then_some(base.reference_delay_s)),
+    };
+    let result = calibrate(&train, &holdout, &base.config, &options, &mut |_, _, _| {})
+        .map_err(|e| error(&e))?;
+    let mut out = base.clone();
+    out.config = result.config;
+    out.reference_delay_s = result.reference_delay.delay_s;
+    if let Some(u) = result
+        .scale
+        .residual_relative_upper
+        .map(|u| u.min(1.0))
+        .filter(|u| *u >= 0.0)
+    {
+        out.scale_sigma = u;
+    }
+    let largest = model::largest_plausible_abs_rate(
+        train
+            .iter()
+            .chain(&holdout)
+            .flat_map(|run| &run.log.slots)
+            .map(|slot| slot.rate_dps),
+        base.config.max_abs_rate_dps,
+    );
+    out.drop_contradicted_range(largest);
+    if let Some(path) = &a.out {
+        model::save(path, &out)
+            .map_err(|e| Error(format!("writing the model file: {}", error(&e))))?;
+    }
+    let model_json = serde_json::to_string_pretty(&out).map_err(|e| error(&e))?;
+    let inputs: Vec<_> = train
+        .iter()
+        .chain(&holdout)
+        .map(|run| gyro_report::input::InputJson {
+            file: &run.name,
+            input: &run.log.quality,
+        })
+        .collect();
+    let json = gyro_report::calibrate::json(&inputs, &result).map_err(|e| error(&e))?;
+    Ok((json, model_json))
+}
+
 /// The tightening decision on one angle ([`gyro_core::decide`]): `None` for a turn the
 /// other way. The window is checked as a model file's is.
 pub fn decide(

@@ -2,7 +2,7 @@
 //! while it works. The package `gyro` (python/gyro) wraps it: the JSON text becomes Python
 //! objects there, the options arrive here as a dict.
 
-use crate::{Arrays, Error, NoiseOptions, RunOptions, RunOutput, Stream};
+use crate::{Arrays, CalibrateArgs, Error, NoiseOptions, RunOptions, RunOutput, Stream};
 use clap::ValueEnum;
 use gyro_analysis::replay::SeriesPoint;
 use gyro_core::{Compensation, Direction, MotionState, Tightening, Verdict};
@@ -258,6 +258,60 @@ fn noise_files(
     Ok(py.detach(|| crate::noise_files(&paths, &files, &o))?)
 }
 
+/// `gyro-cli calibrate LOG... --format json`: (JSON text, model file text).
+#[pyfunction]
+#[pyo3(signature = (logs, options=None))]
+fn calibrate_files(
+    py: Python<'_>,
+    logs: Vec<PathBuf>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<(String, String)> {
+    let mut a = CalibrateArgs {
+        logs,
+        leave_one_out: true,
+        ..CalibrateArgs::default()
+    };
+    if let Some(options) = options {
+        for (key, value) in options.iter() {
+            let key: String = key.extract()?;
+            if value.is_none() {
+                continue;
+            }
+            let columns = &mut a.input.columns;
+            let mcap = &mut a.input.mcap;
+            match key.as_str() {
+                "holdout" => a.holdout = value.extract()?,
+                "objective" => a.objective = choice(&key, &value)?,
+                "model" => a.model = Some(value.extract()?),
+                "tau_s" => a.tau_s = Some(value.extract()?),
+                "fit_motion" => a.fit_motion = value.extract()?,
+                "reference_delay_s" => a.reference_delay_s = Some(value.extract()?),
+                "leave_one_out" => a.leave_one_out = value.extract()?,
+                "out" => a.out = Some(value.extract()?),
+                "sample_rate_hz" => a.grid.sample_rate_hz = Some(value.extract()?),
+                "max_gap_s" => a.grid.max_gap_s = value.extract()?,
+                "time_column" => columns.time_column = value.extract()?,
+                "time_unit" => columns.time_unit = choice(&key, &value)?,
+                "rate_column" => columns.rate_column = value.extract()?,
+                "rate_unit" => columns.rate_unit = choice(&key, &value)?,
+                "reference_column" => columns.reference_column = Some(value.extract()?),
+                "temperature_column" => columns.temperature_column = Some(value.extract()?),
+                "topic" => mcap.topic = Some(value.extract()?),
+                "reference_topic" => mcap.reference_topic = value.extract()?,
+                "axis" => mcap.axis = choice(&key, &value)?,
+                "flip" => mcap.flip = value.extract()?,
+                "time_source" => mcap.time_source = choice(&key, &value)?,
+                _ => {
+                    return Err(PyTypeError::new_err(format!(
+                        "unexpected keyword argument '{key}'"
+                    )))
+                }
+            }
+        }
+    }
+    Ok(py.detach(|| crate::calibrate_files(&a))?)
+}
+
 /// The tightening decision on one angle: "ok", "nok", "recheck", "invalid", or None.
 #[pyfunction]
 #[pyo3(signature = (angle_deg, angle_std_deg, target_deg, tolerance_deg, k_sigma=2.0, tightening_direction="positive", scale_sigma=0.0, untrusted=false))]
@@ -368,6 +422,7 @@ fn _gyro(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(noise_files, m)?)?;
     m.add_function(wrap_pyfunction!(decide, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate_files, m)?)?;
     m.add_class::<PyStream>()?;
     Ok(())
 }

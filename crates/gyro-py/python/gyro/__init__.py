@@ -8,6 +8,7 @@ The pipeline and the host tools of the gyro workspace on numpy arrays and log fi
   the same on arrays, as if they were a CSV log's columns;
 - ``Pipeline(sample_rate_hz, **options)``: the pipeline fed block by block;
 - ``noise(paths, **options)``: ``gyro-cli noise LOG... --format json`` as Python objects;
+- ``calibrate(logs, **options)``: ``gyro-cli calibrate LOG... --format json`` and the model;
 - ``decide(angle_deg, angle_std_deg, target_deg, tolerance_deg, ...)``: one verdict.
 
 Options are ``gyro-cli run``'s flags with ``_`` for ``-`` (``target_deg=90``,
@@ -26,7 +27,7 @@ import numpy as np
 from . import _gyro
 from ._gyro import GyroError
 
-__all__ = ["GyroError", "Pipeline", "decide", "noise", "run", "run_arrays", "__version__"]
+__all__ = ["GyroError", "Pipeline", "calibrate", "decide", "noise", "run", "run_arrays", "__version__"]
 __version__: str = _gyro.__version__
 
 SERIES_KEYS = (
@@ -153,6 +154,24 @@ def noise(paths: Any, **options: Any) -> Dict[str, Any]:
     if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
     return json.loads(_gyro.noise_files([os.fspath(p) for p in paths], options))
+
+
+def calibrate(logs: Any, **options: Any) -> Dict[str, Any]:
+    """``gyro-cli calibrate LOG... --format json`` as Python objects, plus ``"model"``: the
+    model file it fits (a dict), written to ``out`` when given (as ``-o`` writes it).
+
+    Options: ``holdout`` (paths), ``objective`` (``"mean-max-abs"``, ``"movement-rms"``, ...),
+    ``model``, ``tau_s``, ``fit_motion``, ``reference_delay_s``, ``leave_one_out`` (True),
+    ``out``, the grid and the input options.
+    """
+    if isinstance(logs, (str, os.PathLike)):
+        logs = [logs]
+    if "holdout" in options and options["holdout"] is not None:
+        options["holdout"] = [os.fspath(p) for p in options["holdout"]]
+    text, model = _gyro.calibrate_files([os.fspath(p) for p in logs], options)
+    report = json.loads(text)
+    report["model"] = json.loads(model)
+    return report
 
 
 def decide(

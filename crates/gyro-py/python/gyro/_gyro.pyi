@@ -32,6 +32,11 @@ def run_arrays(
 def noise_files(paths: List[str], options: Optional[Dict[str, Any]] = None) -> str:
     """``gyro-cli noise LOG... --format json``: the JSON text."""
 
+def calibrate_files(
+    logs: List[str], options: Optional[Dict[str, Any]] = None
+) -> Tuple[str, str]:
+    """``gyro-cli calibrate LOG... --format json``: (JSON text, model file text)."""
+
 def decide(
     angle_deg: float,
     angle_std_deg: float,
