@@ -716,6 +716,16 @@ impl Replayer {
         }
     }
 
+    /// The movements ended so far, in order (causal angles).
+    pub fn movements(&self) -> &[MovementResult] {
+        &self.movements
+    }
+
+    /// The start (s) of the movement under way, if one is.
+    pub fn moving_since_s(&self) -> Option<f64> {
+        self.open.map(|o| o.start_time_s)
+    }
+
     /// The most outputs the offline smoother has held at once (0 when causal).
     pub fn most_smoothed_held(&self) -> usize {
         self.smoother.most_held()
