@@ -63,9 +63,6 @@ pub fn corrected_model(base: &ModelFile, effects: &[Effect]) -> (ModelFile, Vec<
     (model, ids)
 }
 
-/// Significance of a correction's held-out improvement (bootstrap over runs).
-pub const CORRECTION_P: f64 = 0.05;
-
 /// Id of the bias correction in [`CompensationSummary`]: the nominal model's bias.
 pub const BIAS_ID: &str = "bias";
 
@@ -116,7 +113,7 @@ fn with_tries(base: &ModelFile, tries: &[Try]) -> (ModelFile, Vec<&'static str>)
 /// kept before it: first the nominal model's bias (`bias_dps`, fitted on the training
 /// runs; skipped when zero), then the selected correctable effects in selection order.
 /// Paired over the held-out runs, the total max abs error must fall with bootstrap P <
-/// [`CORRECTION_P`]; the others are named, not corrected. Returns the summary (when there
+/// `tests.p_value` ([`crate::Settings`]); the others are named, not corrected. Returns the summary (when there
 /// is anything to try) and the model to write (when a correction is kept).
 pub(crate) fn compensate(
     holdout: &[RealRun],
@@ -157,7 +154,7 @@ pub(crate) fn compensate(
             Try::Effect(e) if scale_from_turns && is_scale(e) => Some(SCALE_FROM_TURNS),
             _ => None,
         };
-        if reason.is_none() && !paired.is_empty() && p < CORRECTION_P {
+        if reason.is_none() && !paired.is_empty() && p < options.settings.tests.p_value {
             kept = trial;
             current = after;
         } else {

@@ -32,12 +32,14 @@ use gyro_analysis::noise::{characterize, Characterization, NoiseOptions, TauGrid
 use serde::Serialize;
 
 /// Shortest stretch of residual used (s): shorter ones add no τ worth reading.
-const MIN_STRETCH_S: f64 = 2.0;
+/// The default `turns.min_stretch_s` ([`crate::Settings`]), where the settings do not reach yet.
+const MIN_STRETCH_S: f64 = crate::Settings::DEFAULT.turns.min_stretch_s;
 /// Shortest averaging time characterised (s). Below it the residual is shaped by the
 /// smoothing both signals share (the reference derivative's window) and by the rig's
 /// lines; a fit there reads that shaping as a short Gauss-Markov process, whose
 /// random-walk reading at 3 s would be a wander that is not there.
-const MIN_TAU_S: f64 = 0.1;
+/// The default `turns.min_tau_s` ([`crate::Settings`]), where the settings do not reach yet.
+const MIN_TAU_S: f64 = crate::Settings::DEFAULT.turns.min_tau_s;
 
 /// The effective noise of one set of runs.
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -133,9 +133,10 @@ pub fn split(log: &RegularLog, window_s: f64) -> Vec<RegularLog> {
         .collect()
 }
 
+/// The default `reference.quantised_smooth_s` ([`crate::Settings`]), where the settings do not reach yet:
 /// Smoothing of the reference trajectory when it is quantised (s): the encoder's steps
 /// would otherwise be rate spikes in the simulated gyro.
-const QUANTISED_SMOOTH_S: f64 = 0.02;
+const QUANTISED_SMOOTH_S: f64 = crate::Settings::DEFAULT.reference.quantised_smooth_s;
 
 impl RealRun {
     /// Prepare `log` (named `name`).
@@ -254,13 +255,15 @@ pub fn motion_from_reference(reference_deg: &[f64], fs: f64) -> (Motion, Option<
     )
 }
 
+/// The default `reference.print_rounding_floor_dps` ([`crate::Settings`]), where the settings do not reach yet:
 /// Standard deviation of the rounding noise (deg/s) that a reference printed on a
 /// decimal grid puts into a re-simulated rate, below which the print is taken as exact:
 /// under the output step of common MEMS gyros (an MPU6050's 0.0076 °/s at ±250 °/s).
-const PRINT_ROUNDING_FLOOR_DPS: f64 = 0.005;
+const PRINT_ROUNDING_FLOOR_DPS: f64 = crate::Settings::DEFAULT.reference.print_rounding_floor_dps;
 
+/// The default `reference.print_max_decimals` ([`crate::Settings`]), where the settings do not reach yet:
 /// Finest decimal grid [`print_step`] looks for (10⁻⁶°).
-const PRINT_MAX_DECIMALS: i32 = 6;
+const PRINT_MAX_DECIMALS: i32 = crate::Settings::DEFAULT.reference.print_max_decimals;
 
 /// The grid (deg) of a reference printed with few decimals, `10⁻ᵈ` for the fewest
 /// decimals `d` (at most [`PRINT_MAX_DECIMALS`]) that every value is written with, when
@@ -292,11 +295,12 @@ pub fn print_step(values: &[f64], fs: f64) -> Option<f64> {
     (moves && rounding_noise_dps(step, fs, 0) >= PRINT_ROUNDING_FLOOR_DPS).then_some(step)
 }
 
+/// The default `reference.print_max_half_width_s` ([`crate::Settings`]), where the settings do not reach yet:
 /// Longest half width of a print's smoothing (s): a cubic smoothing of ±40 ms passes a
 /// wrench's turns (gain 0.998 at 3 Hz, 0.99 at 5 Hz, at 100 Hz as at 1 kHz); a print
 /// too coarse for it to bring the rounding under [`PRINT_ROUNDING_FLOOR_DPS`] keeps
 /// what it leaves (a 0.001° print at 1 kHz: 0.0067 °/s of the 0.27 °/s unsmoothed).
-const PRINT_MAX_HALF_WIDTH_S: f64 = 0.04;
+const PRINT_MAX_HALF_WIDTH_S: f64 = crate::Settings::DEFAULT.reference.print_max_half_width_s;
 
 /// Half width (samples) of the cubic smoothing of a reference printed to `step` deg at
 /// `fs` Hz: the smallest that brings the rounding noise of the re-simulated rate under
@@ -358,10 +362,10 @@ pub fn reference_step(values: &[f64]) -> Option<f64> {
         .iter()
         .filter(|x| {
             let k = (*x - origin - a) / step;
-            (k - k.round()).abs() < 0.15
+            (k - k.round()).abs() < crate::Settings::DEFAULT.reference.grid_tolerance_steps
         })
         .count();
-    (near as f64 >= 0.9 * v.len() as f64).then_some(step)
+    (near as f64 >= crate::Settings::DEFAULT.reference.grid_share * v.len() as f64).then_some(step)
 }
 
 /// The reference with missing values filled by the previous one (the first present one

@@ -416,8 +416,9 @@ fn setup(real: &[Residuals], fs: f64) -> Setup {
         }
     }
     let span = |v: &mut [f64], q: f64| quantile(v, q).filter(|x| *x > 0.0).unwrap_or(1.0);
-    let rate_max = span(&mut abs_rate, 0.995);
-    let acc_max = span(&mut abs_acc, 0.99);
+    let quantiles = &crate::Settings::DEFAULT.envelopes;
+    let rate_max = span(&mut abs_rate, quantiles.rate_quantile);
+    let acc_max = span(&mut abs_acc, quantiles.acceleration_quantile);
     let temperature = {
         let lo = delta_t
             .iter()

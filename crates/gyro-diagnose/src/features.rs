@@ -115,14 +115,16 @@ pub const RATE_SHAPE_COLUMNS: [usize; 4] =
 /// Scale of ω inside the cubic regressor (deg/s), for conditioning.
 pub const CUBIC_SCALE_DPS: f64 = 100.0;
 /// Length of the line spectrum's Welch segments (s; rounded to a power of two samples).
-pub const LINE_SEGMENT_S: f64 = 2.0;
+/// The default `statistics.line_segment_s` ([`crate::Settings`]), where the settings do not reach yet.
+pub const LINE_SEGMENT_S: f64 = crate::Settings::DEFAULT.statistics.line_segment_s;
 /// Averaging times of the wander feature (s).
 pub const WANDER_TAUS_S: [f64; 3] = [1.0, 4.0, 16.0];
 /// Averaging time of the whiteness check on static samples (s). The Allan variance of the
 /// rests at this τ, beside their first differences, tells white rest noise from noise a
 /// low-pass inside the band has coloured (a MEMS gyro's digital low-pass): the first
 /// differences read the top of the band, the angle integrates the bottom of it.
-pub const WHITE_CHECK_TAU_S: f64 = 0.05;
+/// The default `statistics.white_check_tau_s` ([`crate::Settings`]), where the settings do not reach yet.
+pub const WHITE_CHECK_TAU_S: f64 = crate::Settings::DEFAULT.statistics.white_check_tau_s;
 
 /// Samples per block of the whiteness check at `fs` Hz ([`WHITE_CHECK_TAU_S`], at least 2).
 pub fn white_check_block(fs: f64) -> usize {
@@ -130,7 +132,9 @@ pub fn white_check_block(fs: f64) -> usize {
 }
 
 /// A run's temperature "varies" when its range exceeds this (°C).
-pub const MIN_TEMPERATURE_RANGE_C: f64 = 0.5;
+/// The default `statistics.min_temperature_range_c` ([`crate::Settings`]), where the settings do not reach yet.
+pub const MIN_TEMPERATURE_RANGE_C: f64 =
+    crate::Settings::DEFAULT.statistics.min_temperature_range_c;
 
 /// Features of one run.
 #[derive(Clone, Debug, PartialEq)]
@@ -285,7 +289,9 @@ fn line_spectra(r: &Residuals) -> Spectra {
 /// smooth turn held on one output code (a low-passed gyro whose noise no longer dithers
 /// its output step: 15 Hz on a CRM100's 1/24 °/s) has it range over 0.07–0.27 °/s at
 /// 106–164 °/s, as the reference turns too.
-pub const PLATEAU_REFERENCE_SHARE: f64 = 0.01;
+/// The default `statistics.plateau_reference_share` ([`crate::Settings`]), where the settings do not reach yet.
+pub const PLATEAU_REFERENCE_SHARE: f64 =
+    crate::Settings::DEFAULT.statistics.plateau_reference_share;
 
 /// The features of `r` without the line spectra (empty); `plateau_tol_dps` is the
 /// tolerance of the clip plateau (e.g. an output step).

@@ -12,6 +12,7 @@
 
 use super::ensemble::{simulate_features, simulate_member, Member, RealRun, StampedClock};
 use super::features::{reg, CUBIC_SCALE_DPS, N_REG, WANDER_TAUS_S};
+use crate::Settings;
 use gyro_analysis::noise::fit::gauss_markov_avar_continuous;
 use gyro_analysis::noise::{chi2_quantile, rate_step};
 use gyro_sim::{
@@ -19,21 +20,16 @@ use gyro_sim::{
 };
 use rayon::prelude::*;
 
-/// |z| of the parameter test above which an effect is a candidate (Bonferroni over the
-/// 17 effects at a family-wise 0.1% is 4.0).
-pub const Z_CRITICAL: f64 = 4.0;
-/// Quantisation is named when the output grid is this many times coarser than the
-/// nominal step.
-pub const QUANT_RATIO: f64 = 1.5;
-/// Fewest clipped samples over the training runs for saturation.
-pub const MIN_CLIPPED: usize = 10;
-/// Relative systematic uncertainty added (in quadrature) to the intervals of the
-/// regression-based parameters: re-simulating a run from its sampled reference, and the
-/// gain calibrated by simulation, leave errors of about 1% (measured by the self-test on
-/// large effects, where the statistical interval is far narrower).
-pub const SYSTEMATIC_REL: f64 = 0.02;
-/// Fewest gaps over the training runs for dropouts.
-pub const MIN_GAPS: u64 = 3;
+/// The default `tests.z_critical` ([`Settings`]), for the functions not yet given the
+/// settings (`direct_evidence`): |z| of the parameter test above which an effect is a
+/// candidate.
+pub const Z_CRITICAL: f64 = Settings::DEFAULT.tests.z_critical;
+/// The default `fit.quant_ratio` ([`Settings`]), for `direct_evidence`.
+pub const QUANT_RATIO: f64 = Settings::DEFAULT.fit.quant_ratio;
+/// The default `fit.min_clipped` ([`Settings`]), for `direct_evidence`.
+pub const MIN_CLIPPED: usize = Settings::DEFAULT.fit.min_clipped;
+/// The default `fit.min_gaps` ([`Settings`]), for `direct_evidence`.
+pub const MIN_GAPS: u64 = Settings::DEFAULT.fit.min_gaps;
 
 /// The fitted candidate of one effect.
 #[derive(Clone, Debug, PartialEq)]
@@ -111,9 +107,10 @@ pub(crate) fn is_wander(effect: &Effect) -> bool {
     matches!(effect.info().fit, FitProcedure::Wander(_))
 }
 
+/// The default `tests.replication_z` ([`Settings`]), where the settings do not reach yet:
 /// Smallest z on the held-out runs with which an effect's test replicates its training
 /// fit ([`replicates`]): one-sided 2.3%.
-pub const REPLICATION_Z: f64 = 2.0;
+pub const REPLICATION_Z: f64 = Settings::DEFAULT.tests.replication_z;
 
 /// Whether a regression or wander effect fitted on the training runs shows again on the
 /// held-out runs: the same test on them ([`Fit::holdout_z`]: a regression coefficient
@@ -279,15 +276,18 @@ pub struct WhiteTarget {
     pub block: usize,
 }
 
+/// The default `tests.z_critical` ([`Settings`]), where the settings do not reach yet:
 /// |z| beyond which the rests' noise is not white: the Allan variance at
 /// [`super::features::WHITE_CHECK_TAU_S`] against the first differences', both read as a
 /// white noise through the nominal model (as [`Z_CRITICAL`]).
-pub const WHITE_CHECK_Z: f64 = 4.0;
+pub const WHITE_CHECK_Z: f64 = Settings::DEFAULT.tests.z_critical;
+/// The default `fit.white_check_min` ([`Settings`]), where the settings do not reach yet:
 /// Smallest relative difference of the two white variances that counts as colour: under
 /// it the first differences stand, however many rests measure it.
-pub const WHITE_CHECK_MIN: f64 = 0.1;
+pub const WHITE_CHECK_MIN: f64 = Settings::DEFAULT.fit.white_check_min;
+/// The default `fit.min_white_check_diffs` ([`Settings`]), where the settings do not reach yet:
 /// Fewest block differences over the training runs for the whiteness check.
-pub const MIN_WHITE_CHECK_DIFFS: usize = 20;
+pub const MIN_WHITE_CHECK_DIFFS: usize = Settings::DEFAULT.fit.min_white_check_diffs;
 
 /// The whiteness check of the training runs' rests: the white noise their first
 /// differences give and the one their Allan variance at a short τ gives, each matched
@@ -671,6 +671,8 @@ pub struct FitInput<'a> {
     pub holdout: &'a [&'a RealRun],
     /// Their baseline ensembles.
     pub holdout_null: &'a [Vec<Member>],
+    /// The numbers that decide the fits.
+    pub settings: &'a Settings,
 }
 
 impl FitInput<'_> {
@@ -745,9 +747,10 @@ impl Known {
     }
 }
 
+/// The default `fit.negligible_delay_samples` ([`Settings`]), where the settings do not reach yet:
 /// A delay shorter than this share of a sample period moves no sample by more than that
 /// share of its step: below what the log's timing resolves as an effect of its own.
-pub const NEGLIGIBLE_DELAY_SAMPLES: f64 = 0.1;
+pub const NEGLIGIBLE_DELAY_SAMPLES: f64 = Settings::DEFAULT.fit.negligible_delay_samples;
 
 /// The 95% interval of a regression fit holds the effect's absence: a zero coefficient
 /// (ppm, scale, …); for a latency, a delay under [`NEGLIGIBLE_DELAY_SAMPLES`] of a sample
@@ -953,7 +956,9 @@ fn regression_fit(
     let test = CoefficientTest::of(&run_coefficients(input.train, input.null, index));
     let holdout_z = replication_z(&run_coefficients(input.holdout, input.holdout_null, index));
     let raw = test.deviation - (known.with_effects[index] - known.quiet[index]);
-    let mut half = 1.96 * test.replica_sd * (1.0 + 1.0 / test.replicas.max(1) as f64).sqrt();
+    let s = input.settings;
+    let mut half =
+        s.tests.interval_z * test.replica_sd * (1.0 + 1.0 / test.replicas.max(1) as f64).sqrt();
     if let Some(scatter) = test.wider_scatter() {
         half = half.max(t95(scatter.runs - 1) * scatter.se);
     }
@@ -970,7 +975,8 @@ fn regression_fit(
     if to_param(raw) != 0.0 && to_param(raw).is_finite() {
         let r0 = response(raw);
         let g = r0 / raw;
-        if g.is_finite() && g > 0.2 && g < 5.0 {
+        let ratio = s.fit.gain_ratio_max;
+        if g.is_finite() && g > 1.0 / ratio && g < ratio {
             x = raw / g;
             if screened {
                 let (mut xa, mut ra) = (raw, r0);
@@ -982,7 +988,7 @@ fn regression_fit(
                     let slope = (rb - ra) / (x - xa);
                     let next = x + (raw - rb) / slope;
                     if !(slope.is_finite() && slope > 0.0 && next.is_finite())
-                        || (next / raw).abs() > 5.0
+                        || (next / raw).abs() > ratio
                     {
                         break;
                     }
@@ -994,7 +1000,7 @@ fn regression_fit(
     }
     let gain = if x != 0.0 { raw / x } else { 1.0 };
     // Plus the systematic allowance of the simulation-calibrated gain.
-    let half = (half * half + (SYSTEMATIC_REL * raw).powi(2)).sqrt();
+    let half = (half * half + (s.fit.systematic_rel * raw).powi(2)).sqrt();
     let (lo, hi) = ((raw - half) / gain, (raw + half) / gain);
     RegressionFit {
         effect: make(to_param(x)),
@@ -1026,6 +1032,7 @@ impl RegressionFit {
     /// same bound (either test alone has its false-alarm rate; the held-out runs must
     /// still qualify it, `select`).
     fn passes(
+        tests: &crate::settings::Tests,
         z: f64,
         holdout_z: f64,
         (train_runs, holdout_runs): (usize, usize),
@@ -1034,18 +1041,25 @@ impl RegressionFit {
     ) -> bool {
         let (z, holdout_z) = (sign * z, sign * holdout_z);
         let judge = |v: f64| if two_sided { v.abs() } else { v };
-        if judge(z) >= Z_CRITICAL {
+        if judge(z) >= tests.z_critical {
             return true;
         }
         let pooled = pooled_z(z, train_runs, holdout_z, holdout_runs);
-        judge(z) >= REPLICATION_Z
-            && holdout_z * z.signum() >= REPLICATION_Z
-            && pooled * z.signum() >= Z_CRITICAL
+        judge(z) >= tests.replication_z
+            && holdout_z * z.signum() >= tests.replication_z
+            && pooled * z.signum() >= tests.z_critical
     }
 
     /// Screened for calibration: passes two-sided in the coefficient's direction.
     fn screens(z: f64, holdout_z: f64, input: &FitInput) -> bool {
-        Self::passes(z, holdout_z, Self::runs(input), 1.0, true)
+        Self::passes(
+            &input.settings.tests,
+            z,
+            holdout_z,
+            Self::runs(input),
+            1.0,
+            true,
+        )
     }
 
     /// Training and held-out runs.
@@ -1065,9 +1079,10 @@ impl RegressionFit {
     ) -> Fit {
         let (z, holdout_z) = (sign * self.z, sign * self.holdout_z);
         let runs = Self::runs(input);
-        let mut fit = judged(self.effect, z, ci95, two_sided, test);
+        let tests = &input.settings.tests;
+        let mut fit = judged(tests.z_critical, self.effect, z, ci95, two_sided, test);
         fit.holdout_z = holdout_z.is_finite().then_some(holdout_z);
-        if !fit.passes && Self::passes(self.z, self.holdout_z, runs, sign, two_sided) {
+        if !fit.passes && Self::passes(tests, self.z, self.holdout_z, runs, sign, two_sided) {
             fit.passes = true;
             let pooled = pooled_z(z, runs.0, holdout_z, runs.1);
             fit.test = format!(
@@ -1078,9 +1093,10 @@ impl RegressionFit {
     }
 }
 
+/// The default `fit.scatter_p` ([`Settings`]), where the settings do not reach yet:
 /// Share of the null's chi-square above which the real runs' scatter of a coefficient is
 /// taken as larger than the null's (one-sided, 1%).
-const SCATTER_P: f64 = 0.99;
+const SCATTER_P: f64 = Settings::DEFAULT.fit.scatter_p;
 
 /// The real runs' own scatter of one regression coefficient, when it is larger than
 /// the null replicas' beyond chance.
@@ -1177,12 +1193,12 @@ fn clock_fit(input: &FitInput) -> Result<Fit, FitError> {
     let within = clocks.iter().map(|c| c.se_ppm * c.se_ppm).sum::<f64>() / n;
     let se = ((between + within) / n).sqrt().max(0.01);
     let z = m / se;
-    let half = t95(ppm.len().saturating_sub(1)).max(1.96) * se;
+    let half = t95(ppm.len().saturating_sub(1)).max(input.settings.tests.interval_z) * se;
     Ok(Fit {
         effect: Effect::ClockError { ppm: m },
         ci95: vec![(Some(m - half), Some(m + half))],
         z,
-        passes: z.abs() >= Z_CRITICAL,
+        passes: z.abs() >= input.settings.tests.z_critical,
         test: "time stamps' period vs the nominal sample rate".into(),
         direct: false,
         holdout_z: None,
@@ -1248,6 +1264,7 @@ const EXACT: f64 = f64::NAN;
 /// A fit judged by its z-score: passes when |z| (two-sided) or z (one-sided) reaches
 /// [`Z_CRITICAL`].
 fn judged(
+    z_critical: f64,
     effect: Effect,
     z: f64,
     ci95: Vec<(Option<f64>, Option<f64>)>,
@@ -1255,9 +1272,9 @@ fn judged(
     test: &str,
 ) -> Fit {
     let passes = if two_sided {
-        z.abs() >= Z_CRITICAL
+        z.abs() >= z_critical
     } else {
-        z >= Z_CRITICAL
+        z >= z_critical
     };
     Fit {
         effect,
@@ -1430,6 +1447,7 @@ fn between_run_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, F
     Ok(Fit {
         direct: true,
         ..judged(
+            input.settings.tests.z_critical,
             single(sigma),
             z,
             vec![(Some(lo), Some(hi))],
@@ -1499,15 +1517,18 @@ fn wander_fit(
     let make = |theta: f64| single(theta.max(0.0).sqrt());
     let mut overshoot = None;
     let mut shape_loglik = None;
-    if z >= Z_CRITICAL && theta > 0.0 {
+    if z >= input.settings.tests.z_critical && theta > 0.0 {
         // Gain: the same estimator on the training runs simulated with the
         // effect, against the same seeds without it.
-        const GAIN_MEMBERS: usize = 8;
         let effect = [make(theta)];
         let sims: Vec<Vec<Member>> = (0..input.train.len())
             .into_par_iter()
             .map(|r| {
-                (0..GAIN_MEMBERS.min(input.null[r].len()))
+                (0..input
+                    .settings
+                    .fit
+                    .wander_gain_members
+                    .min(input.null[r].len()))
                     .map(|j| {
                         simulate_member(
                             input.train[r],
@@ -1531,7 +1552,8 @@ fn wander_fit(
             })
             .collect();
         let gain = mean(gains.into_iter()) / theta;
-        let gain = if gain.is_finite() && gain > 0.1 && gain < 10.0 {
+        let ratio = input.settings.fit.wander_gain_ratio_max;
+        let gain = if gain.is_finite() && gain > 1.0 / ratio && gain < ratio {
             theta /= gain;
             half /= gain;
             gain
@@ -1550,7 +1572,14 @@ fn wander_fit(
     let lo = (theta - half).max(0.0).sqrt();
     let hi = (theta + half).max(0.0).sqrt();
     let test = "Allan variance of the regression residual at 1/4/16 s vs null replicas (one-sided)";
-    let mut fit = judged(make(theta), z, vec![(Some(lo), Some(hi))], false, test);
+    let mut fit = judged(
+        input.settings.tests.z_critical,
+        make(theta),
+        z,
+        vec![(Some(lo), Some(hi))],
+        false,
+        test,
+    );
     fit.holdout_z = holdout_z;
     fit.shape_loglik = shape_loglik.filter(|_| fit.passes);
     if let Some((tau, ratio)) = overshoot.filter(|_| fit.passes) {
@@ -1869,6 +1898,7 @@ mod wander_shape_tests {
     }
 }
 
+/// The default `fit.wander_overshoot` ([`Settings`]), where the settings do not reach yet:
 /// Largest ratio of a fitted wander's Allan variance (with the nominal model's) to the
 /// training runs', at any τ of [`WANDER_TAUS_S`], for the wander to pass. A residual whose
 /// excess is largest at 1 s and fades by 16 s (motion the reference does not resolve, a
@@ -1876,7 +1906,7 @@ mod wander_shape_tests {
 /// excess overshoots the 16 s value by orders of magnitude (ssong yaw, slow: 300 times).
 /// Three times allows the sampling spread of a 16 s Allan variance from five one-minute
 /// runs (about 15 windows).
-pub const WANDER_OVERSHOOT: f64 = 3.0;
+pub const WANDER_OVERSHOOT: f64 = Settings::DEFAULT.fit.wander_overshoot;
 
 /// A clip level from samples on a plateau at the largest |rate|.
 fn plateau_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError> {
@@ -1900,19 +1930,21 @@ fn plateau_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitEr
     let z = (clipped as f64 - m0) / s0.max(1.0);
     let tol = input.model.lsb_dps.max(1e-6);
     // No plateau: no clip seen below the range.
-    let limit = if clipped >= MIN_CLIPPED {
+    let min_clipped = input.settings.fit.min_clipped;
+    let limit = if clipped >= min_clipped {
         limit
     } else {
         input.model.range_dps
     };
     let mut f = judged(
+        input.settings.tests.z_critical,
         single(limit.max(1e-3)),
         z,
         vec![(Some(limit - tol), Some(limit + tol))],
         false,
         "samples on a plateau at the largest |rate| while the reference is faster, vs null replicas",
     );
-    f.passes = f.passes && clipped >= MIN_CLIPPED;
+    f.passes = f.passes && clipped >= min_clipped;
     f.direct = true;
     Ok(f)
 }
@@ -1926,9 +1958,10 @@ fn grid_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
         .flat_map(|r| r.measured_rates_dps.iter().copied())
         .collect();
     let nominal = input.model.lsb_dps;
+    let quant_ratio = input.settings.fit.quant_ratio;
     Ok(match rate_step(&values) {
         Some(step) => {
-            let passes = step >= QUANT_RATIO * nominal && step > 0.0;
+            let passes = step >= quant_ratio * nominal && step > 0.0;
             Fit {
                 effect: single(step),
                 ci95: vec![(Some(step * 0.999), Some(step * 1.001))],
@@ -1938,13 +1971,13 @@ fn grid_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
                 holdout_z: None,
                 shape_loglik: None,
                 test: format!(
-                    "output grid step {step:.6} deg/s vs nominal {nominal:.6} (named above {QUANT_RATIO}x)"
+                    "output grid step {step:.6} deg/s vs nominal {nominal:.6} (named above {quant_ratio}x)"
                 ),
             }
         }
         None => Fit {
             effect: single(nominal),
-            ci95: vec![(Some(0.0), Some(QUANT_RATIO * nominal))],
+            ci95: vec![(Some(0.0), Some(quant_ratio * nominal))],
             z: EXACT,
             passes: false,
             direct: true,
@@ -1967,9 +2000,10 @@ fn gaps_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
     } else {
         1.0
     };
-    let rate_half = 1.96 * g.sqrt() / duration.max(1e-9);
+    let min_gaps = input.settings.fit.min_gaps;
+    let rate_half = input.settings.tests.interval_z * g.sqrt() / duration.max(1e-9);
     let sd = (mean_samples * (mean_samples - 1.0)).sqrt();
-    let len_half = 1.96 * sd / g.max(1.0).sqrt();
+    let len_half = input.settings.tests.interval_z * sd / g.max(1.0).sqrt();
     let effect = info
         .typical
         .with_params(&[rate, mean_samples])
@@ -1984,11 +2018,11 @@ fn gaps_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
             (Some((mean_samples - len_half).max(1.0)), Some(mean_samples + len_half)),
         ],
         z: EXACT,
-        passes: gaps >= MIN_GAPS,
+        passes: gaps >= min_gaps,
         direct: true,
         holdout_z: None,
         shape_loglik: None,
-        test: format!("{gaps} gaps ({filled} samples filled) in the training runs; the nominal model has none (named from {MIN_GAPS})"),
+        test: format!("{gaps} gaps ({filled} samples filled) in the training runs; the nominal model has none (named from {min_gaps})"),
     })
 }
 
@@ -2026,7 +2060,7 @@ fn line_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
             ),
         ],
         z: line.z,
-        passes: line.z >= Z_CRITICAL && line.ratio >= super::line::LINE_MIN_RATIO,
+        passes: line.z >= input.settings.tests.z_critical && line.ratio >= super::line::LINE_MIN_RATIO,
         direct: true,
         holdout_z: None,
         shape_loglik: None,
@@ -2223,7 +2257,9 @@ mod replication_tests {
     #[test]
     fn a_weak_coefficient_passes_on_all_runs_in_the_training_direction() {
         let runs = (5, 5);
-        let passes = |z, hz, sign, two_sided| RegressionFit::passes(z, hz, runs, sign, two_sided);
+        let passes = |z, hz, sign, two_sided| {
+            RegressionFit::passes(&Settings::DEFAULT.tests, z, hz, runs, sign, two_sided)
+        };
         // Training alone.
         assert!(passes(4.2, f64::NAN, 1.0, true));
         assert!(passes(-4.2, f64::NAN, 1.0, true));

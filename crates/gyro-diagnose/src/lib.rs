@@ -72,6 +72,7 @@ pub mod posterior;
 pub(crate) mod score;
 mod select;
 pub mod selftest;
+pub mod settings;
 pub mod short_white;
 pub(crate) mod stats;
 mod summarise;
@@ -84,6 +85,7 @@ pub use diagnosis::{
 };
 pub use ensemble::{motion_from_reference, split, GridKind, RealRun, ReferenceGrid};
 pub use features::MIN_TEMPERATURE_RANGE_C;
+pub use settings::{Settings, SettingsError};
 pub use stats::stretches;
 
 use baseline::Runs;
@@ -92,12 +94,6 @@ use select::Scorer;
 
 use gyro_analysis::model::ModelFile;
 use gyro_sim::SensorModel;
-
-/// Most effects the forward selection adds.
-pub const MAX_EFFECTS: usize = 6;
-/// Cosine similarity of two effects' shifts of the held-out z-scores above which one
-/// that is not selected is reported as confounded with the selected one.
-pub const CONFOUND_COSINE: f64 = 0.8;
 
 /// Settings of a diagnosis.
 #[derive(Clone, Debug, PartialEq)]
@@ -122,6 +118,9 @@ pub struct Options {
     /// held-out figures and posterior checks are then reported too, for one more
     /// candidate ensemble each.
     pub score_every_candidate: bool,
+    /// Every number that decides the diagnosis: thresholds, p-values, z-limits, windows,
+    /// bounds ([`Settings`]).
+    pub settings: Settings,
 }
 
 impl Default for Options {
@@ -135,6 +134,7 @@ impl Default for Options {
             fixed_model: false,
             base_model: ModelFile::new(gyro_core::Config::default()),
             score_every_candidate: false,
+            settings: Settings::default(),
         }
     }
 }
@@ -236,7 +236,10 @@ pub fn diagnose(
 
     // 1. Baseline, and 2. where.
     let base = baseline::baseline(&runs, options, progress);
-    let r#where = locate::locate(base.train.scores.iter().chain(&base.holdout.scores));
+    let r#where = locate::locate(
+        base.train.scores.iter().chain(&base.holdout.scores),
+        &options.settings,
+    );
 
     // 3. Fit every effect on the training runs.
     let input = FitInput {
@@ -247,6 +250,7 @@ pub fn diagnose(
         seed: options.seed,
         holdout: &runs.holdout,
         holdout_null: &base.holdout.members,
+        settings: &options.settings,
     };
     let (fits, untestable, joint) = fit::fit_all(&input);
 
@@ -306,5 +310,6 @@ pub fn diagnose(
         compensation,
         corrected_model,
         turns,
+        settings: &options.settings,
     }))
 }

@@ -26,15 +26,20 @@ use gyro_analysis::median;
 /// be found, on the held-out runs to replicate): the null replicas' spectra are smooth,
 /// a real sensor's have texture (an encoder's steps, the motion), so a ratio of 1.1 can
 /// be many null standard deviations without being a line.
-pub const LINE_MIN_RATIO: f64 = 3.0;
+/// The default `statistics.line_min_ratio` ([`crate::Settings`]), where the settings do not reach yet.
+pub const LINE_MIN_RATIO: f64 = crate::Settings::DEFAULT.statistics.line_min_ratio;
 /// A line of the motion is reported when it stands this many times above its floor.
-pub const MOTION_LINE_RATIO: f64 = 20.0;
+/// The default `statistics.motion_line_ratio` ([`crate::Settings`]), where the settings do not reach yet.
+pub const MOTION_LINE_RATIO: f64 = crate::Settings::DEFAULT.statistics.motion_line_ratio;
 /// Lowest frequency searched for a line (Hz).
-pub const MIN_LINE_HZ: f64 = 2.0;
+/// The default `statistics.min_line_hz` ([`crate::Settings`]), where the settings do not reach yet.
+pub const MIN_LINE_HZ: f64 = crate::Settings::DEFAULT.statistics.min_line_hz;
 /// Bins on either side of a line that belong to it (Hann main lobe).
-pub const GUARD_BINS: usize = 2;
+/// The default `statistics.guard_bins` ([`crate::Settings`]), where the settings do not reach yet.
+pub const GUARD_BINS: usize = crate::Settings::DEFAULT.statistics.guard_bins;
 /// Bins on either side whose median is the local floor.
-pub const FLOOR_BINS: usize = 10;
+/// The default `statistics.floor_bins` ([`crate::Settings`]), where the settings do not reach yet.
+pub const FLOOR_BINS: usize = crate::Settings::DEFAULT.statistics.floor_bins;
 
 /// The pooled incoherent PSD of `features` (mean over those with a spectrum of the
 /// common length).

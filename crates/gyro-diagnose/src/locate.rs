@@ -4,28 +4,20 @@
 
 use super::score::RunScore;
 use super::{Unexplained, Where};
+use crate::Settings;
 use std::collections::BTreeMap;
 
-/// |z| (combined over the training runs, tolerant) at or above which a statistic is unexplained by
-/// the selected model: the bound of the parameter tests (a Bonferroni bound over the
-/// vocabulary at a family-wise 0.1%; over the ~65 statistics it leaves a well-fitting
-/// model's list empty with probability above 99%).
-pub const UNEXPLAINED_Z: f64 = 4.0;
-
-/// Relative tolerance of the unexplained test: each run's z is taken against at least
-/// this share of the statistic's size (max(|real|, |simulated|)) as its spread. A model is
-/// judged at the precision its parameters are known to (the regression parameters carry a
-/// 2% systematic uncertainty): the statistics of a long run are measured far more
-/// precisely, and a correct model fitted to them (the white noise matched to static
-/// differences, a strong scale factor) leaves a z of 5 to 10 in their last percent.
-pub const UNEXPLAINED_TOLERANCE: f64 = 0.02;
+/// The default |z| at or above which a statistic is unexplained by the selected model
+/// (`tests.z_critical` of [`Settings::DEFAULT`]), for the report's wording; the
+/// diagnosis reads the settings it is given.
+pub const UNEXPLAINED_Z: f64 = Settings::DEFAULT.tests.z_critical;
 
 /// One statistic over a set of runs.
 #[derive(Default)]
 struct Combined {
     z_sum: f64,
     z_count: usize,
-    /// Σ of each run's z against at least [`UNEXPLAINED_TOLERANCE`] of the value.
+    /// Σ of each run's z against at least `locate.unexplained_tolerance` of the value.
     z_tolerant_sum: f64,
     real_sum: f64,
     real_count: usize,
@@ -72,7 +64,10 @@ fn ratio(sum: f64, n: usize) -> f64 {
 
 /// Every statistic of `scores` combined over the runs: z, the real value's mean and the
 /// ensembles' means' mean.
-fn combine<'a>(scores: impl Iterator<Item = &'a RunScore>) -> BTreeMap<(String, String), Combined> {
+fn combine<'a>(
+    scores: impl Iterator<Item = &'a RunScore>,
+    locate: &crate::settings::Locate,
+) -> BTreeMap<(String, String), Combined> {
     let mut combined: BTreeMap<(String, String), Combined> = BTreeMap::new();
     for s in scores {
         for (i, (stat, z)) in s.z.iter().enumerate() {
@@ -85,7 +80,7 @@ fn combine<'a>(scores: impl Iterator<Item = &'a RunScore>) -> BTreeMap<(String, 
                 e.z_tolerant_sum += match s.moments.get(i) {
                     Some(&(mean, sd)) if mean.is_finite() && sd.is_finite() => {
                         let size = mean.abs().max(stat.value.abs());
-                        (stat.value - mean) / sd.max(UNEXPLAINED_TOLERANCE * size)
+                        (stat.value - mean) / sd.max(locate.unexplained_tolerance * size)
                     }
                     _ => *z,
                 };
@@ -104,8 +99,11 @@ fn combine<'a>(scores: impl Iterator<Item = &'a RunScore>) -> BTreeMap<(String, 
 }
 
 /// Stage 2: the combined z of every statistic over `scores`, by |z|, largest first.
-pub(crate) fn locate<'a>(scores: impl Iterator<Item = &'a RunScore>) -> Vec<Where> {
-    let mut r#where: Vec<Where> = combine(scores)
+pub(crate) fn locate<'a>(
+    scores: impl Iterator<Item = &'a RunScore>,
+    settings: &Settings,
+) -> Vec<Where> {
+    let mut r#where: Vec<Where> = combine(scores, &settings.locate)
         .into_iter()
         .filter(|(_, c)| c.z_count > 0)
         .map(|((segment, statistic), c)| Where {
@@ -119,8 +117,8 @@ pub(crate) fn locate<'a>(scores: impl Iterator<Item = &'a RunScore>) -> Vec<Wher
 }
 
 /// The statistics the selected model leaves unexplained on the training runs: combined
-/// |z| at least [`UNEXPLAINED_Z`] against the ensembles with the selected effects
-/// (`train_after`), each run's z taken against at least [`UNEXPLAINED_TOLERANCE`] of the
+/// |z| at least `tests.z_critical` against the ensembles with the selected effects
+/// (`train_after`), each run's z taken against at least `locate.unexplained_tolerance` of the
 /// statistic's size, largest |z| first, each with its real value, the nominal and the selected
 /// model's simulated values (means over the runs) and its combined z on the held-out runs
 /// (`holdout_after`) and under the nominal model (`train_before`).
@@ -128,12 +126,13 @@ pub(crate) fn unexplained(
     train_before: &[RunScore],
     train_after: &[RunScore],
     holdout_after: &[RunScore],
+    settings: &Settings,
 ) -> Vec<Unexplained> {
-    let before = combine(train_before.iter());
-    let holdout = combine(holdout_after.iter());
-    let mut out: Vec<Unexplained> = combine(train_after.iter())
+    let before = combine(train_before.iter(), &settings.locate);
+    let holdout = combine(holdout_after.iter(), &settings.locate);
+    let mut out: Vec<Unexplained> = combine(train_after.iter(), &settings.locate)
         .into_iter()
-        .filter(|(_, c)| c.z_tolerant().abs() >= UNEXPLAINED_Z)
+        .filter(|(_, c)| c.z_tolerant().abs() >= settings.tests.z_critical)
         .map(|(key, c)| {
             let b = before.get(&key);
             let h = holdout.get(&key);
@@ -198,7 +197,7 @@ mod tests {
             .map(|_| run(&[("wander", 5.0, 1.0, 40.0), ("noise", 0.1, 0.0, 1.0)]))
             .collect();
         let holdout: Vec<RunScore> = (0..2).map(|_| run(&[("wander", 6.0, 2.0, 5.0)])).collect();
-        let u = unexplained(&before, &after, &holdout);
+        let u = unexplained(&before, &after, &holdout, &Settings::DEFAULT);
         assert_eq!(u.len(), 1);
         let w = &u[0];
         assert_eq!(w.statistic, "wander");
@@ -218,16 +217,19 @@ mod tests {
             .map(|_| run(&[("slope", 2.0, 0.0, 1000.0)]))
             .collect();
         let after: Vec<RunScore> = (0..4).map(|_| run(&[("slope", 2.0, 1.98, 10.0)])).collect();
-        assert!(unexplained(&before, &after, &after).is_empty());
+        assert!(unexplained(&before, &after, &after, &Settings::DEFAULT).is_empty());
         // Selected 1.5: a quarter off (tolerant z 12.5 per run).
         let after: Vec<RunScore> = (0..4).map(|_| run(&[("slope", 2.0, 1.5, 250.0)])).collect();
-        assert_eq!(unexplained(&before, &after, &after).len(), 1);
+        assert_eq!(
+            unexplained(&before, &after, &after, &Settings::DEFAULT).len(),
+            1
+        );
     }
 
     #[test]
     fn a_model_that_fits_leaves_nothing_unexplained() {
         let after: Vec<RunScore> = (0..5).map(|_| run(&[("a", 1.0, 1.0, 0.5)])).collect();
-        assert!(unexplained(&after, &after, &after).is_empty());
+        assert!(unexplained(&after, &after, &after, &Settings::DEFAULT).is_empty());
     }
 
     #[test]
@@ -236,7 +238,7 @@ mod tests {
             run(&[("a", 0.0, 0.0, 1.0), ("b", 0.0, 0.0, -3.0)]),
             run(&[("a", 0.0, 0.0, 1.0), ("b", 0.0, 0.0, -3.0)]),
         ];
-        let w = locate(scores.iter());
+        let w = locate(scores.iter(), &Settings::DEFAULT);
         assert_eq!(w[0].statistic, "b");
         assert!((w[0].z + 6.0 / 2f64.sqrt()).abs() < 1e-12);
         assert!((w[1].z - 2.0 / 2f64.sqrt()).abs() < 1e-12);

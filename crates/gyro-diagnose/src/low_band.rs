@@ -20,7 +20,8 @@
 use gyro_core::Butterworth;
 
 /// Cut-off of the low band (Hz).
-pub const LOW_BAND_HZ: f64 = 2.0;
+/// The default `statistics.low_band_hz` ([`crate::Settings`]), where the settings do not reach yet.
+pub const LOW_BAND_HZ: f64 = crate::Settings::DEFAULT.statistics.low_band_hz;
 /// Order of the Butterworth run forwards and backwards (the pair is of twice the order).
 pub const LOW_BAND_ORDER: u8 = 2;
 

@@ -43,7 +43,8 @@ use super::score::RunScore;
 use serde::Serialize;
 
 /// Share of the nominal discrepancy of a signature statistic the effect may leave.
-pub const REMAINING_SHARE: f64 = 0.5;
+/// The default `score.remaining_share` ([`crate::Settings`]), where the settings do not reach yet.
+pub const REMAINING_SHARE: f64 = crate::Settings::DEFAULT.score.remaining_share;
 
 /// The statistics (segment, statistic) that identify each effect.
 pub fn signature(id: &str) -> &'static [(&'static str, &'static str)] {
@@ -165,14 +166,14 @@ fn short(x: f64) -> String {
 }
 
 /// The relative standard deviation of a single-parameter fit from its 95% interval,
-/// `(hi − lo) / (2 · 1.96 · |value|)`, at most 1 (an effect known to within its own size
+/// `(hi − lo) / (2 · z · |value|)` (z the interval's, `tests.interval_z`), at most 1 (an effect known to within its own size
 /// at least); 1 when a bound is open or the value is zero. For an effect of several
 /// parameters (none has a signature statistic), 0.
-pub fn parameter_relative_sd(fit: &Fit) -> f64 {
+pub fn parameter_relative_sd(fit: &Fit, interval_z: f64) -> f64 {
     let params = fit.effect.params();
     match (params.as_slice(), fit.ci95.as_slice()) {
         ([value], [(Some(lo), Some(hi))]) if *value != 0.0 => {
-            let r = (hi - lo).abs() / (2.0 * 1.96 * value.abs());
+            let r = (hi - lo).abs() / (2.0 * interval_z * value.abs());
             if r.is_finite() {
                 r.min(1.0)
             } else {
@@ -194,9 +195,10 @@ pub fn check(
     after: &[RunScore],
     alone: &[RunScore],
     sample_rate_hz: f64,
+    interval_z: f64,
 ) -> PosteriorCheck {
     let expected = signature(fit.effect.id());
-    let relative_sd = parameter_relative_sd(fit);
+    let relative_sd = parameter_relative_sd(fit, interval_z);
     let statistics: Vec<SignatureCheck> = expected
         .iter()
         .filter_map(|&(segment, statistic)| {
@@ -205,6 +207,7 @@ pub fn check(
                 [before, after, alone],
                 sample_rate_hz,
                 relative_sd,
+                interval_z,
             )
         })
         .collect();
@@ -224,6 +227,7 @@ fn pooled(
     [before, after, alone]: [&[RunScore]; 3],
     sample_rate_hz: f64,
     relative_sd: f64,
+    interval_z: f64,
 ) -> Option<SignatureCheck> {
     let lag = statistic == "xcorr_peak_lag_s";
     let find = |s: &RunScore| -> Option<(f64, f64, f64)> {
@@ -258,9 +262,9 @@ fn pooled(
     // effect as fitted (the value written) must reach it; its interval reaching it is not
     // enough (a 41 ms [17, 65] latency against a pose 86 ms behind).
     let band = if cut {
-        1.96 * var.sqrt() / nf
+        interval_z * var.sqrt() / nf
     } else {
-        1.96 * (var / (nf * nf) + (relative_sd * own).powi(2)).sqrt()
+        interval_z * (var / (nf * nf) + (relative_sd * own).powi(2)).sqrt()
     };
     let left = (real - with).abs();
     let passes = if cut {
@@ -287,6 +291,8 @@ mod tests {
     use crate::stats::Stat;
     use gyro_sim::EFFECTS;
 
+    const Z: f64 = crate::Settings::DEFAULT.tests.interval_z;
+
     /// A fit of effect `id` at its typical value, with a 95% interval of ±1.96 times
     /// `relative_sd` of it.
     fn fit(id: &str, relative_sd: f64) -> Fit {
@@ -299,7 +305,7 @@ mod tests {
             .params()
             .iter()
             .map(|v| {
-                let half = 1.96 * relative_sd * v.abs();
+                let half = Z * relative_sd * v.abs();
                 (Some(v - half), Some(v + half))
             })
             .collect();
@@ -358,6 +364,7 @@ mod tests {
             &vec![score(0.0108, 0.0276, 0.0001); 4],
             &vec![score(0.0108, 0.0276, 0.0001); 4],
             1000.0,
+            Z,
         );
         assert!(!over.passes, "{over:?}");
         let close = check(
@@ -366,6 +373,7 @@ mod tests {
             &vec![score(0.0108, 0.013, 0.0001); 4],
             &vec![score(0.0108, 0.013, 0.0001); 4],
             1000.0,
+            Z,
         );
         assert!(close.passes, "{close:?}");
         let covered = check(
@@ -374,6 +382,7 @@ mod tests {
             &vec![score(0.0108, 0.0109, 0.0002); 4],
             &vec![score(0.0108, 0.0109, 0.0002); 4],
             1000.0,
+            Z,
         );
         assert!(covered.passes && covered.statistics[0].band > 1e-4);
         assert!(close.describe().contains("explains most of it"));
@@ -388,34 +397,34 @@ mod tests {
         // ±50% (r 0.25), 8 ms lies inside what its interval predicts.
         let before = vec![score(0.008, 0.0002, 0.0001); 4];
         let after = vec![score(0.008, 0.013, 0.0001); 4];
-        let sure = check(&fit("latency", 0.001), &before, &after, &after, 1000.0);
+        let sure = check(&fit("latency", 0.001), &before, &after, &after, 1000.0, Z);
         assert!(!sure.passes, "{sure:?}");
-        let unsure = check(&fit("latency", 0.25), &before, &after, &after, 1000.0);
+        let unsure = check(&fit("latency", 0.25), &before, &after, &after, 1000.0, Z);
         assert!(unsure.passes, "{unsure:?}");
         let band = unsure.statistics[0].band;
         assert!(
-            (band - 1.96 * (0.25f64 * 0.0128).hypot(0.0001 / 2.0)).abs() < 1e-9,
+            (band - Z * (0.25f64 * 0.0128).hypot(0.0001 / 2.0)).abs() < 1e-9,
             "{band}"
         );
         // The parameter's share is of the effect's own shift, not the named set's: beside
         // another effect that moves the lag to 12.8 ms, a latency whose own shift is
         // 0.1 ms adds little to the band.
         let own = vec![score(0.008, 0.0003, 0.0001); 4];
-        let beside = check(&fit("latency", 0.25), &before, &after, &own, 1000.0);
+        let beside = check(&fit("latency", 0.25), &before, &after, &own, 1000.0, Z);
         assert!(!beside.passes, "{beside:?}");
         assert!(beside.statistics[0].band < 2e-4, "{beside:?}");
         // An open bound counts as r = 1; a relative sd is never above 1.
         let mut open = fit("latency", 0.1);
         open.ci95 = vec![(None, Some(0.02))];
-        assert_eq!(parameter_relative_sd(&open), 1.0);
-        assert_eq!(parameter_relative_sd(&fit("latency", 3.0)), 1.0);
-        assert!((parameter_relative_sd(&fit("latency", 0.15)) - 0.15).abs() < 1e-12);
+        assert_eq!(parameter_relative_sd(&open, Z), 1.0);
+        assert_eq!(parameter_relative_sd(&fit("latency", 3.0), Z), 1.0);
+        assert!((parameter_relative_sd(&fit("latency", 0.15), Z) - 0.15).abs() < 1e-12);
     }
 
     #[test]
     fn no_signature_statistic_means_the_check_does_not_apply() {
         let before = vec![score(0.0108, 0.0002, 0.0001); 2];
-        let c = check(&fit("dropouts", 0.0), &before, &before, &before, 1000.0);
+        let c = check(&fit("dropouts", 0.0), &before, &before, &before, 1000.0, Z);
         assert!(c.passes && c.statistics.is_empty() && !c.unmeasured);
     }
 
@@ -425,7 +434,7 @@ mod tests {
         // clock's lag trend (not measured when the lag lies beyond the search), is missing.
         let before = vec![score(0.0108, 0.0002, 0.0001); 2];
         for id in ["scale_factor", "clock_error_count_stamped"] {
-            let c = check(&fit(id, 0.0), &before, &before, &before, 1000.0);
+            let c = check(&fit(id, 0.0), &before, &before, &before, 1000.0, Z);
             assert!(
                 !c.passes && c.unmeasured && c.statistics.is_empty(),
                 "{c:?}"
@@ -446,6 +455,7 @@ mod tests {
             &vec![score(0.05, 0.034, 0.0001); 2],
             &vec![score(0.05, 0.034, 0.0001); 2],
             100.0,
+            Z,
         );
         assert!(!short.passes && short.statistics[0].cut, "{short:?}");
         // However wide the fitted interval: the value written must reach the bound.
@@ -455,6 +465,7 @@ mod tests {
             &vec![score(0.05, 0.034, 0.0001); 2],
             &vec![score(0.05, 0.034, 0.0001); 2],
             100.0,
+            Z,
         );
         assert!(!unsure.passes, "{unsure:?}");
         assert!(short.describe().contains("does not reach it"));
@@ -464,6 +475,7 @@ mod tests {
             &vec![score(0.05, 0.05, 0.0001); 2],
             &vec![score(0.05, 0.05, 0.0001); 2],
             100.0,
+            Z,
         );
         assert!(far.passes && far.statistics[0].cut, "{far:?}");
         // Inside the search nothing is cut.
@@ -473,6 +485,7 @@ mod tests {
             &vec![score(0.05, 0.034, 0.0001); 2],
             &vec![score(0.05, 0.034, 0.0001); 2],
             1000.0 / 0.9,
+            Z,
         );
         assert!(!inside.statistics[0].cut, "{inside:?}");
     }

@@ -26,7 +26,8 @@ use super::stats::{z_scores, Stat, STD_FLOOR_ABS, STD_FLOOR_REL};
 use std::collections::BTreeMap;
 
 /// Members taken out in turn per run for the floor.
-pub const FLOOR_MEMBERS: usize = 10;
+/// The default `score.floor_members` ([`crate::Settings`]), where the settings do not reach yet.
+pub const FLOOR_MEMBERS: usize = crate::Settings::DEFAULT.score.floor_members;
 
 /// One run scored against one ensemble.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -90,7 +91,8 @@ fn score_stats(real: &[Stat], ensemble: &[Vec<Stat>]) -> RunScore {
 }
 
 /// Degrees of freedom of the Student-t likelihood of one statistic.
-pub const LIKELIHOOD_DOF: f64 = 4.0;
+/// The default `score.likelihood_dof` ([`crate::Settings`]), where the settings do not reach yet.
+pub const LIKELIHOOD_DOF: f64 = crate::Settings::DEFAULT.score.likelihood_dof;
 
 /// Log-likelihood of a statistic at `z` standard deviations `sd` from its ensemble's
 /// mean: Student-t with [`LIKELIHOOD_DOF`] degrees of freedom, up to a constant. Close to

@@ -6,7 +6,7 @@ use super::baseline::{evaluate, Baseline, Runs};
 use super::fit::{self, Fit, Joint};
 use super::posterior::{self, PosteriorCheck};
 use super::score::{bootstrap_p, gap, RunScore};
-use super::{Options, Progress, CONFOUND_COSINE, MAX_EFFECTS};
+use super::{Options, Progress};
 use gyro_analysis::seed::derive_seed;
 use gyro_sim::{Effect, SensorModel};
 use std::collections::BTreeMap;
@@ -164,7 +164,11 @@ impl<'a> Scorer<'a> {
         } else {
             f.passes
                 && !fit::contradicted(f)
-                && held_out_evidence(st, fit::replicates_beside(f, beside))
+                && held_out_evidence(
+                    st,
+                    fit::replicates_beside(f, beside),
+                    self.options.settings.tests.p_value,
+                )
         }
     }
 
@@ -193,8 +197,8 @@ impl<'a> Scorer<'a> {
 /// Whether the held-out runs bear out an effect (not seen directly) whose parameter test
 /// passes: its ΔBIC positive with bootstrap P < 5%, or its own test `replicated` on them
 /// with the held-out likelihood not lowered (Σ Δℓ > 0).
-fn held_out_evidence(st: &Step, replicated: bool) -> bool {
-    st.delta_bic > 0.0 && st.p < 0.05 || replicated && st.loglik_gain > 0.0
+fn held_out_evidence(st: &Step, replicated: bool, p_value: f64) -> bool {
+    st.delta_bic > 0.0 && st.p < p_value || replicated && st.loglik_gain > 0.0
 }
 
 fn loglik_diffs(after: &[RunScore], before: &[RunScore]) -> Vec<f64> {
@@ -332,7 +336,7 @@ pub(crate) fn select(scorer: &Scorer, candidates: &mut [Candidate]) -> Selection
 fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<RunScore>) {
     let mut selected: Vec<usize> = Vec::new();
     let mut current = scorer.before.clone();
-    for step in 0..MAX_EFFECTS {
+    for step in 0..scorer.options.settings.select.max_effects {
         // One bias wander per model: the look-alike wanders are told apart by their
         // shape, not stacked.
         let wander_selected = selected.iter().any(|&j| is_wander(&candidates[j].fit));
@@ -466,7 +470,7 @@ fn swaps(
                     &diffs,
                     scorer.options.bootstrap,
                     scorer.seed("swap test", a),
-                ) < 0.05;
+                ) < scorer.options.settings.tests.p_value;
             if better {
                 let out = selected[slot];
                 let st = scorer.step_of(
@@ -563,7 +567,7 @@ fn confounds(
             .map(|&j| (j, cosine(&si, &shift(candidates[j].alone_scores()))))
             .max_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((j, c)) = best {
-            if c > CONFOUND_COSINE || dropped.contains(&i) {
+            if c > scorer.options.settings.select.confound_cosine || dropped.contains(&i) {
                 partners
                     .entry(i)
                     .or_default()
@@ -629,6 +633,7 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
                 &selection.holdout_scores,
                 candidates[i].alone_scores(),
                 scorer.sample_rate_hz(),
+                scorer.options.settings.tests.interval_z,
             );
             if !check.passes && first_failed.is_none() {
                 first_failed = Some(i);
@@ -673,6 +678,7 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
                     &alone.scores,
                     &alone.scores,
                     scorer.sample_rate_hz(),
+                    scorer.options.settings.tests.interval_z,
                 ));
             }
         }
@@ -742,19 +748,20 @@ mod tests {
 
     #[test]
     fn a_replicated_test_needs_the_likelihood_not_lowered_only() {
+        const P: f64 = crate::Settings::DEFAULT.tests.p_value;
         // A temperature_bias beside scale_asymmetry (self-test seed 20261130): ΔBIC −4.5
         // (the charge for its parameter, ln N ≈ 5.9, exceeds 2 Σ Δℓ ≈ 1.4), P 0.50,
         // coefficient replicated.
         let weak = step(-4.5, 0.7, 0.50);
-        assert!(held_out_evidence(&weak, true));
-        assert!(!held_out_evidence(&weak, false));
+        assert!(held_out_evidence(&weak, true, P));
+        assert!(!held_out_evidence(&weak, false, P));
         // A likelihood that falls is not borne out, replicated or not.
         let lower = step(-6.0, -0.2, 0.60);
-        assert!(!held_out_evidence(&lower, true));
+        assert!(!held_out_evidence(&lower, true, P));
         // The bootstrap route needs both a positive ΔBIC and P < 5%.
-        assert!(held_out_evidence(&step(12.0, 8.8, 0.01), false));
-        assert!(!held_out_evidence(&step(12.0, 8.8, 0.06), false));
-        assert!(!held_out_evidence(&step(-1.0, 2.2, 0.01), false));
+        assert!(held_out_evidence(&step(12.0, 8.8, 0.01), false, P));
+        assert!(!held_out_evidence(&step(12.0, 8.8, 0.06), false, P));
+        assert!(!held_out_evidence(&step(-1.0, 2.2, 0.01), false, P));
     }
     /// The end of a one-sided interval nearest zero, for an effect whose nominal value is
     /// zero; nothing for an interval holding zero or an effect neutral elsewhere (a

@@ -66,15 +66,19 @@ use std::collections::BTreeMap;
 use std::fmt;
 
 /// A sample is still when |reference rate| is below this (deg/s).
-pub const STATIC_RATE_DPS: f64 = 1.0;
+/// The default `statistics.static_rate_dps` ([`crate::Settings`]), where the settings do not reach yet.
+pub const STATIC_RATE_DPS: f64 = crate::Settings::DEFAULT.statistics.static_rate_dps;
 /// Shortest still run counted as static (s).
-pub const STATIC_MIN_S: f64 = 0.5;
+/// The default `statistics.static_min_s` ([`crate::Settings`]), where the settings do not reach yet.
+pub const STATIC_MIN_S: f64 = crate::Settings::DEFAULT.statistics.static_min_s;
 /// Averaging window of the gyro's stillness check (s).
-pub const GYRO_STILL_WINDOW_S: f64 = 0.05;
+/// The default `statistics.gyro_still_window_s` ([`crate::Settings`]), where the settings do not reach yet.
+pub const GYRO_STILL_WINDOW_S: f64 = crate::Settings::DEFAULT.statistics.gyro_still_window_s;
 /// Left out at each end of a rest for the white-noise features (s): the reference rate is
 /// under [`STATIC_RATE_DPS`] on the first and last ramps of the turns around it, whose
 /// steps would count as noise.
-pub const REST_EDGE_S: f64 = 0.1;
+/// The default `statistics.rest_edge_s` ([`crate::Settings`]), where the settings do not reach yet.
+pub const REST_EDGE_S: f64 = crate::Settings::DEFAULT.statistics.rest_edge_s;
 /// Bins of |reference rate| of the dynamic samples (deg/s): `[lo, hi)`.
 pub const RATE_BINS_DPS: [(f64, f64); 4] = [
     (0.0, 30.0),
@@ -87,7 +91,8 @@ pub const ALLAN_BANDS_S: [(f64, f64); 3] = [(0.01, 0.1), (0.1, 1.0), (1.0, 10.0)
 /// Averaging factors tried per Allan band (log-spaced, duplicates dropped).
 pub const ALLAN_FACTORS_PER_BAND: usize = 5;
 /// Largest lag searched by the cross-correlation (s).
-pub const MAX_LAG_S: f64 = 0.05;
+/// The default `statistics.max_lag_s` ([`crate::Settings`]), where the settings do not reach yet.
+pub const MAX_LAG_S: f64 = crate::Settings::DEFAULT.statistics.max_lag_s;
 /// Horizons of the angle error growth (s).
 pub const HORIZONS_S: [f64; 3] = [1.0, 5.0, 20.0];
 /// Absolute floor of the ensemble standard deviation in [`z_scores`].

@@ -171,6 +171,7 @@ pub(crate) struct Findings<'a> {
     pub(crate) compensation: Option<CompensationSummary>,
     pub(crate) corrected_model: Option<ModelFile>,
     pub(crate) turns: Option<super::turns::TurnEvidence>,
+    pub(crate) settings: &'a crate::Settings,
 }
 
 /// Stage 6: the diagnosis.
@@ -187,6 +188,7 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         &f.baseline.train.scores,
         &f.train_after.0,
         &f.selection.holdout_scores,
+        f.settings,
     );
     let runs = run_summaries(
         f.runs,

@@ -11,7 +11,7 @@
 //! - **lag**: each run's gyro–reference cross-correlation peak searched within
 //!   ±[`gyro_analysis::lag::SEARCH_S`] ([`gyro_analysis::lag::log_lag_s`]), median over the training runs;
 //! - **scale**: the least-squares slope of the training turns' errors on their reference
-//!   turns ([`scale::fit`]), named when it is [`Z_CRITICAL`] standard errors from zero, at
+//!   turns ([`scale::fit`]), named when it is `tests.z_critical` ([`crate::Settings`]) standard errors from zero, at
 //!   least [`MIN_K`], and the held-out runs' own turns show it too (their slope, before
 //!   and after the correction: at most half of it left);
 //! - **untracked**: movements the gyro makes and the reference does not follow (a turn
@@ -19,13 +19,13 @@
 //!   reference misses): no effect of the vocabulary expresses them, so they are listed.
 //!
 //! A scale is written into the model file only if it lowers the held-out turns' RMS error,
-//! paired over the held-out runs (bootstrap P < [`CORRECTION_P`]); a lag beyond the
+//! paired over the held-out runs (bootstrap P < `tests.p_value` ([`crate::Settings`])); a lag beyond the
 //! per-sample statistic's reach only if, as the model's `reference_delay_s`, it lowers the
 //! held-out runs' max abs angle error alike.
 
-use super::compensate::{max_abs_errors, paired_gains, CORRECTION_P};
+use super::compensate::{max_abs_errors, paired_gains};
 use super::ensemble::RealRun;
-use super::fit::{t95, Z_CRITICAL};
+use super::fit::t95;
 use super::score::bootstrap_p;
 use super::stats::MAX_LAG_S;
 
@@ -43,7 +43,8 @@ pub use gyro_analysis::findings::{not_followed, UNTRACKED_FRACTION, UNTRACKED_MI
 /// Smallest scale error named (1 = 100%): 0.1% is 0.09° on a 90° turn, below what the
 /// totals of real turns resolve, and what the pipeline's own filtering and grid leave on
 /// noise-free turns (about 0.002%) must not be named however small its scatter.
-pub const MIN_K: f64 = 1e-3;
+/// The default `turns.min_k` ([`crate::Settings`]), where the settings do not reach yet.
+pub const MIN_K: f64 = crate::Settings::DEFAULT.turns.min_k;
 
 /// The turn-level evidence of a diagnosis.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -104,11 +105,11 @@ pub struct TurnScale {
     pub holdout_runs_better: (usize, usize),
     /// Bootstrap P over held-out runs that the correction does not lower their turn RMS.
     pub bootstrap_p: f64,
-    /// Named: `|z| ≥` [`Z_CRITICAL`], `|k| ≥` [`MIN_K`], and the held-out turns keep at
+    /// Named: `|z| ≥ tests.z_critical`, `|k| ≥` [`MIN_K`], and the held-out turns keep at
     /// most half of their slope with it.
     pub named: bool,
     /// Written into the model file's `config.correction.scale_k`: named, and it lowers
-    /// the held-out turns' RMS (bootstrap P < [`CORRECTION_P`]).
+    /// the held-out turns' RMS (bootstrap P < `tests.p_value` ([`crate::Settings`])).
     pub written: bool,
 }
 
@@ -244,7 +245,7 @@ fn wide_lag(
         let p = bootstrap_p(&paired, options.bootstrap.max(1), seed);
         out.holdout_max_abs_error_deg = median(&before).zip(median(&after));
         out.bootstrap_p = Some(p);
-        if !paired.is_empty() && p < CORRECTION_P {
+        if !paired.is_empty() && p < options.settings.tests.p_value {
             *model = trial;
             *changed = true;
             out.written = true;
@@ -289,8 +290,10 @@ fn turn_scale(
     let p = bootstrap_p(&paired, options.bootstrap.max(1), seed);
 
     let z = k / se;
-    let named = z.abs() >= Z_CRITICAL && k.abs() >= MIN_K && k_after.abs() <= 0.5 * k_before.abs();
-    let written = named && !paired.is_empty() && p < CORRECTION_P && rms_after < rms_before;
+    let tests = &options.settings.tests;
+    let named =
+        z.abs() >= tests.z_critical && k.abs() >= MIN_K && k_after.abs() <= 0.5 * k_before.abs();
+    let written = named && !paired.is_empty() && p < tests.p_value && rms_after < rms_before;
     if written {
         *model = trial;
     }
