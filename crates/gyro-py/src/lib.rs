@@ -824,26 +824,7 @@ pub fn calibrate_files(a: &CalibrateArgs) -> Result<(String, String), Error> {
     };
     let result = calibrate(&train, &holdout, &base.config, &options, &mut |_, _, _| {})
         .map_err(|e| error(&e))?;
-    let mut out = base.clone();
-    out.config = result.config;
-    out.reference_delay_s = result.reference_delay.delay_s;
-    if let Some(u) = result
-        .scale
-        .residual_relative_upper
-        .map(|u| u.min(1.0))
-        .filter(|u| *u >= 0.0)
-    {
-        out.scale_sigma = u;
-    }
-    let largest = model::largest_plausible_abs_rate(
-        train
-            .iter()
-            .chain(&holdout)
-            .flat_map(|run| &run.log.slots)
-            .map(|slot| slot.rate_dps),
-        base.config.max_abs_rate_dps,
-    );
-    out.drop_contradicted_range(largest);
+    let (out, _) = result.model_file(&base, train.iter().chain(&holdout));
     if let Some(path) = &a.out {
         model::save(path, &out)
             .map_err(|e| Error(format!("writing the model file: {}", error(&e))))?;

@@ -511,6 +511,37 @@ pub struct Calibration {
 }
 
 impl Calibration {
+    /// The model file calibration writes: `base` (the starting model) with the chosen
+    /// configuration, the reference delay every run was scored with, the scale uncertainty
+    /// left held out (its 95% upper bound, for run's tightening decision; `base`'s when
+    /// nothing was measured), and the sensor's range dropped when `runs` show rates beyond
+    /// it. Returns the file and, when the range was dropped, the note that says why.
+    pub fn model_file<'a>(
+        &self,
+        base: &crate::model::ModelFile,
+        runs: impl IntoIterator<Item = &'a BenchRun>,
+    ) -> (crate::model::ModelFile, Option<String>) {
+        let mut out = base.clone();
+        out.config = self.config;
+        out.reference_delay_s = self.reference_delay.delay_s;
+        if let Some(u) = self
+            .scale
+            .residual_relative_upper
+            .map(|u| u.min(1.0))
+            .filter(|u| *u >= 0.0)
+        {
+            out.scale_sigma = u;
+        }
+        let largest = crate::model::largest_plausible_abs_rate(
+            runs.into_iter()
+                .flat_map(|run| &run.log.slots)
+                .map(|slot| slot.rate_dps),
+            base.config.max_abs_rate_dps,
+        );
+        let note = out.drop_contradicted_range(largest);
+        (out, note)
+    }
+
     /// The configuration of `candidate` as fitted on all training runs.
     pub fn candidate_config(&self, candidate: Candidate) -> Config {
         self.fitted.config(&self.start, candidate)

@@ -128,28 +128,8 @@ pub fn run(args: &Args) -> Result<()> {
     );
     bar.finish_and_clear();
     let result = result?;
-    let mut out = base.clone();
-    out.config = result.config;
-    out.reference_delay_s = result.reference_delay.delay_s;
-    // The scale uncertainty left held out (its 95% upper bound), for run's tightening
-    // decision (kept from `--model` when nothing was measured).
-    if let Some(u) = result
-        .scale
-        .residual_relative_upper
-        .map(|u| u.min(1.0))
-        .filter(|u| *u >= 0.0)
-    {
-        out.scale_sigma = u;
-    }
-    let largest = model::largest_plausible_abs_rate(
-        train
-            .iter()
-            .chain(&holdout)
-            .flat_map(|run| &run.log.slots)
-            .map(|slot| slot.rate_dps),
-        base.config.max_abs_rate_dps,
-    );
-    if let Some(note) = out.drop_contradicted_range(largest) {
+    let (out, note) = result.model_file(&base, train.iter().chain(&holdout));
+    if let Some(note) = note {
         say!("{}: {note}", args.out.display());
     }
     model::save(&args.out, &out).with_context(|| "writing the model file".to_string())?;
