@@ -324,8 +324,9 @@ impl LagTrendMeter {
 pub const TREND_OUTLIER_S: f64 = 0.05;
 
 /// The points of `lags` near their Theil–Sen line (the median of the pairwise slopes,
-/// through the median point), in time order; `None` for fewer than two.
-fn inliers(lags: &[(f64, f64)]) -> Option<Vec<(f64, f64)>> {
+/// through the median point), in time order; `None` for fewer than two. Shared by `run`'s
+/// lag trend and the diagnosis's lag line.
+pub fn inliers(lags: &[(f64, f64)]) -> Option<Vec<(f64, f64)>> {
     let mut slopes = Vec::new();
     for (i, a) in lags.iter().enumerate() {
         for b in &lags[i + 1..] {

@@ -10,7 +10,10 @@
 //! - `config.correction` ([`gyro_core::Correction`]): scale, asymmetry and temperature
 //!   errors, which the core removes from every sample — on the wrench as in `run`;
 //! - `reference_delay_s`: the gyro's latency behind the reference, which only scoring uses
-//!   (the reference is shifted by it before comparing; see [`crate::replay::ReplayOptions`]).
+//!   (the reference is shifted by it before comparing; see [`crate::replay::ReplayOptions`]);
+//! - `count_clock_ppm`: a sensor clock off its nominal rate in a log stamped by the sensor's
+//!   sample count, which only scoring uses too (the reference is read at the gyro's own
+//!   time), beside the scale it gives the angle in `config.correction.scale_k`.
 //!
 //! ```json
 //! {"format": "gyro-model", "version": 1,
@@ -32,6 +35,9 @@ pub const VERSION: u32 = 1;
 /// The largest |`reference_delay_s`| accepted (s): a gyro's latency is milliseconds; a
 /// second is a wrong unit or a wrong sign convention, not a latency.
 pub const MAX_REFERENCE_DELAY_S: f64 = 1.0;
+/// The largest |`count_clock_ppm`| accepted (ppm): 10%, beyond the ±1–3% of a MEMS gyro's
+/// internal oscillator.
+pub const MAX_COUNT_CLOCK_PPM: f64 = 1e5;
 
 /// A model file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -53,6 +59,16 @@ pub struct ModelFile {
     /// slots), so that the error measures the sensor, not the logger's timing. Default 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub reference_delay_s: f64,
+    /// The sensor's sample clock runs fast by this (ppm; negative: slow) and the log's rows
+    /// are stamped by its sample count, as fitted by `diagnose` (effect
+    /// `clock_error_count_stamped`): the sample of stamp `t` was taken at `t / (1 + ε)`,
+    /// so its lag behind the reference grows through the run. Applied when scoring, not by
+    /// the core: `run` compares the angle at `t` with the reference at `t / (1 + ε) −
+    /// reference_delay_s` (`t` from the log's first slot). The angle's scale, 1 + ε, is
+    /// `config.correction.scale_k`'s, written with it. Within ±[`MAX_COUNT_CLOCK_PPM`];
+    /// default 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub count_clock_ppm: f64,
     /// The gyro's scale uncertainty left after calibration (relative, 0.01 = 1%), as
     /// `calibrate` measured it on runs it was not fitted on. The movement's σ knows the bias
     /// and the noise, not the scale: `run`'s tightening decision adds it to each movement's
@@ -75,6 +91,7 @@ impl ModelFile {
             config,
             sensor: SensorModel::default(),
             reference_delay_s: 0.0,
+            count_clock_ppm: 0.0,
             scale_sigma: 0.0,
         }
     }
@@ -191,6 +208,14 @@ pub enum ModelError {
         /// The value found.
         value: f64,
     },
+    /// `count_clock_ppm` is not finite or beyond ±[`MAX_COUNT_CLOCK_PPM`].
+    #[error("{path}: count_clock_ppm must be within ±{MAX_COUNT_CLOCK_PPM} ppm, found {value}")]
+    CountClock {
+        /// File.
+        path: PathBuf,
+        /// The value found.
+        value: f64,
+    },
     /// `scale_sigma` is not within 0..1.
     #[error("{path}: scale_sigma must be within 0 and 1 (a share of the angle), found {value}")]
     ScaleSigma {
@@ -249,6 +274,12 @@ pub fn load(path: &Path) -> Result<ModelFile, ModelError> {
         return Err(ModelError::ReferenceDelay {
             path: path.to_path_buf(),
             value: model.reference_delay_s,
+        });
+    }
+    if !(model.count_clock_ppm.is_finite() && model.count_clock_ppm.abs() <= MAX_COUNT_CLOCK_PPM) {
+        return Err(ModelError::CountClock {
+            path: path.to_path_buf(),
+            value: model.count_clock_ppm,
         });
     }
     if !(0.0..=1.0).contains(&model.scale_sigma) {
@@ -335,6 +366,32 @@ mod tests {
             .prefix("gyro-model-test-")
             .tempdir()
             .unwrap()
+    }
+
+    #[test]
+    fn a_count_clock_beyond_ten_percent_is_refused_naming_the_file() {
+        let scratch = temp_dir();
+        let path = scratch.path().join("clock.json");
+        let model = ModelFile {
+            count_clock_ppm: 2e5,
+            ..ModelFile::new(Config::default())
+        };
+        save(&path, &model).unwrap();
+        let e = load(&path).expect_err("20% is no clock error");
+        assert!(matches!(e, ModelError::CountClock { .. }), "{e}");
+        assert!(
+            e.to_string().contains("clock.json") && e.to_string().contains("count_clock_ppm"),
+            "{e}"
+        );
+        let fine = ModelFile {
+            count_clock_ppm: -24_000.0,
+            ..ModelFile::new(Config::default())
+        };
+        save(&path, &fine).unwrap();
+        assert_eq!(
+            load(&path).expect("within range").count_clock_ppm,
+            -24_000.0
+        );
     }
 
     #[test]

@@ -169,6 +169,10 @@ pub struct ReplayOptions {
     /// between grid slots; where that time falls outside the log (or next to a slot without
     /// reference) the sample has no reference. 0: the reference as logged.
     pub reference_delay_s: f64,
+    /// The sensor's clock runs fast by this (ppm) in a log stamped by its sample count
+    /// ([`ModelFile::count_clock_ppm`]): the reference is read at `t / (1 + ε)` (then less
+    /// `reference_delay_s`), `t` from the log's first slot. 0: none.
+    pub count_clock_ppm: f64,
 }
 
 impl ReplayOptions {
@@ -176,7 +180,22 @@ impl ReplayOptions {
     pub fn from_model(model: &ModelFile) -> Self {
         Self {
             reference_delay_s: model.reference_delay_s,
+            count_clock_ppm: model.count_clock_ppm,
         }
+    }
+
+    /// Whether the reference is read at other times than logged.
+    pub fn shifts_reference(&self) -> bool {
+        let finite_nonzero = |x: f64| x.is_finite() && x != 0.0;
+        finite_nonzero(self.reference_delay_s) || finite_nonzero(self.count_clock_ppm)
+    }
+
+    /// The reference's shift at slot `i` in grid slots at `sample_rate_hz` (positive: the
+    /// reference is read that many slots earlier); a non-finite setting counts as none.
+    fn shift_slots(&self, i: usize, sample_rate_hz: f64) -> f64 {
+        let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
+        let eps = finite(self.count_clock_ppm) * 1e-6;
+        finite(self.reference_delay_s) * sample_rate_hz + i as f64 * eps / (1.0 + eps)
     }
 }
 
@@ -291,14 +310,8 @@ pub fn replay_with_mode(
 ) -> Result<RunReport, gyro_core::Error> {
     let mut replayer =
         Replayer::new(log.sample_rate_hz, config, options, log.has_temperature)?.with_mode(mode);
-    // The reference's shift in grid slots (a non-finite delay is treated as none).
-    let shift_slots = if options.reference_delay_s.is_finite() {
-        options.reference_delay_s * log.sample_rate_hz
-    } else {
-        0.0
-    };
     let mut series = Vec::new();
-    if shift_slots == 0.0 {
+    if !options.shifts_reference() {
         for slot in &log.slots {
             if let Some(point) = replayer.push(slot) {
                 replayer.emit(point, &mut series);
@@ -308,8 +321,8 @@ pub fn replay_with_mode(
         // The reference at other slots, ahead or behind: the whole log is at hand.
         replayer.reference_origin = log.slots.iter().find_map(|s| s.reference_deg);
         for (i, slot) in log.slots.iter().enumerate() {
-            if let Some(point) =
-                replayer.push_scored(slot, shifted_reference(&log.slots, i, shift_slots))
+            let shift = options.shift_slots(i, log.sample_rate_hz);
+            if let Some(point) = replayer.push_scored(slot, shifted_reference(&log.slots, i, shift))
             {
                 replayer.emit(point, &mut series);
             }
@@ -467,8 +480,7 @@ pub fn replay_file_into_mode(
         sample_rate_hz,
         output_rate_hz: config.output_rate_hz,
     };
-    let delay = replay_options.reference_delay_s;
-    if delay.is_finite() && delay != 0.0 {
+    if replay_options.shifts_reference() {
         let regular = gyro_log::load(path, options, grid, warn)?;
         let mut report = replay_with_mode(&regular, config, replay_options, mode)
             .map_err(|cause| config_error(cause, regular.sample_rate_hz))?;
@@ -1237,6 +1249,41 @@ mod tests {
         )
     }
 
+    /// A count-stamped clock 1% fast on a steady turn: the scale it writes alone leaves
+    /// an error growing through the run (the angle is the one at the gyro's own time);
+    /// with `count_clock_ppm` the reference is read there and the error goes.
+    #[test]
+    fn a_count_stamped_clock_is_scored_at_the_gyros_own_time() {
+        let ppm = 10_000.0;
+        let mut config = Config::default();
+        config.correction.scale_k = (ppm * 1e-6) as f32;
+        let max_error = |options: &ReplayOptions| {
+            replay_with(&turning_log(0.0), &config, options)
+                .expect("replay")
+                .summary
+                .max_abs_error_deg
+                .expect("scored")
+        };
+        let scale_only = max_error(&ReplayOptions::default());
+        let both = max_error(&ReplayOptions {
+            count_clock_ppm: ppm,
+            ..ReplayOptions::default()
+        });
+        assert!(scale_only > 7.0, "{scale_only}");
+        assert!(both < 0.05 * scale_only, "{both} against {scale_only}");
+        // The shift in slots: the delay's, and the clock's growing with the slot.
+        let options = ReplayOptions {
+            reference_delay_s: 0.01,
+            count_clock_ppm: ppm,
+        };
+        let shift = options.shift_slots(1000, 1000.0);
+        assert!(
+            (shift - (10.0 + 1000.0 * 0.01 / 1.01)).abs() < 1e-9,
+            "{shift}"
+        );
+        assert!(options.shifts_reference() && !ReplayOptions::default().shifts_reference());
+    }
+
     /// Settled on a constant, the reference's low-pass made this log's error the rate
     /// times the filter delay (2.85°) from its start to its end.
     #[test]
@@ -1244,6 +1291,7 @@ mod tests {
         for (lead_s, delay_s) in [(0.0, 0.0), (0.012, 0.012)] {
             let options = ReplayOptions {
                 reference_delay_s: delay_s,
+                ..ReplayOptions::default()
             };
             let report =
                 replay_with(&turning_log(lead_s), &Config::default(), &options).expect("replay");

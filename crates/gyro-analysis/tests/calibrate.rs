@@ -462,6 +462,7 @@ fn a_gyro_latency_is_measured_as_the_reference_delay() {
 fn median_max_abs_delayed(runs: &[BenchRun], config: &Config, delay_s: f64) -> f64 {
     let scoring = gyro_analysis::replay::ReplayOptions {
         reference_delay_s: delay_s,
+        ..Default::default()
     };
     let errors: Vec<f64> = runs
         .iter()

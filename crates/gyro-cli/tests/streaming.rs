@@ -102,6 +102,7 @@ fn assert_same(path: &Path, all: bool) -> String {
     let none_delay = ReplayOptions::default();
     let delayed = ReplayOptions {
         reference_delay_s: 0.004,
+        ..ReplayOptions::default()
     };
     let mut runs = vec![
         (GridOptions::default(), Config::default(), none_delay),

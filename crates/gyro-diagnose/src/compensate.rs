@@ -6,7 +6,8 @@
 //! (`gyro_sim::EFFECTS`): a scale, asymmetry or temperature coefficient of the core's
 //! correction (ΔT from the first temperature of the run, as the simulator defines it),
 //! the model file's reference delay (a low-pass: its low-frequency delay,
-//! [`gyro_sim::low_pass_delay_s`]), or Kalman compensation of the bias at every rest.
+//! [`gyro_sim::low_pass_delay_s`]), a count-stamped clock (a scale and the model file's
+//! `count_clock_ppm`), or Kalman compensation of the bias at every rest.
 
 use super::ensemble::RealRun;
 use super::{CompensationRun, CompensationSummary, NotCorrected};
@@ -45,6 +46,11 @@ pub fn corrected_model(base: &ModelFile, effects: &[Effect]) -> (ModelFile, Vec<
             }
             CoreCorrection::ReferenceDelay => {
                 model.reference_delay_s += value;
+                true
+            }
+            CoreCorrection::CountClock => {
+                c.scale_k += (value * 1e-6) as f32;
+                model.count_clock_ppm += value;
                 true
             }
             CoreCorrection::LowPassReferenceDelay => {

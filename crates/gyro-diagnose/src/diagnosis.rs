@@ -181,8 +181,19 @@ impl Diagnosis {
     /// Why the residual-based figures (the effective noise, the where-statistics) say
     /// little about the sensor here, when they do: a reference that lags or leads the
     /// gyro beyond the per-sample statistics' reach makes the residual during turns the
-    /// rate times the lag ([`super::turns`]). `None` otherwise.
+    /// rate times the lag ([`super::turns`]), and so does a lag that grows with a named
+    /// count-stamped clock. `None` otherwise.
     pub fn residual_caveat(&self) -> Option<String> {
+        let clock_ppm = self.model.effects.iter().find_map(|e| match e {
+            gyro_sim::Effect::ClockErrorCountStamped { ppm } => Some(*ppm),
+            _ => None,
+        });
+        if let Some(ppm) = clock_ppm {
+            return Some(format!(
+                "the gyro's lag grows through each run with its clock ({:.0} ms each minute): this residual holds the rate times that lag, above the sensor's own noise",
+                ppm.abs() * 1e-6 * 6e4
+            ));
+        }
         let lag = self.turns.as_ref()?.lag.as_ref()?;
         lag.beyond_statistic.then(|| {
             format!(

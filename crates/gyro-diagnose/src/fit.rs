@@ -64,16 +64,18 @@ pub struct Fit {
 /// again ([`Fit::direct`]): saturation, quantisation and dropouts seen directly in
 /// `runs`, and the turn-on bias's between-run spread against their `null` ensembles
 /// (each held-out run alone says little about a between-run effect: one run with a large
-/// bias cannot carry a bootstrap over runs). False for the other effects.
+/// bias cannot carry a bootstrap over runs; the biases less what the `known` effects
+/// give them, [`bias_spread`]). False for the other effects.
 pub fn direct_evidence(
     effect: &Effect,
     runs: &[&RealRun],
     null: &[Vec<Member>],
     model: &SensorModel,
+    known: &[Effect],
 ) -> bool {
     match effect.info().fit {
         FitProcedure::BetweenRunSpread => {
-            runs.len() >= 3 && bias_spread(runs, null).0 >= Z_CRITICAL
+            runs.len() >= 3 && bias_spread(runs, null, model, known).0 >= Z_CRITICAL
         }
         FitProcedure::Plateau => {
             runs.iter()
@@ -221,12 +223,20 @@ impl CoefficientTest {
 }
 
 /// The between-run spread of the bias ([`super::features::Features::bias_dps`]) of
-/// `runs` against
-/// their null ensembles: `(n−1) s²/v0` is χ²(n−1) without a turn-on bias (s²: the runs'
-/// sample variance, v0: the mean of the replicas'). Returns (its Wilson–Hilferty
-/// z-score, s², v0, n−1).
-fn bias_spread(runs: &[&RealRun], null: &[Vec<Member>]) -> (f64, f64, f64, f64) {
-    let real: Vec<f64> = runs.iter().map(|r| r.features.bias_dps).collect();
+/// `runs` against their null ensembles: `(n−1) s²/v0` is χ²(n−1) without a turn-on bias
+/// (s²: the runs' sample variance, v0: the mean of the replicas'). Each run's bias is
+/// taken less what the `known` effects give it in a noise-free simulation of the run with
+/// `model` ([`known_bias_dps`]). Returns (its Wilson–Hilferty z-score, s², v0, n−1).
+fn bias_spread(
+    runs: &[&RealRun],
+    null: &[Vec<Member>],
+    model: &SensorModel,
+    known: &[Effect],
+) -> (f64, f64, f64, f64) {
+    let real: Vec<f64> = runs
+        .par_iter()
+        .map(|r| r.features.bias_dps - known_bias_dps(r, model, known))
+        .collect();
     let s2 = sample_var(&real);
     let members = null.iter().map(Vec::len).min().unwrap_or(0);
     let null_vars: Vec<f64> = (0..members)
@@ -241,6 +251,20 @@ fn bias_spread(runs: &[&RealRun], null: &[Vec<Member>]) -> (f64, f64, f64, f64) 
     let c = 2.0 / (9.0 * k);
     let z = ((x / k).cbrt() - (1.0 - c)) / c.sqrt();
     (z, s2, v0, k)
+}
+
+/// The bias the `known` effects alone give `run` (its regression intercept in a
+/// noise-free simulation with `model`, less the model's own): 0 without known effects.
+/// A count-stamped clock whose lag grows leaks the rate times the lag into the intercept,
+/// by as much as the turns differ between runs: unremoved, it reads as a turn-on bias.
+pub(crate) fn known_bias_dps(run: &RealRun, model: &SensorModel, known: &[Effect]) -> f64 {
+    if known.is_empty() {
+        return 0.0;
+    }
+    let quiet = model.noise_free();
+    let with = simulate_member(run, &quiet, known, 1).features.bias_dps;
+    let without = simulate_member(run, &quiet, &[], 1).features.bias_dps;
+    with - without
 }
 
 /// Two-sided 95% quantile of Student's t with `dof` degrees of freedom.
@@ -673,6 +697,9 @@ pub struct FitInput<'a> {
     pub holdout_null: &'a [Vec<Member>],
     /// The numbers that decide the fits.
     pub settings: &'a Settings,
+    /// A count-stamped clock read from the lag lines, beyond the per-sample statistics'
+    /// reach ([`super::lag_line::grown_clock_fit`]), its test passed: held as known.
+    pub grown_clock: Option<&'a Fit>,
 }
 
 impl FitInput<'_> {
@@ -812,6 +839,12 @@ pub struct Joint<'a> {
 }
 
 impl Joint<'_> {
+    /// The effects held as known under every fit: the clock, stamped or read from the
+    /// lag line.
+    pub fn known(&self) -> &[Effect] {
+        &self.clock
+    }
+
     /// The refitted fit of each effect of `set` (`None`: kept as fitted alone).
     pub fn fits(&self, set: &[Effect]) -> Vec<Option<Fit>> {
         if set.len() < 2 || !set.iter().any(conditional) {
@@ -901,15 +934,23 @@ pub fn fit_all<'a>(input: &'a FitInput<'a>) -> (Vec<Fit>, Vec<Untestable>, Joint
     let mut fits = Vec::new();
     let mut untestable = Vec::new();
     let quiet = input.noise_free(&[]);
-    let clock: Vec<Effect> = clock_fit(input)
+    let mut clock: Vec<Effect> = clock_fit(input)
         .ok()
         .filter(|f| f.passes)
         .map(|f| f.effect)
         .into_iter()
         .collect();
+    // A count-stamped clock whose lag grows beyond the per-sample statistics' reach is
+    // read from the lag lines and held as known, like the stamped one.
+    let grown = input.grown_clock;
+    clock.extend(grown.iter().map(|f| f.effect));
     let known = Known::new(input, quiet, clock.clone());
     for info in EFFECTS {
-        let fitted = fit_one(input, &known, info).and_then(|f| {
+        let fitted = match &grown {
+            Some(f) if f.effect.id() == info.id => Ok((*f).clone()),
+            _ => fit_one(input, &known, info),
+        };
+        let fitted = fitted.and_then(|f| {
             let finite = f.effect.params().iter().all(|v| v.is_finite())
                 && f.ci95
                     .iter()
@@ -1349,7 +1390,7 @@ fn fit_one(input: &FitInput, known: &Known, info: &'static EffectInfo) -> Result
             regression_procedure(input, known, info, index, reading, test)
         }
         FitProcedure::StampedClock => clock_fit(input),
-        FitProcedure::BetweenRunSpread => between_run_fit(input, info),
+        FitProcedure::BetweenRunSpread => between_run_fit(input, known, info),
         FitProcedure::Wander(shape) => wander_fit(input, info, shape),
         FitProcedure::Plateau => plateau_fit(input, info),
         FitProcedure::OutputGrid => grid_fit(input, info),
@@ -1435,12 +1476,16 @@ fn regression_procedure(
 
 /// A between-run spread of the bias: σ² is the runs' variance less the replicas'
 /// ([`bias_spread`]), with χ² bounds.
-fn between_run_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError> {
+fn between_run_fit(
+    input: &FitInput,
+    known: &Known,
+    info: &'static EffectInfo,
+) -> Result<Fit, FitError> {
     let single = single_param(info)?;
     if input.train.len() < 3 {
         return Err(FitError::TooFewRunsForSpread);
     }
-    let (z, s2, v0, k) = bias_spread(input.train, input.null);
+    let (z, s2, v0, k) = bias_spread(input.train, input.null, input.model, &known.effects);
     let sigma = (s2 - v0).max(0.0).sqrt();
     let lo = (k * s2 / chi2_quantile(0.975, k) - v0).max(0.0).sqrt();
     let hi = (k * s2 / chi2_quantile(0.025, k) - v0).max(0.0).sqrt();

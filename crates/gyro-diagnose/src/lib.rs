@@ -65,6 +65,7 @@ pub(crate) mod ensemble;
 pub mod envelopes;
 pub(crate) mod features;
 pub(crate) mod fit;
+pub mod lag_line;
 pub mod line;
 pub mod locate;
 pub(crate) mod low_band;
@@ -180,6 +181,9 @@ pub enum DiagnoseError {
         /// That run's sample rate (Hz).
         other_hz: f64,
     },
+    /// A setting of [`Options::settings`] is not valid.
+    #[error("diagnose settings: {0}")]
+    Settings(#[from] SettingsError),
 }
 
 /// Progress reports.
@@ -231,11 +235,18 @@ pub fn diagnose(
     options: &Options,
     progress: &dyn Progress,
 ) -> Result<Diagnosis, DiagnoseError> {
+    options.settings.validate()?;
     check_runs(train, holdout)?;
     let runs = Runs::new(train, holdout);
 
+    // 0. A count-stamped clock whose lag grows beyond the per-sample statistics' reach,
+    // read directly from the lag lines (no model needed): held as known from the start.
+    let grown_clock = lag_line::grown_clock_fit(&runs.train, &runs.holdout, &options.settings)
+        .filter(|f| f.passes);
+    let known: Vec<gyro_sim::Effect> = grown_clock.iter().map(|f| f.effect).collect();
+
     // 1. Baseline, and 2. where.
-    let base = baseline::baseline(&runs, options, progress);
+    let base = baseline::baseline(&runs, &known, options, progress);
     let r#where = locate::locate(
         base.train.scores.iter().chain(&base.holdout.scores),
         &options.settings,
@@ -251,6 +262,7 @@ pub fn diagnose(
         holdout: &runs.holdout,
         holdout_null: &base.holdout.members,
         settings: &options.settings,
+        grown_clock: grown_clock.as_ref(),
     };
     let (fits, untestable, joint) = fit::fit_all(&input);
 
@@ -264,7 +276,10 @@ pub fn diagnose(
 
     // 5. Compensate the correctable effects (scales from the turns when the reference
     // lags beyond the per-sample statistic).
-    let train_lags_s = turns::run_lags_s(train);
+    // A count-stamped clock named: the lag grows by its doing, and what is left is the
+    // lag line's start.
+    let growing = selected_effects.iter().any(summarise::is_count_clock);
+    let train_lags_s = turns::run_lags_s(train, growing, &options.settings);
     let (compensation, corrected_model) = compensate::compensate(
         holdout,
         options,
@@ -284,7 +299,7 @@ pub fn diagnose(
         .clone()
         .unwrap_or_else(|| options.base_model.clone());
     let (turns, turn_model) =
-        turns::turn_evidence(train, &train_lags_s, holdout, &turn_base, options);
+        turns::turn_evidence(train, &train_lags_s, growing, holdout, &turn_base, options);
     let corrected_model = turn_model.or(corrected_model);
 
     // 6. Summarise.
@@ -312,4 +327,21 @@ pub fn diagnose(
         turns,
         settings: &options.settings,
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn invalid_settings_are_refused_before_any_run_is_read() {
+        let mut options = Options::default();
+        options.settings.tests.z_critical = f64::NAN;
+        let e = diagnose(&[], &[], &options, &Silent).expect_err("NaN z must be refused");
+        assert!(matches!(
+            e,
+            DiagnoseError::Settings(SettingsError::NonFinite(name)) if name.ends_with("z_critical")
+        ));
+        assert!(e.to_string().contains("z_critical"), "{e}");
+    }
 }

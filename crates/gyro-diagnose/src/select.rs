@@ -160,6 +160,7 @@ impl<'a> Scorer<'a> {
                     &self.runs.holdout,
                     &self.baseline.holdout.members,
                     self.nominal(),
+                    self.joint.known(),
                 )
         } else {
             f.passes

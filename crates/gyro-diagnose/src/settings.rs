@@ -231,6 +231,23 @@ pub struct Statistics {
     /// Cut-off of the low band. Unit Hz, valid (0, 10⁴]. 2.0: the band of a wrench's
     /// turns, where the angle is integrated.
     pub low_band_hz: f64,
+    /// Window over which the gyro–reference lag is read, one point of the lag line
+    /// (`lag_line`, the statistic `xcorr_lag_trend`): a sensor clock stamped by its own count makes the lag grow through the
+    /// run. Unit s, valid (0, 3600]. 4.0: a bench movement or two, and 22 points in 90 s
+    /// with windows overlapping by half.
+    pub lag_window_s: f64,
+    /// Least RMS reference rate in a window for its lag to be read. Unit deg/s, valid
+    /// (0, 10⁴]. 5.0: below it a window is mostly rest and its cross-correlation is noise.
+    pub lag_min_motion_dps: f64,
+    /// Largest sample-clock error the lag line searches for (1 = 100%): the first windows
+    /// are searched within ±([`Statistics::max_lag_s`] + this × their time). Unit 1, valid
+    /// (0, 0.5]. 0.05: beyond the ±1–3% of a MEMS gyro's internal oscillator (MPU-6050,
+    /// BMI160 datasheets) with a margin.
+    pub lag_max_clock: f64,
+    /// Rate the rates are block-averaged to before the lag line reads them. Unit Hz,
+    /// valid (0, 10⁶]. 200.0: a wrench's motion lies below 20 Hz, and the peak is placed
+    /// between samples by a parabola; at 1 kHz it cuts the search 25-fold.
+    pub lag_line_hz: f64,
 }
 
 /// Scores, floor and posterior checks.
@@ -388,6 +405,10 @@ impl Settings {
             guard_bins: 2,
             floor_bins: 10,
             low_band_hz: 2.0,
+            lag_window_s: 4.0,
+            lag_min_motion_dps: 5.0,
+            lag_max_clock: 0.05,
+            lag_line_hz: 200.0,
         },
         score: Score {
             floor_members: 10,
@@ -497,6 +518,14 @@ impl Settings {
                 "bins on either side whose median is a line's local floor"),
             entry("statistics.low_band_hz", st.low_band_hz, "Hz", (OPEN, 0.0, 1e4, CLOSED),
                 "cut-off of the low band: the band of the turns"),
+            entry("statistics.lag_window_s", st.lag_window_s, "s", (OPEN, 0.0, 3600.0, CLOSED),
+                "window of one point of the lag line, whose growth through the run is a count-stamped clock"),
+            entry("statistics.lag_min_motion_dps", st.lag_min_motion_dps, "deg/s", (OPEN, 0.0, 1e4, CLOSED),
+                "least RMS reference rate in a window for its lag to be read"),
+            entry("statistics.lag_max_clock", st.lag_max_clock, "1", (OPEN, 0.0, 0.5, CLOSED),
+                "largest clock error the lag line searches for: beyond the ±1–3% of an internal oscillator"),
+            entry("statistics.lag_line_hz", st.lag_line_hz, "Hz", (OPEN, 0.0, 1e6, CLOSED),
+                "rate the lag line block-averages the rates to: the motion lies below 20 Hz"),
             count("score.floor_members", sc.floor_members as f64, "members", 1.0, 1e4,
                 "members taken out in turn per run for the floor"),
             entry("score.likelihood_dof", sc.likelihood_dof, "1", (OPEN, 0.0, 1e6, CLOSED),

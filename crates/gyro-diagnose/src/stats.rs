@@ -46,15 +46,16 @@
 //! - `xcorr_peak_lag_s` (s): lag of the peak of the cross-correlation of gyro rate and
 //!   reference rate (means removed) within ±[`MAX_LAG_S`], refined by a parabola through
 //!   the peak and its neighbours; positive when the gyro lags the reference: `all`.
-//! - `xcorr_lag_trend` (s/s): the same lag in the last third of the run less that in the
-//!   first third, over the time between their starts (a sample clock stamped by its own
-//!   count lags more and more): `all`; left out when either lag sits on the edge of the
-//!   search.
+//! - `xcorr_lag_trend` (s/s): the slope of the lag line ([`crate::lag_line`]): the lag
+//!   read window by window through the run, tracked beyond ±[`MAX_LAG_S`] (a sample clock
+//!   stamped by its own count lags more and more, up to seconds at 1–3%): `all`; left out
+//!   when fewer than three windows have motion.
 //! - `angle_error_rms_<H>s` (deg): RMS over non-overlapping windows of `H` s
 //!   ([`HORIZONS_S`]) of the residual integrated over the window, after removing the
 //!   static residual mean (the bias; the mean over all samples when there is no static
 //!   run); windows with a sample lacking a residual are skipped: `all`.
 
+use crate::lag_line::lag_line;
 use gyro_analysis::noise::{AllanDeviation, ONE_SIGMA};
 pub use gyro_analysis::xcorr::{
     centred_difference, is_at_edge_of, smooth_half_width, xcorr_peak_lag_within, Overlap,
@@ -436,24 +437,6 @@ fn lag1(x: &[f64], runs: &[std::ops::Range<usize>]) -> Option<f64> {
     (den > 0.0).then(|| num / den)
 }
 
-/// Change of the cross-correlation peak lag over the run (s per s): the lag of the last
-/// third less that of the first, over the time between their centres. `None` when either
-/// lag sits on the edge of the search: a bound is not a measurement, and the difference of
-/// two bounds says nothing of a trend.
-fn xcorr_lag_trend(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
-    let third = gyro.len() / 3;
-    if third < 3 {
-        return None;
-    }
-    let first = xcorr_peak_lag(&gyro[..third], &reference[..third], fs)?;
-    let start = gyro.len() - third;
-    let last = xcorr_peak_lag(&gyro[start..], &reference[start..], fs)?;
-    if is_at_search_edge(first, fs) || is_at_search_edge(last, fs) {
-        return None;
-    }
-    Some((last - first) / (start as f64 / fs))
-}
-
 /// The lag of `stats`' cross-correlation peak (`all`/`xcorr_peak_lag_s`, at sample rate
 /// `fs`) when it sits on the edge of the search (±[`MAX_LAG_S`]): then the true lag is at
 /// least that, and the value is cut, not measured.
@@ -705,8 +688,13 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
     if let Some(lag) = xcorr_peak_lag(&r.rate_dps, &r.reference_rate_dps, fs) {
         out.push("all", "xcorr_peak_lag_s", lag);
     }
-    if let Some(trend) = xcorr_lag_trend(&r.rate_dps, &r.reference_rate_dps, fs) {
-        out.push("all", "xcorr_lag_trend", trend);
+    if let Some(line) = lag_line(
+        &r.rate_dps,
+        &r.reference_rate_dps,
+        fs,
+        &crate::Settings::DEFAULT,
+    ) {
+        out.push("all", "xcorr_lag_trend", line.slope);
     }
 
     // Angle error growth.
@@ -910,9 +898,11 @@ mod tests {
             "{:?}",
             get(&beyond, "all", "xcorr_peak_lag_s")
         );
-        // A lag trend is measured within the search, not between two cut lags.
-        assert!(late.iter().any(|s| s.statistic == "xcorr_lag_trend"));
-        assert!(!beyond.iter().any(|s| s.statistic == "xcorr_lag_trend"));
+        // The lag's trend is tracked beyond the search: a constant delay is flat.
+        for lagging in [&late, &beyond] {
+            let trend = get(lagging, "all", "xcorr_lag_trend");
+            assert!(trend.abs() < 1e-4, "trend {trend}");
+        }
     }
 
     #[test]

@@ -177,6 +177,7 @@ pub(crate) struct Findings<'a> {
 /// Stage 6: the diagnosis.
 pub(crate) fn summarise(f: Findings) -> Diagnosis {
     let floor = f.baseline.floor;
+    let growing = f.selected_effects.iter().any(is_count_clock);
     let effects = effect_results(floor, gap(&f.holdout_before), &f.candidates, &f.selection);
     let unmodelled: Vec<&'static str> = effects
         .iter()
@@ -225,7 +226,7 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         runs,
         compensation: f.compensation,
         reference_warnings: sense_warnings(f.runs),
-        warnings: lag_warnings(f.runs)
+        warnings: lag_warnings(f.runs, growing)
             .into_iter()
             .chain(f.baseline.whiteness.as_ref().and_then(colour_warning))
             .collect(),
@@ -299,9 +300,6 @@ fn sense_warnings(runs: &Runs) -> Vec<String> {
     out
 }
 
-/// A warning when the gyro–reference lag of some runs lies beyond the cross-correlation's
-/// search: their `xcorr_peak_lag_s` is cut at its edge, and the latency's fit and
-/// posterior check read a cut value.
 /// The warning a coloured rest noise gives: the nominal model's white noise cannot be the
 /// rests' at every frequency.
 fn colour_warning(w: &super::fit::RestWhiteness) -> Option<String> {
@@ -313,7 +311,16 @@ fn colour_warning(w: &super::fit::RestWhiteness) -> Option<String> {
     })
 }
 
-fn lag_warnings(runs: &Runs) -> Vec<String> {
+/// A warning when the gyro–reference lag of some runs lies beyond the cross-correlation's
+/// search: their `xcorr_peak_lag_s` is cut at its edge, and the latency's fit and
+/// posterior check read a cut value. Beside a named count-stamped clock (`growing`) the
+/// lag grows there by the clock's doing, which the lag line follows.
+/// A count-stamped clock: the lag grows through the run.
+pub(crate) fn is_count_clock(effect: &gyro_sim::Effect) -> bool {
+    matches!(effect, gyro_sim::Effect::ClockErrorCountStamped { .. })
+}
+
+fn lag_warnings(runs: &Runs, growing: bool) -> Vec<String> {
     let all: Vec<&RealRun> = runs.train.iter().chain(&runs.holdout).copied().collect();
     // The runs cut at the edge, with the edge.
     let cut: Vec<(&RealRun, f64)> = all
@@ -345,6 +352,14 @@ fn lag_warnings(runs: &Runs) -> Vec<String> {
         ),
         _ => String::new(),
     };
+    if growing {
+        return vec![format!(
+            "on {} of {} runs the gyro-reference lag reaches beyond the edge of the cross-correlation's search, ±{:.0} ms{wider}: it grows through each run with the count-stamped clock named above, which the lag line follows window by window (xcorr_lag_trend); the latency is read at the line's start, not from the cut statistic",
+            cut.len(),
+            all.len(),
+            1e3 * edge.abs()
+        )];
+    }
     vec![format!(
         "on {} of {} runs the gyro-reference lag lies at or beyond the edge of the cross-correlation's search, ±{:.0} ms{wider}: their lag statistic is cut there, not measured, and a latency fitted or checked on it is not to be trusted (a logger that buffers, over a wireless link or USB, can put 100 ms between the two)",
         cut.len(),

@@ -152,6 +152,7 @@ fn median(values: &[f64]) -> Option<f64> {
 pub(crate) fn turn_evidence(
     train: &[RealRun],
     train_lags_s: &[f64],
+    growing: bool,
     holdout: &[RealRun],
     model: &ModelFile,
     options: &super::Options,
@@ -159,7 +160,14 @@ pub(crate) fn turn_evidence(
     let mut written = model.clone();
     let mut changed = false;
 
-    let lag = wide_lag(train_lags_s, holdout, &mut written, &mut changed, options);
+    let lag = wide_lag(
+        train_lags_s,
+        growing,
+        holdout,
+        &mut written,
+        &mut changed,
+        options,
+    );
 
     // The totals with the model as it stands after the lag (read at mid-rest, they barely
     // depend on it, but every figure below is then of one model).
@@ -196,10 +204,18 @@ pub(crate) fn turn_evidence(
 }
 
 /// Each run's gyro–reference lag searched wide (s), where it is measured
-/// ([`gyro_analysis::lag::log_lag_s`]).
-pub(crate) fn run_lags_s(runs: &[RealRun]) -> Vec<f64> {
+/// ([`gyro_analysis::lag::log_lag_s`]). Beside a count-stamped clock (`growing`, named by
+/// the diagnosis) the lag grows through the run by the clock's doing: each run's lag is
+/// then its lag line's start ([`crate::lag_line`]), the delay the clock does not explain.
+pub(crate) fn run_lags_s(runs: &[RealRun], growing: bool, settings: &crate::Settings) -> Vec<f64> {
     runs.par_iter()
-        .filter_map(|r| gyro_analysis::lag::log_lag_s(&r.log))
+        .filter_map(|r| {
+            if growing {
+                crate::lag_line::of_log(&r.log, settings).map(|l| l.intercept_s)
+            } else {
+                gyro_analysis::lag::log_lag_s(&r.log)
+            }
+        })
         .collect()
 }
 
@@ -216,6 +232,7 @@ pub(crate) fn lag_beyond_statistic(lags_s: &[f64]) -> bool {
 /// held-out runs' max abs angle error.
 fn wide_lag(
     lags: &[f64],
+    growing: bool,
     holdout: &[RealRun],
     model: &mut ModelFile,
     changed: &mut bool,
@@ -224,7 +241,7 @@ fn wide_lag(
     let median_s = median(lags)?;
     let lo = lags.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = lags.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let held = run_lags_s(holdout);
+    let held = run_lags_s(holdout, growing, &options.settings);
     let beyond_statistic = lag_beyond_statistic(lags);
     let mut out = WideLag {
         median_s,
@@ -375,7 +392,14 @@ mod tests {
         base: &ModelFile,
     ) -> (Option<TurnEvidence>, Option<ModelFile>) {
         let options = super::super::Options::default();
-        turn_evidence(train, &run_lags_s(train), holdout, base, &options)
+        turn_evidence(
+            train,
+            &run_lags_s(train, false, &options.settings),
+            false,
+            holdout,
+            base,
+            &options,
+        )
     }
 
     #[test]

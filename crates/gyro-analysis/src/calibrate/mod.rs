@@ -1169,6 +1169,7 @@ pub fn calibrate(
     };
     let scoring = ReplayOptions {
         reference_delay_s: reference_delay.delay_s,
+        ..ReplayOptions::default()
     };
     // The scale first: when it is written, every candidate is fitted and scored with it
     // (each fold with the scale fitted on its own runs), so that the compensation is

@@ -359,7 +359,9 @@ fn with_advice(e: DiagnoseError) -> anyhow::Error {
         DiagnoseError::MismatchedRates { .. } => {
             "resample, or pass --sample-rate-hz to place all on one grid"
         }
-        DiagnoseError::Run { .. } | DiagnoseError::TooFewTrainingRuns { .. } => {
+        DiagnoseError::Run { .. }
+        | DiagnoseError::TooFewTrainingRuns { .. }
+        | DiagnoseError::Settings(_) => {
             return e.into();
         }
     };

@@ -367,8 +367,8 @@ pub const EFFECTS: &[EffectInfo] = &[
             test: "regression on time x angular acceleration vs null replicas",
         },
         // Integrated over nominal periods, the angle of a movement is 1 + ε times the
-        // true one, as with the logger-stamped clock.
-        correction: CoreCorrection::ScaleK { per_unit: 1e-6 },
+        // true one, as with the logger-stamped clock; and its lag grows through the run.
+        correction: CoreCorrection::CountClock,
         term: |p, t| t.count_clock_ppm += p[0],
         neutral: |p, _| p[0] == 0.0,
     },

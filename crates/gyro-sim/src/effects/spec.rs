@@ -212,6 +212,11 @@ pub enum CoreCorrection {
     ScalePerC,
     /// The model file's `reference_delay_s` += parameter (s).
     ReferenceDelay,
+    /// A sample clock in a log stamped by the sensor's count: `correction.scale_k` +=
+    /// parameter × 1e-6 (integrated over nominal periods a movement's angle is 1 + ε times
+    /// the true one) and the model file's `count_clock_ppm` += parameter (scoring reads the
+    /// reference at the gyro's own time).
+    CountClock,
     /// `reference_delay_s` += the low-frequency delay of a two-pole low-pass of this
     /// cutoff (Hz).
     LowPassReferenceDelay,

@@ -1,0 +1,367 @@
+//! The gyro–reference lag through a run, window by window, and the straight line through
+//! it: a sensor clock fast by ε whose rows are stamped by the sensor's own count (k / fs)
+//! puts the gyro's sample of stamp t at true time t / (1 + ε), so its lag behind the
+//! reference grows as ε / (1 + ε) · t. A constant delay (latency, a bandwidth) leaves the
+//! line flat; a logger-stamped clock shows in the stamps instead (`StampedClock`).
+//!
+//! The per-sample statistics search the lag within ±`statistics.max_lag_s` and read its
+//! growth as a regression linear in ε, which holds for a few hundred ppm; a clock error of
+//! 1–3% moves the lag by a second over a run. The lag line tracks it, on rates
+//! block-averaged to `statistics.lag_line_hz`: each window with motion is searched around
+//! the last lag found carried on by the slope so far, within ±(`max_lag_s` +
+//! `statistics.lag_max_clock` · the time since that lag); the line is fitted through the
+//! windows near their Theil–Sen line (`gyro_analysis::lag::inliers`).
+
+use crate::ensemble::RealRun;
+use crate::fit::{t95, Fit};
+use crate::settings::Settings;
+use gyro_analysis::lag::{inliers, parabola_offset};
+use gyro_analysis::xcorr::centred_difference;
+use gyro_log::RegularLog;
+use gyro_sim::Effect;
+
+/// Fewest windows with a lag for a line.
+const MIN_POINTS: usize = 3;
+
+/// The lag's straight line through a run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LagLine {
+    /// Growth of the lag (s per s; positive: the gyro falls further behind).
+    pub slope: f64,
+    /// Standard error of the slope from the points' scatter about the line (s per s).
+    pub se_slope: f64,
+    /// The lag at the run's start (s).
+    pub intercept_s: f64,
+    /// Windows whose lag was read.
+    pub points: usize,
+    /// Time from the first to the last of those windows' centres (s).
+    pub span_s: f64,
+}
+
+impl LagLine {
+    /// The sample-clock error (ppm) of a count-stamped sensor with this line: slope
+    /// = ε / (1 + ε).
+    pub fn clock_ppm(&self) -> f64 {
+        self.slope / (1.0 - self.slope) * 1e6
+    }
+
+    /// The standard error of [`Self::clock_ppm`] (ppm).
+    pub fn se_ppm(&self) -> f64 {
+        self.se_slope / (1.0 - self.slope).powi(2) * 1e6
+    }
+
+    /// How far the lag moves over a run of `duration_s` (s).
+    pub fn growth_s(&self, duration_s: f64) -> f64 {
+        self.slope * duration_s
+    }
+}
+
+/// The count-stamped clock read from the training runs' lag lines, when it moves the lag
+/// beyond the per-sample statistics' search (±`statistics.max_lag_s`) over a run: the mean
+/// of the runs' ppm, tested against its standard error (between-run scatter and each
+/// line's own), its held-out replication read alike. `None` when fewer than two training
+/// runs have a line, or the growth stays within the search (the regression on time ×
+/// angular acceleration reads it there).
+pub(crate) fn grown_clock_fit(
+    train: &[&RealRun],
+    holdout: &[&RealRun],
+    s: &Settings,
+) -> Option<Fit> {
+    let (m, se, runs) = mean_ppm(train, s)?;
+    let longest_s = train.iter().map(|r| r.duration_s).fold(0.0, f64::max);
+    if (m * 1e-6 * longest_s).abs() < s.statistics.max_lag_s {
+        return None;
+    }
+    let z = m / se;
+    let holdout_z = mean_ppm(holdout, s).map(|(mh, seh, _)| mh / seh);
+    let half = t95(runs - 1).max(s.tests.interval_z) * se;
+    Some(Fit {
+        effect: Effect::ClockErrorCountStamped { ppm: m },
+        ci95: vec![(Some(m - half), Some(m + half))],
+        z,
+        passes: z.abs() >= s.tests.z_critical,
+        test: "the gyro's lag behind the reference, window by window, grows through the run".into(),
+        direct: false,
+        holdout_z,
+        shape_loglik: None,
+    })
+}
+
+/// Mean clock ppm of `runs`' lag lines, its standard error (at least 1 ppm) and the
+/// number of runs with a line (at least 2).
+fn mean_ppm(runs: &[&RealRun], settings: &Settings) -> Option<(f64, f64, usize)> {
+    let lines: Vec<LagLine> = runs
+        .iter()
+        .filter_map(|r| of_log(&r.log, settings))
+        .filter(|l| l.se_slope.is_finite())
+        .collect();
+    if lines.len() < 2 {
+        return None;
+    }
+    let n = lines.len() as f64;
+    let ppm: Vec<f64> = lines.iter().map(LagLine::clock_ppm).collect();
+    let m = ppm.iter().sum::<f64>() / n;
+    let between = ppm.iter().map(|p| (p - m).powi(2)).sum::<f64>() / (n - 1.0);
+    let within = lines.iter().map(|l| l.se_ppm().powi(2)).sum::<f64>() / n;
+    Some((m, ((between + within) / n).sqrt().max(1.0), lines.len()))
+}
+
+/// The lag line of `log` (gyro rate against the reference angle's centred difference).
+pub fn of_log(log: &RegularLog, settings: &Settings) -> Option<LagLine> {
+    let fs = log.sample_rate_hz;
+    let rate: Vec<f64> = log.slots.iter().map(|s| s.rate_dps).collect();
+    let reference: Vec<f64> = log
+        .slots
+        .iter()
+        .map(|s| s.reference_deg.unwrap_or(f64::NAN))
+        .collect();
+    lag_line(&rate, &centred_difference(&reference, fs), fs, settings)
+}
+
+/// The lag line of `gyro` against `reference` (rates on one grid at `fs`; NaN where
+/// undefined), or `None` when fewer than [`MIN_POINTS`] windows have motion and a lag.
+pub fn lag_line(gyro: &[f64], reference: &[f64], fs: f64, settings: &Settings) -> Option<LagLine> {
+    let fit = &settings.statistics;
+    let near_s = fit.max_lag_s;
+    // Block means: the motion's band lies far below the rate it is read at.
+    let q = ((fs / fit.lag_line_hz).round() as usize).max(1);
+    let (gyro, reference) = (&block_means(gyro, q), &block_means(reference, q));
+    let fs = fs / q as f64;
+    // A block's mean sits half a block after its first sample.
+    let offset_s = 0.5 * (q - 1) as f64 / (fs * q as f64);
+    let n = gyro.len().min(reference.len());
+    let w = (fit.lag_window_s * fs).round() as usize;
+    if w < 4 || n < w {
+        return None;
+    }
+    let step = w / 2;
+    let mut points: Vec<(f64, f64)> = Vec::new();
+    let mut start = 0;
+    while start + w <= n {
+        let centre_s = (start as f64 + 0.5 * w as f64) / fs + offset_s;
+        if rms(&reference[start..start + w]) >= fit.lag_min_motion_dps {
+            // From the last point on the slope so far, searched wider the further it lies
+            // (the clock may be as far off as `lag_max_clock`); from 0 before any point.
+            let slope = line(&points).map_or(0.0, |(_, b, _)| b);
+            let (predicted_s, half_s) = match points.last() {
+                Some(&(t, lag)) => (
+                    lag + slope * (centre_s - t),
+                    near_s + fit.lag_max_clock * (centre_s - t),
+                ),
+                None => (0.0, near_s + fit.lag_max_clock * centre_s),
+            };
+            if let Some(lag) = window_lag(gyro, reference, fs, start, w, predicted_s, half_s) {
+                points.push((centre_s, lag));
+            }
+        }
+        start += step;
+    }
+    // A window whose peak fell on another period of the motion lies off the line.
+    let points = inliers(&points)?;
+    if points.len() < MIN_POINTS {
+        return None;
+    }
+    let (intercept_s, slope, se_slope) = line(&points)?;
+    Some(LagLine {
+        slope,
+        se_slope,
+        intercept_s,
+        points: points.len(),
+        span_s: points[points.len() - 1].0 - points[0].0,
+    })
+}
+
+/// The lag (s) of the window `start..start + w` of `gyro`, searched within ±`half_s` of
+/// `predicted_s`: the peak of the correlation coefficient of g[i] and r[i − d] over the whole window at every lag d (the
+/// reference read beyond the window, so no lag has fewer terms and none is favoured),
+/// every few lags and then refined, placed by a parabola; `None` on the search's edge or
+/// when the search reaches outside the run.
+fn window_lag(
+    gyro: &[f64],
+    reference: &[f64],
+    fs: f64,
+    start: usize,
+    w: usize,
+    predicted_s: f64,
+    half_s: f64,
+) -> Option<f64> {
+    let centre = (predicted_s * fs).round() as i64;
+    let half = ((half_s * fs).round() as i64).max(1);
+    // gyro(t) ≈ reference(t − d): lags centre ± half read the reference from
+    // start − centre − half to start − centre + half + w.
+    let first = start as i64 - centre - half;
+    if first < 0 || (start as i64 - centre + half) as usize + w > reference.len() {
+        return None;
+    }
+    let g = &gyro[start..start + w];
+    let mean = |x: &[f64]| {
+        let f: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
+        if f.is_empty() {
+            0.0
+        } else {
+            f.iter().sum::<f64>() / f.len() as f64
+        }
+    };
+    let mg = mean(g);
+    let g: Vec<f64> = g
+        .iter()
+        .map(|v| if v.is_finite() { v - mg } else { 0.0 })
+        .collect();
+    let span = &reference[first as usize..(start as i64 - centre + half) as usize + w];
+    let mr = mean(span);
+    let r: Vec<f64> = span
+        .iter()
+        .map(|v| if v.is_finite() { v - mr } else { 0.0 })
+        .collect();
+    // Lag d = centre + j, j in −half..=half: reference index start − d + i = (half − j) + i in `r`.
+    // Normalised by the reference segment's variance about its own mean (Pearson's r up to
+    // the gyro's constant norm): unnormalised, the sum leans towards lags whose segment
+    // holds more motion. `g` has zero mean, so Σ g·r needs no mean of `r`.
+    let corr = |j: i64| -> f64 {
+        let off = (half - j) as usize;
+        let seg = &r[off..off + w];
+        let (sum, sq) = seg.iter().fold((0.0, 0.0), |(s, q), b| (s + b, q + b * b));
+        let energy = sq - sum * sum / w as f64;
+        let dot: f64 = g.iter().zip(seg).map(|(a, b)| a * b).sum();
+        if energy > 0.0 {
+            dot / energy.sqrt()
+        } else {
+            f64::NEG_INFINITY
+        }
+    };
+    let step = (half / 10).clamp(1, 8);
+    let mut best = (0i64, f64::NEG_INFINITY);
+    let mut j = -half;
+    while j <= half {
+        let c = corr(j);
+        if c > best.1 {
+            best = (j, c);
+        }
+        j += step;
+    }
+    for j in (best.0 - step).max(-half)..=(best.0 + step).min(half) {
+        let c = corr(j);
+        if c > best.1 {
+            best = (j, c);
+        }
+    }
+    let k = best.0;
+    if !best.1.is_finite() || k <= -half || k >= half {
+        return None;
+    }
+    // A neighbour without variance (a flat stretch) places nothing.
+    let offset = parabola_offset(corr(k - 1), best.1, corr(k + 1));
+    let offset = if offset.is_finite() { offset } else { 0.0 };
+    Some((centre as f64 + k as f64 + offset) / fs).filter(|lag| lag.is_finite())
+}
+
+/// Means of consecutive blocks of `q` samples of `x` (their finite values; NaN when none),
+/// a last partial block dropped.
+fn block_means(x: &[f64], q: usize) -> Vec<f64> {
+    if q == 1 {
+        return x.to_vec();
+    }
+    x.chunks_exact(q)
+        .map(|b| {
+            let (sum, count) = b
+                .iter()
+                .filter(|v| v.is_finite())
+                .fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
+            if count == 0 {
+                f64::NAN
+            } else {
+                sum / count as f64
+            }
+        })
+        .collect()
+}
+
+/// RMS of the finite values of `x` (0 when none).
+fn rms(x: &[f64]) -> f64 {
+    let (mut sum, mut count) = (0.0, 0usize);
+    for v in x.iter().filter(|v| v.is_finite()) {
+        sum += v * v;
+        count += 1;
+    }
+    if count == 0 {
+        0.0
+    } else {
+        (sum / count as f64).sqrt()
+    }
+}
+
+/// Least-squares line `y = a + b·x` through `points`: (a, b, standard error of b; ∞ with
+/// two points).
+fn line(points: &[(f64, f64)]) -> Option<(f64, f64, f64)> {
+    let m = points.len();
+    if m < 2 {
+        return None;
+    }
+    let mx = points.iter().map(|p| p.0).sum::<f64>() / m as f64;
+    let my = points.iter().map(|p| p.1).sum::<f64>() / m as f64;
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    if sxx <= 0.0 {
+        return None;
+    }
+    let b = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx;
+    let a = my - b * mx;
+    let se = if m > 2 {
+        let ss: f64 = points.iter().map(|p| (p.1 - a - b * p.0).powi(2)).sum();
+        (ss / (m - 2) as f64 / sxx).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    Some((a, b, se))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A band-limited motion: a sum of a few slow sines (deg/s), at time `t` (s).
+    fn motion(t: f64) -> f64 {
+        60.0 * (0.7 * t).sin() + 35.0 * (1.9 * t + 1.0).sin() + 20.0 * (3.3 * t + 2.0).sin()
+    }
+
+    /// Gyro sampled at stamp k/fs but taken at true time k/(fs(1+ε)) − delay; reference
+    /// rate at the stamp.
+    fn pair(fs: f64, seconds: f64, eps: f64, delay_s: f64) -> (Vec<f64>, Vec<f64>) {
+        let n = (seconds * fs) as usize;
+        let gyro = (0..n)
+            .map(|k| motion(k as f64 / (fs * (1.0 + eps)) - delay_s))
+            .collect();
+        let reference = (0..n).map(|k| motion(k as f64 / fs)).collect();
+        (gyro, reference)
+    }
+
+    #[test]
+    fn the_line_reads_the_clock_of_a_count_stamped_sensor_up_to_its_largest() {
+        let s = Settings::DEFAULT;
+        for eps in [-0.03, -0.005, 5e-4, 0.006, 0.03] {
+            let (g, r) = pair(500.0, 90.0, eps, 0.0);
+            let l = lag_line(&g, &r, 500.0, &s).expect("a line");
+            let ppm = eps * 1e6;
+            assert!(
+                (l.clock_ppm() - ppm).abs() < 0.01 * ppm.abs() + 20.0,
+                "ε {eps}: read {} ppm",
+                l.clock_ppm()
+            );
+            assert!(l.points >= 30, "{l:?}");
+        }
+    }
+
+    #[test]
+    fn a_constant_delay_is_a_flat_line_at_the_delay() {
+        let (g, r) = pair(500.0, 60.0, 0.0, 0.02);
+        let l = lag_line(&g, &r, 500.0, &Settings::DEFAULT).expect("a line");
+        assert!(l.clock_ppm().abs() < 20.0, "{l:?}");
+        assert!((l.intercept_s - 0.02).abs() < 1e-3, "{l:?}");
+    }
+
+    #[test]
+    fn rest_gives_no_line() {
+        let g = vec![0.01; 30_000];
+        assert!(lag_line(&g, &g, 500.0, &Settings::DEFAULT).is_none());
+        assert!(lag_line(&g[..10], &g[..10], 500.0, &Settings::DEFAULT).is_none());
+    }
+}
