@@ -1014,6 +1014,27 @@ mod tests {
     }
 
     #[test]
+    fn noise_on_arrays_gives_the_files_json() {
+        let c = columns();
+        let arrays = Arrays {
+            time_s: &c.0,
+            rate_dps: &c.1,
+            reference_deg: Some(&c.2),
+            temperature_c: Some(&c.3),
+            nominal_rate_hz: Some(1000.0),
+            first_line: 5,
+        };
+        let o = NoiseOptions {
+            static_only: true,
+            ..NoiseOptions::default()
+        };
+        let file = noise_files(&[bench()], &["bench".into()], &o).unwrap();
+        assert_eq!(noise_arrays(&[("bench", arrays)], &o).unwrap(), file);
+        let twice = noise_files(&[bench(), bench()], &["a".into(), "b".into()], &o);
+        assert!(twice.unwrap_err().0.contains("give each run once"));
+    }
+
+    #[test]
     fn blocks_give_the_one_call() {
         let c = columns();
         let options = RunOptions {
