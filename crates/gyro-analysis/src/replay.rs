@@ -22,6 +22,9 @@ use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
 mod offline;
+pub mod settings;
+
+pub use settings::{Resolved, RunSettings, SettingsError};
 
 /// How a replay estimates each movement's angle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]

@@ -64,6 +64,7 @@ pub mod effective;
 pub(crate) mod ensemble;
 pub mod envelopes;
 pub(crate) mod features;
+pub mod files;
 pub(crate) mod fit;
 pub mod lag_line;
 pub mod line;
@@ -184,6 +185,42 @@ pub enum DiagnoseError {
     /// A setting of [`Options::settings`] is not valid.
     #[error("diagnose settings: {0}")]
     Settings(#[from] SettingsError),
+}
+
+impl DiagnoseError {
+    /// What to pass to `gyro-cli diagnose` to get past it, where there is advice.
+    pub fn advice(&self) -> Option<&'static str> {
+        match self {
+            Self::TooFewHeldOutRuns { .. } => {
+                Some("pass --holdout, or --split-s to cut logs into windows")
+            }
+            Self::MismatchedRates { .. } => {
+                Some("resample, or pass --sample-rate-hz to place all on one grid")
+            }
+            Self::Run { .. } | Self::TooFewTrainingRuns { .. } | Self::Settings(_) => None,
+        }
+    }
+
+    /// The message with its [`advice`](Self::advice) in parentheses, as `gyro-cli` says it.
+    pub fn with_advice(&self) -> String {
+        match self.advice() {
+            Some(advice) => format!("{self} ({advice})"),
+            None => self.to_string(),
+        }
+    }
+}
+
+impl Options {
+    /// Diagnose against `file`'s sensor model as it is (`--model`), its pipeline
+    /// configuration replaying the held-out runs.
+    pub fn with_fixed_model(self, file: ModelFile) -> Self {
+        Self {
+            prior: file.sensor,
+            base_model: file,
+            fixed_model: true,
+            ..self
+        }
+    }
 }
 
 /// Progress reports.

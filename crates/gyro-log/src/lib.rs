@@ -28,6 +28,7 @@ mod load;
 pub mod mcap;
 pub mod real_data;
 mod regular;
+pub mod repeated;
 pub mod sense;
 pub mod value;
 pub mod whole;

@@ -8,8 +8,10 @@
 
 use gyro_analysis::findings::{self, Finding};
 use gyro_analysis::model;
-use gyro_analysis::replay::{self, Mode, MovementResult, ReplayOptions, Replayer, SeriesPoint};
-use gyro_core::{Compensation, Config, Direction, Tightening};
+use gyro_analysis::replay::{
+    self, Mode, MovementResult, ReplayOptions, Replayer, RunSettings, SeriesPoint,
+};
+use gyro_core::{Config, Tightening};
 use gyro_log::{GridOptions, LogError, LogInfo, LogOptions, Quality, Row, Slot};
 use std::path::{Path, PathBuf};
 
@@ -48,30 +50,14 @@ fn error(e: &dyn std::error::Error) -> Error {
     )
 }
 
-/// The options of `gyro-cli run` (each named after its flag), checked as the command line
-/// checks them ([`RunOptions::check`]).
+/// The options of `gyro-cli run`: the settings of the replay ([`RunSettings`], resolved by
+/// the same function as the command line's) and the log's, checked as the command line
+/// checks its flags ([`RunOptions::check`]).
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
-    /// `--model`.
-    pub model: Option<PathBuf>,
-    /// `--compensation`.
-    pub compensation: Option<Compensation>,
-    /// `--range-dps`.
-    pub range_dps: Option<f32>,
-    /// `--target-deg`.
-    pub target_deg: Option<f32>,
-    /// `--tolerance-deg`.
-    pub tolerance_deg: Option<f32>,
-    /// `--k-sigma` (`None`: 2).
-    pub k_sigma: Option<f32>,
-    /// `--tightening-direction`.
-    pub tightening_direction: Direction,
-    /// `--scale-sigma`.
-    pub scale_sigma: Option<f32>,
-    /// `--reference-delay-s`.
-    pub reference_delay_s: Option<f64>,
-    /// `--offline`.
-    pub offline: bool,
+    /// `--model`, `--compensation`, `--range-dps`, the tightening window, `--scale-sigma`,
+    /// `--reference-delay-s`, `--offline`.
+    pub run: RunSettings,
     /// `--sample-rate-hz`, `--max-gap-s`.
     pub grid: GridOptions,
     /// The CSV and MCAP input options.
@@ -96,35 +82,32 @@ impl RunOptions {
         let f = |v: Option<f32>| v.map(f64::from);
         let p = "a positive finite number";
         let n = "a finite number >= 0";
-        check_value(
-            "range_dps",
-            f(self.range_dps),
-            positive(f(self.range_dps)),
-            p,
-        )?;
+        let r = &self.run;
+        let k_sigma = Some(f64::from(r.k_sigma));
+        check_value("range_dps", f(r.range_dps), positive(f(r.range_dps)), p)?;
         check_value(
             "target_deg",
-            f(self.target_deg),
-            finite(f(self.target_deg)),
+            f(r.target_deg),
+            finite(f(r.target_deg)),
             "a finite number",
         )?;
         check_value(
             "tolerance_deg",
-            f(self.tolerance_deg),
-            positive(f(self.tolerance_deg)),
+            f(r.tolerance_deg),
+            positive(f(r.tolerance_deg)),
             p,
         )?;
-        check_value("k_sigma", f(self.k_sigma), non_negative(f(self.k_sigma)), n)?;
+        check_value("k_sigma", k_sigma, non_negative(k_sigma), n)?;
         check_value(
             "scale_sigma",
-            f(self.scale_sigma),
-            non_negative(f(self.scale_sigma)),
+            f(r.scale_sigma),
+            non_negative(f(r.scale_sigma)),
             n,
         )?;
         check_value(
             "reference_delay_s",
-            self.reference_delay_s,
-            finite(self.reference_delay_s),
+            r.reference_delay_s,
+            finite(r.reference_delay_s),
             "a finite number",
         )?;
         check_value(
@@ -138,90 +121,15 @@ impl RunOptions {
             Some(self.grid.max_gap_s),
             non_negative(Some(self.grid.max_gap_s)),
             n,
-        )?;
-        match (self.target_deg, self.tolerance_deg) {
-            (Some(_), None) => Err(Error(
-                "target_deg needs tolerance_deg (the tightening window's half-width)".into(),
-            )),
-            (None, Some(_)) => Err(Error(
-                "tolerance_deg needs target_deg (the tightening window's target)".into(),
-            )),
-            _ => Ok(()),
-        }
+        )
     }
 
     /// The pipeline configuration, the scoring options and the mode, as `gyro-cli run`
-    /// assembles them (crates/gyro-cli/src/cmd/run.rs).
+    /// has them ([`RunSettings::resolve`], the command line's own function).
     pub fn settings(&self) -> Result<(Config, ReplayOptions, Mode), Error> {
         self.check()?;
-        if let Some(d) = self.reference_delay_s {
-            if d.abs() > model::MAX_REFERENCE_DELAY_S {
-                return Err(Error(format!(
-                    "--reference-delay-s {d}: expected at most {} s either way",
-                    model::MAX_REFERENCE_DELAY_S
-                )));
-            }
-        }
-        let (mut config, mut options, model_scale_sigma) = match &self.model {
-            Some(path) => {
-                let model = model::load(path).map_err(|e| error(&e))?;
-                let config = Config {
-                    range_dps: model.range_dps(),
-                    ..model.config
-                };
-                (
-                    config,
-                    ReplayOptions::from_model(&model),
-                    model.scale_sigma as f32,
-                )
-            }
-            None => (Config::default(), ReplayOptions::default(), 0.0),
-        };
-        if let Some(delay_s) = self.reference_delay_s {
-            options.reference_delay_s = delay_s;
-        }
-        if let Some(range_dps) = self.range_dps {
-            config.range_dps = Some(range_dps);
-        }
-        if let (Some(target_deg), Some(tolerance_deg)) = (self.target_deg, self.tolerance_deg) {
-            config.tightening = Some(Tightening {
-                target_deg,
-                tolerance_deg,
-                k_sigma: self.k_sigma.unwrap_or(2.0),
-                direction: self.tightening_direction,
-                scale_sigma: 0.0,
-            });
-        }
-        if let Some(t) = &mut config.tightening {
-            t.scale_sigma = match self.scale_sigma {
-                Some(given) => given,
-                None => t.scale_sigma.max(model_scale_sigma),
-            };
-        }
-        if let Some(c) = self.compensation {
-            config.compensation = c;
-        }
-        if self.offline && config.compensation != Compensation::Kalman {
-            return Err(Error(format!(
-                "--offline smooths the Kalman form's bias: it needs --compensation kalman (the model's compensation is {})",
-                compensation_name(config.compensation)
-            )));
-        }
-        let mode = if self.offline {
-            Mode::Offline
-        } else {
-            Mode::Causal
-        };
-        Ok((config, options, mode))
-    }
-}
-
-/// The compensation's name on the command line.
-pub fn compensation_name(c: Compensation) -> &'static str {
-    match c {
-        Compensation::None => "none",
-        Compensation::Paper => "paper",
-        Compensation::Kalman => "kalman",
+        let r = self.run.resolve().map_err(|e| error(&e))?;
+        Ok((r.config, r.options, r.mode))
     }
 }
 
@@ -323,6 +231,37 @@ impl Arrays<'_> {
         Ok(())
     }
 
+    /// The log's description for the grid (`path`: its name in errors).
+    fn info<'p>(&self, path: &'p Path) -> LogInfo<'p> {
+        LogInfo {
+            path,
+            metadata_rate_hz: self.nominal_rate_hz,
+            has_reference: self.reference_deg.is_some(),
+            has_temperature: self.temperature_c.is_some(),
+        }
+    }
+
+    /// The rows, as a CSV reader gives them.
+    fn rows(&self) -> impl Iterator<Item = Result<Row, LogError>> + '_ {
+        (0..self.time_s.len()).map(|i| Ok(self.row(i)))
+    }
+
+    /// The arrays placed on the grid whole, as [`gyro_log::load`] places a CSV holding
+    /// them (`name`: its file name in errors).
+    pub fn regular(&self, name: &str, grid: &GridOptions) -> Result<gyro_log::RegularLog, Error> {
+        self.check()?;
+        let mut slots = Slots::default();
+        let quality = gyro_log::place(&self.info(Path::new(name)), self.rows(), grid, &mut slots)
+            .map_err(|e| error(&e))?;
+        Ok(gyro_log::RegularLog {
+            slots: slots.0,
+            sample_rate_hz: quality.sample_rate_hz,
+            has_reference: slots.1,
+            has_temperature: slots.2,
+            quality,
+        })
+    }
+
     /// Row `i` (line `i + 1`), a NaN field missing.
     fn row(&self, i: usize) -> Row {
         let present = |v: f64| (!v.is_nan()).then_some(v);
@@ -396,13 +335,6 @@ pub fn run_arrays(
     arrays.check()?;
     let (config, replay_options, mode) = options.settings()?;
     let path = Path::new(name);
-    let info = LogInfo {
-        path,
-        metadata_rate_hz: arrays.nominal_rate_hz,
-        has_reference: arrays.reference_deg.is_some(),
-        has_temperature: arrays.temperature_c.is_some(),
-    };
-    let rows = (0..arrays.time_s.len()).map(|i| Ok::<Row, LogError>(arrays.row(i)));
     let config_error = |cause, sample_rate_hz| {
         replay_error(replay::ReplayFileError::Config {
             path: path.to_path_buf(),
@@ -414,16 +346,7 @@ pub fn run_arrays(
     let delay = replay_options.reference_delay_s;
     let report = if delay.is_finite() && delay != 0.0 {
         // The shifted reference needs the log whole, as `replay_file_into` does.
-        let mut slots = Slots::default();
-        let quality =
-            gyro_log::place(&info, rows, &options.grid, &mut slots).map_err(|e| error(&e))?;
-        let regular = gyro_log::RegularLog {
-            slots: slots.0,
-            sample_rate_hz: quality.sample_rate_hz,
-            has_reference: slots.1,
-            has_temperature: slots.2,
-            quality,
-        };
+        let regular = arrays.regular(name, &options.grid)?;
         replay::replay_with_mode(&regular, &config, &replay_options, mode)
             .map_err(|cause| config_error(cause, regular.sample_rate_hz))?
     } else {
@@ -435,8 +358,8 @@ pub fn run_arrays(
             replayer: None,
             series: Vec::new(),
         };
-        let quality =
-            gyro_log::place(&info, rows, &options.grid, &mut sink).map_err(|e| error(&e))?;
+        let quality = gyro_log::place(&arrays.info(path), arrays.rows(), &options.grid, &mut sink)
+            .map_err(|e| error(&e))?;
         let sample_rate_hz = quality.sample_rate_hz;
         match sink.replayer {
             Some(Ok(replayer)) => {
@@ -662,12 +585,10 @@ impl Default for NoiseOptions {
     }
 }
 
-/// `gyro-cli noise LOG... --format json` (`files`: the logs as given): its JSON text.
-pub fn noise_files(paths: &[PathBuf], files: &[String], o: &NoiseOptions) -> Result<String, Error> {
-    use gyro_analysis::noise::{self, NoiseLog, PsdOptions, TauGrid};
-    if paths.is_empty() {
-        return Err(Error("noise needs at least one log".into()));
-    }
+/// The noise options checked as the command line checks them, the configuration that
+/// finds the rests (the model's, else the built-in one), the analysis options.
+fn noise_settings(o: &NoiseOptions) -> Result<(Config, gyro_analysis::noise::NoiseOptions), Error> {
+    use gyro_analysis::noise::{self, PsdOptions, TauGrid};
     if !(o.confidence > 0.0 && o.confidence < 1.0) {
         return Err(Error("--confidence must be in (0, 1)".into()));
     }
@@ -707,47 +628,94 @@ pub fn noise_files(paths: &[PathBuf], files: &[String], o: &NoiseOptions) -> Res
         },
         ..noise::NoiseOptions::default()
     };
+    Ok((config, options))
+}
+
+/// One log of a noise run (`file`: its name in the JSON and the errors): whole, or its
+/// rests with `static_only`.
+fn noise_log(
+    file: &str,
+    regular: gyro_log::RegularLog,
+    config: &Config,
+    o: &NoiseOptions,
+) -> Result<gyro_analysis::noise::NoiseLog, Error> {
+    use gyro_analysis::noise;
+    let rate: Vec<f64> = regular.slots.iter().map(|s| s.rate_dps).collect();
+    let rests = |margin_s: f64, min_rest_s: f64| {
+        noise::rest_segments(&regular, config, margin_s, min_rest_s).map_err(|e| {
+            Error(format!(
+                "{file}: cannot configure the pipeline for this log: {}",
+                error(&e)
+            ))
+        })
+    };
+    let mut moving_share = None;
+    let segments = if o.static_only {
+        let segments = rests(o.margin_s, o.min_rest_s)?;
+        if segments.is_empty() {
+            return Err(Error(format!(
+                "{file}: no rest stretch of at least {} s found (--static-only)",
+                o.min_rest_s
+            )));
+        }
+        segments
+    } else {
+        let at_rest: usize = rests(0.0, 0.0)?.iter().map(ExactSizeIterator::len).sum();
+        moving_share = Some(1.0 - at_rest as f64 / rate.len().max(1) as f64);
+        std::iter::once(0..rate.len()).collect()
+    };
+    Ok(noise::NoiseLog {
+        file: file.to_string(),
+        rate_dps: rate,
+        sample_rate_hz: regular.sample_rate_hz,
+        segments,
+        input: regular.quality,
+        moving_share,
+    })
+}
+
+/// The JSON of a noise run on `loaded`.
+fn noise_json(
+    loaded: &[gyro_analysis::noise::NoiseLog],
+    options: &gyro_analysis::noise::NoiseOptions,
+    o: &NoiseOptions,
+) -> Result<String, Error> {
+    let run = gyro_analysis::noise::characterize_logs(loaded, options).map_err(|e| error(&e))?;
+    gyro_report::noise::json(loaded, &run, o.static_only, None).map_err(|e| error(&e))
+}
+
+/// `gyro-cli noise LOG... --format json` (`files`: the logs as given): its JSON text.
+pub fn noise_files(paths: &[PathBuf], files: &[String], o: &NoiseOptions) -> Result<String, Error> {
+    if paths.is_empty() {
+        return Err(Error("noise needs at least one log".into()));
+    }
+    refuse_repeated_runs(&[("static", paths)])?;
+    let (config, options) = noise_settings(o)?;
     let mut loaded = Vec::new();
     for (path, file) in paths.iter().zip(files) {
         let regular =
             gyro_log::load(path, &o.input, &o.grid, &mut |_| {}).map_err(|e| error(&e))?;
-        let rate: Vec<f64> = regular.slots.iter().map(|s| s.rate_dps).collect();
-        let rests = |margin_s: f64, min_rest_s: f64| {
-            noise::rest_segments(&regular, &config, margin_s, min_rest_s).map_err(|e| {
-                Error(format!(
-                    "{}: cannot configure the pipeline for this log: {}",
-                    path.display(),
-                    error(&e)
-                ))
-            })
-        };
-        let mut moving_share = None;
-        let segments = if o.static_only {
-            let segments = rests(o.margin_s, o.min_rest_s)?;
-            if segments.is_empty() {
-                return Err(Error(format!(
-                    "{}: no rest stretch of at least {} s found (--static-only)",
-                    path.display(),
-                    o.min_rest_s
-                )));
-            }
-            segments
-        } else {
-            let at_rest: usize = rests(0.0, 0.0)?.iter().map(ExactSizeIterator::len).sum();
-            moving_share = Some(1.0 - at_rest as f64 / rate.len().max(1) as f64);
-            std::iter::once(0..rate.len()).collect()
-        };
-        loaded.push(NoiseLog {
-            file: file.clone(),
-            rate_dps: rate,
-            sample_rate_hz: regular.sample_rate_hz,
-            segments,
-            input: regular.quality,
-            moving_share,
-        });
+        loaded.push(noise_log(&path.display().to_string(), regular, &config, o)?);
+        if let Some(last) = loaded.last_mut() {
+            last.file.clone_from(file);
+        }
     }
-    let run = noise::characterize_logs(&loaded, &options).map_err(|e| error(&e))?;
-    gyro_report::noise::json(&loaded, &run, o.static_only, None).map_err(|e| error(&e))
+    noise_json(&loaded, &options, o)
+}
+
+/// [`noise_files`] on logs given as arrays, each with its name (as if a CSV of that name
+/// held them): the same JSON. The input options (columns, MCAP) do not apply.
+pub fn noise_arrays(logs: &[(&str, Arrays<'_>)], o: &NoiseOptions) -> Result<String, Error> {
+    if logs.is_empty() {
+        return Err(Error("noise needs at least one log".into()));
+    }
+    let (config, options) = noise_settings(o)?;
+    let mut loaded = Vec::new();
+    for (name, arrays) in logs {
+        let regular = arrays.regular(name, &o.grid)?;
+        loaded.push(noise_log(name, regular, &config, o)?);
+    }
+    noise_json(&loaded, &options, o)
 }
 
 /// The options of `gyro-cli calibrate` (each named after its flag; `out` may be left out).
@@ -780,24 +748,8 @@ pub struct CalibrateArgs {
 /// `gyro-cli calibrate LOG... --format json`: its JSON text and the model file's (the file
 /// written to `out` when given, as `-o` writes it).
 pub fn calibrate_files(a: &CalibrateArgs) -> Result<(String, String), Error> {
-    use gyro_analysis::calibrate::{calibrate, BenchRun, CalibrateOptions};
-    if let Some(t) = a.tau_s.filter(|t| !(t.is_finite() && *t > 0.0)) {
-        return Err(Error(format!(
-            "invalid value {t} for tau_s: expected a positive finite number"
-        )));
-    }
-    if let Some(d) = a.reference_delay_s {
-        if !d.is_finite() || d.abs() > model::MAX_REFERENCE_DELAY_S {
-            return Err(Error(format!(
-                "--reference-delay-s {d}: expected at most {} s either way",
-                model::MAX_REFERENCE_DELAY_S
-            )));
-        }
-    }
-    let base = match &a.model {
-        Some(path) => model::load(path).map_err(|e| error(&e))?,
-        None => model::ModelFile::new(Config::default()),
-    };
+    use gyro_analysis::calibrate::BenchRun;
+    let base = calibrate_base(a, true)?;
     let load = |paths: &[PathBuf]| -> Result<Vec<BenchRun>, Error> {
         paths
             .iter()
@@ -813,6 +765,65 @@ pub fn calibrate_files(a: &CalibrateArgs) -> Result<(String, String), Error> {
     };
     let train = load(&a.logs)?;
     let holdout = load(&a.holdout)?;
+    calibrate_runs(&base, &train, &holdout, a)
+}
+
+/// [`calibrate_files`] on runs given as arrays, each with its name (as if a CSV of that
+/// name held them): the same JSON and model. `a`'s logs and input options do not apply.
+pub fn calibrate_arrays(
+    train: &[(&str, Arrays<'_>)],
+    holdout: &[(&str, Arrays<'_>)],
+    a: &CalibrateArgs,
+) -> Result<(String, String), Error> {
+    use gyro_analysis::calibrate::BenchRun;
+    let base = calibrate_base(a, false)?;
+    let runs = |logs: &[(&str, Arrays<'_>)]| -> Result<Vec<BenchRun>, Error> {
+        logs.iter()
+            .map(|(name, arrays)| {
+                Ok(BenchRun {
+                    name: (*name).to_string(),
+                    log: arrays.regular(name, &a.grid)?,
+                })
+            })
+            .collect()
+    };
+    let train = runs(train)?;
+    let holdout = runs(holdout)?;
+    calibrate_runs(&base, &train, &holdout, a)
+}
+
+/// The calibrate options checked as the command line checks them (`files`: a run given
+/// twice refused), and the model file to start from.
+fn calibrate_base(a: &CalibrateArgs, files: bool) -> Result<model::ModelFile, Error> {
+    if let Some(t) = a.tau_s.filter(|t| !(t.is_finite() && *t > 0.0)) {
+        return Err(Error(format!(
+            "invalid value {t} for tau_s: expected a positive finite number"
+        )));
+    }
+    if let Some(d) = a.reference_delay_s.filter(|d| !d.is_finite()) {
+        return Err(Error(format!(
+            "invalid value {d} for reference_delay_s: expected a finite number"
+        )));
+    }
+    if files {
+        refuse_repeated_runs(&[("training", &a.logs), ("hold-out", &a.holdout)])?;
+    }
+    replay::settings::check_reference_delay(a.reference_delay_s).map_err(|e| error(&e))?;
+    match &a.model {
+        Some(path) => model::load(path).map_err(|e| error(&e)),
+        None => Ok(model::ModelFile::new(Config::default())),
+    }
+}
+
+/// Calibrate on `train`, scored on `holdout`, from `base`: the JSON and the model file's
+/// text (written to `a.out` when given).
+fn calibrate_runs(
+    base: &model::ModelFile,
+    train: &[gyro_analysis::calibrate::BenchRun],
+    holdout: &[gyro_analysis::calibrate::BenchRun],
+    a: &CalibrateArgs,
+) -> Result<(String, String), Error> {
+    use gyro_analysis::calibrate::{calibrate, CalibrateOptions};
     let options = CalibrateOptions {
         objective: a.objective,
         leave_one_out: a.leave_one_out,
@@ -822,9 +833,9 @@ pub fn calibrate_files(a: &CalibrateArgs) -> Result<(String, String), Error> {
             .reference_delay_s
             .or((base.reference_delay_s != 0.0).then_some(base.reference_delay_s)),
     };
-    let result = calibrate(&train, &holdout, &base.config, &options, &mut |_, _, _| {})
+    let result = calibrate(train, holdout, &base.config, &options, &mut |_, _, _| {})
         .map_err(|e| error(&e))?;
-    let (out, _) = result.model_file(&base, train.iter().chain(&holdout));
+    let (out, _) = result.model_file(base, train.iter().chain(holdout));
     if let Some(path) = &a.out {
         model::save(path, &out)
             .map_err(|e| Error(format!("writing the model file: {}", error(&e))))?;
@@ -832,7 +843,7 @@ pub fn calibrate_files(a: &CalibrateArgs) -> Result<(String, String), Error> {
     let model_json = serde_json::to_string_pretty(&out).map_err(|e| error(&e))?;
     let inputs: Vec<_> = train
         .iter()
-        .chain(&holdout)
+        .chain(holdout)
         .map(|run| gyro_report::input::InputJson {
             file: &run.name,
             input: &run.log.quality,
@@ -840,6 +851,99 @@ pub fn calibrate_files(a: &CalibrateArgs) -> Result<(String, String), Error> {
         .collect();
     let json = gyro_report::calibrate::json(&inputs, &result).map_err(|e| error(&e))?;
     Ok((json, model_json))
+}
+
+/// Refuse a run given twice, as `gyro-cli` does
+/// ([`gyro_log::repeated::refuse_repeated_runs`]).
+fn refuse_repeated_runs(lists: &[(&str, &[PathBuf])]) -> Result<(), Error> {
+    gyro_log::repeated::refuse_repeated_runs(lists).map_err(|e| error(&e))
+}
+
+/// The options of `gyro-cli diagnose` that diagnose logs and write no file (each named
+/// after its flag).
+#[derive(Clone, Debug)]
+pub struct DiagnoseArgs {
+    /// `--train`.
+    pub train: Vec<PathBuf>,
+    /// `--holdout`.
+    pub holdout: Vec<PathBuf>,
+    /// `--split-s`.
+    pub split_s: Option<f64>,
+    /// `--model`.
+    pub model: Option<PathBuf>,
+    /// `--seed`.
+    pub seed: u64,
+    /// `--members`.
+    pub members: usize,
+    /// `--candidate-members`.
+    pub candidate_members: usize,
+    /// `--score-every-candidate`.
+    pub score_every_candidate: bool,
+    /// `--sample-rate-hz`, `--max-gap-s`.
+    pub grid: GridOptions,
+    /// The CSV and MCAP input options.
+    pub input: LogOptions,
+}
+
+impl Default for DiagnoseArgs {
+    fn default() -> Self {
+        let o = gyro_diagnose::Options::default();
+        Self {
+            train: Vec::new(),
+            holdout: Vec::new(),
+            split_s: None,
+            model: None,
+            seed: o.seed,
+            members: o.members,
+            candidate_members: o.candidate_members,
+            score_every_candidate: o.score_every_candidate,
+            grid: GridOptions::default(),
+            input: LogOptions::default(),
+        }
+    }
+}
+
+/// `gyro-cli diagnose --train … --holdout … --format json`: its JSON text (the contract of
+/// docs/diagnose-json.md), the runs read as the command line reads them
+/// ([`gyro_diagnose::files::load_files`]).
+pub fn diagnose_files(a: &DiagnoseArgs) -> Result<String, Error> {
+    use gyro_diagnose::files::{self, FileOptions, FileRuns};
+    if a.members < 2 || a.candidate_members < 2 {
+        return Err(Error(
+            "--members and --candidate-members must be at least 2".into(),
+        ));
+    }
+    let mut options = gyro_diagnose::Options {
+        seed: a.seed,
+        members: a.members,
+        candidate_members: a.candidate_members,
+        score_every_candidate: a.score_every_candidate,
+        ..gyro_diagnose::Options::default()
+    };
+    if let Some(path) = &a.model {
+        options = options.with_fixed_model(model::load(path).map_err(|e| error(&e))?);
+    }
+    let FileRuns {
+        train,
+        holdout,
+        inputs,
+    } = files::load_files(
+        &a.train,
+        &a.holdout,
+        &FileOptions {
+            input: &a.input,
+            grid: &a.grid,
+            split_s: a.split_s,
+        },
+        &mut |_| {},
+    )
+    .map_err(|e| error(&e))?;
+    let advice = |e: gyro_diagnose::DiagnoseError| Error(e.with_advice());
+    gyro_diagnose::check_runs(&train, &holdout).map_err(advice)?;
+    let mut result = gyro_diagnose::diagnose(&train, &holdout, &options, &gyro_diagnose::Silent)
+        .map_err(advice)?;
+    result.inputs = inputs;
+    serde_json::to_string_pretty(&result).map_err(|e| error(&e))
 }
 
 /// The tightening decision on one angle ([`gyro_core::decide`]): `None` for a turn the
@@ -886,8 +990,11 @@ mod tests {
     #[test]
     fn arrays_give_the_files_json() {
         let options = RunOptions {
-            target_deg: Some(90.0),
-            tolerance_deg: Some(1.0),
+            run: RunSettings {
+                target_deg: Some(90.0),
+                tolerance_deg: Some(1.0),
+                ..RunSettings::default()
+            },
             ..RunOptions::default()
         };
         let file = run_file(&bench(), "bench", &options).unwrap();
@@ -904,6 +1011,27 @@ mod tests {
         assert_eq!(file.json, from_arrays.json);
         assert_eq!(file.series, from_arrays.series);
         assert!(file.json.contains("\"verdict\": \"ok\""));
+    }
+
+    #[test]
+    fn noise_on_arrays_gives_the_files_json() {
+        let c = columns();
+        let arrays = Arrays {
+            time_s: &c.0,
+            rate_dps: &c.1,
+            reference_deg: Some(&c.2),
+            temperature_c: Some(&c.3),
+            nominal_rate_hz: Some(1000.0),
+            first_line: 5,
+        };
+        let o = NoiseOptions {
+            static_only: true,
+            ..NoiseOptions::default()
+        };
+        let file = noise_files(&[bench()], &["bench".into()], &o).unwrap();
+        assert_eq!(noise_arrays(&[("bench", arrays)], &o).unwrap(), file);
+        let twice = noise_files(&[bench(), bench()], &["a".into(), "b".into()], &o);
+        assert!(twice.unwrap_err().0.contains("give each run once"));
     }
 
     #[test]
@@ -980,9 +1108,12 @@ mod tests {
         let e = run_file(Path::new("/nonexistent.csv"), "x", &RunOptions::default()).unwrap_err();
         assert!(e.0.contains("/nonexistent.csv"), "{e}");
         let options = RunOptions {
-            target_deg: Some(90.0),
+            run: RunSettings {
+                target_deg: Some(90.0),
+                ..RunSettings::default()
+            },
             ..RunOptions::default()
         };
-        assert!(options.check().is_err());
+        assert!(options.settings().is_err());
     }
 }

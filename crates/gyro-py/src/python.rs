@@ -2,10 +2,13 @@
 //! while it works. The package `gyro` (python/gyro) wraps it: the JSON text becomes Python
 //! objects there, the options arrive here as a dict.
 
-use crate::{Arrays, CalibrateArgs, Error, NoiseOptions, RunOptions, RunOutput, Stream};
+use crate::{
+    Arrays, CalibrateArgs, DiagnoseArgs, Error, NoiseOptions, RunOptions, RunOutput, Stream,
+};
 use clap::ValueEnum;
 use gyro_analysis::replay::SeriesPoint;
 use gyro_core::{Compensation, Direction, MotionState, Tightening, Verdict};
+use gyro_log::{GridOptions, LogOptions};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -48,16 +51,15 @@ fn run_options(options: Option<&Bound<'_, PyDict>>, files: bool) -> PyResult<Run
     };
     for (key, value) in options.iter() {
         let key: String = key.extract()?;
-        if value.is_none() {
+        let inputs = if files { Inputs::All } else { Inputs::Grid };
+        if value.is_none() || log_option(&key, &value, &mut o.input, &mut o.grid, inputs)? {
             continue;
         }
         let f32_ = |v: &Bound<'_, PyAny>| v.extract::<f64>().map(|v| v as f32);
-        let columns = &mut o.input.columns;
-        let mcap = &mut o.input.mcap;
         match key.as_str() {
-            "model" => o.model = Some(value.extract::<PathBuf>()?),
+            "model" => o.run.model = Some(value.extract::<PathBuf>()?),
             "compensation" => {
-                o.compensation = Some(match value.extract::<String>()?.as_str() {
+                o.run.compensation = Some(match value.extract::<String>()?.as_str() {
                     "none" => Compensation::None,
                     "paper" => Compensation::Paper,
                     "kalman" => Compensation::Kalman,
@@ -68,12 +70,12 @@ fn run_options(options: Option<&Bound<'_, PyDict>>, files: bool) -> PyResult<Run
                     }
                 })
             }
-            "range_dps" => o.range_dps = Some(f32_(&value)?),
-            "target_deg" => o.target_deg = Some(f32_(&value)?),
-            "tolerance_deg" => o.tolerance_deg = Some(f32_(&value)?),
-            "k_sigma" => o.k_sigma = Some(f32_(&value)?),
+            "range_dps" => o.run.range_dps = Some(f32_(&value)?),
+            "target_deg" => o.run.target_deg = Some(f32_(&value)?),
+            "tolerance_deg" => o.run.tolerance_deg = Some(f32_(&value)?),
+            "k_sigma" => o.run.k_sigma = f32_(&value)?,
             "tightening_direction" => {
-                o.tightening_direction = match value.extract::<String>()?.as_str() {
+                o.run.tightening_direction = match value.extract::<String>()?.as_str() {
                     "positive" => Direction::Positive,
                     "negative" => Direction::Negative,
                     other => {
@@ -83,27 +85,10 @@ fn run_options(options: Option<&Bound<'_, PyDict>>, files: bool) -> PyResult<Run
                     }
                 }
             }
-            "scale_sigma" => o.scale_sigma = Some(f32_(&value)?),
-            "reference_delay_s" => o.reference_delay_s = Some(value.extract()?),
-            "offline" => o.offline = value.extract()?,
-            "sample_rate_hz" => o.grid.sample_rate_hz = Some(value.extract()?),
-            "max_gap_s" => o.grid.max_gap_s = value.extract()?,
-            "time_column" if files => columns.time_column = value.extract()?,
-            "time_unit" if files => columns.time_unit = choice(&key, &value)?,
-            "rate_column" if files => columns.rate_column = value.extract()?,
-            "rate_unit" if files => columns.rate_unit = choice(&key, &value)?,
-            "reference_column" if files => columns.reference_column = Some(value.extract()?),
-            "temperature_column" if files => columns.temperature_column = Some(value.extract()?),
-            "topic" if files => mcap.topic = Some(value.extract()?),
-            "reference_topic" if files => mcap.reference_topic = value.extract()?,
-            "axis" if files => mcap.axis = choice(&key, &value)?,
-            "flip" if files => mcap.flip = value.extract()?,
-            "time_source" if files => mcap.time_source = choice(&key, &value)?,
-            _ => {
-                return Err(PyTypeError::new_err(format!(
-                    "unexpected keyword argument '{key}'"
-                )))
-            }
+            "scale_sigma" => o.run.scale_sigma = Some(f32_(&value)?),
+            "reference_delay_s" => o.run.reference_delay_s = Some(value.extract()?),
+            "offline" => o.run.offline = value.extract()?,
+            _ => return Err(unexpected(&key)),
         }
     }
     Ok(o)
@@ -210,6 +195,32 @@ fn run_arrays<'py>(
     result(py, out)
 }
 
+/// `gyro-cli noise`'s options from keyword arguments (`inputs`: which log options apply).
+fn noise_options(options: Option<&Bound<'_, PyDict>>, inputs: Inputs) -> PyResult<NoiseOptions> {
+    let mut o = NoiseOptions::default();
+    let Some(options) = options else {
+        return Ok(o);
+    };
+    for (key, value) in options.iter() {
+        let key: String = key.extract()?;
+        if value.is_none() || log_option(&key, &value, &mut o.input, &mut o.grid, inputs)? {
+            continue;
+        }
+        match key.as_str() {
+            "static_only" => o.static_only = value.extract()?,
+            "margin_s" => o.margin_s = value.extract()?,
+            "min_rest_s" => o.min_rest_s = value.extract()?,
+            "model" => o.model = Some(value.extract()?),
+            "tau_grid" => o.tau_grid = value.extract()?,
+            "per_decade" => o.per_decade = value.extract()?,
+            "confidence" => o.confidence = value.extract()?,
+            "psd_segment" => o.psd_segment = Some(value.extract()?),
+            _ => return Err(unexpected(&key)),
+        }
+    }
+    Ok(o)
+}
+
 /// `gyro-cli noise LOG... --format json`: the JSON text.
 #[pyfunction]
 #[pyo3(signature = (paths, options=None))]
@@ -218,44 +229,94 @@ fn noise_files(
     paths: Vec<PathBuf>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let mut o = NoiseOptions::default();
-    if let Some(options) = options {
-        for (key, value) in options.iter() {
-            let key: String = key.extract()?;
-            if value.is_none() {
-                continue;
-            }
-            let columns = &mut o.input.columns;
-            let mcap = &mut o.input.mcap;
-            match key.as_str() {
-                "static_only" => o.static_only = value.extract()?,
-                "margin_s" => o.margin_s = value.extract()?,
-                "min_rest_s" => o.min_rest_s = value.extract()?,
-                "model" => o.model = Some(value.extract()?),
-                "tau_grid" => o.tau_grid = value.extract()?,
-                "per_decade" => o.per_decade = value.extract()?,
-                "confidence" => o.confidence = value.extract()?,
-                "psd_segment" => o.psd_segment = Some(value.extract()?),
-                "sample_rate_hz" => o.grid.sample_rate_hz = Some(value.extract()?),
-                "max_gap_s" => o.grid.max_gap_s = value.extract()?,
-                "time_column" => columns.time_column = value.extract()?,
-                "time_unit" => columns.time_unit = choice(&key, &value)?,
-                "rate_column" => columns.rate_column = value.extract()?,
-                "rate_unit" => columns.rate_unit = choice(&key, &value)?,
-                "topic" => mcap.topic = Some(value.extract()?),
-                "axis" => mcap.axis = choice(&key, &value)?,
-                "flip" => mcap.flip = value.extract()?,
-                "time_source" => mcap.time_source = choice(&key, &value)?,
-                _ => {
-                    return Err(PyTypeError::new_err(format!(
-                        "unexpected keyword argument '{key}'"
-                    )))
-                }
-            }
-        }
-    }
+    let o = noise_options(options, Inputs::Rate)?;
     let files: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     Ok(py.detach(|| crate::noise_files(&paths, &files, &o))?)
+}
+
+/// A log as arrays from Python: (name, time_s, rate_dps, reference_deg, temperature_c,
+/// nominal_rate_hz, first_line).
+type ArrayLog<'py> = (
+    String,
+    PyReadonlyArray1<'py, f64>,
+    PyReadonlyArray1<'py, f64>,
+    Option<PyReadonlyArray1<'py, f64>>,
+    Option<PyReadonlyArray1<'py, f64>>,
+    Option<f64>,
+    u64,
+);
+
+/// The logs' names and arrays, borrowed.
+fn array_logs<'a>(logs: &'a [ArrayLog<'_>]) -> PyResult<Vec<(&'a str, Arrays<'a>)>> {
+    logs.iter()
+        .map(
+            |(
+                name,
+                time_s,
+                rate_dps,
+                reference_deg,
+                temperature_c,
+                nominal_rate_hz,
+                first_line,
+            )| {
+                Ok((
+                    name.as_str(),
+                    Arrays {
+                        time_s: values(time_s)?,
+                        rate_dps: values(rate_dps)?,
+                        reference_deg: reference_deg.as_ref().map(values).transpose()?,
+                        temperature_c: temperature_c.as_ref().map(values).transpose()?,
+                        nominal_rate_hz: *nominal_rate_hz,
+                        first_line: *first_line,
+                    },
+                ))
+            },
+        )
+        .collect()
+}
+
+/// `gyro-cli noise` on logs as arrays: the JSON text.
+#[pyfunction]
+#[pyo3(signature = (logs, options=None))]
+fn noise_arrays(
+    py: Python<'_>,
+    logs: Vec<ArrayLog<'_>>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<String> {
+    let o = noise_options(options, Inputs::Grid)?;
+    let logs = array_logs(&logs)?;
+    Ok(py.detach(|| crate::noise_arrays(&logs, &o))?)
+}
+
+/// `gyro-cli calibrate`'s options from keyword arguments (`files`: the logs are files, the
+/// hold-out runs and the input options given here).
+fn calibrate_args(options: Option<&Bound<'_, PyDict>>, files: bool) -> PyResult<CalibrateArgs> {
+    let mut a = CalibrateArgs {
+        leave_one_out: true,
+        ..CalibrateArgs::default()
+    };
+    let Some(options) = options else {
+        return Ok(a);
+    };
+    let inputs = if files { Inputs::All } else { Inputs::Grid };
+    for (key, value) in options.iter() {
+        let key: String = key.extract()?;
+        if value.is_none() || log_option(&key, &value, &mut a.input, &mut a.grid, inputs)? {
+            continue;
+        }
+        match key.as_str() {
+            "holdout" if files => a.holdout = value.extract()?,
+            "objective" => a.objective = choice(&key, &value)?,
+            "model" => a.model = Some(value.extract()?),
+            "tau_s" => a.tau_s = Some(value.extract()?),
+            "fit_motion" => a.fit_motion = value.extract()?,
+            "reference_delay_s" => a.reference_delay_s = Some(value.extract()?),
+            "leave_one_out" => a.leave_one_out = value.extract()?,
+            "out" => a.out = Some(value.extract()?),
+            _ => return Err(unexpected(&key)),
+        }
+    }
+    Ok(a)
 }
 
 /// `gyro-cli calibrate LOG... --format json`: (JSON text, model file text).
@@ -266,50 +327,108 @@ fn calibrate_files(
     logs: Vec<PathBuf>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<(String, String)> {
-    let mut a = CalibrateArgs {
+    let a = CalibrateArgs {
         logs,
-        leave_one_out: true,
-        ..CalibrateArgs::default()
+        ..calibrate_args(options, true)?
+    };
+    Ok(py.detach(|| crate::calibrate_files(&a))?)
+}
+
+/// `gyro-cli calibrate` on runs as arrays: (JSON text, model file text).
+#[pyfunction]
+#[pyo3(signature = (train, holdout, options=None))]
+fn calibrate_arrays(
+    py: Python<'_>,
+    train: Vec<ArrayLog<'_>>,
+    holdout: Vec<ArrayLog<'_>>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<(String, String)> {
+    let a = calibrate_args(options, false)?;
+    let (train, holdout) = (array_logs(&train)?, array_logs(&holdout)?);
+    Ok(py.detach(|| crate::calibrate_arrays(&train, &holdout, &a))?)
+}
+
+/// Which log-reading options a function takes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Inputs {
+    /// The grid only (arrays).
+    Grid,
+    /// The grid, the time and rate columns and the MCAP channel (`noise`).
+    Rate,
+    /// All: also the reference and temperature columns and the reference topic.
+    All,
+}
+
+/// Set the log-reading option `key` (`--sample-rate-hz`, `--max-gap-s`, the CSV columns,
+/// the MCAP channel) if `inputs` takes it: false if it is none of them.
+fn log_option(
+    key: &str,
+    value: &Bound<'_, PyAny>,
+    input: &mut LogOptions,
+    grid: &mut GridOptions,
+    inputs: Inputs,
+) -> PyResult<bool> {
+    let columns = &mut input.columns;
+    let mcap = &mut input.mcap;
+    let files = inputs != Inputs::Grid;
+    let all = inputs == Inputs::All;
+    match key {
+        "sample_rate_hz" => grid.sample_rate_hz = Some(value.extract()?),
+        "max_gap_s" => grid.max_gap_s = value.extract()?,
+        "time_column" if files => columns.time_column = value.extract()?,
+        "time_unit" if files => columns.time_unit = choice(key, value)?,
+        "rate_column" if files => columns.rate_column = value.extract()?,
+        "rate_unit" if files => columns.rate_unit = choice(key, value)?,
+        "reference_column" if all => columns.reference_column = Some(value.extract()?),
+        "temperature_column" if all => columns.temperature_column = Some(value.extract()?),
+        "topic" if files => mcap.topic = Some(value.extract()?),
+        "reference_topic" if all => mcap.reference_topic = value.extract()?,
+        "axis" if files => mcap.axis = choice(key, value)?,
+        "flip" if files => mcap.flip = value.extract()?,
+        "time_source" if files => mcap.time_source = choice(key, value)?,
+        _ => return Ok(false),
+    }
+    Ok(true)
+}
+
+/// A keyword argument no function of the module takes.
+fn unexpected(key: &str) -> PyErr {
+    PyTypeError::new_err(format!("unexpected keyword argument '{key}'"))
+}
+
+/// `gyro-cli diagnose --train … --holdout … --format json`: the JSON text.
+#[pyfunction]
+#[pyo3(signature = (train, holdout, options=None))]
+fn diagnose_files(
+    py: Python<'_>,
+    train: Vec<PathBuf>,
+    holdout: Vec<PathBuf>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<String> {
+    let mut a = DiagnoseArgs {
+        train,
+        holdout,
+        ..DiagnoseArgs::default()
     };
     if let Some(options) = options {
         for (key, value) in options.iter() {
             let key: String = key.extract()?;
-            if value.is_none() {
+            if value.is_none() || log_option(&key, &value, &mut a.input, &mut a.grid, Inputs::All)?
+            {
                 continue;
             }
-            let columns = &mut a.input.columns;
-            let mcap = &mut a.input.mcap;
             match key.as_str() {
-                "holdout" => a.holdout = value.extract()?,
-                "objective" => a.objective = choice(&key, &value)?,
+                "split_s" => a.split_s = Some(value.extract()?),
                 "model" => a.model = Some(value.extract()?),
-                "tau_s" => a.tau_s = Some(value.extract()?),
-                "fit_motion" => a.fit_motion = value.extract()?,
-                "reference_delay_s" => a.reference_delay_s = Some(value.extract()?),
-                "leave_one_out" => a.leave_one_out = value.extract()?,
-                "out" => a.out = Some(value.extract()?),
-                "sample_rate_hz" => a.grid.sample_rate_hz = Some(value.extract()?),
-                "max_gap_s" => a.grid.max_gap_s = value.extract()?,
-                "time_column" => columns.time_column = value.extract()?,
-                "time_unit" => columns.time_unit = choice(&key, &value)?,
-                "rate_column" => columns.rate_column = value.extract()?,
-                "rate_unit" => columns.rate_unit = choice(&key, &value)?,
-                "reference_column" => columns.reference_column = Some(value.extract()?),
-                "temperature_column" => columns.temperature_column = Some(value.extract()?),
-                "topic" => mcap.topic = Some(value.extract()?),
-                "reference_topic" => mcap.reference_topic = value.extract()?,
-                "axis" => mcap.axis = choice(&key, &value)?,
-                "flip" => mcap.flip = value.extract()?,
-                "time_source" => mcap.time_source = choice(&key, &value)?,
-                _ => {
-                    return Err(PyTypeError::new_err(format!(
-                        "unexpected keyword argument '{key}'"
-                    )))
-                }
+                "seed" => a.seed = value.extract()?,
+                "members" => a.members = value.extract()?,
+                "candidate_members" => a.candidate_members = value.extract()?,
+                "score_every_candidate" => a.score_every_candidate = value.extract()?,
+                _ => return Err(unexpected(&key)),
             }
         }
     }
-    Ok(py.detach(|| crate::calibrate_files(&a))?)
+    Ok(py.detach(|| crate::diagnose_files(&a))?)
 }
 
 /// The tightening decision on one angle: "ok", "nok", "recheck", "invalid", or None.
@@ -423,6 +542,9 @@ fn _gyro(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(noise_files, m)?)?;
     m.add_function(wrap_pyfunction!(decide, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate_files, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose_files, m)?)?;
+    m.add_function(wrap_pyfunction!(noise_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate_arrays, m)?)?;
     m.add_class::<PyStream>()?;
     Ok(())
 }

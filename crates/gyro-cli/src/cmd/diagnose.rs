@@ -4,8 +4,9 @@
 use anyhow::{bail, Result};
 use clap::ValueEnum;
 use gyro_analysis::model;
+use gyro_diagnose::files::{self, FileOptions, FileRuns, LoadError};
+use gyro_diagnose::RealRun;
 use gyro_diagnose::{self as diagnose, selftest, DiagnoseError, Diagnosis, Options, Progress};
-use gyro_diagnose::{split, InputEntry, RealRun};
 use gyro_log as log;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -113,55 +114,13 @@ fn progress_bar() -> Bar {
     Bar(bar)
 }
 
-/// The runs of `paths` (cut by --split-s), each log's input report added to `inputs`.
-fn load(
-    paths: &[PathBuf],
-    args: &Args,
-    role: &str,
-    inputs: &mut Vec<InputEntry>,
-) -> Result<Vec<RealRun>> {
-    let mut runs = Vec::new();
-    for path in paths {
-        let regular = super::load(path, &args.input, &args.grid)?;
-        inputs.push(InputEntry {
-            file: path.display().to_string(),
-            input: regular.quality.clone(),
-        });
-        if !regular.has_reference {
-            bail!(
-                "{}: no reference_deg column; diagnose compares the gyro with an encoder reference, so every {role} run needs one",
-                path.display()
-            );
-        }
-        let pieces = match args.split_s {
-            Some(s) if !(s.is_finite() && s > 0.0) => {
-                bail!("--split-s {s}: expected a positive number of seconds")
-            }
-            Some(s) => {
-                let pieces = split(&regular, s);
-                if pieces.is_empty() {
-                    bail!(
-                        "{}: shorter than half a --split-s window ({s} s)",
-                        path.display()
-                    );
-                }
-                pieces
-            }
-            None => vec![regular],
-        };
-        let count = pieces.len();
-        for (i, piece) in pieces.into_iter().enumerate() {
-            let name = if count > 1 {
-                format!("{}#{}", path.display(), i + 1)
-            } else {
-                path.display().to_string()
-            };
-            let run = RealRun::prepare(name.clone(), piece)
-                .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
-            runs.push(run);
-        }
+/// A failure to read the runs as the command line reports it: a log's own error as it is
+/// (for `main`'s flag hints), the others with their message.
+fn load_error(e: LoadError) -> anyhow::Error {
+    match e {
+        LoadError::Log(e) => e.into(),
+        e => e.into(),
     }
-    Ok(runs)
 }
 
 /// Run the command.
@@ -200,15 +159,23 @@ pub fn run(args: &Args) -> Result<()> {
         bail!("--members and --candidate-members must be at least 2");
     }
     if let Some(path) = &args.model {
-        let file = model::load(path)?;
-        options.prior = file.sensor;
-        options.base_model = file;
-        options.fixed_model = true;
+        options = options.with_fixed_model(model::load(path)?);
     }
-    super::refuse_repeated_runs(&[("training", &args.train), ("hold-out", &args.holdout)])?;
-    let mut inputs = Vec::new();
-    let train = load(&args.train, args, "training", &mut inputs)?;
-    let holdout = load(&args.holdout, args, "held-out", &mut inputs)?;
+    let FileRuns {
+        train,
+        holdout,
+        inputs,
+    } = files::load_files(
+        &args.train,
+        &args.holdout,
+        &FileOptions {
+            input: &args.input,
+            grid: &args.grid,
+            split_s: args.split_s,
+        },
+        &mut super::warn,
+    )
+    .map_err(load_error)?;
     diagnose::check_runs(&train, &holdout).map_err(with_advice)?;
     let bar = progress_bar();
     let result = diagnose::diagnose(&train, &holdout, &options, &bar);
@@ -352,20 +319,10 @@ fn write_noise_yaml(out: &Path, args: &Args, result: &Diagnosis) -> Result<()> {
 
 /// `e` with what to pass on the command line to get past it, where there is advice.
 fn with_advice(e: DiagnoseError) -> anyhow::Error {
-    let advice = match &e {
-        DiagnoseError::TooFewHeldOutRuns { .. } => {
-            "pass --holdout, or --split-s to cut logs into windows"
-        }
-        DiagnoseError::MismatchedRates { .. } => {
-            "resample, or pass --sample-rate-hz to place all on one grid"
-        }
-        DiagnoseError::Run { .. }
-        | DiagnoseError::TooFewTrainingRuns { .. }
-        | DiagnoseError::Settings(_) => {
-            return e.into();
-        }
-    };
-    anyhow::anyhow!("{e} ({advice})")
+    match e.advice() {
+        Some(_) => anyhow::anyhow!("{}", e.with_advice()),
+        None => e.into(),
+    }
 }
 
 fn write_report(

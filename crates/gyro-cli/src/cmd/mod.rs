@@ -19,34 +19,10 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 /// Refuse a run given twice: the same file (by device and inode, whatever the spelling)
-/// twice in one list, or in two lists (`names` say which: "training", "hold-out"), would
-/// count as independent evidence twice, or score a fit on the runs it was fitted to.
+/// twice in one list, or in two lists (`names` say which: "training", "hold-out")
+/// ([`gyro_log::repeated::refuse_repeated_runs`]).
 pub fn refuse_repeated_runs(lists: &[(&str, &[PathBuf])]) -> Result<()> {
-    let mut seen: Vec<(std::fs::Metadata, &Path, &str)> = Vec::new();
-    for (name, paths) in lists {
-        for path in paths.iter() {
-            let Ok(meta) = std::fs::metadata(path) else {
-                continue; // reading it reports the error
-            };
-            if let Some((_, first, first_list)) = seen
-                .iter()
-                .find(|(m, p, _)| output::same_file(m, &meta, p, path))
-            {
-                let where_ = if first_list == name {
-                    format!("twice among the {name} runs")
-                } else {
-                    format!("among the {first_list} runs and again among the {name} runs")
-                };
-                anyhow::bail!(
-                    "{}: the same run as {} is given {where_}; give each run once",
-                    path.display(),
-                    first.display()
-                );
-            }
-            seen.push((meta, path, name));
-        }
-    }
-    Ok(())
+    Ok(gyro_log::repeated::refuse_repeated_runs(lists)?)
 }
 
 /// Write a command's output to stdout with `write`, then flush: any failure is one error
@@ -96,15 +72,11 @@ impl NoiseYamlArgs {
 }
 
 /// Refuse a `--reference-delay-s` beyond what a model file may hold
-/// ([`gyro_analysis::model::MAX_REFERENCE_DELAY_S`]).
+/// ([`gyro_analysis::replay::settings::check_reference_delay`]).
 pub fn check_reference_delay(delay_s: Option<f64>) -> Result<()> {
-    match delay_s {
-        Some(d) if d.abs() > gyro_analysis::model::MAX_REFERENCE_DELAY_S => anyhow::bail!(
-            "--reference-delay-s {d}: expected at most {} s either way",
-            gyro_analysis::model::MAX_REFERENCE_DELAY_S
-        ),
-        _ => Ok(()),
-    }
+    Ok(gyro_analysis::replay::settings::check_reference_delay(
+        delay_s,
+    )?)
 }
 
 /// Print a warning about the input on stderr.

@@ -3,7 +3,8 @@
 //! whole ([`gyro_log::whole`]).
 
 use anyhow::{Context, Result};
-use std::fs::{File, Metadata};
+use gyro_log::repeated::same_file;
+use std::fs::File;
 use std::io::{self, BufWriter};
 use std::path::{Path, PathBuf};
 
@@ -133,17 +134,4 @@ fn refuse_to_overwrite<'a>(
         }
     }
     Ok(())
-}
-
-/// True if `a` (of path `pa`) and `b` (of `pb`) are the same file.
-#[cfg(unix)]
-pub fn same_file(a: &Metadata, b: &Metadata, _pa: &Path, _pb: &Path) -> bool {
-    use std::os::unix::fs::MetadataExt;
-    a.dev() == b.dev() && a.ino() == b.ino()
-}
-
-/// True if `a` (of path `pa`) and `b` (of `pb`) are the same file.
-#[cfg(not(unix))]
-pub fn same_file(_: &Metadata, _: &Metadata, pa: &Path, pb: &Path) -> bool {
-    matches!((pa.canonicalize(), pb.canonicalize()), (Ok(x), Ok(y)) if x == y)
 }

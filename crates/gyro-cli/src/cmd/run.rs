@@ -3,9 +3,8 @@
 use anyhow::{Context, Result};
 use clap::ValueEnum;
 use gyro_analysis::findings::Finding;
-use gyro_analysis::model;
 use gyro_analysis::replay;
-use gyro_core::{Compensation, Config, Direction, Tightening};
+use gyro_core::{Compensation, Direction};
 use gyro_log as log;
 use gyro_log::value;
 use gyro_log::whole::Partial;
@@ -65,7 +64,7 @@ pub struct Args {
     /// Guard band of the decision in standard deviations of the movement's angle: `ok`
     /// needs the angle inside the window by more than k·σ, `nok` outside by more than k·σ,
     /// else `recheck`.
-    #[arg(long, value_name = "K", default_value_t = 2.0, value_parser = value::non_negative::<f32>)]
+    #[arg(long, value_name = "K", default_value_t = replay::settings::DEFAULT_K_SIGMA, value_parser = value::non_negative::<f32>)]
     k_sigma: f32,
     /// Which sign of the angle tightens; a turn the other way gets no verdict.
     #[arg(long, value_enum, default_value_t = DirectionArg::Positive)]
@@ -114,70 +113,30 @@ pub fn run(args: &Args) -> Result<()> {
             .into_iter()
             .chain(args.model.as_deref()),
     )?;
-    super::check_reference_delay(args.reference_delay_s)?;
-    let (mut config, mut options, model_scale_sigma) = match &args.model {
-        Some(path) => {
-            let model = model::load(path)?;
-            let config = Config {
-                range_dps: model.range_dps(),
-                ..model.config
-            };
-            (
-                config,
-                replay::ReplayOptions::from_model(&model),
-                model.scale_sigma as f32,
-            )
-        }
-        None => (Config::default(), replay::ReplayOptions::default(), 0.0),
-    };
-    if let Some(delay_s) = args.reference_delay_s {
-        options.reference_delay_s = delay_s;
-    }
-    if let Some(range_dps) = args.range_dps {
-        config.range_dps = Some(range_dps);
-    }
-    if let (Some(target_deg), Some(tolerance_deg)) = (args.target_deg, args.tolerance_deg) {
-        config.tightening = Some(Tightening {
-            target_deg,
-            tolerance_deg,
-            k_sigma: args.k_sigma,
-            direction: match args.tightening_direction {
-                DirectionArg::Positive => Direction::Positive,
-                DirectionArg::Negative => Direction::Negative,
-            },
-            scale_sigma: 0.0,
-        });
-    }
-    // The scale uncertainty: as given, else at least what the model's calibration
-    // measured (the model's own window keeps a larger one).
-    if let Some(t) = &mut config.tightening {
-        t.scale_sigma = match args.scale_sigma {
-            Some(given) => given,
-            None => t.scale_sigma.max(model_scale_sigma),
-        };
-    }
-    if let Some(c) = args.compensation {
-        config.compensation = match c {
+    let settings = replay::RunSettings {
+        model: args.model.clone(),
+        compensation: args.compensation.map(|c| match c {
             CompensationArg::None => Compensation::None,
             CompensationArg::Paper => Compensation::Paper,
             CompensationArg::Kalman => Compensation::Kalman,
-        };
-    }
-    if args.offline && config.compensation != Compensation::Kalman {
-        anyhow::bail!(
-            "--offline smooths the Kalman form's bias: it needs --compensation kalman (the model's compensation is {})",
-            match config.compensation {
-                Compensation::None => "none",
-                Compensation::Paper => "paper",
-                Compensation::Kalman => "kalman",
-            }
-        );
-    }
-    let mode = if args.offline {
-        replay::Mode::Offline
-    } else {
-        replay::Mode::Causal
+        }),
+        range_dps: args.range_dps,
+        target_deg: args.target_deg,
+        tolerance_deg: args.tolerance_deg,
+        k_sigma: args.k_sigma,
+        tightening_direction: match args.tightening_direction {
+            DirectionArg::Positive => Direction::Positive,
+            DirectionArg::Negative => Direction::Negative,
+        },
+        scale_sigma: args.scale_sigma,
+        reference_delay_s: args.reference_delay_s,
+        offline: args.offline,
     };
+    let replay::Resolved {
+        config,
+        options,
+        mode,
+    } = settings.resolve()?;
     // One pass: rows are read, placed on the grid and replayed as they come. The output
     // series is kept only for the plot, which needs it whole, or for an `--out` that is a
     // stream (`/dev/stdout`: written after the report, as the report may share it);

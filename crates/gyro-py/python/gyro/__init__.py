@@ -8,7 +8,11 @@ The pipeline and the host tools of the gyro workspace on numpy arrays and log fi
   the same on arrays, as if they were a CSV log's columns;
 - ``Pipeline(sample_rate_hz, **options)``: the pipeline fed block by block;
 - ``noise(paths, **options)``: ``gyro-cli noise LOG... --format json`` as Python objects;
+  ``noise_arrays(logs, **options)`` the same on arrays;
 - ``calibrate(logs, **options)``: ``gyro-cli calibrate LOG... --format json`` and the model;
+  ``calibrate_arrays(train, holdout, **options)`` the same on arrays;
+- ``diagnose(train, holdout, **options)``: ``gyro-cli diagnose --format json`` as Python
+  objects (the contract of docs/diagnose-json.md);
 - ``decide(angle_deg, angle_std_deg, target_deg, tolerance_deg, ...)``: one verdict.
 
 Options are ``gyro-cli run``'s flags with ``_`` for ``-`` (``target_deg=90``,
@@ -27,7 +31,19 @@ import numpy as np
 from . import _gyro
 from ._gyro import GyroError
 
-__all__ = ["GyroError", "Pipeline", "calibrate", "decide", "noise", "run", "run_arrays", "__version__"]
+__all__ = [
+    "GyroError",
+    "Pipeline",
+    "calibrate",
+    "calibrate_arrays",
+    "decide",
+    "diagnose",
+    "noise",
+    "noise_arrays",
+    "run",
+    "run_arrays",
+    "__version__",
+]
 __version__: str = _gyro.__version__
 
 SERIES_KEYS = (
@@ -172,6 +188,96 @@ def calibrate(logs: Any, **options: Any) -> Dict[str, Any]:
     report = json.loads(text)
     report["model"] = json.loads(model)
     return report
+
+
+def _array_log(log: Any, name: str) -> tuple:
+    """One log given as arrays (a mapping such as a dict or a pandas DataFrame with
+    ``time_s``, ``rate_dps`` and optionally ``reference_deg``, ``temperature_c``, ``name``,
+    ``nominal_rate_hz``, ``first_line``) as the native module takes it."""
+
+    def get(key: str) -> Any:
+        return log[key] if key in log else None
+
+    for key in ("time_s", "rate_dps"):
+        if key not in log:
+            raise GyroError(f"a log given as arrays needs {key!r}")
+    nominal = get("nominal_rate_hz")
+    first_line = get("first_line")
+    return (
+        str(get("name") or name),
+        _f64("time_s", log["time_s"]),
+        _f64("rate_dps", log["rate_dps"]),
+        _f64("reference_deg", get("reference_deg")),
+        _f64("temperature_c", get("temperature_c")),
+        None if nominal is None else float(nominal),
+        1 if first_line is None else int(first_line),
+    )
+
+
+def _is_one_log(logs: Any) -> bool:
+    """True if ``logs`` is one log given as arrays, not a sequence of them."""
+    if isinstance(logs, (list, tuple)):
+        return False
+    try:
+        return "time_s" in logs
+    except TypeError:
+        return False
+
+
+def _array_logs(logs: Any, prefix: str) -> List[tuple]:
+    if _is_one_log(logs):
+        return [_array_log(logs, f"<{prefix}>")]
+    return [_array_log(log, f"<{prefix} {i}>") for i, log in enumerate(logs, start=1)]
+
+
+def noise_arrays(logs: Any, **options: Any) -> Dict[str, Any]:
+    """``noise`` on logs given as arrays: the same JSON as ``noise`` on CSVs holding them.
+
+    ``logs``: one log or a list of them, each a mapping (a dict, a pandas DataFrame) with
+    ``time_s`` (s) and ``rate_dps`` (deg/s), and optionally ``name`` (its file name in the
+    result; default ``"<arrays>"``, ``"<arrays 1>"``, ...), ``nominal_rate_hz`` (a CSV's
+    ``# sample_rate_hz:`` line) and ``first_line`` (the line of the first sample in errors).
+    Options as ``noise``'s, without the input options (columns, MCAP).
+    """
+    return json.loads(_gyro.noise_arrays(_array_logs(logs, "arrays"), options))
+
+
+def calibrate_arrays(train: Any, holdout: Any = (), **options: Any) -> Dict[str, Any]:
+    """``calibrate`` on runs given as arrays: the same JSON and model as ``calibrate`` on
+    CSVs holding them.
+
+    ``train``, ``holdout``: runs as ``noise_arrays`` takes logs, each with ``reference_deg``
+    (and ``temperature_c`` where logged); default names ``"<train 1>"``, ``"<holdout 1>"``,
+    ... Options as ``calibrate``'s, without ``holdout`` and the input options.
+    """
+    text, model = _gyro.calibrate_arrays(
+        _array_logs(train, "train"), _array_logs(holdout, "holdout"), options
+    )
+    report = json.loads(text)
+    report["model"] = json.loads(model)
+    return report
+
+
+def diagnose(train: Any, holdout: Any, **options: Any) -> Dict[str, Any]:
+    """``gyro-cli diagnose --train ... --holdout ... --format json`` as Python objects.
+
+    Where a real sensor differs from its simulation, which unmodelled effect causes it, and
+    how far adding it closes the gap on the held-out runs: the JSON contract of
+    ``docs/diagnose-json.md``, the same numbers as the command line's. ``train``,
+    ``holdout``: log paths (each with ``reference_deg``; at least two runs each, or cut
+    into windows by ``split_s``). Options: ``split_s``, ``model``, ``seed`` (1),
+    ``members`` (50), ``candidate_members`` (20), ``score_every_candidate``, the grid and
+    the input options. A log given twice (by any spelling) raises ``GyroError``, as on the
+    command line. The files the command line can write (``-o``, ``--report``,
+    ``--noise-yaml``) and ``--self-test`` are not offered.
+    """
+    if isinstance(train, (str, os.PathLike)):
+        train = [train]
+    if isinstance(holdout, (str, os.PathLike)):
+        holdout = [holdout]
+    return json.loads(
+        _gyro.diagnose_files([os.fspath(p) for p in train], [os.fspath(p) for p in holdout], options)
+    )
 
 
 def decide(

@@ -37,6 +37,33 @@ def calibrate_files(
 ) -> Tuple[str, str]:
     """``gyro-cli calibrate LOG... --format json``: (JSON text, model file text)."""
 
+ArrayLog = Tuple[
+    str,
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    Optional[npt.NDArray[np.float64]],
+    Optional[npt.NDArray[np.float64]],
+    Optional[float],
+    int,
+]
+"""A log as arrays: (name, time_s, rate_dps, reference_deg, temperature_c,
+nominal_rate_hz, first_line)."""
+
+def noise_arrays(logs: List[ArrayLog], options: Optional[Dict[str, Any]] = None) -> str:
+    """``gyro-cli noise`` on logs as arrays: the JSON text."""
+
+def calibrate_arrays(
+    train: List[ArrayLog],
+    holdout: List[ArrayLog],
+    options: Optional[Dict[str, Any]] = None,
+) -> Tuple[str, str]:
+    """``gyro-cli calibrate`` on runs as arrays: (JSON text, model file text)."""
+
+def diagnose_files(
+    train: List[str], holdout: List[str], options: Optional[Dict[str, Any]] = None
+) -> str:
+    """``gyro-cli diagnose --train ... --holdout ... --format json``: the JSON text."""
+
 def decide(
     angle_deg: float,
     angle_std_deg: float,
