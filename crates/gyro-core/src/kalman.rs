@@ -86,11 +86,12 @@ impl KalmanConfig {
 
 /// The bias wander during a movement that its σ counts, as a multiple of the filter's own
 /// (`q_b`, scaled by the rests): the filter's gain is set for the wander the rests show,
-/// which misses the fast components a bias instability adds, and a guard band must hold
-/// for those too. Measured on simulated CRM100 bench runs (`rest_mean_bench 100 101`,
-/// 4 494 movements): with 1, four movements with a bias instability of 0.05 deg/s got a
-/// wrong `ok` (2.6–3.7 σ off); with 3 none, 45% `recheck`; with 10 none, 50%.
-const GUARD_WANDER: f32 = 3.0;
+/// which misses the fast components a bias instability adds and what a few rests tell of a
+/// random walk early in a run, and a guard band must hold for those too. Measured on
+/// simulated CRM100 bench runs (`rest_mean_bench 100 101` and `100 2001`, 4 494 and 4 506
+/// movements): with 1, four and three movements got a wrong `ok` (2.6–3.7 σ off); with 3,
+/// none and three; with 10, none in either, 48–50% `recheck`.
+const GUARD_WANDER: f32 = 10.0;
 /// Weight of a new pair of rest-block means in the block-mean variance estimate.
 const BLOCK_VARIANCE_WEIGHT: f32 = 1.0 / 16.0;
 /// Share of the movement bias-error variance kept at each movement (the largest one seen
