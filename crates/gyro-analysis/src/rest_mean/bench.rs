@@ -5,7 +5,7 @@
 //! angle error| read at the middle of the rests ([`super::score_report`]), for the causal
 //! run, the offline run and the per-rest mean; and how often each movement's 95% interval
 //! (1.96 σ, `Movement.angle_std_deg`) covers its true angle, offline and causal.
-//! `cargo run --release -p gyro-analysis --example offline_bench` prints the table.
+//! `cargo run --release -p gyro-analysis --example bench_kinds` prints the table.
 
 use super::{score_report, simulate_bench_run};
 use crate::replay::{replay_with_mode, Mode, ReplayOptions};
