@@ -14,6 +14,8 @@
 //! assert_eq!(per_rest_angles(&rates, 1.0, &rests), vec![0.0, 10.0]);
 //! ```
 
+pub mod bench;
+
 /// A rest: the slots `start..=end` (indices into the rate series).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Rest {

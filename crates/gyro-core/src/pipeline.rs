@@ -1383,8 +1383,8 @@ mod size_tests {
     use super::Pipeline;
 
     /// The firmware budget: the whole pipeline state in 512 bytes at most. It is exactly
-    /// 512, all but 4 bytes of padding a field: `Track` gave up 8 bytes of `Option`
-    /// padding for the corrector, the saturation state (10 bytes) is paid for by `previous` without an
+    /// 512, all but 8 bytes of padding a field (the Kalman filter's 4 free bytes went to
+    /// alignment): `Track` gave up 8 bytes of `Option` padding for the corrector, the saturation state (10 bytes) is paid for by `previous` without an
     /// `Option` tag and the sample rate kept as f32 instead of the period as f64, the
     /// last free byte says whether the correction is the identity, and the Kalman
     /// filter's cached transition φ is paid for by the output period kept once (the

@@ -298,13 +298,14 @@ typedef struct GyroPaperConfig {
 typedef struct GyroKalmanConfig {
     // Inverse correlation time β of the bias (1/s), at least 0.
     float beta_per_s;
-    // Stationary standard deviation of the bias about its mean (deg/s).
+    // Stationary standard deviation of the bias's wander within a run (deg/s).
     float bias_sigma_dps;
-    // Long-term mean of the bias (deg/s).
+    // The bias expected at power-up (deg/s): the estimate before the first rest.
     float bias_mean_dps;
     // White rate noise, standard deviation per output sample (deg/s).
     float rate_noise_dps;
-    // Standard deviation of the initial bias estimate (deg/s).
+    // Standard deviation of the initial bias estimate (deg/s): the spread of the bias
+    // between power-ups.
     float initial_bias_sigma_dps;
 } GyroKalmanConfig;
 

@@ -77,13 +77,14 @@ pub struct GyroPaperConfig {
 pub struct GyroKalmanConfig {
     /// Inverse correlation time β of the bias (1/s), at least 0.
     pub beta_per_s: f32,
-    /// Stationary standard deviation of the bias about its mean (deg/s).
+    /// Stationary standard deviation of the bias's wander within a run (deg/s).
     pub bias_sigma_dps: f32,
-    /// Long-term mean of the bias (deg/s).
+    /// The bias expected at power-up (deg/s): the estimate before the first rest.
     pub bias_mean_dps: f32,
     /// White rate noise, standard deviation per output sample (deg/s).
     pub rate_noise_dps: f32,
-    /// Standard deviation of the initial bias estimate (deg/s).
+    /// Standard deviation of the initial bias estimate (deg/s): the spread of the bias
+    /// between power-ups.
     pub initial_bias_sigma_dps: f32,
 }
 
