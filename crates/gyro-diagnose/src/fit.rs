@@ -104,6 +104,40 @@ pub fn direct_evidence(
     }
 }
 
+/// The output step the training runs' rates show, where it differs from the prior's
+/// `prior_lsb_dps` and is not what `quantization` names: the grid the rates lie on
+/// ([`rate_step`]) when it is finer than [`QUANT_RATIO`] × the prior's (a sensor with its
+/// own LSB: an MPU-6050's 1/131 °/s), or none when the rates lie on no grid (a log written
+/// as floats), with the note that says so. `None`: the prior's step stands (the runs show
+/// it, or a coarser one that `quantization` is fitted to).
+fn runs_output_step(train: &[&RealRun], prior_lsb_dps: f64) -> Option<(f64, String)> {
+    let values: Vec<f64> = train
+        .iter()
+        .flat_map(|r| r.measured_rates_dps.iter().copied())
+        .collect();
+    match rate_step(&values) {
+        Some(step) if step < QUANT_RATIO * prior_lsb_dps => {
+            ((step - prior_lsb_dps).abs() > 0.01 * prior_lsb_dps).then(|| {
+                (
+                    step,
+                    format!(
+                        "output step {step:.5} deg/s: the grid the training runs' rates lie on (the prior's is {prior_lsb_dps:.5})"
+                    ),
+                )
+            })
+        }
+        Some(_) => None,
+        None => (prior_lsb_dps > 0.0 && !values.is_empty()).then(|| {
+            (
+                0.0,
+                format!(
+                    "no output step: the training runs' rates lie on no grid (the prior's is {prior_lsb_dps:.5} deg/s)"
+                ),
+            )
+        }),
+    }
+}
+
 /// A bias wander (a random walk or a bias instability).
 pub(crate) fn is_wander(effect: &Effect) -> bool {
     matches!(effect.info().fit, FitProcedure::Wander(_))
@@ -362,10 +396,12 @@ pub struct Nominal {
 /// [`WHITE_CHECK_Z`]: a low-pass inside the band (a MEMS gyro's digital filter) leaves
 /// the first differences short of the low band that the angle integrates, and the
 /// block's statistic is used instead ([`RestWhiteness`]).
-/// The bias wander and the output step stay the prior's: a wander or a step beyond them
-/// is what the vocabulary's `bias_instability`, `rate_random_walk` and `quantization`
-/// name, and a baseline fitted to them would absorb the effect it should reveal. The notes
-/// say whether the prior's wander is within what the residual allows.
+/// The output step is the runs' own ([`runs_output_step`]) when it is no coarser than
+/// quantization is named at; the bias wander and a coarser step stay the prior's: a
+/// wander or a step beyond them is what the vocabulary's `bias_instability`,
+/// `rate_random_walk` and `quantization` name, and a baseline fitted to them would absorb
+/// the effect it should reveal. The notes say whether the prior's wander is within what
+/// the residual allows.
 pub fn nominal_model(
     train: &[&RealRun],
     prior: &SensorModel,
@@ -388,6 +424,10 @@ pub fn nominal_model(
             "bias {:.4} deg/s: mean over the training runs of each run's regression intercept (runs with 2 s of static samples) or mean residual, gyro - reference rate (runs in continuous motion)",
             model.bias_dps
         ));
+    }
+    if let Some((lsb_dps, note)) = runs_output_step(train, prior.lsb_dps) {
+        model.lsb_dps = lsb_dps;
+        notes.push(note);
     }
     let pooled = |pick: fn(&RealRun) -> (f64, usize)| {
         let (sum, count) = train.iter().fold((0.0, 0usize), |(s, c), r| {
@@ -491,9 +531,15 @@ pub fn nominal_model(
         ));
     }
     let mut wander = format!(
-        "Gauss-Markov bias sigma {} deg/s, T {} s, output step {:.5} deg/s, range {} deg/s: from the prior model",
-        model.gm_sigma_dps, model.gm_tau_s, model.lsb_dps, model.range_dps
+        "Gauss-Markov bias sigma {} deg/s, T {} s, range {} deg/s: from the prior model",
+        model.gm_sigma_dps, model.gm_tau_s, model.range_dps
     );
+    if model.lsb_dps == prior.lsb_dps {
+        wander = format!(
+            "{wander}; output step {:.5} deg/s: the prior's",
+            model.lsb_dps
+        );
+    }
     if let Some(m) = moving {
         let k_prior = gyro_analysis::noise::export::gauss_markov_random_walk(
             model.gm_sigma_dps,

@@ -119,7 +119,8 @@ pub fn of_log(log: &RegularLog, settings: &Settings) -> Option<LagLine> {
 }
 
 /// The lag line of `gyro` against `reference` (rates on one grid at `fs`; NaN where
-/// undefined), or `None` when fewer than [`MIN_POINTS`] windows have motion and a lag.
+/// undefined), or `None` when fewer than [`MIN_POINTS`] windows have motion and a lag, or
+/// they span less than `statistics.lag_min_span_share` of the run.
 pub fn lag_line(gyro: &[f64], reference: &[f64], fs: f64, settings: &Settings) -> Option<LagLine> {
     let fit = &settings.statistics;
     let near_s = fit.max_lag_s;
@@ -158,7 +159,11 @@ pub fn lag_line(gyro: &[f64], reference: &[f64], fs: f64, settings: &Settings) -
     }
     // A window whose peak fell on another period of the motion lies off the line.
     let points = inliers(&points)?;
-    if points.len() < MIN_POINTS {
+    let span_s = match (points.first(), points.last()) {
+        (Some(a), Some(b)) => b.0 - a.0,
+        _ => 0.0,
+    };
+    if points.len() < MIN_POINTS || span_s < fit.lag_min_span_share * n as f64 / fs {
         return None;
     }
     let (intercept_s, slope, se_slope) = line(&points)?;
@@ -167,7 +172,7 @@ pub fn lag_line(gyro: &[f64], reference: &[f64], fs: f64, settings: &Settings) -
         se_slope,
         intercept_s,
         points: points.len(),
-        span_s: points[points.len() - 1].0 - points[0].0,
+        span_s,
     })
 }
 

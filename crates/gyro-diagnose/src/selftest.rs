@@ -3,8 +3,9 @@
 //!
 //! Cases: every effect alone at [`magnitudes`] (a realistic size for a low-cost MEMS
 //! gyro on a torque-wrench bench, stated in the output), the physical variants of
-//! [`VARIANTS`] alone (a gyro ahead of its reference), the pairs of [`PAIRS`], and
-//! [`NULL_CASES`] runs with nothing injected. Each case has [`TRAIN_RUNS`] training and
+//! [`VARIANTS`] alone (a gyro ahead of its reference), the pairs of [`PAIRS`],
+//! [`NULL_CASES`] runs with nothing injected, and the clocks of [`CLOCK_VARIANTS`] alone
+//! (stamped by the sensor's count, −2.5% and +2%). Each case has [`TRAIN_RUNS`] training and
 //! [`HOLDOUT_RUNS`] held-out runs of [`RUN_S`] s of bench-like motion at 1 kHz with a
 //! 5 °C warm-up, each run its own motion and noise seeds (derived from the case seed).
 //!
@@ -30,8 +31,16 @@ pub const HOLDOUT_RUNS: usize = 5;
 pub const RUN_S: f64 = 60.0;
 /// Cases with nothing injected.
 pub const NULL_CASES: usize = 7;
-/// Variants of an effect injected alone besides its self-test magnitude.
+/// Variants of an effect injected alone besides its self-test magnitude: a gyro ahead of
+/// its reference.
 pub const VARIANTS: [Effect; 1] = [Effect::Latency { delay_s: -0.005 }];
+/// Sample clocks stamped by the sensor's count near the ends of a MEMS internal
+/// oscillator's ±1–3% (MPU-6050, BMI160 datasheets), whose lag grows by a second and more
+/// over a run; planned after the null cases, so the earlier cases keep their seeds.
+pub const CLOCK_VARIANTS: [Effect; 2] = [
+    Effect::ClockErrorCountStamped { ppm: -25_000.0 },
+    Effect::ClockErrorCountStamped { ppm: 20_000.0 },
+];
 /// Effects injected together.
 pub const PAIRS: [(&str, &str); 9] = [
     ("scale_factor", "latency"),
@@ -223,6 +232,9 @@ pub fn run(
     }
     for _ in 0..NULL_CASES {
         plan.push(("null", Vec::new()));
+    }
+    for e in CLOCK_VARIANTS {
+        plan.push(("single", vec![e]));
     }
     // Case seeds follow the position in the whole plan, so a case run alone is the same.
     let plan: Vec<(usize, (&'static str, Vec<Effect>))> = plan

@@ -248,6 +248,10 @@ pub struct Statistics {
     /// valid (0, 10⁶]. 200.0: a wrench's motion lies below 20 Hz, and the peak is placed
     /// between samples by a parabola; at 1 kHz it cuts the search 25-fold.
     pub lag_line_hz: f64,
+    /// Least share of the run the windows of a lag line must span from first to last: a
+    /// line through a few neighbouring windows (the track lost after them) says little of
+    /// the slope. Unit 1, valid (0, 1]. 0.5.
+    pub lag_min_span_share: f64,
 }
 
 /// Scores, floor and posterior checks.
@@ -409,6 +413,7 @@ impl Settings {
             lag_min_motion_dps: 5.0,
             lag_max_clock: 0.05,
             lag_line_hz: 200.0,
+            lag_min_span_share: 0.5,
         },
         score: Score {
             floor_members: 10,
@@ -526,6 +531,8 @@ impl Settings {
                 "largest clock error the lag line searches for: beyond the ±1–3% of an internal oscillator"),
             entry("statistics.lag_line_hz", st.lag_line_hz, "Hz", (OPEN, 0.0, 1e6, CLOSED),
                 "rate the lag line block-averages the rates to: the motion lies below 20 Hz"),
+            entry("statistics.lag_min_span_share", st.lag_min_span_share, "1", (OPEN, 0.0, 1.0, CLOSED),
+                "least share of the run a lag line's windows span: a few neighbouring windows say little of the slope"),
             count("score.floor_members", sc.floor_members as f64, "members", 1.0, 1e4,
                 "members taken out in turn per run for the floor"),
             entry("score.likelihood_dof", sc.likelihood_dof, "1", (OPEN, 0.0, 1e6, CLOSED),
