@@ -231,14 +231,32 @@ fn degrees(x: f64) -> String {
 
 /// The answer in a few sentences, in degrees and plain words, for the first lines of
 /// every output: what makes the diagnosis meaningless (a reference that does not measure
-/// the gyro's motion), if anything; what differs from the model, and by how much; what
-/// correcting it does to the held-out angle error; and what the model does not explain.
+/// the gyro's motion), if anything; that the model does not explain the runs, and that
+/// the corrections leave most of the held-out angle error, when so (first, never below
+/// what is named); what differs from the model, and by how much; and what correcting it
+/// does to the held-out angle error.
 pub fn verdict(d: &Diagnosis) -> Vec<String> {
     let mut out: Vec<String> = d
         .reference_warnings
         .iter()
         .map(|w| format!("warning: {w}"))
         .collect();
+    // When the model does not explain the runs, that comes first: what is named below
+    // is then at most part of the answer.
+    if !d.verdict.model_fits {
+        let first = d.unexplained.first().map(super::words::missed);
+        out.push(match first {
+            Some(m) => format!(
+                "The model does not explain these runs: {m}{}.",
+                if d.unexplained.len() > 1 {
+                    format!("; {} statistics in all, listed below", d.unexplained.len())
+                } else {
+                    String::new()
+                }
+            ),
+            None => "The model does not explain these runs.".into(),
+        });
+    }
     let named: Vec<String> = d
         .effects
         .iter()
@@ -275,25 +293,24 @@ pub fn verdict(d: &Diagnosis) -> Vec<String> {
                 c.runs.len(),
                 if turns_wrote { "; the turns' corrections come on top" } else { "" }
             ));
+            // Most of the error left by what is named: not the whole answer, said second
+            // only to the model not fitting (a bias correction alone names nothing).
+            if !named.is_empty() && after > 0.5 * before {
+                let at = if d.verdict.model_fits { 0 } else { 1 } + d.reference_warnings.len();
+                out.insert(
+                    at,
+                    format!(
+                        "What is named leaves most of the held-out angle error: {} of {} remains after correcting it; its cause is not found here.",
+                        degrees(after),
+                        degrees(before)
+                    ),
+                );
+            }
         }
     } else if let Some(line) = turns_error_sentence(d) {
         out.push(line);
     } else if !named.is_empty() {
         out.push("None of the named effects is one the model file corrects, so the held-out angle error is not changed by it.".into());
-    }
-    if !d.verdict.model_fits {
-        let first = d.unexplained.first().map(super::words::missed);
-        out.push(match first {
-            Some(m) => format!(
-                "Not explained by the model: {m}{}.",
-                if d.unexplained.len() > 1 {
-                    format!("; {} statistics in all, listed below", d.unexplained.len())
-                } else {
-                    String::new()
-                }
-            ),
-            None => "The model does not explain these runs.".into(),
-        });
     }
     out
 }
