@@ -110,6 +110,25 @@ pub fn xcorr_peak_lag_within(
         }
     };
     let max_lag = max_lag as i64;
+    let best = coarse_to_fine_peak(max_lag, &corr);
+    if !best.1.is_finite() {
+        return None;
+    }
+    let k = best.0;
+    let offset = if k > -max_lag && k < max_lag {
+        crate::lag::parabola_offset(corr(k - 1), best.1, corr(k + 1))
+    } else {
+        0.0
+    };
+    Some((k as f64 + offset) / fs)
+}
+
+/// The lag in ±`max_lag` (samples) where `corr` peaks, and its value: `corr` is smooth in
+/// the lag (a correlation of rates), so it is read every few lags (a tenth of `max_lag`,
+/// 1 to 8) and then at every lag within a step of the best; the same peak as an
+/// exhaustive search unless two peaks lie within a few samples of each other. The first
+/// of equal values wins; `(0, −∞)` when no value exceeds −∞.
+pub fn coarse_to_fine_peak(max_lag: i64, corr: &dyn Fn(i64) -> f64) -> (i64, f64) {
     let step = (max_lag / 10).clamp(1, 8);
     let mut best = (0i64, f64::NEG_INFINITY);
     let mut lag = -max_lag;
@@ -127,14 +146,5 @@ pub fn xcorr_peak_lag_within(
             best = (lag, c);
         }
     }
-    if !best.1.is_finite() {
-        return None;
-    }
-    let k = best.0;
-    let offset = if k > -max_lag && k < max_lag {
-        crate::lag::parabola_offset(corr(k - 1), best.1, corr(k + 1))
-    } else {
-        0.0
-    };
-    Some((k as f64 + offset) / fs)
+    best
 }

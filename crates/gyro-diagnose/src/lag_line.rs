@@ -16,7 +16,7 @@ use crate::ensemble::RealRun;
 use crate::fit::{t95, Fit};
 use crate::settings::Settings;
 use gyro_analysis::lag::{inliers, parabola_offset};
-use gyro_analysis::xcorr::centred_difference;
+use gyro_analysis::xcorr::{centred_difference, coarse_to_fine_peak};
 use gyro_log::RegularLog;
 use gyro_sim::Effect;
 
@@ -177,10 +177,11 @@ pub fn lag_line(gyro: &[f64], reference: &[f64], fs: f64, settings: &Settings) -
 }
 
 /// The lag (s) of the window `start..start + w` of `gyro`, searched within ±`half_s` of
-/// `predicted_s`: the peak of the correlation coefficient of g[i] and r[i − d] over the whole window at every lag d (the
-/// reference read beyond the window, so no lag has fewer terms and none is favoured),
-/// every few lags and then refined, placed by a parabola; `None` on the search's edge or
-/// when the search reaches outside the run.
+/// `predicted_s`: the peak of the correlation coefficient of g[i] and r[i − d] over the
+/// whole window at every lag d (the reference read beyond the window, so no lag has fewer
+/// terms and none is favoured), found coarse to fine
+/// ([`gyro_analysis::xcorr::coarse_to_fine_peak`]), placed by a parabola; `None` on the
+/// search's edge or when the search reaches outside the run.
 fn window_lag(
     gyro: &[f64],
     reference: &[f64],
@@ -234,22 +235,7 @@ fn window_lag(
             f64::NEG_INFINITY
         }
     };
-    let step = (half / 10).clamp(1, 8);
-    let mut best = (0i64, f64::NEG_INFINITY);
-    let mut j = -half;
-    while j <= half {
-        let c = corr(j);
-        if c > best.1 {
-            best = (j, c);
-        }
-        j += step;
-    }
-    for j in (best.0 - step).max(-half)..=(best.0 + step).min(half) {
-        let c = corr(j);
-        if c > best.1 {
-            best = (j, c);
-        }
-    }
+    let best = coarse_to_fine_peak(half, &corr);
     let k = best.0;
     if !best.1.is_finite() || k <= -half || k >= half {
         return None;
