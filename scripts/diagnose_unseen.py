@@ -1,16 +1,19 @@
 #!/usr/bin/env python3
 """`gyro-cli diagnose` on cases from a generator that is not the project's: numpy only,
 written apart from `gyro-sim` and from the self-test, with magnitudes, rates and motion
-chosen here and nowhere else. Ten cases, each four training and four held-out windows
+chosen here and nowhere else. Twelve cases, each four training and four held-out windows
 of 60 s at 100 Hz (the held-out windows move 1.7 times faster):
 
 - continuous motion (two sines per window, eased in and out over 3 s so that windows join
   without a step in the rate): a latency with a scale error, a negative latency, an odd
   nonlinearity, a logger-stamped clock error (the sensor samples fast, the rows carry the
-  true time, the metadata the nominal 100 Hz), and nothing at all;
+  true time, the metadata the nominal 100 Hz), a clock 1.5% fast stamped by the sensor's
+  own count (the row stamped t holds the rate of true time t / 1.015 from its window's
+  start), and nothing at all;
 - a wrench's rest-turn-rest (turns of 45-135 deg either way, a raised-cosine angle over
   0.6-1.4 s, rests of 1.5-3.5 s): a scale error, a latency with a scale error, a bias
-  random walk, a temperature bias over a warm-up, and nothing at all.
+  random walk, a temperature bias over a warm-up, a count-stamped clock 2.5% slow, and
+  nothing at all.
 
 Every gyro has a bias of 0.15 deg/s and white noise of 0.3 deg/s per sample (1.8
 deg/sqrt(h)); the reference is the exact angle, printed to 0.001 deg. Prints one line per case: what was
@@ -101,17 +104,29 @@ def write(path, stamps, gyro, angle, temperature):
             out.write(line + "\n")
 
 
-def make(directory, name, seed, kind, delay_s=0.0, k=0.0, k3=0.0, rrw=0.0, tbias=0.0, clock_ppm=0.0):
+def make(directory, name, seed, kind, delay_s=0.0, k=0.0, k3=0.0, rrw=0.0, tbias=0.0, clock_ppm=0.0,
+         count_ppm=0.0):
     rng = np.random.default_rng(seed)
     for part, speed in (("train", 1.0), ("holdout", HOLDOUT_SPEED)):
         clock = 1.0 + clock_ppm * 1e-6
         n = int(round(WINDOW_S * FS_HZ * clock)) * WINDOWS
         t = np.arange(n) / (FS_HZ * clock)  # true sample times; the rows carry them
+        # A sensor clock fast by count_ppm whose rows are stamped by its sample count: the
+        # row stamped t (and the reference read then) holds the rate of true time
+        # t / (1 + e) from the start of its window (each window a run of its own, the
+        # sensor started with it).
+        count = 1.0 + count_ppm * 1e-6
+        window_start = np.floor(t / WINDOW_S + 1e-9) * WINDOW_S
+        t_rate = window_start + (t - window_start) / count
         if kind == "continuous":
+            state = rng.bit_generator.state
             angle, rate = continuous(rng, speed, t, delay_s)
+            if count_ppm:
+                rng.bit_generator.state = state
+                _, rate = continuous(rng, speed, t_rate, delay_s)
         else:
             angle, rate = wrench(rng, speed, t)
-            rate = np.interp(t - delay_s, t, rate)
+            rate = np.interp(t_rate - delay_s, t, rate)
         gyro = (1 + k) * rate + k3 * rate**3 + BIAS_DPS
         temperature = None
         within = t - np.floor(t / WINDOW_S + 1e-9) * WINDOW_S
@@ -134,6 +149,8 @@ CASES = [
     ("negative latency", "continuous", 12, dict(delay_s=-0.006), "latency -6 ms"),
     ("odd nonlinearity", "continuous", 13, dict(k3=3e-7), "k3 3e-7 /(deg/s)^2"),
     ("clock, logger-stamped", "continuous", 19, dict(clock_ppm=4000.0), "clock +4000 ppm"),
+    ("clock, count-stamped +1.5%", "continuous", 21, dict(count_ppm=15000.0), "count-stamped clock +15000 ppm"),
+    ("clock, count-stamped -2.5% (turns)", "wrench", 22, dict(count_ppm=-25000.0), "count-stamped clock -25000 ppm"),
     ("nothing (continuous)", "continuous", 14, {}, "nothing"),
     ("scale (turns)", "wrench", 16, dict(k=0.015), "scale +1.5%"),
     ("latency + scale (turns)", "wrench", 20, dict(delay_s=0.010, k=0.008), "latency 10 ms, scale +0.8%"),
