@@ -87,6 +87,28 @@ pub(crate) fn grown_clock_fit(
     })
 }
 
+/// `runs` without their last rows whose gyro sample, under a count-stamped clock slow by
+/// `ppm` (< 0), was taken after the run's last reference: the row stamped `t` holds the
+/// rate of true time `t / (1 + ε)`, so only the first `(1 + ε)` of a run lies within its
+/// reference. Each run is prepared again from its shortened log.
+pub(crate) fn within_reference(
+    runs: &[RealRun],
+    ppm: f64,
+) -> Result<Vec<RealRun>, crate::DiagnoseError> {
+    let keep_share = (1.0 + ppm * 1e-6).clamp(0.0, 1.0);
+    runs.iter()
+        .map(|run| {
+            let mut log = run.log.clone();
+            let keep = ((log.slots.len().saturating_sub(1)) as f64 * keep_share).floor() as usize + 1;
+            log.slots.truncate(keep);
+            RealRun::prepare(run.name.clone(), log).map_err(|e| crate::DiagnoseError::Run {
+                name: run.name.clone(),
+                message: format!("shortened to where its reference reaches under a count-stamped clock {ppm:.0} ppm slow: {e}"),
+            })
+        })
+        .collect()
+}
+
 /// Mean clock ppm of `runs`' lag lines, its standard error (at least 1 ppm) and the
 /// number of runs with a line (at least 2).
 fn mean_ppm(runs: &[&RealRun], settings: &Settings) -> Option<(f64, f64, usize)> {
