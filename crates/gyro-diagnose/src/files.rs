@@ -78,39 +78,57 @@ pub fn load_runs(
     let mut runs = Vec::new();
     for path in paths {
         let regular = gyro_log::load(path, options.input, options.grid, warn)?;
-        inputs.push(InputEntry {
-            file: path.display().to_string(),
-            input: regular.quality.clone(),
+        runs.extend(runs_of_log(
+            &path.display().to_string(),
+            regular,
+            role,
+            options.split_s,
+            inputs,
+        )?);
+    }
+    Ok(runs)
+}
+
+/// The runs of one log already on its grid, named `name` (a file's path, or a name given
+/// with arrays), cut by `split_s`; its input report added to `inputs`.
+pub fn runs_of_log(
+    name: &str,
+    regular: gyro_log::RegularLog,
+    role: &str,
+    split_s: Option<f64>,
+    inputs: &mut Vec<InputEntry>,
+) -> Result<Vec<RealRun>, LoadError> {
+    let path = PathBuf::from(name);
+    inputs.push(InputEntry {
+        file: name.to_string(),
+        input: regular.quality.clone(),
+    });
+    if !regular.has_reference {
+        return Err(LoadError::NoReference {
+            path,
+            role: role.to_string(),
         });
-        if !regular.has_reference {
-            return Err(LoadError::NoReference {
-                path: path.clone(),
-                role: role.to_string(),
-            });
-        }
-        let pieces = match options.split_s {
-            Some(s) if !(s.is_finite() && s > 0.0) => return Err(LoadError::SplitInvalid(s)),
-            Some(s) => {
-                let pieces = crate::split(&regular, s);
-                if pieces.is_empty() {
-                    return Err(LoadError::ShorterThanSplit {
-                        path: path.clone(),
-                        split_s: s,
-                    });
-                }
-                pieces
+    }
+    let pieces = match split_s {
+        Some(s) if !(s.is_finite() && s > 0.0) => return Err(LoadError::SplitInvalid(s)),
+        Some(s) => {
+            let pieces = crate::split(&regular, s);
+            if pieces.is_empty() {
+                return Err(LoadError::ShorterThanSplit { path, split_s: s });
             }
-            None => vec![regular],
-        };
-        let count = pieces.len();
-        for (i, piece) in pieces.into_iter().enumerate() {
-            let name = run_name(path, i, count);
-            let run = RealRun::prepare(name.clone(), piece).map_err(|e| LoadError::Prepare {
-                name,
-                message: e.to_string(),
-            })?;
-            runs.push(run);
+            pieces
         }
+        None => vec![regular],
+    };
+    let count = pieces.len();
+    let mut runs = Vec::with_capacity(count);
+    for (i, piece) in pieces.into_iter().enumerate() {
+        let name = run_name(&path, i, count);
+        let run = RealRun::prepare(name.clone(), piece).map_err(|e| LoadError::Prepare {
+            name,
+            message: e.to_string(),
+        })?;
+        runs.push(run);
     }
     Ok(runs)
 }

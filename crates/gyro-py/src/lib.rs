@@ -908,21 +908,7 @@ impl Default for DiagnoseArgs {
 /// ([`gyro_diagnose::files::load_files`]).
 pub fn diagnose_files(a: &DiagnoseArgs) -> Result<String, Error> {
     use gyro_diagnose::files::{self, FileOptions, FileRuns};
-    if a.members < 2 || a.candidate_members < 2 {
-        return Err(Error(
-            "--members and --candidate-members must be at least 2".into(),
-        ));
-    }
-    let mut options = gyro_diagnose::Options {
-        seed: a.seed,
-        members: a.members,
-        candidate_members: a.candidate_members,
-        score_every_candidate: a.score_every_candidate,
-        ..gyro_diagnose::Options::default()
-    };
-    if let Some(path) = &a.model {
-        options = options.with_fixed_model(model::load(path).map_err(|e| error(&e))?);
-    }
+    let options = diagnose_options(a)?;
     let FileRuns {
         train,
         holdout,
@@ -938,10 +924,67 @@ pub fn diagnose_files(a: &DiagnoseArgs) -> Result<String, Error> {
         &mut |_| {},
     )
     .map_err(|e| error(&e))?;
+    diagnose_runs(&train, &holdout, inputs, &options)
+}
+
+/// [`diagnose_files`] on runs given as arrays, each with its name (as if a CSV of that
+/// name held them, cut by `a.split_s`): the same JSON. `a`'s files and input options do
+/// not apply, its grid does.
+pub fn diagnose_arrays(
+    train: &[(&str, Arrays<'_>)],
+    holdout: &[(&str, Arrays<'_>)],
+    a: &DiagnoseArgs,
+) -> Result<String, Error> {
+    let options = diagnose_options(a)?;
+    let mut inputs = Vec::new();
+    let mut runs =
+        |logs: &[(&str, Arrays<'_>)], role: &str| -> Result<Vec<gyro_diagnose::RealRun>, Error> {
+            let mut out = Vec::new();
+            for (name, arrays) in logs {
+                let regular = arrays.regular(name, &a.grid)?;
+                out.extend(
+                    gyro_diagnose::files::runs_of_log(name, regular, role, a.split_s, &mut inputs)
+                        .map_err(|e| error(&e))?,
+                );
+            }
+            Ok(out)
+        };
+    let train = runs(train, "training")?;
+    let holdout = runs(holdout, "held-out")?;
+    diagnose_runs(&train, &holdout, inputs, &options)
+}
+
+/// The diagnosis options of `a`, checked as the command line checks them.
+fn diagnose_options(a: &DiagnoseArgs) -> Result<gyro_diagnose::Options, Error> {
+    if a.members < 2 || a.candidate_members < 2 {
+        return Err(Error(
+            "--members and --candidate-members must be at least 2".into(),
+        ));
+    }
+    let options = gyro_diagnose::Options {
+        seed: a.seed,
+        members: a.members,
+        candidate_members: a.candidate_members,
+        score_every_candidate: a.score_every_candidate,
+        ..gyro_diagnose::Options::default()
+    };
+    Ok(match &a.model {
+        Some(path) => options.with_fixed_model(model::load(path).map_err(|e| error(&e))?),
+        None => options,
+    })
+}
+
+/// The diagnosis of `train` against `holdout` as JSON text, with the logs' input reports.
+fn diagnose_runs(
+    train: &[gyro_diagnose::RealRun],
+    holdout: &[gyro_diagnose::RealRun],
+    inputs: Vec<gyro_diagnose::InputEntry>,
+    options: &gyro_diagnose::Options,
+) -> Result<String, Error> {
     let advice = |e: gyro_diagnose::DiagnoseError| Error(e.with_advice());
-    gyro_diagnose::check_runs(&train, &holdout).map_err(advice)?;
-    let mut result = gyro_diagnose::diagnose(&train, &holdout, &options, &gyro_diagnose::Silent)
-        .map_err(advice)?;
+    gyro_diagnose::check_runs(train, holdout).map_err(advice)?;
+    let mut result =
+        gyro_diagnose::diagnose(train, holdout, options, &gyro_diagnose::Silent).map_err(advice)?;
     result.inputs = inputs;
     serde_json::to_string_pretty(&result).map_err(|e| error(&e))
 }

@@ -405,16 +405,35 @@ fn diagnose_files(
     holdout: Vec<PathBuf>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let mut a = DiagnoseArgs {
+    let a = DiagnoseArgs {
         train,
         holdout,
-        ..DiagnoseArgs::default()
+        ..diagnose_args(options, Inputs::All)?
     };
+    Ok(py.detach(|| crate::diagnose_files(&a))?)
+}
+
+/// [`diagnose_files`] on logs given as arrays (name, columns): the JSON text.
+#[pyfunction]
+#[pyo3(signature = (train, holdout, options=None))]
+fn diagnose_arrays(
+    py: Python<'_>,
+    train: Vec<ArrayLog<'_>>,
+    holdout: Vec<ArrayLog<'_>>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<String> {
+    let a = diagnose_args(options, Inputs::Grid)?;
+    let (train, holdout) = (array_logs(&train)?, array_logs(&holdout)?);
+    Ok(py.detach(|| crate::diagnose_arrays(&train, &holdout, &a))?)
+}
+
+/// The diagnose options of `options`, the log-reading ones `inputs` takes.
+fn diagnose_args(options: Option<&Bound<'_, PyDict>>, inputs: Inputs) -> PyResult<DiagnoseArgs> {
+    let mut a = DiagnoseArgs::default();
     if let Some(options) = options {
         for (key, value) in options.iter() {
             let key: String = key.extract()?;
-            if value.is_none() || log_option(&key, &value, &mut a.input, &mut a.grid, Inputs::All)?
-            {
+            if value.is_none() || log_option(&key, &value, &mut a.input, &mut a.grid, inputs)? {
                 continue;
             }
             match key.as_str() {
@@ -428,7 +447,7 @@ fn diagnose_files(
             }
         }
     }
-    Ok(py.detach(|| crate::diagnose_files(&a))?)
+    Ok(a)
 }
 
 /// The tightening decision on one angle: "ok", "nok", "recheck", "invalid", or None.
@@ -543,6 +562,7 @@ fn _gyro(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(decide, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate_files, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose_files, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(noise_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate_arrays, m)?)?;
     m.add_class::<PyStream>()?;

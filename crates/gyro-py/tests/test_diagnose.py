@@ -85,3 +85,15 @@ def test_diagnose_refuses_bad_options():
         gyro.diagnose(TRAIN, HOLDOUT, split_s=-1.0)
     with pytest.raises(TypeError):
         gyro.diagnose(TRAIN, HOLDOUT, report="x")
+
+
+def test_diagnose_on_arrays_equals_diagnose_on_the_files():
+    from test_run import arrays_of
+
+    def named(path):
+        return dict(arrays_of(path), name=path)
+
+    got = gyro.diagnose_arrays([named(TRAIN)], [named(HOLDOUT)], **QUICK_KW)
+    assert got == gyro.diagnose(TRAIN, HOLDOUT, **QUICK_KW)
+    with pytest.raises(TypeError):
+        gyro.diagnose_arrays([named(TRAIN)], [named(HOLDOUT)], rate_column="x")

@@ -12,7 +12,8 @@ The pipeline and the host tools of the gyro workspace on numpy arrays and log fi
 - ``calibrate(logs, **options)``: ``gyro-cli calibrate LOG... --format json`` and the model;
   ``calibrate_arrays(train, holdout, **options)`` the same on arrays;
 - ``diagnose(train, holdout, **options)``: ``gyro-cli diagnose --format json`` as Python
-  objects (the contract of docs/diagnose-json.md);
+  objects (the contract of docs/diagnose-json.md); ``diagnose_arrays(train, holdout,
+  **options)`` the same on arrays;
 - ``decide(angle_deg, angle_std_deg, target_deg, tolerance_deg, ...)``: one verdict.
 
 Options are ``gyro-cli run``'s flags with ``_`` for ``-`` (``target_deg=90``,
@@ -38,6 +39,7 @@ __all__ = [
     "calibrate_arrays",
     "decide",
     "diagnose",
+    "diagnose_arrays",
     "noise",
     "noise_arrays",
     "run",
@@ -277,6 +279,20 @@ def diagnose(train: Any, holdout: Any, **options: Any) -> Dict[str, Any]:
         holdout = [holdout]
     return json.loads(
         _gyro.diagnose_files([os.fspath(p) for p in train], [os.fspath(p) for p in holdout], options)
+    )
+
+
+def diagnose_arrays(train: Any, holdout: Any, **options: Any) -> Dict[str, Any]:
+    """``diagnose`` on runs given as arrays: the same JSON as ``diagnose`` on CSVs holding
+    them.
+
+    ``train``, ``holdout``: runs as ``calibrate_arrays`` takes them, each with
+    ``reference_deg`` (and ``temperature_c`` where logged), cut into windows by ``split_s``
+    when given; default names ``"<train 1>"``, ``"<holdout 1>"``, ... Options as
+    ``diagnose``'s, without the input options (columns, MCAP).
+    """
+    return json.loads(
+        _gyro.diagnose_arrays(_array_logs(train, "train"), _array_logs(holdout, "holdout"), options)
     )
 
 

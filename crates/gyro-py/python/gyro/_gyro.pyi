@@ -64,6 +64,13 @@ def diagnose_files(
 ) -> str:
     """``gyro-cli diagnose --train ... --holdout ... --format json``: the JSON text."""
 
+def diagnose_arrays(
+    train: List[ArrayLog],
+    holdout: List[ArrayLog],
+    options: Optional[Dict[str, Any]] = None,
+) -> str:
+    """``gyro-cli diagnose`` on runs as arrays: the JSON text."""
+
 def decide(
     angle_deg: float,
     angle_std_deg: float,
