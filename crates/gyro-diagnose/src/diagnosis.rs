@@ -138,6 +138,9 @@ pub struct Diagnosis {
     pub unexplained: Vec<Unexplained>,
     /// Effects that could not be tested, and why.
     pub untestable: Vec<UntestableEntry>,
+    /// The effects not named, each with the smallest size runs like the self-check's
+    /// show of it ([`super::detection`]): not named means smaller than that, or absent.
+    pub not_seen: Vec<super::detection::NotSeen>,
     /// The nominal model used, and where its values came from.
     pub model: ModelSummary,
     /// Per run figures.

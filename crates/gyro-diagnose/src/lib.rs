@@ -59,6 +59,7 @@
 
 mod baseline;
 pub(crate) mod compensate;
+pub mod detection;
 mod diagnosis;
 pub mod effective;
 pub(crate) mod ensemble;

@@ -341,9 +341,14 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
         // One bias wander per model: the look-alike wanders are told apart by their
         // shape, not stacked.
         let wander_selected = selected.iter().any(|&j| is_wander(&candidates[j].fit));
+        // One delay per model when the rests tell the two apart ([`delay_by_rests`]): the
+        // other on top would only reshape the first's response.
+        let delay_selected = rests_delay(scorer.baseline.whiteness.as_ref()).is_some()
+            && selected.iter().any(|&j| is_delay(&candidates[j].fit));
         let pool: Vec<usize> = (0..candidates.len())
             .filter(|i| !selected.contains(i) && candidates[*i].eligible())
             .filter(|i| !(wander_selected && is_wander(&candidates[*i].fit)))
+            .filter(|i| !(delay_selected && is_delay(&candidates[*i].fit)))
             .collect();
         if pool.is_empty() {
             break;
@@ -392,6 +397,7 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
             break;
         }
         let pos = wander_by_shape(&ok, candidates);
+        let pos = delay_by_rests(&ok, pos, candidates, scorer.baseline.whiteness.as_ref());
         let (i, st, scores) = ok.swap_remove(pos);
         candidates[i].added = Some(st);
         selected.push(i);
@@ -399,6 +405,14 @@ fn forward(scorer: &Scorer, candidates: &mut [Candidate]) -> (Vec<usize>, Vec<Ru
     }
     (selected, current)
 }
+
+/// A `latency` or a `bandwidth`: the two delays.
+fn is_delay(f: &Fit) -> bool {
+    DELAYS.contains(&f.effect.id())
+}
+
+/// The effects that delay the motion: a pure latency, the sensor's own low-pass.
+const DELAYS: [&str; 2] = ["latency", "bandwidth"];
 
 /// A bias wander ([`fit::is_wander`]).
 fn is_wander(f: &Fit) -> bool {
@@ -422,6 +436,52 @@ fn wander_by_shape(ok: &[(usize, Step, Vec<RunScore>)], candidates: &[Candidate]
         .filter(|(_, (i, _, _))| is_wander(&candidates[*i].fit))
         .max_by(|a, b| shape(&candidates[a.1 .0].fit).total_cmp(&shape(&candidates[b.1 .0].fit)))
         .map_or(0, |(pos, _)| pos)
+}
+
+/// Which of the two delays the rests point to: a sensor's own low-pass (`bandwidth`)
+/// filters its noise as it delays the motion, so rests whose noise the check finds
+/// low-passed (`RestWhiteness::coloured`, the block's white variance above the first
+/// differences') point to it; white rests point to a pure `latency`, which delays the
+/// motion and leaves the noise as it is. `None` when the rests were not checked, or the
+/// effect is neither.
+fn rests_delay(whiteness: Option<&fit::RestWhiteness>) -> Option<&'static str> {
+    let w = whiteness?;
+    Some(if w.coloured && w.z > 0.0 {
+        "bandwidth"
+    } else if !w.coloured {
+        "latency"
+    } else {
+        return None;
+    })
+}
+
+/// The position in `ok` of the effect to add: `pos`, unless it is a `latency` or a
+/// `bandwidth` and its look-alike, which the rests point to ([`rests_delay`]), qualifies
+/// too. On bench motion the two differ only in the jerk term, so their held-out ΔBICs
+/// are close and follow the shape of the filter more than its existence; the rests'
+/// noise is the one thing that tells them apart.
+fn delay_by_rests(
+    ok: &[(usize, Step, Vec<RunScore>)],
+    pos: usize,
+    candidates: &[Candidate],
+    whiteness: Option<&fit::RestWhiteness>,
+) -> usize {
+    let id = |k: usize| candidates[ok[k].0].fit.effect.id();
+    let (Some(wanted), true) = (rests_delay(whiteness), DELAYS.contains(&id(pos))) else {
+        return pos;
+    };
+    if id(pos) == wanted {
+        return pos;
+    }
+    // A negative latency (a gyro ahead of its reference) is no low-pass.
+    let ahead = matches!(
+        candidates[ok[pos].0].fit.effect,
+        Effect::Latency { delay_s } if delay_s < 0.0
+    );
+    if ahead {
+        return pos;
+    }
+    (0..ok.len()).find(|&k| id(k) == wanted).unwrap_or(pos)
 }
 
 /// Swaps: a selected effect replaced by another that passed its parameter test, kept
@@ -450,6 +510,12 @@ fn swaps(
             // A wander for its look-alike: told apart by their shape in the forward step.
             let look_alike =
                 is_wander(&candidates[selected[slot]].fit) && is_wander(&candidates[a].fit);
+            // A delay for its look-alike: the rests chose between them in the forward step.
+            let out_id = candidates[selected[slot]].fit.effect.id();
+            let in_id = candidates[a].fit.effect.id();
+            let look_alike = look_alike
+                || (rests_delay(scorer.baseline.whiteness.as_ref()) == Some(out_id)
+                    && DELAYS.contains(&in_id));
             if selected.contains(&a) || candidates[selected[slot]].fit.direct || look_alike {
                 continue;
             }

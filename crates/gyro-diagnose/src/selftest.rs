@@ -96,6 +96,11 @@ pub struct CaseResult {
     pub unexplained: Vec<String>,
     /// The diagnosis's table of effects (why an effect was or was not named).
     pub effects: Vec<super::EffectResult>,
+    /// Named effects that explain none of the injected ones (up to confound groups).
+    pub extra: Vec<&'static str>,
+    /// In a matrix case: the injected magnitude's index in its effect's range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub magnitude_index: Option<usize>,
 }
 
 /// The self-check's summary.
@@ -125,6 +130,118 @@ pub struct SelfTest {
     pub model_fits: f64,
     /// Confusion matrix: (injected id, top-1 named or "none", count), single cases.
     pub confusion: Vec<(String, String, usize)>,
+    /// The matrix plan's cells, effect by effect, smallest magnitude first (empty for
+    /// the standard plan).
+    pub matrix: Vec<MatrixCell>,
+    /// Per effect of the matrix: its detection limit on these runs.
+    pub detection_limits: Vec<DetectionLimit>,
+}
+
+/// Share of a matrix cell's cases named first for its magnitude to count as detected.
+pub const DETECTED_SHARE: f64 = 0.9;
+
+/// One effect at one magnitude of the matrix, over its repeats.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MatrixCell {
+    /// The effect id.
+    pub effect: &'static str,
+    /// Index in the effect's range.
+    pub index: usize,
+    /// The injected effect.
+    pub magnitude: Effect,
+    /// Cases (repeats).
+    pub cases: usize,
+    /// Cases whose first named effect is it (confound groups counted as one).
+    pub named_first: usize,
+    /// Cases that name nothing it does not explain.
+    pub nothing_extra: usize,
+    /// Its parameters inside their 95% interval, of those fitted.
+    pub covered: (usize, usize),
+    /// Median held-out gap G before and after the selected effects (1: as close as
+    /// the floor allows).
+    pub holdout_gap: (f64, f64),
+}
+
+/// The smallest magnitude from which up every magnitude of an effect's range is named
+/// first in at least [`DETECTED_SHARE`] of its cases.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DetectionLimit {
+    /// The effect id.
+    pub effect: &'static str,
+    /// That magnitude (`None`: not even the top of the range is).
+    pub limit: Option<Effect>,
+    /// Its index in the range.
+    pub index: Option<usize>,
+}
+
+fn matrix_of(cases: &[CaseResult]) -> (Vec<MatrixCell>, Vec<DetectionLimit>) {
+    let mut cells: Vec<MatrixCell> = Vec::new();
+    for c in cases {
+        let (Some(index), Some(e)) = (c.magnitude_index, c.injected.first()) else {
+            continue;
+        };
+        let pos = match cells
+            .iter()
+            .position(|x| x.effect == e.id() && x.index == index)
+        {
+            Some(p) => p,
+            None => {
+                cells.push(MatrixCell {
+                    effect: e.id(),
+                    index,
+                    magnitude: *e,
+                    cases: 0,
+                    named_first: 0,
+                    nothing_extra: 0,
+                    covered: (0, 0),
+                    holdout_gap: (f64::NAN, f64::NAN),
+                });
+                cells.len() - 1
+            }
+        };
+        let cell = &mut cells[pos];
+        cell.cases += 1;
+        cell.named_first += usize::from(c.top1_group);
+        cell.nothing_extra += usize::from(c.extra.is_empty());
+        cell.covered.0 += c.covered.iter().filter(|x| x.1).count();
+        cell.covered.1 += c.covered.len();
+    }
+    for cell in &mut cells {
+        let gaps = |f: fn(&CaseResult) -> f64| {
+            let v: Vec<f64> = cases
+                .iter()
+                .filter(|c| {
+                    c.magnitude_index == Some(cell.index)
+                        && c.injected.first().is_some_and(|e| e.id() == cell.effect)
+                })
+                .map(f)
+                .collect();
+            gyro_analysis::median(&v).unwrap_or(f64::NAN)
+        };
+        cell.holdout_gap = (gaps(|c| c.holdout_gap.0), gaps(|c| c.holdout_gap.1));
+    }
+    let mut limits = Vec::new();
+    for info in EFFECTS {
+        let mine: Vec<&MatrixCell> = cells.iter().filter(|c| c.effect == info.id).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        let detected = |c: &MatrixCell| c.named_first as f64 >= DETECTED_SHARE * c.cases as f64;
+        // From the top of the range down, while every magnitude is detected.
+        let mut index = None;
+        for m in (0..info.range.len()).rev() {
+            match mine.iter().find(|c| c.index == m) {
+                Some(c) if detected(c) => index = Some(m),
+                _ => break,
+            }
+        }
+        limits.push(DetectionLimit {
+            effect: info.id,
+            limit: index.map(|m| info.range[m]),
+            index,
+        });
+    }
+    (cells, limits)
 }
 
 fn same_group(a: &str, b: &str) -> bool {
@@ -192,6 +309,11 @@ fn score_case(kind: &'static str, injected: Vec<Effect>, d: &Diagnosis) -> CaseR
             }
         }
     }
+    let extra = named
+        .iter()
+        .copied()
+        .filter(|n| !injected.iter().any(|t| confounded_ok(t.id(), n)))
+        .collect();
     CaseResult {
         kind,
         injected,
@@ -210,6 +332,64 @@ fn score_case(kind: &'static str, injected: Vec<Effect>, d: &Diagnosis) -> CaseR
             .map(|u| format!("{}/{}", u.segment, u.statistic))
             .collect(),
         effects: d.effects.clone(),
+        extra,
+        magnitude_index: None,
+    }
+}
+
+/// Which cases the self-check runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Plan {
+    /// Every effect alone at its self-test magnitude, [`VARIANTS`], [`PAIRS`],
+    /// [`NULL_CASES`] and [`CLOCK_VARIANTS`].
+    Standard,
+    /// Every effect alone at each magnitude of its realistic range (`EffectInfo::range`),
+    /// each `repeats` times with its own seeds, then [`PAIRS`] and [`NULL_CASES`].
+    Matrix {
+        /// Seeds per effect and magnitude.
+        repeats: usize,
+    },
+}
+
+/// One planned case: kind, injected effects, and for a matrix case its effect's
+/// magnitude index in `EffectInfo::range`.
+type Planned = (&'static str, Vec<Effect>, Option<usize>);
+
+fn plan_of(plan: Plan) -> (Vec<Planned>, &'static str) {
+    let mut cases: Vec<Planned> = Vec::new();
+    match plan {
+        Plan::Standard => {
+            for e in magnitudes().into_iter().chain(VARIANTS) {
+                cases.push(("single", vec![e], None));
+            }
+        }
+        Plan::Matrix { repeats } => {
+            for info in EFFECTS {
+                for (m, e) in info.range.iter().enumerate() {
+                    for _ in 0..repeats {
+                        cases.push(("single", vec![*e], Some(m)));
+                    }
+                }
+            }
+        }
+    }
+    for (a, b) in PAIRS {
+        if let (Some(a), Some(b)) = (magnitude(a), magnitude(b)) {
+            cases.push(("pair", vec![a, b], None));
+        }
+    }
+    for _ in 0..NULL_CASES {
+        cases.push(("null", Vec::new(), None));
+    }
+    match plan {
+        Plan::Standard => {
+            for e in CLOCK_VARIANTS {
+                cases.push(("single", vec![e], None));
+            }
+            (cases, "self-test case")
+        }
+        // The matrix's cases draw from seeds of their own: none is a standard case again.
+        Plan::Matrix { .. } => (cases, "self-test matrix case"),
     }
 }
 
@@ -217,52 +397,45 @@ fn score_case(kind: &'static str, injected: Vec<Effect>, d: &Diagnosis) -> CaseR
 /// when given); `progress` is told each case as it starts.
 pub fn run(
     seed: u64,
+    plan: Plan,
     only: Option<&str>,
     options: &Options,
     progress: &dyn Fn(usize, usize, &str),
 ) -> Result<SelfTest, super::DiagnoseError> {
-    let mut plan: Vec<(&'static str, Vec<Effect>)> = Vec::new();
-    for e in magnitudes().into_iter().chain(VARIANTS) {
-        plan.push(("single", vec![e]));
-    }
-    for (a, b) in PAIRS {
-        if let (Some(a), Some(b)) = (magnitude(a), magnitude(b)) {
-            plan.push(("pair", vec![a, b]));
-        }
-    }
-    for _ in 0..NULL_CASES {
-        plan.push(("null", Vec::new()));
-    }
-    for e in CLOCK_VARIANTS {
-        plan.push(("single", vec![e]));
-    }
+    let (planned, seed_label) = plan_of(plan);
     // Case seeds follow the position in the whole plan, so a case run alone is the same.
-    let plan: Vec<(usize, (&'static str, Vec<Effect>))> = plan
+    let planned: Vec<(usize, Planned)> = planned
         .into_iter()
         .enumerate()
-        .filter(|(_, (_, effects))| match only {
+        .filter(|(_, (_, effects, _))| match only {
             None => true,
             Some("none") => effects.is_empty(),
             Some(id) => effects.iter().any(|e| e.id() == id),
         })
         .collect();
-    let total = plan.len();
+    let total = planned.len();
     let mut cases = Vec::new();
-    for (n, (k, (kind, effects))) in plan.into_iter().enumerate() {
+    for (n, (k, (kind, effects, magnitude_index))) in planned.into_iter().enumerate() {
         let label = if effects.is_empty() {
             "none".to_string()
         } else {
-            effects.iter().map(|e| e.id()).collect::<Vec<_>>().join("+")
+            effects
+                .iter()
+                .map(Effect::spec)
+                .collect::<Vec<_>>()
+                .join(" + ")
         };
         progress(n, total, &label);
-        let case_seed = derive_seed(seed, "self-test case", k as u64);
+        let case_seed = derive_seed(seed, seed_label, k as u64);
         let (train, holdout) = case_runs(&effects, case_seed);
         let options = Options {
             seed: derive_seed(case_seed, "diagnosis", 0),
             ..options.clone()
         };
         let d = diagnose(&train, &holdout, &options, &Silent)?;
-        cases.push(score_case(kind, effects, &d));
+        let mut case = score_case(kind, effects, &d);
+        case.magnitude_index = magnitude_index;
+        cases.push(case);
     }
     let frac = |f: &dyn Fn(&CaseResult) -> Option<bool>| -> f64 {
         let v: Vec<bool> = cases.iter().filter_map(f).collect();
@@ -302,9 +475,16 @@ pub fn run(
             None => confusion.push((truth, got, 1)),
         }
     }
+    let (matrix, detection_limits) = matrix_of(&cases);
     Ok(SelfTest {
         seed,
-        magnitudes: magnitudes(),
+        magnitudes: match plan {
+            Plan::Standard => magnitudes(),
+            Plan::Matrix { .. } => EFFECTS
+                .iter()
+                .flat_map(|i| i.range.iter().copied())
+                .collect(),
+        },
         cases,
         top1_strict,
         top1_group,
@@ -315,5 +495,7 @@ pub fn run(
         mean_fraction_closed,
         model_fits,
         confusion,
+        matrix,
+        detection_limits,
     })
 }

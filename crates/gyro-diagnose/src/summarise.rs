@@ -207,10 +207,11 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         r#where: f.r#where,
         effects,
         verdict: Verdict {
-            unmodelled,
+            unmodelled: unmodelled.clone(),
             fraction_closed_holdout: closed(floor, gap(&f.holdout_before), holdout_after),
             model_fits: unexplained.is_empty(),
         },
+        not_seen: super::detection::not_seen(&unmodelled),
         unexplained,
         untestable: f
             .untestable

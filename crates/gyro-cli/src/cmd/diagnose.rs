@@ -70,6 +70,11 @@ pub struct Args {
     /// cases); each case is the same as in the whole run.
     #[arg(long, requires = "self_test")]
     only: Option<String>,
+    /// With --self-test: every effect at each magnitude of its realistic range (see
+    /// `gyro-cli simulate --list-effects`), each this many times with its own seeds, then
+    /// the pairs and the null cases; prints each effect's detection limit.
+    #[arg(long, requires = "self_test", value_name = "REPEATS")]
+    matrix: Option<usize>,
     #[command(flatten)]
     noise_yaml: super::NoiseYamlArgs,
     #[command(flatten)]
@@ -244,8 +249,14 @@ fn self_test(args: &Args) -> Result<()> {
             );
         }
     }
+    let plan = match args.matrix {
+        None => selftest::Plan::Standard,
+        Some(0) => anyhow::bail!("--matrix 0: give the number of seeds per magnitude, 1 or more"),
+        Some(repeats) => selftest::Plan::Matrix { repeats },
+    };
     let result = selftest::run(
         args.seed,
+        plan,
         args.only.as_deref(),
         &options,
         &|k, total, label| {

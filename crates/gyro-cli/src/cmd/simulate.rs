@@ -76,6 +76,23 @@ fn list_effects(out: &mut dyn Write) -> std::io::Result<()> {
             params.join(", "),
             info.signature
         )?;
+        let range: Vec<String> = info
+            .range
+            .iter()
+            .map(|e| {
+                e.spec()
+                    .trim_start_matches(info.id)
+                    .trim_start_matches(':')
+                    .to_string()
+            })
+            .collect();
+        writeln!(
+            out,
+            "{:<18} realistic range (the self-check's matrix): {}; {}",
+            "",
+            range.join(" | "),
+            info.range_source
+        )?;
     }
     Ok(())
 }

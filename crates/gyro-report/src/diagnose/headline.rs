@@ -167,6 +167,117 @@ pub fn clause(e: &EffectResult, interval: bool) -> String {
     }
 }
 
+/// An effect's size in words and units, for a detection limit ("bias instability of
+/// σ 0.0125 deg/s (45 deg/h)").
+pub fn size_words(e: &gyro_sim::Effect) -> String {
+    use gyro_sim::Effect as E;
+    // The shortest decimal of the nearest f32: 0.2, not 0.19999999999999998.
+    let g = |x: f64| format!("{}", x as f32);
+    match *e {
+        E::ScaleFactor { k } => format!("a scale factor of {} %", g(100.0 * k.abs())),
+        E::ScaleAsymmetry { k } => format!("a scale asymmetry of {} %", g(100.0 * k.abs())),
+        E::Nonlinearity { k3_per_dps2 } => format!(
+            "a cubic nonlinearity of {} % at 100 deg/s",
+            g(1e6 * k3_per_dps2.abs())
+        ),
+        E::NonlinearityEven { k2_per_dps } => format!(
+            "an even nonlinearity of {} % at 100 deg/s",
+            g(1e4 * k2_per_dps.abs())
+        ),
+        E::Saturation { limit_dps } => format!("a clip at ±{} deg/s", g(limit_dps)),
+        E::Quantization { lsb_dps } => format!("an output step of {} deg/s", g(lsb_dps)),
+        E::Latency { delay_s } => format!("a latency of {} ms", g(1e3 * delay_s.abs())),
+        E::ClockError { ppm } => format!(
+            "a clock error of {} % (stamped by the logger)",
+            g(1e-4 * ppm.abs())
+        ),
+        E::ClockErrorCountStamped { ppm } => format!(
+            "a clock error of {} % (stamped by the sample count)",
+            g(1e-4 * ppm.abs())
+        ),
+        E::Dropouts {
+            rate_per_s,
+            mean_samples,
+        } => format!(
+            "dropouts of {} per s, {} samples each",
+            g(rate_per_s),
+            g(mean_samples)
+        ),
+        E::TemperatureBias { dps_per_c } => format!(
+            "a temperature bias of {} deg/s per degC",
+            g(dps_per_c.abs())
+        ),
+        E::TemperatureScale { per_c } => format!(
+            "a temperature scale of {} % per degC",
+            g(100.0 * per_c.abs())
+        ),
+        E::BiasInstability { sigma_dps } => format!(
+            "a bias instability of σ {} deg/s ({:.0} deg/h)",
+            g(sigma_dps),
+            3600.0 * sigma_dps
+        ),
+        E::RateRandomWalk { k_dps_per_rt_s } => {
+            format!("a rate random walk of {} deg/s/√s", g(k_dps_per_rt_s))
+        }
+        E::TurnOnBias { sigma_dps } => {
+            format!("a turn-on bias of σ {} deg/s from run to run", g(sigma_dps))
+        }
+        E::Bandwidth { cutoff_hz } => format!("a bandwidth of {} Hz", g(cutoff_hz)),
+        E::Vibration {
+            amplitude_dps,
+            frequency_hz,
+        } => format!(
+            "a vibration of {} deg/s at {} Hz",
+            g(amplitude_dps),
+            g(frequency_hz)
+        ),
+    }
+}
+
+/// The effects not named, with their detection limits, as one line of the findings:
+/// what runs like the self-check's cannot show.
+fn not_seen_line(d: &Diagnosis) -> Option<String> {
+    if d.not_seen.is_empty() {
+        return None;
+    }
+    let below: Vec<String> = d
+        .not_seen
+        .iter()
+        .filter_map(|n| {
+            n.limit
+                .as_ref()
+                .map(|e| format!("{} ({})", size_words(e), n.id))
+        })
+        .collect();
+    let never: Vec<&str> = d
+        .not_seen
+        .iter()
+        .filter(|n| n.limit.is_none())
+        .map(|n| n.id)
+        .collect();
+    let train: Vec<f64> = d
+        .runs
+        .iter()
+        .filter(|r| r.role == "train")
+        .map(|r| r.duration_s)
+        .collect();
+    let mut line = format!(
+        "not named, so absent or smaller than what {} training runs of {} s show (these: {} runs, {:.0} s in all); the self-check names from {}",
+        gyro_diagnose::selftest::TRAIN_RUNS,
+        gyro_diagnose::selftest::RUN_S,
+        train.len(),
+        train.iter().sum::<f64>(),
+        below.join(", ")
+    );
+    if !never.is_empty() {
+        line.push_str(&format!(
+            "; not named even at the top of its realistic range: {}",
+            never.join(", ")
+        ));
+    }
+    Some(line)
+}
+
 /// The sentence for a named effect, with its 95% intervals.
 pub fn sentence(e: &EffectResult) -> String {
     format!("the gyro {}", clause(e, true))
@@ -267,7 +378,7 @@ pub fn verdict(d: &Diagnosis) -> Vec<String> {
     let mut differs = named.clone();
     differs.extend(turns);
     out.push(if differs.is_empty() {
-        "No effect of the vocabulary is named: on these runs the gyro behaves as the model predicts, or what differs is not in the vocabulary.".to_string()
+        "No effect of the vocabulary is named: on these runs the gyro behaves as the model predicts, or what differs is smaller than these runs show (the limits are listed below) or not in the vocabulary.".to_string()
     } else {
         format!("The gyro {}.", and_list(&differs))
     });
@@ -393,6 +504,7 @@ pub fn findings(d: &Diagnosis) -> Findings {
     if named.is_empty() {
         named.push("no effect of the vocabulary is named: the nominal model holds on these runs, or what differs is not in the vocabulary (see what the model misses)".into());
     }
+    named.extend(not_seen_line(d));
     named.extend(turn_lines(d));
     if let Some(c) = &d.compensation {
         let (before, after, better) = held_out_error(c);

@@ -1391,6 +1391,7 @@ mod tests {
                 fraction_closed_holdout: 0.9,
                 model_fits: false,
             },
+            not_seen: gyro_diagnose::detection::not_seen(&["clock_error"]),
             unexplained: vec![gyro_diagnose::Unexplained {
                 segment: "dynamic".into(),
                 statistic: "residual_std".into(),

@@ -22,6 +22,7 @@ pub fn self_test_table(t: &selftest::SelfTest) -> String {
         selftest::HOLDOUT_RUNS,
         selftest::RUN_S
     );
+    matrix_table(&mut s, t);
     let _ = writeln!(s, "injected magnitudes:");
     for e in &t.magnitudes {
         let _ = writeln!(s, "  {}", serde_json::to_string(e).unwrap_or_default());
@@ -106,6 +107,49 @@ top-1 accuracy (single effects): {} strict, {} counting confounded pairs ({}) as
         pct(t.model_fits)
     );
     s
+}
+
+/// The matrix plan's answer first: each effect's detection limit, then every cell.
+fn matrix_table(s: &mut String, t: &selftest::SelfTest) {
+    if t.matrix.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "detection limits (the smallest magnitude from which up every magnitude of the range is named first in {} of its cases):",
+        pct(selftest::DETECTED_SHARE)
+    );
+    for l in &t.detection_limits {
+        let _ = writeln!(
+            s,
+            "  {:<26} {}",
+            l.effect,
+            l.limit.map_or_else(
+                || "not named at the top of its range".to_string(),
+                |e| e.spec()
+            )
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nmatrix (effect alone at each magnitude; named first, nothing else named, 95% interval covers, held-out gap G before -> after):"
+    );
+    for c in &t.matrix {
+        let _ = writeln!(
+            s,
+            "  {:<58} named first {}/{}  nothing extra {}/{}  covers {}/{}  G {:>7.2} -> {:>6.2}",
+            c.magnitude.spec(),
+            c.named_first,
+            c.cases,
+            c.nothing_extra,
+            c.cases,
+            c.covered.0,
+            c.covered.1,
+            c.holdout_gap.0,
+            c.holdout_gap.1
+        );
+    }
+    let _ = writeln!(s);
 }
 
 fn num(x: f64) -> String {

@@ -216,6 +216,12 @@ pub struct EffectInfo {
     pub typical: Effect,
     /// The magnitude the diagnosis self-test injects.
     pub self_test: Effect,
+    /// The magnitudes the self-check's matrix injects (`diagnose --self-test --matrix`),
+    /// smallest first: from near what a bench run can show to the top of the realistic
+    /// range for a low-cost MEMS or CRM100-class gyro.
+    pub range: &'static [Effect],
+    /// Where that range comes from (datasheet figures, the bench's motion).
+    pub range_source: &'static str,
     /// How the diagnosis fits it.
     pub fit: FitProcedure,
     /// What the core can compensate of it.
@@ -255,6 +261,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "only in motion, residual proportional to rate",
         typical: Effect::ScaleFactor { k: 0.01 },
         self_test: Effect::ScaleFactor { k: 0.01 },
+        range: &[
+            Effect::ScaleFactor { k: 0.002 },
+            Effect::ScaleFactor { k: -0.01 },
+            Effect::ScaleFactor { k: 0.03 },
+        ],
+        range_source: "sensitivity tolerance: ±3% (MPU-6050, BMI160 datasheets), ±1% class (CRM100, ADXRS450)",
         fit: regression(Regressor::Rate, "straight-line slope on rate in the 2 Hz low band vs null replicas"),
         correction: CoreCorrection::ScaleK { per_unit: 1.0 },
         term: |p, t| t.scale_k += p[0],
@@ -266,6 +278,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "scale error that differs by the sign of the rate",
         typical: Effect::ScaleAsymmetry { k: 0.005 },
         self_test: Effect::ScaleAsymmetry { k: 0.005 },
+        range: &[
+            Effect::ScaleAsymmetry { k: 0.002 },
+            Effect::ScaleAsymmetry { k: -0.006 },
+            Effect::ScaleAsymmetry { k: 0.02 },
+        ],
+        range_source: "a share of the sensitivity tolerance that differs by direction; up to 2%",
         fit: regression(Regressor::AbsRate, "regression slope on |rate| vs null replicas"),
         correction: CoreCorrection::AsymmetryK,
         term: |p, t| t.asymmetry_k += p[0],
@@ -277,6 +295,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "residual curved (cubic) in the rate",
         typical: Effect::Nonlinearity { k3_per_dps2: 2e-7 },
         self_test: Effect::Nonlinearity { k3_per_dps2: 2e-7 },
+        range: &[
+            Effect::Nonlinearity { k3_per_dps2: 5e-8 },
+            Effect::Nonlinearity { k3_per_dps2: 2e-7 },
+            Effect::Nonlinearity { k3_per_dps2: 8e-7 },
+        ],
+        range_source: "nonlinearity 0.1–0.5% of full scale (MPU-6050 0.2%, ADXRS450 0.05%): 0.05–0.8% of the rate at 100 °/s",
         fit: FitProcedure::Regression {
             regressor: Regressor::RateCubed,
             reading: Reading::CubicCoefficient,
@@ -293,6 +317,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "residual curved (quadratic, the same sign both ways) in the rate",
         typical: Effect::NonlinearityEven { k2_per_dps: 2e-5 },
         self_test: Effect::NonlinearityEven { k2_per_dps: 2e-5 },
+        range: &[
+            Effect::NonlinearityEven { k2_per_dps: 5e-6 },
+            Effect::NonlinearityEven { k2_per_dps: 2e-5 },
+            Effect::NonlinearityEven { k2_per_dps: 8e-5 },
+        ],
+        range_source: "the same nonlinearity budget with an even shape: 0.05–0.8% of the rate at 100 °/s",
         fit: FitProcedure::Regression {
             regressor: Regressor::RateSquared,
             reading: Reading::SquareCoefficient,
@@ -309,6 +339,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "raw values clipped at a level",
         typical: Effect::Saturation { limit_dps: 120.0 },
         self_test: Effect::Saturation { limit_dps: 120.0 },
+        range: &[
+            Effect::Saturation { limit_dps: 150.0 },
+            Effect::Saturation { limit_dps: 120.0 },
+            Effect::Saturation { limit_dps: 80.0 },
+        ],
+        range_source: "a range set below the bench's peak rates (about 150–200 °/s): ±75 to ±150 °/s settings",
         fit: FitProcedure::Plateau,
         correction: CoreCorrection::None,
         term: |p, t| t.limit_dps = t.limit_dps.min(p[0]),
@@ -320,6 +356,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "raw values on a grid (rounding each rate sample adds white rate noise of lsb^2/12: a higher -1/2 Allan slope, not -1)",
         typical: Effect::Quantization { lsb_dps: 0.2 },
         self_test: Effect::Quantization { lsb_dps: 0.2 },
+        range: &[
+            Effect::Quantization { lsb_dps: 0.1 },
+            Effect::Quantization { lsb_dps: 0.2 },
+            Effect::Quantization { lsb_dps: 0.3 },
+        ],
+        range_source: "output steps of coarse ranges and 12-bit paths: 0.1–0.3 °/s",
         fit: FitProcedure::OutputGrid,
         correction: CoreCorrection::None,
         term: |p, t| t.extra_lsb_dps = p[0],
@@ -331,6 +373,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "residual proportional to angular acceleration; cross-correlation peak off zero (either side)",
         typical: Effect::Latency { delay_s: 0.005 },
         self_test: Effect::Latency { delay_s: 0.005 },
+        range: &[
+            Effect::Latency { delay_s: 0.002 },
+            Effect::Latency { delay_s: -0.01 },
+            Effect::Latency { delay_s: 0.05 },
+        ],
+        range_source: "logger and bus delays of 1–50 ms, either side of the reference",
         fit: FitProcedure::Regression {
             regressor: Regressor::Acceleration,
             reading: Reading::Delay,
@@ -347,6 +395,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "time stamps drift from the nominal rate; angle error proportional to total angle; rate residual clean at the stamps",
         typical: Effect::ClockError { ppm: 5000.0 },
         self_test: Effect::ClockError { ppm: 5000.0 },
+        range: &[
+            Effect::ClockError { ppm: 500.0 },
+            Effect::ClockError { ppm: -5000.0 },
+            Effect::ClockError { ppm: 30_000.0 },
+        ],
+        range_source: "internal RC oscillators: ±1–3% (MPU-6050/6500, BMI160 datasheets); crystals 0.005–0.05%",
         fit: FitProcedure::StampedClock,
         // Integrated over nominal periods, a clock fast by ε gives 1 + ε times the angle,
         // exactly like a scale factor.
@@ -360,6 +414,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "rows stamped by the sensor's sample count: stamps on the nominal grid, the lag behind the reference growing linearly over the run (residual proportional to time x angular acceleration)",
         typical: Effect::ClockErrorCountStamped { ppm: 500.0 },
         self_test: Effect::ClockErrorCountStamped { ppm: 500.0 },
+        range: &[
+            Effect::ClockErrorCountStamped { ppm: 500.0 },
+            Effect::ClockErrorCountStamped { ppm: -5000.0 },
+            Effect::ClockErrorCountStamped { ppm: 30_000.0 },
+        ],
+        range_source: "internal RC oscillators: ±1–3% (MPU-6050/6500, BMI160 datasheets); crystals 0.005–0.05%",
         fit: FitProcedure::Regression {
             regressor: Regressor::TimeAcceleration,
             reading: Reading::ClockPpm,
@@ -387,6 +447,21 @@ pub const EFFECTS: &[EffectInfo] = &[
             rate_per_s: 0.5,
             mean_samples: 5.0,
         },
+        range: &[
+            Effect::Dropouts {
+                rate_per_s: 0.1,
+                mean_samples: 2.0,
+            },
+            Effect::Dropouts {
+                rate_per_s: 0.5,
+                mean_samples: 5.0,
+            },
+            Effect::Dropouts {
+                rate_per_s: 2.0,
+                mean_samples: 10.0,
+            },
+        ],
+        range_source: "a busy USB or serial link: 0.1–2 losses per second of 2–10 samples",
         fit: FitProcedure::Gaps,
         correction: CoreCorrection::None,
         term: |p, t| t.dropouts = Some((p[0], p[1])),
@@ -398,6 +473,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "static bias tracks temperature",
         typical: Effect::TemperatureBias { dps_per_c: 0.05 },
         self_test: Effect::TemperatureBias { dps_per_c: 0.05 },
+        range: &[
+            Effect::TemperatureBias { dps_per_c: 0.02 },
+            Effect::TemperatureBias { dps_per_c: -0.05 },
+            Effect::TemperatureBias { dps_per_c: 0.15 },
+        ],
+        range_source: "bias temperature coefficients 0.01–0.2 °/s/°C (CRM100 class to MPU-6050's ±20 °/s over −40…85 °C)",
         fit: FitProcedure::Regression {
             regressor: Regressor::DeltaT,
             reading: Reading::Coefficient,
@@ -414,6 +495,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "scale error tracks temperature",
         typical: Effect::TemperatureScale { per_c: 1e-3 },
         self_test: Effect::TemperatureScale { per_c: 2e-3 },
+        range: &[
+            Effect::TemperatureScale { per_c: 5e-4 },
+            Effect::TemperatureScale { per_c: -2e-3 },
+            Effect::TemperatureScale { per_c: 5e-3 },
+        ],
+        range_source: "sensitivity temperature drift 0.05–0.5% per °C (MPU-6050 ±2% over −40…85 °C; BMI160)",
         fit: FitProcedure::Regression {
             regressor: Regressor::RateDeltaT,
             reading: Reading::Coefficient,
@@ -430,6 +517,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "Allan deviation flat (slope 0) at long tau",
         typical: Effect::BiasInstability { sigma_dps: 0.05 },
         self_test: Effect::BiasInstability { sigma_dps: 0.05 },
+        range: &[
+            Effect::BiasInstability { sigma_dps: 0.003 },
+            Effect::BiasInstability { sigma_dps: 0.0125 },
+            Effect::BiasInstability { sigma_dps: 0.05 },
+        ],
+        range_source: "bias instability 5–200 °/h (CRM100 class 10–50 °/h; consumer MEMS 20–200 °/h): a wander of σ 11, 45 and 180 °/h",
         fit: FitProcedure::Wander(WanderShape::Flicker),
         correction: CoreCorrection::None,
         term: |p, t| t.flicker_sigma_dps = Some(p[0]),
@@ -445,6 +538,18 @@ pub const EFFECTS: &[EffectInfo] = &[
         self_test: Effect::RateRandomWalk {
             k_dps_per_rt_s: 0.02,
         },
+        range: &[
+            Effect::RateRandomWalk {
+                k_dps_per_rt_s: 0.005,
+            },
+            Effect::RateRandomWalk {
+                k_dps_per_rt_s: 0.02,
+            },
+            Effect::RateRandomWalk {
+                k_dps_per_rt_s: 0.05,
+            },
+        ],
+        range_source: "rate random walk of low-cost MEMS, 0.005–0.05 °/s/√s",
         fit: FitProcedure::Wander(WanderShape::RandomWalk),
         correction: CoreCorrection::None,
         term: |p, t| t.walk_dps_per_rt_s += p[0],
@@ -456,6 +561,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "between-run spread of static means much larger than within-run",
         typical: Effect::TurnOnBias { sigma_dps: 0.5 },
         self_test: Effect::TurnOnBias { sigma_dps: 0.5 },
+        range: &[
+            Effect::TurnOnBias { sigma_dps: 0.1 },
+            Effect::TurnOnBias { sigma_dps: 0.3 },
+            Effect::TurnOnBias { sigma_dps: 1.0 },
+        ],
+        range_source: "run-to-run bias repeatability 0.1–1 °/s (CRM100 class to consumer MEMS)",
         fit: FitProcedure::BetweenRunSpread,
         correction: CoreCorrection::KalmanBias,
         term: |p, t| t.turn_on_sigma_dps += p[0],
@@ -467,6 +578,12 @@ pub const EFFECTS: &[EffectInfo] = &[
         signature: "high-band PSD attenuated, lag",
         typical: Effect::Bandwidth { cutoff_hz: 15.0 },
         self_test: Effect::Bandwidth { cutoff_hz: 15.0 },
+        range: &[
+            Effect::Bandwidth { cutoff_hz: 80.0 },
+            Effect::Bandwidth { cutoff_hz: 30.0 },
+            Effect::Bandwidth { cutoff_hz: 10.0 },
+        ],
+        range_source: "selectable digital low-pass settings 10–100 Hz (MPU-6050 DLPF, BMI160 ODR filter; CRM100 77 Hz)",
         fit: FitProcedure::Regression {
             regressor: Regressor::Acceleration,
             reading: Reading::LowPassDelay,
@@ -493,6 +610,21 @@ pub const EFFECTS: &[EffectInfo] = &[
             amplitude_dps: 0.2,
             frequency_hz: 37.0,
         },
+        range: &[
+            Effect::Vibration {
+                amplitude_dps: 0.05,
+                frequency_hz: 37.0,
+            },
+            Effect::Vibration {
+                amplitude_dps: 0.2,
+                frequency_hz: 13.0,
+            },
+            Effect::Vibration {
+                amplitude_dps: 1.0,
+                frequency_hz: 150.0,
+            },
+        ],
+        range_source: "a motor or tool on the bench: 0.05–1 °/s lines between 10 and 150 Hz",
         fit: FitProcedure::SpectralLine,
         correction: CoreCorrection::None,
         term: |p, t| t.vibration = Some((p[0], p[1])),
@@ -526,6 +658,18 @@ impl Effect {
     /// (its ensemble is the nominal one, seed for seed).
     pub fn is_neutral(&self, model: &SensorModel) -> bool {
         (self.info().neutral)(&self.params(), model)
+    }
+
+    /// The effect as [`Self::parse`] reads it: `id:name=value,name=value`.
+    pub fn spec(&self) -> String {
+        let pairs: Vec<String> = self
+            .info()
+            .params
+            .iter()
+            .zip(self.params())
+            .map(|(p, v)| format!("{}={v}", p.name))
+            .collect();
+        format!("{}:{}", self.id(), pairs.join(","))
     }
 
     /// Parse `id` or `id:name=value,name=value` (missing parameters take the typical value).
@@ -626,6 +770,18 @@ mod tests {
             assert!(info.typical.validate().is_ok());
             assert_eq!(info.self_test.id(), id);
             assert!(info.self_test.validate().is_ok());
+            // The matrix: three magnitudes or more, each a valid, non-neutral effect.
+            assert!(info.range.len() >= 3, "{id}");
+            for e in info.range {
+                assert_eq!(e.id(), id);
+                assert!(e.validate().is_ok(), "{id}");
+                assert!(
+                    !(info.neutral)(&e.params(), &SensorModel::default()),
+                    "{id}"
+                );
+            }
+            assert!(!info.range_source.is_empty());
+            assert_eq!(Effect::parse(&info.self_test.spec()), Ok(info.self_test));
             // JSON uses the same id.
             let json = serde_json::to_value(info.typical).unwrap();
             assert_eq!(json["id"], id);
