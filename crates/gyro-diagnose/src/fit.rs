@@ -546,10 +546,18 @@ pub fn nominal_model(
             model.gm_tau_s,
         );
         let k = m.rate_random_walk_dps_per_rt_s;
-        let verdict = match (m.rate_random_walk_resolved, k_prior <= k) {
+        let floor = Settings::DEFAULT.fit.wander_prior_floor;
+        let verdict = match (m.rate_random_walk_resolved, k >= floor * k_prior) {
             (true, _) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, against {k:.3e} fitted to the training residual (a larger wander is the vocabulary's to name)"),
-            (false, true) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, within the bound the training residual allows ({k:.3e})"),
-            (false, false) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, beyond the bound the training residual allows ({k:.3e}): the prior's wander is larger than these runs show"),
+            (false, true) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, against the bound the training residual allows ({k:.3e}): kept"),
+            (false, false) => {
+                // A prior that wanders more than the runs allow is not this sensor's:
+                // its σ comes down to the bound (never up: a larger wander is an effect
+                // to name), so that a quiet sensor's own wander is its model's.
+                let sigma_prior = model.gm_sigma_dps;
+                model.gm_sigma_dps *= k / k_prior;
+                format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, and the training residual allows at most {k:.3e}, under {floor} of it: the prior's wander is larger than these runs show, so its sigma is lowered from {sigma_prior} to {:.4} deg/s, at that bound", model.gm_sigma_dps)
+            }
         };
         wander.push_str("; its wander: ");
         wander.push_str(&verdict);

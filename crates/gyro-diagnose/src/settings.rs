@@ -115,6 +115,13 @@ pub struct Fit {
     /// wander statistic for a wander to pass. Unit 1, valid [1, 10⁶]. 3.0: the sampling
     /// spread of a 16 s Allan variance from five one-minute runs (about 15 windows).
     pub wander_overshoot: f64,
+    /// The prior's Gauss-Markov wander is lowered to the bound the training residual
+    /// allows when that bound (its random walk coefficient at τ = 3 s) is under this
+    /// share of the prior's; never raised (a larger wander is an effect to name). Unit 1,
+    /// valid (0, 1]. 0.5: a bound that close to the prior is the prior's own wander drawn
+    /// low in five one-minute runs, not a quieter sensor (nearer 1, a null case of the
+    /// self-check names a random walk).
+    pub wander_prior_floor: f64,
     /// A regression effect's gain (coefficient change per unit of the coefficient's own
     /// parameter, by simulation) is used when it lies in (1/r, r), r this; the calibration
     /// steps stay within r times the raw coefficient. Unit 1, valid (1, 10⁶]. 5.0: a gain
@@ -373,6 +380,7 @@ impl Settings {
             negligible_delay_samples: 0.1,
             scatter_p: 0.99,
             wander_overshoot: 3.0,
+            wander_prior_floor: 0.5,
             gain_ratio_max: 5.0,
             wander_gain_ratio_max: 10.0,
             wander_gain_members: 8,
@@ -467,6 +475,8 @@ impl Settings {
                 "null chi-square share above which the runs' own scatter of a coefficient is used: one-sided 1%"),
             entry("fit.wander_overshoot", f.wander_overshoot, "1", (CLOSED, 1.0, 1e6, CLOSED),
                 "largest fitted-over-real Allan variance of a wander at any τ: the spread of a 16 s Allan variance from five one-minute runs"),
+            entry("fit.wander_prior_floor", f.wander_prior_floor, "1", (OPEN, 0.0, 1.0, CLOSED),
+                "the prior's wander comes down to the runs' bound when that is under this share of it"),
             entry("fit.gain_ratio_max", f.gain_ratio_max, "1", (OPEN, 1.0, 1e6, CLOSED),
                 "a regression effect's simulated gain is used within (1/r, r)"),
             entry("fit.wander_gain_ratio_max", f.wander_gain_ratio_max, "1", (OPEN, 1.0, 1e6, CLOSED),
