@@ -420,7 +420,7 @@ def matrix_case(gyro, directory, name, effect, param, value, seed, label, noise)
     row["extra"] = [n for n in named if n != effect and n != LOOKALIKE.get(effect)]
     row["lookalike"] = [n for n in named if effect and n == LOOKALIKE.get(effect)]
     row["top_strict"] = effect is not None and row["first"] == effect
-    row["top_group"] = effect is not None and row["first"] in (effect, LOOKALIKE.get(effect))
+    row["top_group"] = effect is not None and row["first"] is not None and row["first"] in (effect, LOOKALIKE.get(effect))
     row["injected_named"] = effect in named
     row["fit"] = None
     row["covered"] = None

@@ -15,9 +15,9 @@ use gyro_analysis::rest_mean::{score_report, simulate_bench_run};
 use gyro_core::Config;
 use gyro_sim::{Effect, SensorModel};
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+/// The crate's one median ([`gyro_analysis::median`]), NaN for none.
+fn median(v: Vec<f64>) -> f64 {
+    gyro_analysis::median(&v).unwrap_or(f64::NAN)
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -137,9 +137,9 @@ impl KindScore {
     }
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+/// The crate's one median ([`crate::median`]), NaN for none.
+fn median(v: Vec<f64>) -> f64 {
+    crate::median(&v).unwrap_or(f64::NAN)
 }
 
 /// Score `kind` with `config` on the runs of `seeds`.
