@@ -87,17 +87,10 @@ def continuous(rng, speed, t, delay_s):
 def wrench(rng, speed, t):
     rate = np.zeros_like(t)
     angle = np.zeros_like(t)
-    for w in range(WINDOWS):
-        now, end = w * WINDOW_S + rng.uniform(1.5, 3.0), (w + 1) * WINDOW_S
-        while True:
-            d = rng.uniform(0.6, 1.4) / speed
-            if now + d + 1.5 > end:
-                break
-            a = rng.choice([-1, 1]) * rng.uniform(45, 135)
-            s = (t >= now) & (t < now + d)
-            rate[s] += a * np.pi / (2 * d) * np.sin(np.pi * (t[s] - now) / d)
-            angle += a * (1 - np.cos(np.pi * np.clip((t - now) / d, 0, 1))) / 2
-            now += d + rng.uniform(1.5, 3.5)
+    for now, d, a in turn_plan(rng, speed):
+        s = (t >= now) & (t < now + d)
+        rate[s] += a * np.pi / (2 * d) * np.sin(np.pi * (t[s] - now) / d)
+        angle += a * (1 - np.cos(np.pi * np.clip((t - now) / d, 0, 1))) / 2
     return angle, rate
 
 
@@ -252,7 +245,7 @@ MATRIX = [
 
 
 def turn_plan(rng, speed):
-    """The wrench's turns as (start, duration, angle): the same draws as `wrench`."""
+    """The wrench's turns as (start, duration, angle), which `wrench` draws its motion from."""
     turns = []
     for w in range(WINDOWS):
         now, end = w * WINDOW_S + rng.uniform(1.5, 3.0), (w + 1) * WINDOW_S
