@@ -10,6 +10,7 @@
 #
 # Usage: scripts/same_behaviour.sh [REV]      exit 0 when every output is equal
 #        OLD_BIN=path/to/old/gyro-cli scripts/same_behaviour.sh   (skip building REV)
+#        NEW_BIN=path/to/new/gyro-cli scripts/same_behaviour.sh   (skip building the work tree)
 #        KEEP=dir scripts/same_behaviour.sh                       (keep the outputs in dir)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,8 +26,12 @@ else
     (cd "$work/old" && CARGO_TARGET_DIR="$top/target/same-behaviour-old" cargo build --release -q -p gyro-cli)
     old="$top/target/same-behaviour-old/release/gyro-cli"
 fi
-cargo build --release -q -p gyro-cli
-new="$top/target/release/gyro-cli"
+if [ -n "${NEW_BIN:-}" ]; then
+    new="$NEW_BIN" # a gyro-cli already built from the work tree
+else
+    cargo build --release -q -p gyro-cli
+    new="$top/target/release/gyro-cli"
+fi
 real="$top/../shared/data/real"
 
 # snapshot BIN OUTDIR: every output of BIN on the inputs, one file each.

@@ -10,7 +10,8 @@
 # jq, od, awk.
 #   apt-get install -y --no-install-recommends gcc-arm-none-eabi qemu-system-arm jq
 # Environment: QEMU (default qemu-system-arm), ARM_CC (default arm-none-eabi-gcc),
-# QEMU_TIMEOUT_S (default 120).
+# QEMU_TIMEOUT_S (default 120), GYRO_CLI (the host's gyro-cli; default: `cargo run -p
+# gyro-cli`).
 # Exit status: 0 if the firmware ran clean and matches the host, 1 otherwise, 2 if a tool is
 # missing.
 set -euo pipefail
@@ -77,8 +78,15 @@ csv=$work/bench_run_20s.csv
     od -An -v -t d2 --endian=big "$fixture" |
         awk '{ for (i = 1; i <= NF; i++) { printf "%.6f,%.17g\n", k / 1000, $i / 24; k++ } }'
 } >"$csv"
+# The host's gyro-cli: $GYRO_CLI when given (CI passes the one its test step built), else
+# built here.
+if [ -n "${GYRO_CLI:-}" ]; then
+    host_cli=("$GYRO_CLI")
+else
+    host_cli=(cargo run -q -p gyro-cli --)
+fi
 for compensation in paper kalman; do
-    (cd "$root" && cargo run -q -p gyro-cli -- run "$csv" --compensation "$compensation" \
+    (cd "$root" && "${host_cli[@]}" run "$csv" --compensation "$compensation" \
         --range-dps 300 --target-deg "$target_deg" --tolerance-deg "$tolerance_deg" \
         --format json) >"$work/host-$compensation.json"
     # One "compensation what key value" line per figure (flags as 0 or 1, null as none).

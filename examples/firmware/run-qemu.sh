@@ -6,7 +6,8 @@
 #
 # Needs: cargo with the thumbv7em-none-eabihf target, qemu-system-arm, jq, od, awk.
 #   apt-get install -y --no-install-recommends qemu-system-arm jq
-# Environment: QEMU (default qemu-system-arm), QEMU_TIMEOUT_S (default 120).
+# Environment: QEMU (default qemu-system-arm), QEMU_TIMEOUT_S (default 120), GYRO_CLI (the
+# host's gyro-cli; default: `cargo run -p gyro-cli`).
 # Exit status: 0 if the firmware ran clean and matches the host, 1 otherwise, 2 if a tool is
 # missing.
 set -euo pipefail
@@ -55,8 +56,15 @@ csv=$work/bench_run_20s.csv
     od -An -v -t d2 --endian=big "$fixture" |
         awk '{ for (i = 1; i <= NF; i++) { printf "%.6f,%.17g\n", k / 1000, $i / 24; k++ } }'
 } >"$csv"
+# The host's gyro-cli: $GYRO_CLI when given (CI passes the one its test step built), else
+# built here.
+if [ -n "${GYRO_CLI:-}" ]; then
+    host_cli=("$GYRO_CLI")
+else
+    host_cli=(cargo run -q -p gyro-cli --)
+fi
 for compensation in paper kalman; do
-    (cd "$root" && cargo run -q -p gyro-cli -- run "$csv" --compensation "$compensation" \
+    (cd "$root" && "${host_cli[@]}" run "$csv" --compensation "$compensation" \
         --range-dps 300 --format json) >"$work/host-$compensation.json"
     # One "compensation what key value" line per figure (the saturated flag as 0 or 1).
     jq -r --arg c "$compensation" '

@@ -56,7 +56,7 @@ pub(crate) fn evaluate(
     let scores = runs
         .iter()
         .zip(&ens)
-        .map(|(r, m)| score(&r.stats, m))
+        .map(|(r, m)| score(&r.stats, m, options.settings.score.likelihood_dof))
         .collect();
     Evaluation {
         scores,
@@ -65,10 +65,15 @@ pub(crate) fn evaluate(
 }
 
 /// Scores against only the first `k` members of each ensemble.
-pub(crate) fn rescore(runs: &[&RealRun], members: &[Vec<Member>], k: usize) -> Vec<RunScore> {
+pub(crate) fn rescore(
+    runs: &[&RealRun],
+    members: &[Vec<Member>],
+    k: usize,
+    likelihood_dof: f64,
+) -> Vec<RunScore> {
     runs.iter()
         .zip(members)
-        .map(|(r, m)| score(&r.stats, &m[..k.min(m.len())]))
+        .map(|(r, m)| score(&r.stats, &m[..k.min(m.len())], likelihood_dof))
         .collect()
 }
 
@@ -112,13 +117,17 @@ pub(crate) fn baseline(
     options: &Options,
     progress: &dyn Progress,
 ) -> Baseline {
-    let moving = measure(&runs.train, "training");
+    let moving = measure(&runs.train, "training", &options.settings.turns);
     // Runs that never rest: the moving residual's white level, read again where it
     // holds the most blocks.
     let short = match &moving {
-        Some(m) if !options.fixed_model && !fit::rests_suffice(&runs.train) => {
-            short_white(&runs.train, &options.prior, m, options.seed)
-        }
+        Some(m) if !options.fixed_model && !fit::rests_suffice(&runs.train) => short_white(
+            &runs.train,
+            &options.prior,
+            m,
+            options.seed,
+            options.settings.tests.z_critical,
+        ),
         _ => None,
     };
     let (nominal, notes, white_target, whiteness) = if options.fixed_model {
@@ -138,7 +147,13 @@ pub(crate) fn baseline(
             mut notes,
             white_target,
             whiteness,
-        } = fit::nominal_model(&runs.train, &options.prior, moving.as_ref(), short.as_ref());
+        } = fit::nominal_model(
+            &runs.train,
+            &options.prior,
+            moving.as_ref(),
+            short.as_ref(),
+            &options.settings,
+        );
         if !known.is_empty() {
             let shares: Vec<f64> = runs
                 .train
@@ -209,7 +224,7 @@ pub(crate) fn baseline(
             .chain(&holdout.members)
             .cloned()
             .collect();
-        score::floor(&all)
+        score::floor(&all, &options.settings.score)
     };
     Baseline {
         nominal,

@@ -31,16 +31,6 @@ use gyro_analysis::noise::export::{residual_random_walk, white_bound, white_leve
 use gyro_analysis::noise::{characterize, Characterization, NoiseOptions, TauGrid};
 use serde::Serialize;
 
-/// Shortest stretch of residual used (s): shorter ones add no τ worth reading.
-/// The default `turns.min_stretch_s` ([`crate::Settings`]), where the settings do not reach yet.
-const MIN_STRETCH_S: f64 = crate::Settings::DEFAULT.turns.min_stretch_s;
-/// Shortest averaging time characterised (s). Below it the residual is shaped by the
-/// smoothing both signals share (the reference derivative's window) and by the rig's
-/// lines; a fit there reads that shaping as a short Gauss-Markov process, whose
-/// random-walk reading at 3 s would be a wander that is not there.
-/// The default `turns.min_tau_s` ([`crate::Settings`]), where the settings do not reach yet.
-const MIN_TAU_S: f64 = crate::Settings::DEFAULT.turns.min_tau_s;
-
 /// The effective noise of one set of runs.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct MeasuredNoise {
@@ -92,16 +82,20 @@ pub struct EffectiveNoise {
 }
 
 /// The effective noise of `runs` (those at the first run's sample rate), or `None` when
-/// their residual has no stretch of [`MIN_STRETCH_S`] or cannot be characterised. Not yet
+/// their residual has no stretch of `turns.min_stretch_s` or cannot be characterised. Not yet
 /// compared with anything ([`MeasuredNoise::compared_to`]).
-pub fn measure(runs: &[&RealRun], label: &'static str) -> Option<MeasuredNoise> {
+pub fn measure(
+    runs: &[&RealRun],
+    label: &'static str,
+    settings: &crate::settings::Turns,
+) -> Option<MeasuredNoise> {
     let fs = runs.first()?.sample_rate_hz;
     let same_rate: Vec<&&RealRun> = runs.iter().filter(|r| r.sample_rate_hz == fs).collect();
     let residuals: Vec<&[f64]> = same_rate
         .iter()
         .map(|r| r.residual_dps.as_slice())
         .collect();
-    let (c, samples) = characterize_residuals(&residuals, fs)?;
+    let (c, samples) = characterize_residuals(&residuals, fs, settings)?;
     let arw = 60.0 * white_bound(&c)?;
     let level = 60.0 * white_level(&c)?;
     let (k, resolved) = residual_random_walk(&c);
@@ -121,11 +115,16 @@ pub fn measure(runs: &[&RealRun], label: &'static str) -> Option<MeasuredNoise> 
     })
 }
 
-/// The Allan characterisation, from τ = [`MIN_TAU_S`], of the finite stretches of at
-/// least [`MIN_STRETCH_S`] of `residuals` (regression residuals at `fs` Hz), with the
+/// The Allan characterisation, from τ = `turns.min_tau_s` (below it the residual is
+/// shaped by the smoothing both signals share and by the rig's lines), of the finite
+/// stretches of at least `turns.min_stretch_s` of `residuals` (regression residuals at `fs` Hz), with the
 /// samples used; `None` when no stretch is long enough or it cannot be characterised.
-fn characterize_residuals(residuals: &[&[f64]], fs: f64) -> Option<(Characterization, usize)> {
-    let min_len = (MIN_STRETCH_S * fs).ceil() as usize;
+fn characterize_residuals(
+    residuals: &[&[f64]],
+    fs: f64,
+    settings: &crate::settings::Turns,
+) -> Option<(Characterization, usize)> {
+    let min_len = (settings.min_stretch_s * fs).ceil() as usize;
     let segments: Vec<&[f64]> = residuals
         .iter()
         .flat_map(|residual| {
@@ -137,7 +136,7 @@ fn characterize_residuals(residuals: &[&[f64]], fs: f64) -> Option<(Characteriza
         .collect();
     let samples = segments.iter().map(|s| s.len()).sum();
     let longest = segments.iter().map(|s| s.len()).max()?;
-    let shortest_m = (MIN_TAU_S * fs).ceil() as usize;
+    let shortest_m = (settings.min_tau_s * fs).ceil() as usize;
     let options = NoiseOptions {
         taus: TauGrid::Factors(
             TauGrid::default()
@@ -256,7 +255,7 @@ pub(crate) mod tests {
         ] {
             let runs = moving_runs(6.0, &effects);
             let refs: Vec<&RealRun> = runs.iter().collect();
-            let m = measure(&refs, "training")
+            let m = measure(&refs, "training", &crate::Settings::DEFAULT.turns)
                 .unwrap()
                 .compared_to(0.5, "prior model");
             // The −½ line under the upper bounds (68%) of a dozen τ up to 10 s: on 600 s it
@@ -288,14 +287,20 @@ pub(crate) mod tests {
     fn runs_without_rest_give_the_baseline_their_moving_noise() {
         let runs = moving_runs(6.0, &[]);
         let refs: Vec<&RealRun> = runs.iter().collect();
-        let m = measure(&refs, "training").unwrap();
+        let m = measure(&refs, "training", &crate::Settings::DEFAULT.turns).unwrap();
         let prior = SensorModel::default();
         let super::super::fit::Nominal {
             model,
             notes,
             white_target,
             whiteness,
-        } = super::super::fit::nominal_model(&refs, &prior, Some(&m), None);
+        } = super::super::fit::nominal_model(
+            &refs,
+            &prior,
+            Some(&m),
+            None,
+            &crate::Settings::DEFAULT,
+        );
         assert!(white_target.is_none(), "these runs do not rest");
         assert!(whiteness.is_none(), "these runs do not rest");
         assert_eq!(model.arw_deg_per_rt_h, m.white_level_deg_per_rt_h);
@@ -304,7 +309,7 @@ pub(crate) mod tests {
         assert!(text.contains("fitted to the moving residual"), "{text}");
         assert!(text.contains("; its wander: K "), "{text}");
         let super::super::fit::Nominal { model, notes, .. } =
-            super::super::fit::nominal_model(&refs, &prior, None, None);
+            super::super::fit::nominal_model(&refs, &prior, None, None, &crate::Settings::DEFAULT);
         assert_eq!(model.arw_deg_per_rt_h, prior.arw_deg_per_rt_h);
         assert!(notes.join("\n").contains("from the prior model"));
     }
@@ -313,6 +318,6 @@ pub(crate) mod tests {
     /// nothing.
     #[test]
     fn no_runs_measure_nothing() {
-        assert!(measure(&[], "training").is_none());
+        assert!(measure(&[], "training", &crate::Settings::DEFAULT.turns).is_none());
     }
 }

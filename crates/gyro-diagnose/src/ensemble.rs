@@ -11,6 +11,7 @@ use super::features::{
     WANDER_TAUS_S,
 };
 use super::stats::{residuals, residuals_of, stats_of, Residuals, Stat, StatsError};
+use crate::settings::{Reference as ReferenceSettings, Statistics};
 use gyro_analysis::seed::derive_seed;
 use gyro_log::RegularLog;
 use gyro_sim::{rounding_noise_dps, simulate_series, Effect, Motion, SensorModel, SimOptions};
@@ -50,6 +51,10 @@ pub struct RealRun {
     pub clock: Option<StampedClock>,
     /// The regular log, for replays through the pipeline.
     pub log: RegularLog,
+    /// The statistics settings it was prepared with, which its simulations share.
+    pub statistics: Statistics,
+    /// The reference settings its motion was read with.
+    pub reference_settings: ReferenceSettings,
 }
 
 /// The sample clock seen through the time stamps: the least-squares period of the
@@ -133,21 +138,26 @@ pub fn split(log: &RegularLog, window_s: f64) -> Vec<RegularLog> {
         .collect()
 }
 
-/// The default `reference.quantised_smooth_s` ([`crate::Settings`]), where the settings do not reach yet:
-/// Smoothing of the reference trajectory when it is quantised (s): the encoder's steps
-/// would otherwise be rate spikes in the simulated gyro.
-const QUANTISED_SMOOTH_S: f64 = crate::Settings::DEFAULT.reference.quantised_smooth_s;
-
 impl RealRun {
-    /// Prepare `log` (named `name`).
+    /// Prepare `log` (named `name`) with the default settings.
     pub fn prepare(name: String, log: RegularLog) -> Result<Self, StatsError> {
-        let r = residuals(&log)?;
+        Self::prepare_with(name, log, &crate::Settings::DEFAULT)
+    }
+
+    /// Prepare `log` (named `name`) with `settings`' statistics and reference settings.
+    pub fn prepare_with(
+        name: String,
+        log: RegularLog,
+        settings: &crate::Settings,
+    ) -> Result<Self, StatsError> {
+        let r = residuals(&log, &settings.statistics)?;
         let (features, residual_dps) = real_features(&r, 1e-9);
         let mut stats = stats_of(&r);
         stats.extend(feature_stats(&features));
         let fs = log.sample_rate_hz;
         let reference: Vec<f64> = filled_reference(&log);
-        let (motion, reference_grid) = motion_from_reference(&reference, fs);
+        let (motion, reference_grid) =
+            motion_from_reference_with(&reference, fs, &settings.reference);
         let temperature_c = log.has_temperature.then(|| {
             log.slots
                 .iter()
@@ -180,7 +190,25 @@ impl RealRun {
             filled_slots: log.slots.iter().filter(|s| s.filled).count() as u64,
             clock: StampedClock::of(&log),
             log,
+            statistics: settings.statistics,
+            reference_settings: settings.reference,
         })
+    }
+
+    /// The default settings with this run's statistics and reference settings: what it
+    /// was prepared with, for preparing a shortened copy of it alike.
+    pub fn settings(&self) -> crate::Settings {
+        crate::Settings {
+            statistics: self.statistics,
+            reference: self.reference_settings,
+            ..crate::Settings::DEFAULT
+        }
+    }
+
+    /// Whether it was prepared with `settings`' statistics and reference settings (what a
+    /// run's statistics, features and motion are read with).
+    pub fn prepared_with(&self, settings: &crate::Settings) -> bool {
+        self.statistics == settings.statistics && self.reference_settings == settings.reference
     }
 
     /// Number of samples.
@@ -218,7 +246,7 @@ pub enum GridKind {
 
 /// The motion a reference's samples `reference_deg` (at `fs` Hz) show, as a re-simulation
 /// takes it, and the reference's grid step (deg) when it is quantised. An encoder's
-/// ([`reference_step`]) is smoothed over [`QUANTISED_SMOOTH_S`] (its steps would otherwise
+/// ([`reference_step`]) is smoothed over `reference.quantised_smooth_s` (its steps would otherwise
 /// be rate spikes in the simulated gyro) and rounded again by the re-simulation; a
 /// print's ([`print_step`]) keeps its angle and takes its rate through a cubic smoothing
 /// of [`print_half_width`] ([`Motion::from_rounded_reference`]: the real gyro does not
@@ -226,9 +254,18 @@ pub enum GridKind {
 /// a one-sided derivative beside each step of the acceleration
 /// ([`Motion::from_reference_with_steps`]).
 pub fn motion_from_reference(reference_deg: &[f64], fs: f64) -> (Motion, Option<ReferenceGrid>) {
+    motion_from_reference_with(reference_deg, fs, &crate::Settings::DEFAULT.reference)
+}
+
+/// [`motion_from_reference`] with the reference settings `settings`.
+pub fn motion_from_reference_with(
+    reference_deg: &[f64],
+    fs: f64,
+    settings: &ReferenceSettings,
+) -> (Motion, Option<ReferenceGrid>) {
     let period_s = 1.0 / fs;
-    if let Some(step_deg) = reference_step(reference_deg) {
-        let smooth = ((QUANTISED_SMOOTH_S * fs).round() as usize).max(1);
+    if let Some(step_deg) = reference_step(reference_deg, settings) {
+        let smooth = ((settings.quantised_smooth_s * fs).round() as usize).max(1);
         let motion =
             Motion::from_reference_with_steps(0.0, period_s, reference_deg, smooth, step_deg);
         let grid = ReferenceGrid {
@@ -238,8 +275,8 @@ pub fn motion_from_reference(reference_deg: &[f64], fs: f64) -> (Motion, Option<
         };
         return (motion, Some(grid));
     }
-    if let Some(step_deg) = print_step(reference_deg, fs) {
-        let half_width = print_half_width(step_deg, fs);
+    if let Some(step_deg) = print_step(reference_deg, fs, settings) {
+        let half_width = print_half_width(step_deg, fs, settings);
         let motion =
             Motion::from_rounded_reference(0.0, period_s, reference_deg, half_width, step_deg);
         let grid = ReferenceGrid {
@@ -255,18 +292,8 @@ pub fn motion_from_reference(reference_deg: &[f64], fs: f64) -> (Motion, Option<
     )
 }
 
-/// The default `reference.print_rounding_floor_dps` ([`crate::Settings`]), where the settings do not reach yet:
-/// Standard deviation of the rounding noise (deg/s) that a reference printed on a
-/// decimal grid puts into a re-simulated rate, below which the print is taken as exact:
-/// under the output step of common MEMS gyros (an MPU6050's 0.0076 °/s at ±250 °/s).
-const PRINT_ROUNDING_FLOOR_DPS: f64 = crate::Settings::DEFAULT.reference.print_rounding_floor_dps;
-
-/// The default `reference.print_max_decimals` ([`crate::Settings`]), where the settings do not reach yet:
-/// Finest decimal grid [`print_step`] looks for (10⁻⁶°).
-const PRINT_MAX_DECIMALS: i32 = crate::Settings::DEFAULT.reference.print_max_decimals;
-
 /// The grid (deg) of a reference printed with few decimals, `10⁻ᵈ` for the fewest
-/// decimals `d` (at most [`PRINT_MAX_DECIMALS`]) that every value is written with, when
+/// decimals `d` (at most `reference.print_max_decimals`) that every value is written with, when
 /// the reference spans at least two steps of it and its rounding matters at `fs` Hz. A reference printed to 0.001° rounds each angle by up
 /// to 0.0005°; differentiated at 1 kHz that is noise of 0.27 °/s, twice a CRM100's own
 /// per sample. The real gyro does not see it, but a re-simulated one would (its rate is
@@ -274,8 +301,8 @@ const PRINT_MAX_DECIMALS: i32 = crate::Settings::DEFAULT.reference.print_max_dec
 /// then differ in spread and in their regression on the reference's jerk (which at 100 Hz
 /// the rounding dominates). Kept when the rounding noise of a five-point derivative,
 /// `0.274 · step · fs` ([`gyro_sim::rounding_noise_dps`]), reaches
-/// [`PRINT_ROUNDING_FLOOR_DPS`].
-pub fn print_step(values: &[f64], fs: f64) -> Option<f64> {
+/// `reference.print_rounding_floor_dps`.
+pub fn print_step(values: &[f64], fs: f64, settings: &ReferenceSettings) -> Option<f64> {
     let finite = || values.iter().copied().filter(|v| v.is_finite());
     finite().next()?;
     let on_grid = |scale: f64| {
@@ -284,7 +311,7 @@ pub fn print_step(values: &[f64], fs: f64) -> Option<f64> {
             (x - x.round()).abs() <= 1e-6 + 1e-12 * x.abs()
         })
     };
-    let decimals = (0..=PRINT_MAX_DECIMALS).find(|&d| on_grid(10f64.powi(d)))?;
+    let decimals = (0..=settings.print_max_decimals).find(|&d| on_grid(10f64.powi(d)))?;
     let step = 10f64.powi(-decimals);
     // A reference that stays within two steps (one at rest lies on every grid) shows
     // no print.
@@ -292,25 +319,18 @@ pub fn print_step(values: &[f64], fs: f64) -> Option<f64> {
         (lo.min(v), hi.max(v))
     });
     let moves = hi - lo >= 2.0 * step * (1.0 - 1e-9);
-    (moves && rounding_noise_dps(step, fs, 0) >= PRINT_ROUNDING_FLOOR_DPS).then_some(step)
+    (moves && rounding_noise_dps(step, fs, 0) >= settings.print_rounding_floor_dps).then_some(step)
 }
-
-/// The default `reference.print_max_half_width_s` ([`crate::Settings`]), where the settings do not reach yet:
-/// Longest half width of a print's smoothing (s): a cubic smoothing of ±40 ms passes a
-/// wrench's turns (gain 0.998 at 3 Hz, 0.99 at 5 Hz, at 100 Hz as at 1 kHz); a print
-/// too coarse for it to bring the rounding under [`PRINT_ROUNDING_FLOOR_DPS`] keeps
-/// what it leaves (a 0.001° print at 1 kHz: 0.0067 °/s of the 0.27 °/s unsmoothed).
-const PRINT_MAX_HALF_WIDTH_S: f64 = crate::Settings::DEFAULT.reference.print_max_half_width_s;
 
 /// Half width (samples) of the cubic smoothing of a reference printed to `step` deg at
 /// `fs` Hz: the smallest that brings the rounding noise of the re-simulated rate under
-/// [`PRINT_ROUNDING_FLOOR_DPS`] ([`gyro_sim::rounding_noise_dps`]), at most
-/// [`PRINT_MAX_HALF_WIDTH_S`]. At 0.001°: the longest, 4 samples at 100 Hz and 40 at
+/// `reference.print_rounding_floor_dps` ([`gyro_sim::rounding_noise_dps`]), at most
+/// `reference.print_max_half_width_s`. At 0.001°: the longest, 4 samples at 100 Hz and 40 at
 /// 1 kHz; at 0.0001° and 1 kHz, 7.
-pub fn print_half_width(step: f64, fs: f64) -> usize {
-    let longest = ((PRINT_MAX_HALF_WIDTH_S * fs).round() as usize).max(2);
+pub fn print_half_width(step: f64, fs: f64, settings: &ReferenceSettings) -> usize {
+    let longest = ((settings.print_max_half_width_s * fs).round() as usize).max(2);
     (2..=longest)
-        .find(|&m| rounding_noise_dps(step, fs, m) < PRINT_ROUNDING_FLOOR_DPS)
+        .find(|&m| rounding_noise_dps(step, fs, m) < settings.print_rounding_floor_dps)
         .unwrap_or(longest)
 }
 
@@ -319,7 +339,7 @@ pub fn print_half_width(step: f64, fs: f64) -> usize {
 /// grid indices; accepted when 90% of the distinct values lie within 15% of a step of
 /// the grid (an encoder angle printed with fewer decimals than its step is only near its
 /// grid).
-pub fn reference_step(values: &[f64]) -> Option<f64> {
+pub fn reference_step(values: &[f64], settings: &ReferenceSettings) -> Option<f64> {
     let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
     v.sort_by(f64::total_cmp);
     v.dedup();
@@ -362,10 +382,10 @@ pub fn reference_step(values: &[f64]) -> Option<f64> {
         .iter()
         .filter(|x| {
             let k = (*x - origin - a) / step;
-            (k - k.round()).abs() < crate::Settings::DEFAULT.reference.grid_tolerance_steps
+            (k - k.round()).abs() < settings.grid_tolerance_steps
         })
         .count();
-    (near as f64 >= crate::Settings::DEFAULT.reference.grid_share * v.len() as f64).then_some(step)
+    (near as f64 >= settings.grid_share * v.len() as f64).then_some(step)
 }
 
 /// The reference with missing values filled by the previous one (the first present one
@@ -467,7 +487,14 @@ pub fn simulate_residuals(
     } else {
         vec![f64::NAN; n]
     };
-    residuals_of(fs, time, s.rate_dps, &s.reference_deg, temperature)
+    residuals_of(
+        fs,
+        time,
+        s.rate_dps,
+        &s.reference_deg,
+        temperature,
+        &run.statistics,
+    )
 }
 
 /// Simulate `run` with `model` and `effects` and `seed`, and measure it; the line
@@ -601,6 +628,7 @@ pub fn ensembles(
 #[cfg(test)]
 mod tests {
     use super::*;
+    const REF: ReferenceSettings = crate::Settings::DEFAULT.reference;
 
     #[test]
     fn fill_gaps_interpolates_and_holds_ends() {
@@ -618,11 +646,11 @@ mod tests {
                 ((count.round() * 0.08775) * 100.0).round() / 100.0
             })
             .collect();
-        let step = reference_step(&values).unwrap();
+        let step = reference_step(&values, &REF).unwrap();
         assert!((step - 0.08775).abs() < 2e-4, "{step}");
         // A smooth reference has no step.
         let smooth: Vec<f64> = (0..4000).map(|i| (i as f64 * 0.001).sin() * 90.0).collect();
-        assert_eq!(reference_step(&smooth), None);
+        assert_eq!(reference_step(&smooth, &REF), None);
         // Nor bench motion that rests most of the time (the rests' samples alone would
         // put 90% of the samples on a grid through the few rest angles).
         let profile = gyro_sim::BenchProfile {
@@ -637,7 +665,7 @@ mod tests {
             let reference: Vec<f64> = (0..60_000)
                 .map(|k| (motion.angle_deg(k as f64 * 1e-3) * 1e6).round() / 1e6)
                 .collect();
-            assert_eq!(reference_step(&reference), None, "seed {seed}");
+            assert_eq!(reference_step(&reference, &REF), None, "seed {seed}");
         }
     }
 
@@ -647,33 +675,33 @@ mod tests {
         let printed: Vec<f64> = (0..4000)
             .map(|i| ((i as f64 * 0.01).sin() * 90.0 * 1000.0).round() / 1000.0)
             .collect();
-        assert_eq!(print_step(&printed, 100.0), Some(0.001));
-        assert_eq!(print_step(&printed, 1000.0), Some(0.001));
+        assert_eq!(print_step(&printed, 100.0, &REF), Some(0.001));
+        assert_eq!(print_step(&printed, 1000.0, &REF), Some(0.001));
         // With six decimals its rounding is far below any gyro's output step.
         let fine: Vec<f64> = printed
             .iter()
             .enumerate()
             .map(|(i, v)| v + ((i % 7) as f64) * 1e-6)
             .collect();
-        assert_eq!(print_step(&fine, 1000.0), None);
+        assert_eq!(print_step(&fine, 1000.0, &REF), None);
         // Full precision is on no grid; nor is an empty or all-NaN reference.
         let exact: Vec<f64> = (0..4000).map(|i| (i as f64 * 0.01).sin() * 90.0).collect();
-        assert_eq!(print_step(&exact, 1000.0), None);
-        assert_eq!(print_step(&[f64::NAN, f64::NAN], 1000.0), None);
-        assert_eq!(print_step(&[], 1000.0), None);
+        assert_eq!(print_step(&exact, 1000.0, &REF), None);
+        assert_eq!(print_step(&[f64::NAN, f64::NAN], 1000.0, &REF), None);
+        assert_eq!(print_step(&[], 1000.0, &REF), None);
         // A reference at rest lies on every grid, and shows no print.
-        assert_eq!(print_step(&[25.0; 1000], 1000.0), None);
-        assert_eq!(print_step(&[0.0, 0.001, 0.0, 0.001], 1000.0), None);
-        assert_eq!(print_step(&[0.0, 0.001, 0.002], 1000.0), Some(0.001));
+        assert_eq!(print_step(&[25.0; 1000], 1000.0, &REF), None);
+        assert_eq!(print_step(&[0.0, 0.001, 0.0, 0.001], 1000.0, &REF), None);
+        assert_eq!(print_step(&[0.0, 0.001, 0.002], 1000.0, &REF), Some(0.001));
         // The motion taken from a printed reference carries the grid to the re-simulation.
         let grid = motion_from_reference(&printed, 1000.0).1.unwrap();
         assert_eq!((grid.step_deg, grid.kind), (0.001, GridKind::Print));
         assert_eq!(grid.smoothing_half_width_s, 0.04);
         assert_eq!(motion_from_reference(&exact, 1000.0).1, None);
         // Smoothed as far as the rounding needs, no further than ±40 ms.
-        assert_eq!(print_half_width(0.001, 100.0), 4);
-        assert_eq!(print_half_width(0.001, 1000.0), 40);
-        assert_eq!(print_half_width(0.0001, 1000.0), 7);
+        assert_eq!(print_half_width(0.001, 100.0, &REF), 4);
+        assert_eq!(print_half_width(0.001, 1000.0, &REF), 40);
+        assert_eq!(print_half_width(0.0001, 1000.0, &REF), 7);
     }
 
     #[test]
@@ -732,7 +760,7 @@ mod tests {
             }),
         );
         let run = RealRun::prepare("bench".into(), log).unwrap();
-        let real = residuals(&run.log).unwrap();
+        let real = residuals(&run.log, &run.statistics).unwrap();
         let sim = simulate_residuals(&run, &model, &[], 5).unwrap();
         let spread = |r: &Residuals| {
             let moving: Vec<f64> = (0..r.residual_dps.len())
@@ -743,6 +771,65 @@ mod tests {
             (moving.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / moving.len() as f64).sqrt()
         };
         (spread(&real), spread(&sim))
+    }
+
+    /// A run of a gyro 30 ms late, prepared with `settings`.
+    fn late_run(settings: &crate::Settings) -> RealRun {
+        let fs = 1000.0;
+        let profile = gyro_sim::BenchProfile {
+            duration_s: 20.0,
+            ..Default::default()
+        };
+        let motion = Motion::bench(&profile, 3);
+        let options = SimOptions {
+            seed: 4,
+            ..SimOptions::default()
+        };
+        let late = [Effect::Latency { delay_s: 0.03 }];
+        let s = simulate_series(&SensorModel::default(), &late, &motion, &options, None);
+        let log = gyro_log::RegularLog::with_reference(
+            fs,
+            (0..s.rate_dps.len()).map(|k| (k as f64 / fs, s.rate_dps[k], s.reference_deg[k])),
+        );
+        RealRun::prepare_with("late".into(), log, settings).unwrap()
+    }
+
+    #[test]
+    fn a_run_reads_the_statistics_settings_it_is_prepared_with() {
+        let lag = |run: &RealRun| {
+            run.stats
+                .iter()
+                .find(|s| s.segment == "all" && s.statistic == "xcorr_peak_lag_s")
+                .map(|s| s.value)
+        };
+        let default = late_run(&crate::Settings::DEFAULT);
+        // The 30 ms and the default sensor's own filter delay, well inside ±50 ms.
+        let found = lag(&default).unwrap();
+        assert!((0.03..0.045).contains(&found), "{found}");
+        // A search of ±10 ms cannot reach a 30 ms lag: the peak sits on its edge.
+        let narrow = crate::Settings {
+            statistics: Statistics {
+                max_lag_s: 0.01,
+                ..crate::Settings::DEFAULT.statistics
+            },
+            ..crate::Settings::DEFAULT
+        };
+        narrow.validate().unwrap();
+        let run = late_run(&narrow);
+        let cut = lag(&run).unwrap();
+        assert!((cut - 0.01).abs() < 0.0015, "{cut}");
+        assert!(run.prepared_with(&narrow) && !run.prepared_with(&crate::Settings::DEFAULT));
+        assert!(default.prepared_with(&crate::Settings::DEFAULT));
+        // Its simulations read them too.
+        let late = [Effect::Latency { delay_s: 0.03 }];
+        let sim = simulate_member(&run, &SensorModel::default(), &late, 9);
+        let sim_lag = sim
+            .stats
+            .iter()
+            .find(|s| s.segment == "all" && s.statistic == "xcorr_peak_lag_s")
+            .map(|s| s.value)
+            .unwrap();
+        assert!((sim_lag - 0.01).abs() < 0.0015, "{sim_lag}");
     }
 
     #[test]

@@ -11,8 +11,7 @@
 //! used (real and simulated alike).
 
 use super::ensemble::{member_seed, simulate_residuals, RealRun};
-use super::features::MIN_TEMPERATURE_RANGE_C;
-use super::stats::{residuals, stretches, Residuals, MAX_LAG_S};
+use super::stats::{residuals, stretches, Residuals};
 use super::{Diagnosis, Options};
 use gyro_analysis::noise::{welch, AllanDeviation, PsdOptions, TauGrid, ONE_SIGMA};
 use gyro_sim::{Effect, SensorModel};
@@ -375,7 +374,7 @@ pub fn quantile(values: &mut [f64], q: f64) -> Option<f64> {
 }
 
 /// The measurement set-up from the real runs' residuals.
-fn setup(real: &[Residuals], fs: f64) -> Setup {
+fn setup(real: &[Residuals], fs: f64, settings: &crate::Settings) -> Setup {
     let longest_static = real
         .iter()
         .flat_map(|r| {
@@ -416,7 +415,7 @@ fn setup(real: &[Residuals], fs: f64) -> Setup {
         }
     }
     let span = |v: &mut [f64], q: f64| quantile(v, q).filter(|x| *x > 0.0).unwrap_or(1.0);
-    let quantiles = &crate::Settings::DEFAULT.envelopes;
+    let quantiles = &settings.envelopes;
     let rate_max = span(&mut abs_rate, quantiles.rate_quantile);
     let acc_max = span(&mut abs_acc, quantiles.acceleration_quantile);
     let temperature = {
@@ -430,9 +429,10 @@ fn setup(real: &[Residuals], fs: f64) -> Setup {
             .copied()
             .filter(|v| v.is_finite())
             .fold(f64::NEG_INFINITY, f64::max);
-        (hi - lo >= MIN_TEMPERATURE_RANGE_C).then(|| Bins::linear(lo, hi, TEMPERATURE_BINS))
+        (hi - lo >= settings.statistics.min_temperature_range_c)
+            .then(|| Bins::linear(lo, hi, TEMPERATURE_BINS))
     };
-    let max_lag = ((MAX_LAG_S * fs).round() as i64).max(1);
+    let max_lag = ((settings.statistics.max_lag_s * fs).round() as i64).max(1);
     let step = ((fs / 1000.0).round() as i64).max(1);
     let lags = (-max_lag / step..=max_lag / step)
         .map(|k| k * step)
@@ -568,7 +568,10 @@ pub fn envelopes(
     options: &Options,
 ) -> Option<Envelopes> {
     let runs = figure_runs(train, holdout);
-    let computed: Vec<_> = runs.par_iter().map(|f| residuals(&f.run.log)).collect();
+    let computed: Vec<_> = runs
+        .par_iter()
+        .map(|f| residuals(&f.run.log, &f.run.statistics))
+        .collect();
     let mut real_errors = Vec::new();
     let mut real_res: Vec<Residuals> = Vec::new();
     for (f, r) in runs.iter().zip(computed) {
@@ -578,7 +581,7 @@ pub fn envelopes(
         }
     }
     let fs = runs.first()?.run.sample_rate_hz;
-    let setup = setup(&real_res, fs);
+    let setup = setup(&real_res, fs, &options.settings);
     let mut real = Measures::new(&setup);
     for r in &real_res {
         real.merge(&Measures::of(r, &setup));

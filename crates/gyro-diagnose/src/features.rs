@@ -31,7 +31,7 @@
 //!   wander not explained by the regressors: `bias_instability`, `rate_random_walk`).
 //! - **Plateau**: the largest |rate| and how many samples sit on it while the reference
 //!   is faster (`saturation`).
-//! - **Line spectrum**: Welch spectra on segments of [`LINE_SEGMENT_S`]: the part of the
+//! - **Line spectrum**: Welch spectra on segments of `statistics.line_segment_s`: the part of the
 //!   gyro's PSD not coherent with the reference rate, `S_gg − |S_gr|²/S_rr` (`vibration`:
 //!   a line the reference does not see; a latency or a low-pass is a linear response to
 //!   the motion, coherent with it, and leaves none), and the reference rate's PSD (the
@@ -114,27 +114,15 @@ pub const RATE_SHAPE_COLUMNS: [usize; 4] =
     [reg::RATE, reg::ABS_RATE, reg::RATE_CUBED, reg::RATE_SQUARED];
 /// Scale of ω inside the cubic regressor (deg/s), for conditioning.
 pub const CUBIC_SCALE_DPS: f64 = 100.0;
-/// Length of the line spectrum's Welch segments (s; rounded to a power of two samples).
-/// The default `statistics.line_segment_s` ([`crate::Settings`]), where the settings do not reach yet.
-pub const LINE_SEGMENT_S: f64 = crate::Settings::DEFAULT.statistics.line_segment_s;
 /// Averaging times of the wander feature (s).
 pub const WANDER_TAUS_S: [f64; 3] = [1.0, 4.0, 16.0];
-/// Averaging time of the whiteness check on static samples (s). The Allan variance of the
-/// rests at this τ, beside their first differences, tells white rest noise from noise a
-/// low-pass inside the band has coloured (a MEMS gyro's digital low-pass): the first
-/// differences read the top of the band, the angle integrates the bottom of it.
-/// The default `statistics.white_check_tau_s` ([`crate::Settings`]), where the settings do not reach yet.
-pub const WHITE_CHECK_TAU_S: f64 = crate::Settings::DEFAULT.statistics.white_check_tau_s;
 
-/// Samples per block of the whiteness check at `fs` Hz ([`WHITE_CHECK_TAU_S`], at least 2).
-pub fn white_check_block(fs: f64) -> usize {
-    ((WHITE_CHECK_TAU_S * fs).round() as usize).max(2)
+/// Samples per block of the whiteness check at `fs` Hz: `tau_s` (the setting
+/// `statistics.white_check_tau_s`, [`crate::settings::Statistics::white_check_tau_s`]),
+/// at least 2.
+pub fn white_check_block(fs: f64, tau_s: f64) -> usize {
+    ((tau_s * fs).round() as usize).max(2)
 }
-
-/// A run's temperature "varies" when its range exceeds this (°C).
-/// The default `statistics.min_temperature_range_c` ([`crate::Settings`]), where the settings do not reach yet.
-pub const MIN_TEMPERATURE_RANGE_C: f64 =
-    crate::Settings::DEFAULT.statistics.min_temperature_range_c;
 
 /// Features of one run.
 #[derive(Clone, Debug, PartialEq)]
@@ -180,15 +168,16 @@ pub struct Features {
     pub cross_psd: Vec<(f64, f64)>,
 }
 
-/// Samples of a line-spectrum segment at `sample_rate_hz` (a power of two).
-pub fn line_segment_len(sample_rate_hz: f64) -> usize {
-    let target = (LINE_SEGMENT_S * sample_rate_hz).max(16.0);
+/// Samples of a line-spectrum segment of about `segment_s` (the setting
+/// `statistics.line_segment_s`) at `sample_rate_hz` (a power of two).
+pub fn line_segment_len(sample_rate_hz: f64, segment_s: f64) -> usize {
+    let target = (segment_s * sample_rate_hz).max(16.0);
     1usize << (target.log2().round() as u32).min(24)
 }
 
-/// Bin width of the line spectrum at `sample_rate_hz` (Hz).
-pub fn line_resolution_hz(sample_rate_hz: f64) -> f64 {
-    sample_rate_hz / line_segment_len(sample_rate_hz) as f64
+/// Bin width of the line spectrum at `sample_rate_hz` (Hz), segments of about `segment_s`.
+pub fn line_resolution_hz(sample_rate_hz: f64, segment_s: f64) -> f64 {
+    sample_rate_hz / line_segment_len(sample_rate_hz, segment_s) as f64
 }
 
 /// The features of `r` with the line spectra: for real runs and the null ensembles,
@@ -222,7 +211,7 @@ fn with_spectra(r: &Residuals, f: Features) -> Features {
 /// cross-spectrum of g and w), all empty when no stretch holds a segment.
 type Spectra = (Vec<f64>, Vec<f64>, Vec<(f64, f64)>);
 fn line_spectra(r: &Residuals) -> Spectra {
-    let len = line_segment_len(r.sample_rate_hz);
+    let len = line_segment_len(r.sample_rate_hz, r.statistics.line_segment_s);
     let both = |i: usize| r.rate_dps[i].is_finite() && r.reference_rate_dps[i].is_finite();
     let window = gyro_analysis::noise::psd::hann(len);
     let bins = len / 2 + 1;
@@ -283,16 +272,6 @@ fn line_spectra(r: &Residuals) -> Spectra {
     (incoherent, reference, cross)
 }
 
-/// Smallest range of the reference's |rate| over a run's plateau samples, as a share of
-/// the plateau's level, for them to be a clip: a clip at 120 °/s of turns peaking at
-/// 200 °/s has the reference range over 80 °/s while the output holds; the peak of a
-/// smooth turn held on one output code (a low-passed gyro whose noise no longer dithers
-/// its output step: 15 Hz on a CRM100's 1/24 °/s) has it range over 0.07–0.27 °/s at
-/// 106–164 °/s, as the reference turns too.
-/// The default `statistics.plateau_reference_share` ([`crate::Settings`]), where the settings do not reach yet.
-pub const PLATEAU_REFERENCE_SHARE: f64 =
-    crate::Settings::DEFAULT.statistics.plateau_reference_share;
-
 /// The features of `r` without the line spectra (empty); `plateau_tol_dps` is the
 /// tolerance of the clip plateau (e.g. an output step).
 pub fn features(r: &Residuals, plateau_tol_dps: f64) -> Features {
@@ -335,7 +314,7 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
         .fold((0, f64::INFINITY, f64::NEG_INFINITY), |(c, lo, hi), v| {
             (c + 1, lo.min(v), hi.max(v))
         });
-    let plateau_samples = if highest - lowest >= PLATEAU_REFERENCE_SHARE * max_abs {
+    let plateau_samples = if highest - lowest >= r.statistics.plateau_reference_share * max_abs {
         count
     } else {
         0
@@ -364,7 +343,8 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
             (a.min(t), b.max(t))
         });
-    let temperature_varies = t_first.is_some() && t_max - t_min >= MIN_TEMPERATURE_RANGE_C;
+    let temperature_varies =
+        t_first.is_some() && t_max - t_min >= r.statistics.min_temperature_range_c;
     let used: usize = if temperature_varies { N_REG } else { N_REG - 2 };
     let t_mid = match (r.time_s.first(), r.time_s.last()) {
         (Some(a), Some(b)) => 0.5 * (a + b),
@@ -417,7 +397,7 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
 
     // The gain columns in the low band (`low_band`), away from clip plateaus by the
     // filter's reach.
-    let low_coef = match low_band::cutoff_hz(fs) {
+    let low_coef = match low_band::cutoff_hz(fs, r.statistics.low_band_hz) {
         Some(cutoff) if coef[0].is_finite() => {
             let accel = low_band::derivative(&r.low_reference_rate_dps, fs);
             let low_jerk = low_band::derivative(&accel, fs);
@@ -533,8 +513,11 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
         (f64::NAN, 0)
     };
     // Of the raw gyro, as the first differences (the reference's own noise stays out).
-    let static_block_var =
-        static_allan_variance(&r.rate_dps, |i| r.is_rest[i], white_check_block(fs));
+    let static_block_var = static_allan_variance(
+        &r.rate_dps,
+        |i| r.is_rest[i],
+        white_check_block(fs, r.statistics.white_check_tau_s),
+    );
 
     let features = Features {
         coef,
@@ -792,7 +775,15 @@ mod tests {
         let s = simulate_series(&model, effects, &motion, &options, None);
         let fs = s.sample_rate_hz;
         let time: Vec<f64> = (0..s.rate_dps.len()).map(|k| k as f64 / fs).collect();
-        let r = residuals_of(fs, time, s.rate_dps, &s.reference_deg, s.temperature_c).unwrap();
+        let r = residuals_of(
+            fs,
+            time,
+            s.rate_dps,
+            &s.reference_deg,
+            s.temperature_c,
+            &crate::Settings::DEFAULT.statistics,
+        )
+        .unwrap();
         features_with_spectra(&r, model.lsb_dps)
     }
 
@@ -820,7 +811,15 @@ mod tests {
         let s = simulate_series(&model, &effects, &motion, &SimOptions::default(), None);
         let fs = s.sample_rate_hz;
         let time: Vec<f64> = (0..s.rate_dps.len()).map(|k| k as f64 / fs).collect();
-        let r = residuals_of(fs, time, s.rate_dps, &s.reference_deg, s.temperature_c).unwrap();
+        let r = residuals_of(
+            fs,
+            time,
+            s.rate_dps,
+            &s.reference_deg,
+            s.temperature_c,
+            &crate::Settings::DEFAULT.statistics,
+        )
+        .unwrap();
         let (f, residual) = real_features(&r, 1e-9);
         // Odd and even rate terms are not told apart on one sign: none is read.
         for k in RATE_SHAPE_COLUMNS {
@@ -893,7 +892,15 @@ mod tests {
             None,
         );
         let time: Vec<f64> = (0..s.rate_dps.len()).map(|k| k as f64 / fs).collect();
-        let r = residuals_of(fs, time, s.rate_dps, &s.reference_deg, s.temperature_c).unwrap();
+        let r = residuals_of(
+            fs,
+            time,
+            s.rate_dps,
+            &s.reference_deg,
+            s.temperature_c,
+            &crate::Settings::DEFAULT.statistics,
+        )
+        .unwrap();
         let f = features(&r, 1e-9);
         assert!(
             f.coef[reg::RATE].abs() < 2e-3,
@@ -1048,7 +1055,15 @@ mod tests {
             let time: Vec<f64> = (0..s.rate_dps.len()).map(|k| k as f64 / fs).collect();
             let peak_dps = s.rate_dps.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
             held += s.rate_dps.iter().filter(|v| v.abs() == peak_dps).count();
-            let r = residuals_of(fs, time, s.rate_dps, &s.reference_deg, s.temperature_c).unwrap();
+            let r = residuals_of(
+                fs,
+                time,
+                s.rate_dps,
+                &s.reference_deg,
+                s.temperature_c,
+                &crate::Settings::DEFAULT.statistics,
+            )
+            .unwrap();
             assert_eq!(features(&r, 1e-9).plateau_samples, 0, "seed {seed}");
         }
         // The peaks are held: the case the rule is for.
@@ -1065,7 +1080,7 @@ mod tests {
 
     /// The peak of `psd` at least `from_hz` and the bin width.
     fn peak_hz(psd: &[f64], from_hz: f64) -> f64 {
-        let res = line_resolution_hz(1000.0);
+        let res = line_resolution_hz(1000.0, crate::Settings::DEFAULT.statistics.line_segment_s);
         let k0 = (from_hz / res) as usize;
         let k = (k0..psd.len())
             .max_by(|a, b| psd[*a].total_cmp(&psd[*b]))
@@ -1083,7 +1098,7 @@ mod tests {
             }],
             1,
         );
-        let res = line_resolution_hz(1000.0);
+        let res = line_resolution_hz(1000.0, crate::Settings::DEFAULT.statistics.line_segment_s);
         assert!((peak_hz(&vib.incoherent_psd, 2.0) - 37.0).abs() <= res);
         let k = (37.0 / res).round() as usize;
         assert!(vib.incoherent_psd[k] > 50.0 * nominal.incoherent_psd[k]);

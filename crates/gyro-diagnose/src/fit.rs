@@ -20,17 +20,6 @@ use gyro_sim::{
 };
 use rayon::prelude::*;
 
-/// The default `tests.z_critical` ([`Settings`]), for the functions not yet given the
-/// settings (`direct_evidence`): |z| of the parameter test above which an effect is a
-/// candidate.
-pub const Z_CRITICAL: f64 = Settings::DEFAULT.tests.z_critical;
-/// The default `fit.quant_ratio` ([`Settings`]), for `direct_evidence`.
-pub const QUANT_RATIO: f64 = Settings::DEFAULT.fit.quant_ratio;
-/// The default `fit.min_clipped` ([`Settings`]), for `direct_evidence`.
-pub const MIN_CLIPPED: usize = Settings::DEFAULT.fit.min_clipped;
-/// The default `fit.min_gaps` ([`Settings`]), for `direct_evidence`.
-pub const MIN_GAPS: u64 = Settings::DEFAULT.fit.min_gaps;
-
 /// The fitted candidate of one effect.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Fit {
@@ -72,29 +61,33 @@ pub fn direct_evidence(
     null: &[Vec<Member>],
     model: &SensorModel,
     known: &[Effect],
+    settings: &Settings,
 ) -> bool {
     match effect.info().fit {
         FitProcedure::BetweenRunSpread => {
-            runs.len() >= 3 && bias_spread(runs, null, model, known).0 >= Z_CRITICAL
+            runs.len() >= 3 && bias_spread(runs, null, model, known).0 >= settings.tests.z_critical
         }
         FitProcedure::Plateau => {
             runs.iter()
                 .map(|r| r.features.plateau_samples)
                 .sum::<usize>()
-                >= MIN_CLIPPED
+                >= settings.fit.min_clipped
         }
         FitProcedure::OutputGrid => {
             let values: Vec<f64> = runs
                 .iter()
                 .flat_map(|r| r.measured_rates_dps.iter().copied())
                 .collect();
-            rate_step(&values).is_some_and(|s| s >= QUANT_RATIO * model.lsb_dps && s > 0.0)
+            rate_step(&values)
+                .is_some_and(|s| s >= settings.fit.quant_ratio * model.lsb_dps && s > 0.0)
         }
-        FitProcedure::Gaps => runs.iter().map(|r| r.gaps).sum::<u64>() >= MIN_GAPS,
+        FitProcedure::Gaps => runs.iter().map(|r| r.gaps).sum::<u64>() >= settings.fit.min_gaps,
         FitProcedure::SpectralLine => match effect.params().as_slice() {
             [amplitude_dps, frequency_hz] if *amplitude_dps > 0.0 => {
-                super::line::at(runs, null, *frequency_hz)
-                    .is_some_and(|l| l.z >= Z_CRITICAL && l.ratio >= super::line::LINE_MIN_RATIO)
+                super::line::at(runs, null, *frequency_hz).is_some_and(|l| {
+                    l.z >= settings.tests.z_critical
+                        && l.ratio >= settings.statistics.line_min_ratio
+                })
             }
             _ => false,
         },
@@ -106,17 +99,21 @@ pub fn direct_evidence(
 
 /// The output step the training runs' rates show, where it differs from the prior's
 /// `prior_lsb_dps` and is not what `quantization` names: the grid the rates lie on
-/// ([`rate_step`]) when it is finer than [`QUANT_RATIO`] × the prior's (a sensor with its
+/// ([`rate_step`]) when it is finer than `quant_ratio` (`fit.quant_ratio`) × the prior's (a sensor with its
 /// own LSB: an MPU-6050's 1/131 °/s), or none when the rates lie on no grid (a log written
 /// as floats), with the note that says so. `None`: the prior's step stands (the runs show
 /// it, or a coarser one that `quantization` is fitted to).
-fn runs_output_step(train: &[&RealRun], prior_lsb_dps: f64) -> Option<(f64, String)> {
+fn runs_output_step(
+    train: &[&RealRun],
+    prior_lsb_dps: f64,
+    quant_ratio: f64,
+) -> Option<(f64, String)> {
     let values: Vec<f64> = train
         .iter()
         .flat_map(|r| r.measured_rates_dps.iter().copied())
         .collect();
     match rate_step(&values) {
-        Some(step) if step < QUANT_RATIO * prior_lsb_dps => {
+        Some(step) if step < quant_ratio * prior_lsb_dps => {
             ((step - prior_lsb_dps).abs() > 0.01 * prior_lsb_dps).then(|| {
                 (
                     step,
@@ -143,16 +140,11 @@ pub(crate) fn is_wander(effect: &Effect) -> bool {
     matches!(effect.info().fit, FitProcedure::Wander(_))
 }
 
-/// The default `tests.replication_z` ([`Settings`]), where the settings do not reach yet:
-/// Smallest z on the held-out runs with which an effect's test replicates its training
-/// fit ([`replicates`]): one-sided 2.3%.
-pub const REPLICATION_Z: f64 = Settings::DEFAULT.tests.replication_z;
-
 /// Whether a regression or wander effect fitted on the training runs shows again on the
 /// held-out runs: the same test on them ([`Fit::holdout_z`]: a regression coefficient
 /// against their null replicas, with the test's standard error (the replicas' spread, or
 /// the runs' own scatter where larger); the wander estimator's excess over their
-/// ensembles against the replicas') deviates by at least [`REPLICATION_Z`] in the
+/// ensembles against the replicas') deviates by at least `replication_z` (`tests.replication_z`) in the
 /// direction of the training test. The test named in advance for this effect's
 /// signature: a weak effect (a temperature bias of 0.05 °/s/°C over a 2 °C warm-up,
 /// beside the bias's wander) moves one coefficient by a few standard errors, and a
@@ -161,17 +153,17 @@ pub const REPLICATION_Z: f64 = Settings::DEFAULT.tests.replication_z;
 /// either at P < 5% over a few runs. Against the nominal model: the share of the
 /// coefficient other effects would give is a product of effects, left out. False for
 /// the other fit procedures.
-pub fn replicates(fit: &Fit) -> bool {
+pub fn replicates(fit: &Fit, replication_z: f64) -> bool {
     fit.holdout_z
-        .is_some_and(|z| z.is_finite() && fit.z.is_finite() && z * fit.z.signum() >= REPLICATION_Z)
+        .is_some_and(|z| z.is_finite() && fit.z.is_finite() && z * fit.z.signum() >= replication_z)
 }
 
 /// [`replicates`], for an effect added to the effects `beside`: a wander's held-out test
 /// reads the Allan-variance excess over the nominal model, which another wander beside it
 /// already explains (a bias instability named on top of a rate random walk on the
 /// walk's held-out excess), so a wander replicates only with no other wander beside it.
-pub fn replicates_beside(fit: &Fit, beside: &[Effect]) -> bool {
-    replicates(fit) && !(is_wander(&fit.effect) && beside.iter().any(is_wander))
+pub fn replicates_beside(fit: &Fit, beside: &[Effect], replication_z: f64) -> bool {
+    replicates(fit, replication_z) && !(is_wander(&fit.effect) && beside.iter().any(is_wander))
 }
 
 /// Whether an effect's own test, read on the held-out runs ([`Fit::holdout_z`]), points
@@ -198,8 +190,8 @@ pub fn pooled_z(train_z: f64, train_runs: usize, holdout_z: f64, holdout_runs: u
 
 /// The z-score of the runs' mean coefficient against their replicas'
 /// ([`CoefficientTest`]), as the training test reads it ([`regression_fit`]).
-fn replication_z(coefficients: &[(f64, Vec<f64>)]) -> f64 {
-    let test = CoefficientTest::of(coefficients);
+fn replication_z(coefficients: &[(f64, Vec<f64>)], scatter_p: f64) -> f64 {
+    let test = CoefficientTest::of(coefficients, scatter_p);
     test.deviation / test.se()
 }
 
@@ -229,7 +221,7 @@ struct CoefficientTest {
 }
 
 impl CoefficientTest {
-    fn of(coefficients: &[(f64, Vec<f64>)]) -> Self {
+    fn of(coefficients: &[(f64, Vec<f64>)], scatter_p: f64) -> Self {
         let real = mean(coefficients.iter().map(|(c, _)| *c));
         let members = coefficients.iter().map(|(_, r)| r.len()).min().unwrap_or(0);
         let replicas: Vec<f64> = (0..members)
@@ -240,7 +232,7 @@ impl CoefficientTest {
             deviation: real - m0,
             replica_sd,
             replicas: replicas.len(),
-            scatter: scatter_of(coefficients),
+            scatter: scatter_of(coefficients, scatter_p),
         }
     }
 
@@ -334,19 +326,6 @@ pub struct WhiteTarget {
     pub block: usize,
 }
 
-/// The default `tests.z_critical` ([`Settings`]), where the settings do not reach yet:
-/// |z| beyond which the rests' noise is not white: the Allan variance at
-/// [`super::features::WHITE_CHECK_TAU_S`] against the first differences', both read as a
-/// white noise through the nominal model (as [`Z_CRITICAL`]).
-pub const WHITE_CHECK_Z: f64 = Settings::DEFAULT.tests.z_critical;
-/// The default `fit.white_check_min` ([`Settings`]), where the settings do not reach yet:
-/// Smallest relative difference of the two white variances that counts as colour: under
-/// it the first differences stand, however many rests measure it.
-pub const WHITE_CHECK_MIN: f64 = Settings::DEFAULT.fit.white_check_min;
-/// The default `fit.min_white_check_diffs` ([`Settings`]), where the settings do not reach yet:
-/// Fewest block differences over the training runs for the whiteness check.
-pub const MIN_WHITE_CHECK_DIFFS: usize = Settings::DEFAULT.fit.min_white_check_diffs;
-
 /// The whiteness check of the training runs' rests: the white noise their first
 /// differences give and the one their Allan variance at a short τ gives, each matched
 /// through the nominal model (its wander and output step included).
@@ -364,7 +343,7 @@ pub struct RestWhiteness {
     /// (consecutive block differences share a block: a white noise's non-overlapping
     /// Allan variance from n differences has a relative variance of about 3/n).
     pub z: f64,
-    /// |z| ≥ [`WHITE_CHECK_Z`] and the variances differ by at least [`WHITE_CHECK_MIN`]
+    /// |z| ≥ `tests.z_critical` and the variances differ by at least `fit.white_check_min`
     /// of the first differences': the rests' noise is coloured, and the baseline's white
     /// noise is the block's (the band the angle integrates), not the first differences'.
     pub coloured: bool,
@@ -392,8 +371,8 @@ pub struct Nominal {
 /// effective noise reports would widen every simulated residual by its margin), else from
 /// the prior.
 /// At rest it is matched to the first differences, unless the rests' Allan variance at
-/// [`super::features::WHITE_CHECK_TAU_S`] reads a white noise that differs beyond
-/// [`WHITE_CHECK_Z`]: a low-pass inside the band (a MEMS gyro's digital filter) leaves
+/// `statistics.white_check_tau_s` reads a white noise that differs beyond
+/// `tests.z_critical`: a low-pass inside the band (a MEMS gyro's digital filter) leaves
 /// the first differences short of the low band that the angle integrates, and the
 /// block's statistic is used instead ([`RestWhiteness`]).
 /// The output step is the runs' own ([`runs_output_step`]) when it is no coarser than
@@ -407,6 +386,7 @@ pub fn nominal_model(
     prior: &SensorModel,
     moving: Option<&super::effective::MeasuredNoise>,
     short: Option<&super::short_white::ShortWhite>,
+    settings: &Settings,
 ) -> Nominal {
     let mut model = *prior;
     let mut notes = Vec::new();
@@ -425,7 +405,8 @@ pub fn nominal_model(
             model.bias_dps
         ));
     }
-    if let Some((lsb_dps, note)) = runs_output_step(train, prior.lsb_dps) {
+    if let Some((lsb_dps, note)) = runs_output_step(train, prior.lsb_dps, settings.fit.quant_ratio)
+    {
         model.lsb_dps = lsb_dps;
         notes.push(note);
     }
@@ -452,8 +433,11 @@ pub fn nominal_model(
         };
         let diff_sigma = solve_white_sigma(diff_target, &model, &[model.lsb_dps], None);
         let mut chosen = (diff_target, diff_sigma);
-        let block = super::features::white_check_block(model.sample_rate_hz);
-        if block_count >= MIN_WHITE_CHECK_DIFFS && diff_sigma > 0.0 {
+        let block = super::features::white_check_block(
+            model.sample_rate_hz,
+            settings.statistics.white_check_tau_s,
+        );
+        if block_count >= settings.fit.min_white_check_diffs && diff_sigma > 0.0 {
             let block_target = WhiteTarget {
                 avar_dps2: block_var,
                 block,
@@ -461,7 +445,8 @@ pub fn nominal_model(
             let block_sigma = solve_white_sigma(block_target, &model, &[model.lsb_dps], None);
             let ratio = (block_sigma / diff_sigma).powi(2);
             let z = (ratio - 1.0) / (3.0 / block_count as f64).sqrt();
-            let coloured = z.abs() >= WHITE_CHECK_Z && (ratio - 1.0).abs() >= WHITE_CHECK_MIN;
+            let coloured = z.abs() >= settings.tests.z_critical
+                && (ratio - 1.0).abs() >= settings.fit.white_check_min;
             if coloured {
                 chosen = (block_target, block_sigma);
             }
@@ -546,7 +531,7 @@ pub fn nominal_model(
             model.gm_tau_s,
         );
         let k = m.rate_random_walk_dps_per_rt_s;
-        let floor = Settings::DEFAULT.fit.wander_prior_floor;
+        let floor = settings.fit.wander_prior_floor;
         let verdict = match (m.rate_random_walk_resolved, k >= floor * k_prior) {
             (true, _) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, against {k:.3e} fitted to the training residual (a larger wander is the vocabulary's to name)"),
             (false, true) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, against the bound the training residual allows ({k:.3e}): kept"),
@@ -828,17 +813,16 @@ impl Known {
     }
 }
 
-/// The default `fit.negligible_delay_samples` ([`Settings`]), where the settings do not reach yet:
-/// A delay shorter than this share of a sample period moves no sample by more than that
-/// share of its step: below what the log's timing resolves as an effect of its own.
-pub const NEGLIGIBLE_DELAY_SAMPLES: f64 = Settings::DEFAULT.fit.negligible_delay_samples;
-
 /// The 95% interval of a regression fit holds the effect's absence: a zero coefficient
-/// (ppm, scale, …); for a latency, a delay under [`NEGLIGIBLE_DELAY_SAMPLES`] of a sample
+/// (ppm, scale, …); for a latency, a delay under `negligible_delay_samples` (`fit.negligible_delay_samples`) of a sample
 /// period of `model`; for a bandwidth, a cutoff the effect table counts as neutral (at the
 /// Nyquist frequency, the fit's stand-in for no limit) or none (a delay interval reaching
 /// zero maps to it).
-pub(crate) fn interval_holds_absence(fit: &Fit, model: &SensorModel) -> bool {
+pub(crate) fn interval_holds_absence(
+    fit: &Fit,
+    model: &SensorModel,
+    negligible_delay_samples: f64,
+) -> bool {
     let [(lo, hi)] = fit.ci95.as_slice() else {
         return false;
     };
@@ -847,23 +831,23 @@ pub(crate) fn interval_holds_absence(fit: &Fit, model: &SensorModel) -> bool {
             return hi.is_none_or(|cutoff_hz| Effect::Bandwidth { cutoff_hz }.is_neutral(model))
         }
         Effect::Latency { .. } if model.sample_rate_hz > 0.0 => {
-            NEGLIGIBLE_DELAY_SAMPLES / model.sample_rate_hz
+            negligible_delay_samples / model.sample_rate_hz
         }
         _ => 0.0,
     };
     lo.is_none_or(|l| l <= absent) && hi.is_none_or(|h| h >= -absent)
 }
 
-/// A latency whose whole 95% interval lies under [`NEGLIGIBLE_DELAY_SAMPLES`] of a sample
+/// A latency whose whole 95% interval lies under `negligible_delay_samples` of a sample
 /// period of `model` (either sign): what it could be is below what the log's timing
 /// resolves, so it is not named, however many standard errors it lies from zero (a
 /// −57 µs [−85, −28] latency at 1 kHz beside a rate random walk, whose wander the
 /// acceleration regression reads a little of). False for the other effects.
-pub(crate) fn negligible(fit: &Fit, model: &SensorModel) -> bool {
+pub(crate) fn negligible(fit: &Fit, model: &SensorModel, negligible_delay_samples: f64) -> bool {
     let (Effect::Latency { .. }, [(Some(lo), Some(hi))]) = (fit.effect, fit.ci95.as_slice()) else {
         return false;
     };
-    let bound_s = NEGLIGIBLE_DELAY_SAMPLES / model.sample_rate_hz;
+    let bound_s = negligible_delay_samples / model.sample_rate_hz;
     bound_s.is_finite() && lo.abs() < bound_s && hi.abs() < bound_s
 }
 
@@ -1048,8 +1032,12 @@ fn regression_fit(
     make: &dyn Fn(f64) -> Effect,
     to_param: &dyn Fn(f64) -> f64,
 ) -> RegressionFit {
-    let test = CoefficientTest::of(&run_coefficients(input.train, input.null, index));
-    let holdout_z = replication_z(&run_coefficients(input.holdout, input.holdout_null, index));
+    let scatter_p = input.settings.fit.scatter_p;
+    let test = CoefficientTest::of(&run_coefficients(input.train, input.null, index), scatter_p);
+    let holdout_z = replication_z(
+        &run_coefficients(input.holdout, input.holdout_null, index),
+        scatter_p,
+    );
     let raw = test.deviation - (known.with_effects[index] - known.quiet[index]);
     let s = input.settings;
     let mut half =
@@ -1120,10 +1108,10 @@ struct RegressionFit {
 impl RegressionFit {
     /// The test in direction `sign` (+1: the coefficient's; −1 for readings that negate
     /// it; `two_sided` tests take |z|) passes on the training runs, or on all the runs:
-    /// each half shows the coefficient at least [`REPLICATION_Z`] standard errors from
+    /// each half shows the coefficient at least `tests.replication_z` standard errors from
     /// its null in the same direction (so the interval fitted on the training runs does
     /// not hold the effect's absence), and the two pooled ([`pooled_z`]) reach
-    /// [`Z_CRITICAL`]. A weak effect's coefficient is then tested on every run at the
+    /// `tests.z_critical`. A weak effect's coefficient is then tested on every run at the
     /// same bound (either test alone has its false-alarm rate; the held-out runs must
     /// still qualify it, `select`).
     fn passes(
@@ -1188,11 +1176,6 @@ impl RegressionFit {
     }
 }
 
-/// The default `fit.scatter_p` ([`Settings`]), where the settings do not reach yet:
-/// Share of the null's chi-square above which the real runs' scatter of a coefficient is
-/// taken as larger than the null's (one-sided, 1%).
-const SCATTER_P: f64 = Settings::DEFAULT.fit.scatter_p;
-
 /// The real runs' own scatter of one regression coefficient, when it is larger than
 /// the null replicas' beyond chance.
 struct Scatter {
@@ -1208,10 +1191,10 @@ struct Scatter {
 /// against the null alone then finds a scale or a temperature term in a random walk.
 /// Each run's excess over its own replicas' mean is compared with a replica's spread
 /// about that mean: when their variance exceeds the null's beyond chance (χ² with
-/// runs − 1 degrees of freedom, one-sided [`SCATTER_P`]), the runs' own standard error
+/// runs − 1 degrees of freedom, one-sided `scatter_p`, the setting `fit.scatter_p`), the runs' own standard error
 /// is returned. `None`: fewer than 3 runs, or no excess scatter.
 /// On each run's real value and its replicas' values ([`run_coefficients`]).
-fn scatter_of(runs: &[(f64, Vec<f64>)]) -> Option<Scatter> {
+fn scatter_of(runs: &[(f64, Vec<f64>)], scatter_p: f64) -> Option<Scatter> {
     let mut excess = Vec::new();
     let mut null_var = Vec::new();
     for (real, coefs) in runs {
@@ -1228,7 +1211,7 @@ fn scatter_of(runs: &[(f64, Vec<f64>)]) -> Option<Scatter> {
     let between = sample_var(&excess);
     let null = null_var.iter().sum::<f64>() / n as f64;
     let dof = (n - 1) as f64;
-    (between * dof > chi2_quantile(SCATTER_P, dof) * null).then(|| Scatter {
+    (between * dof > chi2_quantile(scatter_p, dof) * null).then(|| Scatter {
         se: (between / n as f64).sqrt(),
         runs: n,
     })
@@ -1251,7 +1234,7 @@ mod scatter_tests {
             .iter()
             .map(|&x| (x, replicas()))
             .collect();
-        assert!(scatter_of(&runs).is_none());
+        assert!(scatter_of(&runs, Settings::DEFAULT.fit.scatter_p).is_none());
     }
 
     #[test]
@@ -1260,16 +1243,20 @@ mod scatter_tests {
         // runs' standard error, sd / √n.
         let values = [6.0, -5.0, 7.0, -6.0, 4.0];
         let runs: Vec<_> = values.iter().map(|&x| (x, replicas())).collect();
-        let s = scatter_of(&runs).expect("scatter beyond the null");
+        let s =
+            scatter_of(&runs, Settings::DEFAULT.fit.scatter_p).expect("scatter beyond the null");
         let (_, sd) = mean_sd(&values);
         assert_eq!(s.runs, 5);
         assert!((s.se - sd / 5f64.sqrt()).abs() < 1e-12, "{}", s.se);
         // Fewer than 3 runs: no scatter to judge.
-        assert!(scatter_of(&runs[..2]).is_none());
+        assert!(scatter_of(&runs[..2], Settings::DEFAULT.fit.scatter_p).is_none());
         // A run without a finite coefficient is left out.
         let mut with_nan = runs.clone();
         with_nan.push((f64::NAN, replicas()));
-        assert_eq!(scatter_of(&with_nan).map(|s| s.runs), Some(5));
+        assert_eq!(
+            scatter_of(&with_nan, Settings::DEFAULT.fit.scatter_p).map(|s| s.runs),
+            Some(5)
+        );
     }
 }
 
@@ -1312,10 +1299,12 @@ pub(crate) enum FitError {
     NoNominalRate,
     /// The temperature does not vary enough.
     #[error(
-        "needs a temperature column that varies by at least {min} degC in every training run",
-        min = super::features::MIN_TEMPERATURE_RANGE_C
+        "needs a temperature column that varies by at least {min_c} degC in every training run"
     )]
-    NoTemperatureChange,
+    NoTemperatureChange {
+        /// The smallest range that counts (`statistics.min_temperature_range_c`, °C).
+        min_c: f64,
+    },
     /// Fewer than 3 training runs for a between-run spread.
     #[error("needs at least 3 training runs (between-run spread of the bias)")]
     TooFewRunsForSpread,
@@ -1357,7 +1346,7 @@ pub(crate) enum FitError {
 const EXACT: f64 = f64::NAN;
 
 /// A fit judged by its z-score: passes when |z| (two-sided) or z (one-sided) reaches
-/// [`Z_CRITICAL`].
+/// `tests.z_critical`.
 fn judged(
     z_critical: f64,
     effect: Effect,
@@ -1438,7 +1427,9 @@ fn fit_one(input: &FitInput, known: &Known, info: &'static EffectInfo) -> Result
             test,
         } => {
             if needs_temperature && !input.temperature_ok {
-                return Err(FitError::NoTemperatureChange);
+                return Err(FitError::NoTemperatureChange {
+                    min_c: input.settings.statistics.min_temperature_range_c,
+                });
             }
             let index = regressor_index(regressor);
             regression_procedure(input, known, info, index, reading, test)
@@ -1665,7 +1656,7 @@ fn wander_fit(
         let observed: Vec<(f64, f64)> =
             per_tau.iter().map(|&(real, m0, _, _)| (real, m0)).collect();
         let terms = shape_terms(input, &observed, &sims, gain);
-        overshoot = wander_overshoot(&terms);
+        overshoot = wander_overshoot(&terms, input.settings.fit.wander_overshoot);
         shape_loglik = wander_shape_loglik(&terms);
     }
     let lo = (theta - half).max(0.0).sqrt();
@@ -1685,7 +1676,8 @@ fn wander_fit(
         fit.passes = false;
         fit.test = format!(
             "{test}, and its shape: at {tau} s the fitted wander's Allan variance is {ratio:.0} \
-             times the runs' (more than {WANDER_OVERSHOOT}: not a bias wander)"
+             times the runs' (more than {}: not a bias wander)",
+            input.settings.fit.wander_overshoot
         );
     }
     Ok(fit)
@@ -1798,7 +1790,7 @@ fn wander_excess(
 }
 
 /// The τ (s) and ratio where a fitted wander predicts the most Allan variance against
-/// the runs', if more than [`WANDER_OVERSHOOT`] times; `terms` at each of
+/// the runs', if more than `overshoot` (`fit.wander_overshoot`) times; `terms` at each of
 /// [`WANDER_TAUS_S`]. The runs are the training runs, with the held-out runs' pooled
 /// values added when the wander predicts their value at the first τ (1 s, where it is
 /// fitted) within the same factor: one minute holds about three 16 s windows, so five
@@ -1806,13 +1798,13 @@ fn wander_excess(
 /// runs that wander like the training ones tell it; held-out runs whose 1 s value the
 /// wander is far from (motion at another speed leaving another residual) cannot vouch
 /// for its shape.
-fn wander_overshoot(terms: &[ShapeTerm]) -> Option<(f64, f64)> {
+fn wander_overshoot(terms: &[ShapeTerm], overshoot: f64) -> Option<(f64, f64)> {
     let ratio =
         |t: &ShapeTerm, half: usize| t.observed[half].map(|(real, null)| (null + t.excess) / real);
     let holdout_alike = terms
         .first()
         .and_then(|t| ratio(t, 1))
-        .is_some_and(|r| r.is_finite() && (1.0 / WANDER_OVERSHOOT..=WANDER_OVERSHOOT).contains(&r));
+        .is_some_and(|r| r.is_finite() && (1.0 / overshoot..=overshoot).contains(&r));
     let halves: &[usize] = if holdout_alike { &[0, 1] } else { &[0] };
     terms
         .iter()
@@ -1826,7 +1818,7 @@ fn wander_overshoot(terms: &[ShapeTerm]) -> Option<(f64, f64)> {
                 });
             (tau, predicted / real)
         })
-        .filter(|(_, ratio)| ratio.is_finite() && *ratio > WANDER_OVERSHOOT)
+        .filter(|(_, ratio)| ratio.is_finite() && *ratio > overshoot)
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
@@ -1853,7 +1845,11 @@ mod wander_shape_tests {
                 sample_rate_hz: fs,
                 ..SensorModel::default()
             };
-            interval_holds_absence(&fit(effect, lo, hi), &model)
+            interval_holds_absence(
+                &fit(effect, lo, hi),
+                &model,
+                Settings::DEFAULT.fit.negligible_delay_samples,
+            )
         };
         let latency = Effect::Latency { delay_s: -0.0003 };
         assert!(holds(latency, Some(-0.0025), Some(0.0018), 100.0));
@@ -1872,7 +1868,13 @@ mod wander_shape_tests {
         // Negligible: the whole interval under a tenth of a sample, either sign; only a
         // latency.
         let model = SensorModel::default();
-        let negligible_at = |effect, lo, hi| negligible(&fit(effect, lo, hi), &model);
+        let negligible_at = |effect, lo, hi| {
+            negligible(
+                &fit(effect, lo, hi),
+                &model,
+                Settings::DEFAULT.fit.negligible_delay_samples,
+            )
+        };
         assert!((model.sample_rate_hz - 1000.0).abs() < 1e-9);
         assert!(negligible_at(latency, Some(-8.5e-5), Some(-2.8e-5)));
         assert!(negligible_at(latency, Some(2e-5), Some(9e-5)));
@@ -1889,7 +1891,13 @@ mod wander_shape_tests {
             (0.05, 0.0005, 0.06),
             (0.2, 0.0002, 0.3),
         ];
-        assert_eq!(wander_overshoot(&training(&per_tau, 1.0)), None);
+        assert_eq!(
+            wander_overshoot(
+                &training(&per_tau, 1.0),
+                Settings::DEFAULT.fit.wander_overshoot
+            ),
+            None
+        );
     }
 
     #[test]
@@ -1900,11 +1908,19 @@ mod wander_shape_tests {
             (0.008, 0.0005, 0.03),
             (0.0004, 0.0002, 0.11),
         ];
-        let (tau, ratio) = wander_overshoot(&training(&per_tau, 1.0)).unwrap();
+        let (tau, ratio) = wander_overshoot(
+            &training(&per_tau, 1.0),
+            Settings::DEFAULT.fit.wander_overshoot,
+        )
+        .unwrap();
         assert_eq!(tau, 16.0);
         assert!((ratio - 275.0).abs() < 1.0, "{ratio}");
         // The gain correction scales the simulated excess back.
-        assert!(wander_overshoot(&training(&per_tau, 1000.0)).is_none());
+        assert!(wander_overshoot(
+            &training(&per_tau, 1000.0),
+            Settings::DEFAULT.fit.wander_overshoot
+        )
+        .is_none());
     }
 
     #[test]
@@ -1919,13 +1935,17 @@ mod wander_shape_tests {
             (1.698e-4, 1.029e-4, 5.698e-4, 1.181e-3, 9.447e-5),
         ];
         let mut terms = training(&rows.map(|(r, n, p, _, _)| (r, n, p)), 1.0);
-        let (tau, ratio) = wander_overshoot(&terms).unwrap();
+        let (tau, ratio) =
+            wander_overshoot(&terms, Settings::DEFAULT.fit.wander_overshoot).unwrap();
         assert_eq!(tau, 16.0);
         assert!((ratio - 3.36).abs() < 0.01, "{ratio}");
         for (t, (_, _, _, real, null)) in terms.iter_mut().zip(rows) {
             t.observed[1] = Some((real, null));
         }
-        assert_eq!(wander_overshoot(&terms), None);
+        assert_eq!(
+            wander_overshoot(&terms, Settings::DEFAULT.fit.wander_overshoot),
+            None
+        );
         // ssong yaw, slow → medium: the medium runs' 1 s value is 60 times what a wander
         // fitted to the slow runs predicts; they cannot vouch for its shape.
         let slow = [
@@ -1938,7 +1958,8 @@ mod wander_shape_tests {
             let predicted = t.observed[0].map_or(0.0, |(_, null)| null + t.excess);
             t.observed[1] = Some((predicted * scale, t.observed[0].map_or(0.0, |o| o.1)));
         }
-        let (tau, ratio) = wander_overshoot(&terms).unwrap();
+        let (tau, ratio) =
+            wander_overshoot(&terms, Settings::DEFAULT.fit.wander_overshoot).unwrap();
         assert_eq!(tau, 16.0);
         assert!((ratio - 9.7).abs() < 0.01, "{ratio}");
     }
@@ -1996,16 +2017,6 @@ mod wander_shape_tests {
         assert_eq!(wander_shape_loglik(&[]), None);
     }
 }
-
-/// The default `fit.wander_overshoot` ([`Settings`]), where the settings do not reach yet:
-/// Largest ratio of a fitted wander's Allan variance (with the nominal model's) to the
-/// training runs', at any τ of [`WANDER_TAUS_S`], for the wander to pass. A residual whose
-/// excess is largest at 1 s and fades by 16 s (motion the reference does not resolve, a
-/// noise the nominal model lacks) is not a bias wander, and a wander fitted to its 1 s
-/// excess overshoots the 16 s value by orders of magnitude (ssong yaw, slow: 300 times).
-/// Three times allows the sampling spread of a 16 s Allan variance from five one-minute
-/// runs (about 15 windows).
-pub const WANDER_OVERSHOOT: f64 = Settings::DEFAULT.fit.wander_overshoot;
 
 /// A clip level from samples on a plateau at the largest |rate|.
 fn plateau_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError> {
@@ -2129,7 +2140,7 @@ fn gaps_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
 /// the null replicas' strongest ([`super::line`]); replicated on the held-out runs.
 fn line_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError> {
     let line = super::line::search(input.train, input.null).ok_or(FitError::NoSpectrum {
-        segment_s: super::features::LINE_SEGMENT_S,
+        segment_s: input.settings.statistics.line_segment_s,
     })?;
     let effect = info
         .typical
@@ -2159,15 +2170,16 @@ fn line_fit(input: &FitInput, info: &'static EffectInfo) -> Result<Fit, FitError
             ),
         ],
         z: line.z,
-        passes: line.z >= input.settings.tests.z_critical && line.ratio >= super::line::LINE_MIN_RATIO,
+        passes: line.z >= input.settings.tests.z_critical
+            && line.ratio >= input.settings.statistics.line_min_ratio,
         direct: true,
         holdout_z: None,
         shape_loglik: None,
         test: format!(
             "strongest line of the gyro's spectrum not coherent with the reference, above {} Hz ({:.1} times its local floor, at least {}) vs the null replicas' strongest (one-sided; replicated on the held-out runs)",
-            super::line::MIN_LINE_HZ,
+            input.settings.statistics.min_line_hz,
             line.ratio,
-            super::line::LINE_MIN_RATIO
+            input.settings.statistics.line_min_ratio
         ),
     })
 }
@@ -2225,7 +2237,7 @@ mod whiteness_tests {
             lsb_dps: 0.0,
             ..SensorModel::default()
         };
-        nominal_model(&refs, &prior, None, None)
+        nominal_model(&refs, &prior, None, None, &Settings::DEFAULT)
     }
 
     /// White rest noise passes the check, and the white noise is the first differences'
@@ -2236,7 +2248,7 @@ mod whiteness_tests {
         let n = nominal(None);
         let w = n.whiteness.unwrap();
         assert!(!w.coloured, "{w:?}");
-        assert!(w.z.abs() < WHITE_CHECK_Z, "{w:?}");
+        assert!(w.z.abs() < Settings::DEFAULT.tests.z_critical, "{w:?}");
         assert_eq!(n.white_target.unwrap().block, 1);
         assert!(
             (n.model.arw_deg_per_rt_h / truth - 1.0).abs() < 0.05,
@@ -2257,7 +2269,10 @@ mod whiteness_tests {
         let truth = SIGMA * 60.0 / FS.sqrt();
         let n = nominal(Some(20.0));
         let w = n.whiteness.unwrap();
-        assert!(w.coloured && w.z > WHITE_CHECK_Z, "{w:?}");
+        assert!(
+            w.coloured && w.z > Settings::DEFAULT.tests.z_critical,
+            "{w:?}"
+        );
         assert!(w.first_difference_arw_deg_per_rt_h < 0.6 * truth, "{w:?}");
         assert_eq!(n.white_target.unwrap().block, 10);
         let ratio = n.model.arw_deg_per_rt_h / truth;
@@ -2301,9 +2316,15 @@ mod replication_tests {
     fn a_shift_replicates_in_standard_errors_of_the_pooled_replicas() {
         for seed in 0..20 {
             // Replicas' spread pooled over 5 runs: 1/√5, so a shift of 3 of those is z ≈ 3.
-            let z = replication_z(&coefficients(5, 3.0, 0.0, seed));
+            let z = replication_z(
+                &coefficients(5, 3.0, 0.0, seed),
+                Settings::DEFAULT.fit.scatter_p,
+            );
             assert!((2.0..4.2).contains(&z), "seed {seed}: {z}");
-            let z = replication_z(&coefficients(5, 0.0, 0.0, seed));
+            let z = replication_z(
+                &coefficients(5, 0.0, 0.0, seed),
+                Settings::DEFAULT.fit.scatter_p,
+            );
             assert!(z.abs() < 1.8, "seed {seed}: {z}");
         }
     }
@@ -2325,14 +2346,15 @@ mod replication_tests {
 
     #[test]
     fn the_held_out_test_is_read_in_the_training_direction() {
+        const RZ: f64 = Settings::DEFAULT.tests.replication_z;
         // A delay is the negated acceleration coefficient: its test's z and the held-out
         // z are both negated, and a negative pair replicates.
-        assert!(replicates(&fit(-6.0, Some(-2.5))));
-        assert!(replicates(&fit(6.0, Some(2.0))));
-        assert!(!replicates(&fit(-6.0, Some(2.5))));
-        assert!(!replicates(&fit(6.0, Some(1.9))));
-        assert!(!replicates(&fit(6.0, None)));
-        assert!(!replicates(&fit(f64::NAN, Some(3.0))));
+        assert!(replicates(&fit(-6.0, Some(-2.5)), RZ));
+        assert!(replicates(&fit(6.0, Some(2.0)), RZ));
+        assert!(!replicates(&fit(-6.0, Some(2.5)), RZ));
+        assert!(!replicates(&fit(6.0, Some(1.9)), RZ));
+        assert!(!replicates(&fit(6.0, None), RZ));
+        assert!(!replicates(&fit(f64::NAN, Some(3.0)), RZ));
         // A wander replicates only with no other wander beside it.
         let walk = Fit {
             effect: Effect::RateRandomWalk {
@@ -2342,9 +2364,13 @@ mod replication_tests {
         };
         let instability = Effect::BiasInstability { sigma_dps: 0.05 };
         let scale = Effect::ScaleFactor { k: 0.01 };
-        assert!(replicates_beside(&walk, &[scale]));
-        assert!(!replicates_beside(&walk, &[scale, instability]));
-        assert!(replicates_beside(&fit(-6.0, Some(-2.5)), &[instability]));
+        assert!(replicates_beside(&walk, &[scale], RZ));
+        assert!(!replicates_beside(&walk, &[scale, instability], RZ));
+        assert!(replicates_beside(
+            &fit(-6.0, Some(-2.5)),
+            &[instability],
+            RZ
+        ));
         assert!(contradicted(&fit(-5.3, Some(1.1))));
         assert!(contradicted(&fit(4.3, Some(-1.1))));
         assert!(!contradicted(&fit(4.3, Some(0.4))));
@@ -2404,13 +2430,22 @@ mod replication_tests {
         // The same shift among runs that disagree by 3 replica spreads: the standard error
         // is their scatter's, and the shift no longer replicates.
         for seed in 0..20 {
-            let tight = replication_z(&coefficients(5, 3.0, 0.0, seed));
-            let loose = replication_z(&coefficients(5, 3.0, 3.0, seed));
+            let tight = replication_z(
+                &coefficients(5, 3.0, 0.0, seed),
+                Settings::DEFAULT.fit.scatter_p,
+            );
+            let loose = replication_z(
+                &coefficients(5, 3.0, 3.0, seed),
+                Settings::DEFAULT.fit.scatter_p,
+            );
             assert!(
                 loose.abs() < tight.abs(),
                 "seed {seed}: {loose} against {tight}"
             );
-            assert!(loose < REPLICATION_Z, "seed {seed}: {loose}");
+            assert!(
+                loose < Settings::DEFAULT.tests.replication_z,
+                "seed {seed}: {loose}"
+            );
         }
     }
 }

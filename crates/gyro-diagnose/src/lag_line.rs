@@ -14,7 +14,7 @@
 
 use crate::ensemble::RealRun;
 use crate::fit::{t95, Fit};
-use crate::settings::Settings;
+use crate::settings::{Settings, Statistics};
 use gyro_analysis::lag::{inliers, parabola_offset};
 use gyro_analysis::xcorr::{centred_difference, coarse_to_fine_peak};
 use gyro_log::RegularLog;
@@ -101,7 +101,7 @@ pub(crate) fn within_reference(
             let mut log = run.log.clone();
             let keep = ((log.slots.len().saturating_sub(1)) as f64 * keep_share).floor() as usize + 1;
             log.slots.truncate(keep);
-            RealRun::prepare(run.name.clone(), log).map_err(|e| crate::DiagnoseError::Run {
+            RealRun::prepare_with(run.name.clone(), log, &run.settings()).map_err(|e| crate::DiagnoseError::Run {
                 name: run.name.clone(),
                 message: format!("shortened to where its reference reaches under a count-stamped clock {ppm:.0} ppm slow: {e}"),
             })
@@ -114,7 +114,7 @@ pub(crate) fn within_reference(
 fn mean_ppm(runs: &[&RealRun], settings: &Settings) -> Option<(f64, f64, usize)> {
     let lines: Vec<LagLine> = runs
         .iter()
-        .filter_map(|r| of_log(&r.log, settings))
+        .filter_map(|r| of_log(&r.log, &settings.statistics))
         .filter(|l| l.se_slope.is_finite())
         .collect();
     if lines.len() < 2 {
@@ -129,7 +129,7 @@ fn mean_ppm(runs: &[&RealRun], settings: &Settings) -> Option<(f64, f64, usize)>
 }
 
 /// The lag line of `log` (gyro rate against the reference angle's centred difference).
-pub fn of_log(log: &RegularLog, settings: &Settings) -> Option<LagLine> {
+pub fn of_log(log: &RegularLog, statistics: &Statistics) -> Option<LagLine> {
     let fs = log.sample_rate_hz;
     let rate: Vec<f64> = log.slots.iter().map(|s| s.rate_dps).collect();
     let reference: Vec<f64> = log
@@ -137,14 +137,19 @@ pub fn of_log(log: &RegularLog, settings: &Settings) -> Option<LagLine> {
         .iter()
         .map(|s| s.reference_deg.unwrap_or(f64::NAN))
         .collect();
-    lag_line(&rate, &centred_difference(&reference, fs), fs, settings)
+    lag_line(&rate, &centred_difference(&reference, fs), fs, statistics)
 }
 
 /// The lag line of `gyro` against `reference` (rates on one grid at `fs`; NaN where
 /// undefined), or `None` when fewer than [`MIN_POINTS`] windows have motion and a lag, or
 /// they span less than `statistics.lag_min_span_share` of the run.
-pub fn lag_line(gyro: &[f64], reference: &[f64], fs: f64, settings: &Settings) -> Option<LagLine> {
-    let fit = &settings.statistics;
+pub fn lag_line(
+    gyro: &[f64],
+    reference: &[f64],
+    fs: f64,
+    statistics: &Statistics,
+) -> Option<LagLine> {
+    let fit = statistics;
     let near_s = fit.max_lag_s;
     // Block means: the motion's band lies far below the rate it is read at.
     let q = ((fs / fit.lag_line_hz).round() as usize).max(1);
@@ -352,7 +357,7 @@ mod tests {
         let s = Settings::DEFAULT;
         for eps in [-0.03, -0.005, 5e-4, 0.006, 0.03] {
             let (g, r) = pair(500.0, 90.0, eps, 0.0);
-            let l = lag_line(&g, &r, 500.0, &s).expect("a line");
+            let l = lag_line(&g, &r, 500.0, &s.statistics).expect("a line");
             let ppm = eps * 1e6;
             assert!(
                 (l.clock_ppm() - ppm).abs() < 0.01 * ppm.abs() + 20.0,
@@ -366,7 +371,7 @@ mod tests {
     #[test]
     fn a_constant_delay_is_a_flat_line_at_the_delay() {
         let (g, r) = pair(500.0, 60.0, 0.0, 0.02);
-        let l = lag_line(&g, &r, 500.0, &Settings::DEFAULT).expect("a line");
+        let l = lag_line(&g, &r, 500.0, &Settings::DEFAULT.statistics).expect("a line");
         assert!(l.clock_ppm().abs() < 20.0, "{l:?}");
         assert!((l.intercept_s - 0.02).abs() < 1e-3, "{l:?}");
     }
@@ -374,7 +379,7 @@ mod tests {
     #[test]
     fn rest_gives_no_line() {
         let g = vec![0.01; 30_000];
-        assert!(lag_line(&g, &g, 500.0, &Settings::DEFAULT).is_none());
-        assert!(lag_line(&g[..10], &g[..10], 500.0, &Settings::DEFAULT).is_none());
+        assert!(lag_line(&g, &g, 500.0, &Settings::DEFAULT.statistics).is_none());
+        assert!(lag_line(&g[..10], &g[..10], 500.0, &Settings::DEFAULT.statistics).is_none());
     }
 }

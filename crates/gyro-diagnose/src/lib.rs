@@ -87,7 +87,6 @@ pub use diagnosis::{
     ModelSummary, NotCorrected, RunSummary, Unexplained, UntestableEntry, Verdict, Where,
 };
 pub use ensemble::{motion_from_reference, split, GridKind, RealRun, ReferenceGrid};
-pub use features::MIN_TEMPERATURE_RANGE_C;
 pub use settings::{Settings, SettingsError};
 pub use stats::stretches;
 
@@ -265,6 +264,20 @@ pub fn check_runs(train: &[RealRun], holdout: &[RealRun]) -> Result<(), Diagnose
     Ok(())
 }
 
+/// `runs` prepared again from their logs with `settings`.
+fn prepare_again(runs: &[RealRun], settings: &Settings) -> Result<Vec<RealRun>, DiagnoseError> {
+    runs.iter()
+        .map(|r| {
+            RealRun::prepare_with(r.name.clone(), r.log.clone(), settings).map_err(|e| {
+                DiagnoseError::Run {
+                    name: r.name.clone(),
+                    message: format!("prepared again with the options' settings: {e}"),
+                }
+            })
+        })
+        .collect()
+}
+
 /// Diagnose `train` against `holdout`, stage by stage: baseline, locate, fit, select,
 /// compensate, summarise.
 pub fn diagnose(
@@ -275,6 +288,24 @@ pub fn diagnose(
 ) -> Result<Diagnosis, DiagnoseError> {
     options.settings.validate()?;
     check_runs(train, holdout)?;
+    // Runs prepared with other statistics or reference settings than the options' are
+    // prepared again from their logs: the settings given are the ones every run is read
+    // with.
+    let prepared = (!train
+        .iter()
+        .chain(holdout)
+        .all(|r| r.prepared_with(&options.settings)))
+    .then(|| {
+        Ok::<_, DiagnoseError>((
+            prepare_again(train, &options.settings)?,
+            prepare_again(holdout, &options.settings)?,
+        ))
+    })
+    .transpose()?;
+    let (train, holdout) = match &prepared {
+        Some((t, h)) => (t.as_slice(), h.as_slice()),
+        None => (train, holdout),
+    };
 
     // 0. A count-stamped clock whose lag grows beyond the per-sample statistics' reach,
     // read directly from the lag lines (no model needed): held as known from the start.
@@ -337,7 +368,7 @@ pub fn diagnose(
     let (compensation, corrected_model) = compensate::compensate(
         holdout,
         options,
-        turns::lag_beyond_statistic(&train_lags_s),
+        turns::lag_beyond_statistic(&train_lags_s, options.settings.statistics.max_lag_s),
         // The nominal model's bias is fitted on the training runs unless it was given.
         if options.fixed_model {
             0.0

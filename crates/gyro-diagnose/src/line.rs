@@ -4,42 +4,50 @@
 //! The statistic is the **line ratio** of a bin: the pooled incoherent PSD (mean over
 //! the runs of [`Features::incoherent_psd`]: the gyro's spectrum not explained by the
 //! reference rate, so that a line of the motion itself, seen through a latency, is not a
-//! vibration) over its local floor, the median of the bins [`GUARD_BINS`] + 1 to
-//! [`FLOOR_BINS`] away on either side. A broad mismatch of the spectrum (a noisier
-//! sensor, a differentiated encoder) moves the floor with it; a sinusoid stands above it. The search runs from [`MIN_LINE_HZ`] (below it the motion's
+//! vibration) over its local floor, the median of the bins `statistics.guard_bins` + 1 to
+//! `statistics.floor_bins` away on either side. A broad mismatch of the spectrum (a noisier
+//! sensor, a differentiated encoder) moves the floor with it; a sinusoid stands above it. The search runs from `statistics.min_line_hz` (below it the motion's
 //! own harmonics, times any scale error, make lines of their own) to 95% of the Nyquist
 //! frequency; the strongest ratio is tested against the same search on each null replica
 //! (the largest ratio a nominal sensor shows by chance), so the look-elsewhere effect is
-//! in the null distribution. A line must also stand [`LINE_MIN_RATIO`] times above its
+//! in the null distribution. A line must also stand `statistics.line_min_ratio` times above its
 //! floor, on the training runs and again on the held-out runs.
 //!
 //! A sinusoid of amplitude A has power A²/2: the excess over the floor, summed over the
-//! line's bins (the Hann window spreads it over ±[`GUARD_BINS`]) times the bin width,
+//! line's bins (the Hann window spreads it over ±`statistics.guard_bins`) times the bin width,
 //! gives A; its frequency is the excess-weighted centroid of those bins.
 
 use super::ensemble::{Member, RealRun};
 use super::features::{line_resolution_hz, Features};
 use super::fit::mean_sd;
+use crate::settings::Statistics;
 use gyro_analysis::median;
 
-/// A line must also stand this many times above its local floor (on the training runs to
-/// be found, on the held-out runs to replicate): the null replicas' spectra are smooth,
-/// a real sensor's have texture (an encoder's steps, the motion), so a ratio of 1.1 can
-/// be many null standard deviations without being a line.
-/// The default `statistics.line_min_ratio` ([`crate::Settings`]), where the settings do not reach yet.
-pub const LINE_MIN_RATIO: f64 = crate::Settings::DEFAULT.statistics.line_min_ratio;
-/// A line of the motion is reported when it stands this many times above its floor.
-/// The default `statistics.motion_line_ratio` ([`crate::Settings`]), where the settings do not reach yet.
-pub const MOTION_LINE_RATIO: f64 = crate::Settings::DEFAULT.statistics.motion_line_ratio;
-/// Lowest frequency searched for a line (Hz).
-/// The default `statistics.min_line_hz` ([`crate::Settings`]), where the settings do not reach yet.
-pub const MIN_LINE_HZ: f64 = crate::Settings::DEFAULT.statistics.min_line_hz;
-/// Bins on either side of a line that belong to it (Hann main lobe).
-/// The default `statistics.guard_bins` ([`crate::Settings`]), where the settings do not reach yet.
-pub const GUARD_BINS: usize = crate::Settings::DEFAULT.statistics.guard_bins;
-/// Bins on either side whose median is the local floor.
-/// The default `statistics.floor_bins` ([`crate::Settings`]), where the settings do not reach yet.
-pub const FLOOR_BINS: usize = crate::Settings::DEFAULT.statistics.floor_bins;
+/// The spectrum grid a line is searched on, and the search's settings
+/// (`statistics.guard_bins`, `floor_bins`, `min_line_hz`, `line_segment_s`).
+#[derive(Clone, Copy, Debug)]
+struct Grid {
+    /// Bin width (Hz).
+    resolution_hz: f64,
+    /// Bins on either side of a line that belong to it (Hann main lobe).
+    guard_bins: usize,
+    /// Bins on either side whose median is the local floor.
+    floor_bins: usize,
+    /// Lowest frequency searched (Hz).
+    min_line_hz: f64,
+}
+
+impl Grid {
+    /// The grid of runs at `fs` Hz measured with `statistics`.
+    fn of(fs: f64, statistics: &Statistics) -> Self {
+        Self {
+            resolution_hz: line_resolution_hz(fs, statistics.line_segment_s),
+            guard_bins: statistics.guard_bins,
+            floor_bins: statistics.floor_bins,
+            min_line_hz: statistics.min_line_hz,
+        }
+    }
+}
 
 /// The pooled incoherent PSD of `features` (mean over those with a spectrum of the
 /// common length).
@@ -63,42 +71,42 @@ fn pooled_with<'a>(
 }
 
 /// The local floor of bin `k` (NaN when too close to an end).
-fn floor(psd: &[f64], k: usize) -> f64 {
-    if k < FLOOR_BINS || k + FLOOR_BINS >= psd.len() {
+fn floor(psd: &[f64], k: usize, g: &Grid) -> f64 {
+    if k < g.floor_bins || k + g.floor_bins >= psd.len() {
         return f64::NAN;
     }
-    let around: Vec<f64> = (GUARD_BINS + 1..=FLOOR_BINS)
+    let around: Vec<f64> = (g.guard_bins + 1..=g.floor_bins)
         .flat_map(|d| [psd[k - d], psd[k + d]])
         .collect();
     median(&around).unwrap_or(f64::NAN)
 }
 
-/// The bins searched for a line in a spectrum of `len` bins at `resolution_hz`.
-fn search_range(len: usize, resolution_hz: f64) -> std::ops::Range<usize> {
-    let lo = ((MIN_LINE_HZ / resolution_hz).ceil() as usize).max(FLOOR_BINS);
-    let hi =
-        ((0.95 * (len.saturating_sub(1)) as f64) as usize).min(len.saturating_sub(FLOOR_BINS + 1));
+/// The bins searched for a line in a spectrum of `len` bins on `g`.
+fn search_range(len: usize, g: &Grid) -> std::ops::Range<usize> {
+    let lo = ((g.min_line_hz / g.resolution_hz).ceil() as usize).max(g.floor_bins);
+    let hi = ((0.95 * (len.saturating_sub(1)) as f64) as usize)
+        .min(len.saturating_sub(g.floor_bins + 1));
     lo..hi.max(lo)
 }
 
 /// The line ratio of bin `k`.
-fn ratio(psd: &[f64], k: usize) -> f64 {
-    psd[k] / floor(psd, k)
+fn ratio(psd: &[f64], k: usize, g: &Grid) -> f64 {
+    psd[k] / floor(psd, k, g)
 }
 
 /// The strongest line of `psd`: (bin, ratio).
-fn strongest(psd: &[f64], resolution_hz: f64) -> Option<(usize, f64)> {
-    search_range(psd.len(), resolution_hz)
-        .map(|k| (k, ratio(psd, k)))
+fn strongest(psd: &[f64], g: &Grid) -> Option<(usize, f64)> {
+    search_range(psd.len(), g)
+        .map(|k| (k, ratio(psd, k, g)))
         .filter(|(_, r)| r.is_finite())
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
-/// The largest line ratio within ±[`GUARD_BINS`] of bin `k`.
-fn ratio_near(psd: &[f64], k: usize) -> f64 {
-    (k.saturating_sub(GUARD_BINS)..=k + GUARD_BINS)
+/// The largest line ratio within ±`guard_bins` of bin `k`.
+fn ratio_near(psd: &[f64], k: usize, g: &Grid) -> f64 {
+    (k.saturating_sub(g.guard_bins)..=k + g.guard_bins)
         .filter(|&i| i < psd.len())
-        .map(|i| ratio(psd, i))
+        .map(|i| ratio(psd, i, g))
         .filter(|r| r.is_finite())
         .fold(f64::NAN, f64::max)
 }
@@ -120,11 +128,12 @@ pub struct Line {
 }
 
 /// Frequency and amplitude of the line at bin `k` of `psd`.
-fn measure(psd: &[f64], k: usize, resolution_hz: f64) -> (f64, f64) {
-    let base = floor(psd, k);
+fn measure(psd: &[f64], k: usize, g: &Grid) -> (f64, f64) {
+    let resolution_hz = g.resolution_hz;
+    let base = floor(psd, k, g);
     let (mut power, mut moment) = (0.0, 0.0);
-    let first = k.saturating_sub(GUARD_BINS);
-    let last = (k + GUARD_BINS).min(psd.len() - 1);
+    let first = k.saturating_sub(g.guard_bins);
+    let last = (k + g.guard_bins).min(psd.len() - 1);
     for (i, p) in psd.iter().enumerate().take(last + 1).skip(first) {
         let excess = (p - base).max(0.0);
         power += excess * resolution_hz;
@@ -146,57 +155,57 @@ fn replica(null: &[Vec<Member>], j: usize) -> Vec<f64> {
 /// The strongest line of `runs` against their `null` ensembles; `None` when the runs
 /// have no spectrum or the ensembles fewer than two replicas with one.
 pub fn search(runs: &[&RealRun], null: &[Vec<Member>]) -> Option<Line> {
-    let fs = runs.first()?.sample_rate_hz;
-    let resolution_hz = line_resolution_hz(fs);
+    let first = runs.first()?;
+    let g = Grid::of(first.sample_rate_hz, &first.statistics);
     let psd = pooled(runs.iter().map(|r| &r.features));
-    let (k, ratio) = strongest(&psd, resolution_hz)?;
+    let (k, ratio) = strongest(&psd, &g)?;
     let members = null.iter().map(Vec::len).min().unwrap_or(0);
     let maxima: Vec<f64> = (0..members)
-        .filter_map(|j| strongest(&replica(null, j), resolution_hz).map(|x| x.1))
+        .filter_map(|j| strongest(&replica(null, j), &g).map(|x| x.1))
         .collect();
-    judged(&psd, k, ratio, &maxima, resolution_hz)
+    judged(&psd, k, ratio, &maxima, &g)
 }
 
 /// The line at bin `k` of `psd`, of line ratio `ratio`, with its z-score against the
 /// null replicas' values of the same statistic; `None` if either is not a number.
-fn judged(psd: &[f64], k: usize, ratio: f64, null: &[f64], resolution_hz: f64) -> Option<Line> {
+fn judged(psd: &[f64], k: usize, ratio: f64, null: &[f64], g: &Grid) -> Option<Line> {
     let (m0, s0) = mean_sd(null);
     if !(m0.is_finite() && ratio.is_finite()) {
         return None;
     }
-    let (frequency_hz, amplitude_dps) = measure(psd, k, resolution_hz);
+    let (frequency_hz, amplitude_dps) = measure(psd, k, g);
     Some(Line {
         frequency_hz,
         amplitude_dps,
         ratio,
         z: (ratio - m0) / s0.max(1e-3 * m0),
-        resolution_hz,
+        resolution_hz: g.resolution_hz,
     })
 }
 
 /// The line ratio of `runs` near `frequency_hz` against their `null` ensembles' ratio
 /// there: the held-out replication of a line found on the training runs.
 pub fn at(runs: &[&RealRun], null: &[Vec<Member>], frequency_hz: f64) -> Option<Line> {
-    let fs = runs.first()?.sample_rate_hz;
-    let resolution_hz = line_resolution_hz(fs);
+    let first = runs.first()?;
+    let g = Grid::of(first.sample_rate_hz, &first.statistics);
     let psd = pooled(runs.iter().map(|r| &r.features));
-    let k = (frequency_hz / resolution_hz).round() as usize;
-    if !search_range(psd.len(), resolution_hz).contains(&k) {
+    let k = (frequency_hz / g.resolution_hz).round() as usize;
+    if !search_range(psd.len(), &g).contains(&k) {
         return None;
     }
-    let ratio = ratio_near(&psd, k);
+    let ratio = ratio_near(&psd, k, &g);
     let members = null.iter().map(Vec::len).min().unwrap_or(0);
     let replicas: Vec<f64> = (0..members)
         .map(|j| {
             let p = replica(null, j);
             if p.len() == psd.len() {
-                ratio_near(&p, k)
+                ratio_near(&p, k, &g)
             } else {
                 f64::NAN
             }
         })
         .collect();
-    judged(&psd, k, ratio, &replicas, resolution_hz)
+    judged(&psd, k, ratio, &replicas, &g)
 }
 
 /// A line in the motion itself (the reference rate's spectrum), which the gyro sees with
@@ -224,15 +233,16 @@ pub struct MotionLine {
     pub gyro_lag_s: f64,
 }
 
-/// The strongest line of the motion of `runs` above [`MIN_LINE_HZ`], if it stands
-/// [`MOTION_LINE_RATIO`] times above its floor.
+/// The strongest line of the motion of `runs` above `statistics.min_line_hz`, if it
+/// stands `statistics.motion_line_ratio` times above its floor.
 pub fn motion_line(runs: &[&RealRun], label: &'static str) -> Option<MotionLine> {
-    let fs = runs.first()?.sample_rate_hz;
-    let resolution_hz = line_resolution_hz(fs);
+    let first = runs.first()?;
+    let fs = first.sample_rate_hz;
+    let g = Grid::of(fs, &first.statistics);
     let psd = pooled_with(runs.iter().map(|r| &r.features), |f| &f.reference_psd);
-    let (k, ratio) = strongest(&psd, resolution_hz)?;
-    let (frequency_hz, amplitude_dps) = measure(&psd, k, resolution_hz);
-    if ratio < MOTION_LINE_RATIO {
+    let (k, ratio) = strongest(&psd, &g)?;
+    let (frequency_hz, amplitude_dps) = measure(&psd, k, &g);
+    if ratio < first.statistics.motion_line_ratio {
         return None;
     }
     let amplitude_dps = amplitude_dps / super::stats::reference_rate_gain(fs, frequency_hz);
@@ -279,11 +289,11 @@ pub fn amplitudes(runs: &[&RealRun], frequency_hz: f64) -> Vec<f64> {
     runs.iter()
         .filter_map(|r| {
             let psd = &r.features.incoherent_psd;
-            let resolution_hz = line_resolution_hz(r.sample_rate_hz);
-            let k = (frequency_hz / resolution_hz).round() as usize;
-            search_range(psd.len(), resolution_hz)
+            let g = Grid::of(r.sample_rate_hz, &r.statistics);
+            let k = (frequency_hz / g.resolution_hz).round() as usize;
+            search_range(psd.len(), &g)
                 .contains(&k)
-                .then(|| measure(psd, k, resolution_hz).1)
+                .then(|| measure(psd, k, &g).1)
         })
         .collect()
 }
@@ -307,14 +317,18 @@ mod tests {
             })
             .collect();
         let options = PsdOptions {
-            segment_len: Some(super::super::features::line_segment_len(fs)),
+            segment_len: Some(super::super::features::line_segment_len(
+                fs,
+                crate::Settings::DEFAULT.statistics.line_segment_s,
+            )),
             ..PsdOptions::default()
         };
         let psd = welch(&[&x], fs, &options).unwrap().psd_dps2_per_hz;
-        let res = line_resolution_hz(fs);
-        let (k, r) = strongest(&psd, res).unwrap();
+        let g = Grid::of(fs, &crate::Settings::DEFAULT.statistics);
+        let res = g.resolution_hz;
+        let (k, r) = strongest(&psd, &g).unwrap();
         assert!(r > 100.0, "{r}");
-        let (f, a) = measure(&psd, k, res);
+        let (f, a) = measure(&psd, k, &g);
         assert!((f - 37.0).abs() < res, "{f}");
         assert!((a - 0.2).abs() < 0.02, "{a}");
     }

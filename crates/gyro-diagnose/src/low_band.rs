@@ -8,7 +8,8 @@
 //! 12.8 Hz stepper line, with the same 12 ms phase lag), and a regression over the whole
 //! band reads that roll-off, amplified by the jerk column, as tens of percent of scale.
 //! So the gain-type regression columns and the gain statistics are taken on both signals
-//! low-passed by the same zero-phase Butterworth at [`LOW_BAND_HZ`]: the band of a
+//! low-passed by the same zero-phase Butterworth at `statistics.low_band_hz`
+//! ([`crate::settings::Statistics::low_band_hz`]): the band of a
 //! tightening's turn, where any latency is a small phase the acceleration column
 //! absorbs.
 //!
@@ -19,16 +20,13 @@
 
 use gyro_core::Butterworth;
 
-/// Cut-off of the low band (Hz).
-/// The default `statistics.low_band_hz` ([`crate::Settings`]), where the settings do not reach yet.
-pub const LOW_BAND_HZ: f64 = crate::Settings::DEFAULT.statistics.low_band_hz;
 /// Order of the Butterworth run forwards and backwards (the pair is of twice the order).
 pub const LOW_BAND_ORDER: u8 = 2;
 
-/// The low-band cut-off used at `sample_rate_hz`: [`LOW_BAND_HZ`], raised to the lowest
+/// The low-band cut-off used at `sample_rate_hz`: `low_band_hz`, raised to the lowest
 /// ratio the Butterworth design accepts; `None` when the rate is too low for a low band.
-pub fn cutoff_hz(sample_rate_hz: f64) -> Option<f64> {
-    let cutoff = LOW_BAND_HZ.max(Butterworth::MIN_CUTOFF_RATIO * sample_rate_hz);
+pub fn cutoff_hz(sample_rate_hz: f64, low_band_hz: f64) -> Option<f64> {
+    let cutoff = low_band_hz.max(Butterworth::MIN_CUTOFF_RATIO * sample_rate_hz);
     (sample_rate_hz.is_finite() && cutoff <= Butterworth::MAX_CUTOFF_RATIO * sample_rate_hz)
         .then_some(cutoff)
 }
@@ -115,6 +113,7 @@ pub fn derivative(x: &[f64], sample_rate_hz: f64) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    const LOW_BAND_HZ: f64 = crate::Settings::DEFAULT.statistics.low_band_hz;
 
     /// scipy's `sosfiltfilt(butter(2, 2, fs=1000, output="sos"), x)` on the fixture's input
     /// (`fixtures/filters/low_band.py`).
@@ -170,8 +169,8 @@ mod tests {
 
     #[test]
     fn the_cutoff_follows_the_design_limits() {
-        assert_eq!(cutoff_hz(1000.0), Some(2.0));
-        assert_eq!(cutoff_hz(10_000.0), Some(10.0));
-        assert_eq!(cutoff_hz(3.0), None);
+        assert_eq!(cutoff_hz(1000.0, LOW_BAND_HZ), Some(2.0));
+        assert_eq!(cutoff_hz(10_000.0, LOW_BAND_HZ), Some(10.0));
+        assert_eq!(cutoff_hz(3.0, LOW_BAND_HZ), None);
     }
 }

@@ -23,7 +23,7 @@
 //!   the runs' spread alone.
 //! - It passes when the ensembles with the effect cover the real value
 //!   (`|real − with_effect| ≤ band`) or explain most of the discrepancy without
-//!   overshooting it: `|real − with_effect| ≤` [`REMAINING_SHARE`] `· |real − nominal|`.
+//!   overshooting it: `|real − with_effect| ≤` `score.remaining_share` `· |real − nominal|`.
 //!   The second arm is for real sensors, whose other unmodelled effects keep a
 //!   statistic's ensemble from covering it exactly even when the effect is right.
 //! - A cross-correlation peak cut at the edge of its search on some real run (a lag
@@ -41,10 +41,6 @@
 use super::fit::Fit;
 use super::score::RunScore;
 use serde::Serialize;
-
-/// Share of the nominal discrepancy of a signature statistic the effect may leave.
-/// The default `score.remaining_share` ([`crate::Settings`]), where the settings do not reach yet.
-pub const REMAINING_SHARE: f64 = crate::Settings::DEFAULT.score.remaining_share;
 
 /// The statistics (segment, statistic) that identify each effect.
 pub fn signature(id: &str) -> &'static [(&'static str, &'static str)] {
@@ -81,7 +77,7 @@ pub struct SignatureCheck {
     /// Half-width of the 95% band of the real value predicted with the effect: the
     /// runs' spread and the fitted parameter's uncertainty.
     pub band: f64,
-    /// Covered, or at most [`REMAINING_SHARE`] of the nominal discrepancy left; for a
+    /// Covered, or at most `score.remaining_share` of the nominal discrepancy left; for a
     /// `cut` statistic, reached.
     pub passes: bool,
     /// The real value is cut at the edge of the statistic's search on some run (a lag
@@ -195,10 +191,10 @@ pub fn check(
     after: &[RunScore],
     alone: &[RunScore],
     sample_rate_hz: f64,
-    interval_z: f64,
+    settings: &crate::Settings,
 ) -> PosteriorCheck {
     let expected = signature(fit.effect.id());
-    let relative_sd = parameter_relative_sd(fit, interval_z);
+    let relative_sd = parameter_relative_sd(fit, settings.tests.interval_z);
     let statistics: Vec<SignatureCheck> = expected
         .iter()
         .filter_map(|&(segment, statistic)| {
@@ -207,7 +203,7 @@ pub fn check(
                 [before, after, alone],
                 sample_rate_hz,
                 relative_sd,
-                interval_z,
+                settings,
             )
         })
         .collect();
@@ -227,8 +223,9 @@ fn pooled(
     [before, after, alone]: [&[RunScore]; 3],
     sample_rate_hz: f64,
     relative_sd: f64,
-    interval_z: f64,
+    settings: &crate::Settings,
 ) -> Option<SignatureCheck> {
+    let interval_z = settings.tests.interval_z;
     let lag = statistic == "xcorr_peak_lag_s";
     let find = |s: &RunScore| -> Option<(f64, f64, f64)> {
         let i =
@@ -244,7 +241,12 @@ fn pooled(
     for ((b, a), o) in before.iter().zip(after).zip(alone) {
         if let (Some((r, m0, _)), Some((_, m1, s1)), Some((_, m2, _))) = (find(b), find(a), find(o))
         {
-            cut |= lag && super::stats::is_at_search_edge(r, sample_rate_hz);
+            cut |= lag
+                && super::stats::is_at_search_edge(
+                    r,
+                    sample_rate_hz,
+                    settings.statistics.max_lag_s,
+                );
             real += r;
             nominal += m0;
             with += m1;
@@ -271,7 +273,7 @@ fn pooled(
         // The simulation must reach as far as the real runs' bound, on the same side.
         with * real.signum() >= real.abs() - band
     } else {
-        left <= band || left <= REMAINING_SHARE * (real - nominal).abs()
+        left <= band || left <= settings.score.remaining_share * (real - nominal).abs()
     };
     Some(SignatureCheck {
         segment,
@@ -364,7 +366,7 @@ mod tests {
             &vec![score(0.0108, 0.0276, 0.0001); 4],
             &vec![score(0.0108, 0.0276, 0.0001); 4],
             1000.0,
-            Z,
+            &crate::Settings::DEFAULT,
         );
         assert!(!over.passes, "{over:?}");
         let close = check(
@@ -373,7 +375,7 @@ mod tests {
             &vec![score(0.0108, 0.013, 0.0001); 4],
             &vec![score(0.0108, 0.013, 0.0001); 4],
             1000.0,
-            Z,
+            &crate::Settings::DEFAULT,
         );
         assert!(close.passes, "{close:?}");
         let covered = check(
@@ -382,7 +384,7 @@ mod tests {
             &vec![score(0.0108, 0.0109, 0.0002); 4],
             &vec![score(0.0108, 0.0109, 0.0002); 4],
             1000.0,
-            Z,
+            &crate::Settings::DEFAULT,
         );
         assert!(covered.passes && covered.statistics[0].band > 1e-4);
         assert!(close.describe().contains("explains most of it"));
@@ -397,9 +399,23 @@ mod tests {
         // ±50% (r 0.25), 8 ms lies inside what its interval predicts.
         let before = vec![score(0.008, 0.0002, 0.0001); 4];
         let after = vec![score(0.008, 0.013, 0.0001); 4];
-        let sure = check(&fit("latency", 0.001), &before, &after, &after, 1000.0, Z);
+        let sure = check(
+            &fit("latency", 0.001),
+            &before,
+            &after,
+            &after,
+            1000.0,
+            &crate::Settings::DEFAULT,
+        );
         assert!(!sure.passes, "{sure:?}");
-        let unsure = check(&fit("latency", 0.25), &before, &after, &after, 1000.0, Z);
+        let unsure = check(
+            &fit("latency", 0.25),
+            &before,
+            &after,
+            &after,
+            1000.0,
+            &crate::Settings::DEFAULT,
+        );
         assert!(unsure.passes, "{unsure:?}");
         let band = unsure.statistics[0].band;
         assert!(
@@ -410,7 +426,14 @@ mod tests {
         // another effect that moves the lag to 12.8 ms, a latency whose own shift is
         // 0.1 ms adds little to the band.
         let own = vec![score(0.008, 0.0003, 0.0001); 4];
-        let beside = check(&fit("latency", 0.25), &before, &after, &own, 1000.0, Z);
+        let beside = check(
+            &fit("latency", 0.25),
+            &before,
+            &after,
+            &own,
+            1000.0,
+            &crate::Settings::DEFAULT,
+        );
         assert!(!beside.passes, "{beside:?}");
         assert!(beside.statistics[0].band < 2e-4, "{beside:?}");
         // An open bound counts as r = 1; a relative sd is never above 1.
@@ -424,7 +447,14 @@ mod tests {
     #[test]
     fn no_signature_statistic_means_the_check_does_not_apply() {
         let before = vec![score(0.0108, 0.0002, 0.0001); 2];
-        let c = check(&fit("dropouts", 0.0), &before, &before, &before, 1000.0, Z);
+        let c = check(
+            &fit("dropouts", 0.0),
+            &before,
+            &before,
+            &before,
+            1000.0,
+            &crate::Settings::DEFAULT,
+        );
         assert!(c.passes && c.statistics.is_empty() && !c.unmeasured);
     }
 
@@ -434,7 +464,14 @@ mod tests {
         // clock's lag trend (not measured when the lag lies beyond the search), is missing.
         let before = vec![score(0.0108, 0.0002, 0.0001); 2];
         for id in ["scale_factor", "clock_error_count_stamped"] {
-            let c = check(&fit(id, 0.0), &before, &before, &before, 1000.0, Z);
+            let c = check(
+                &fit(id, 0.0),
+                &before,
+                &before,
+                &before,
+                1000.0,
+                &crate::Settings::DEFAULT,
+            );
             assert!(
                 !c.passes && c.unmeasured && c.statistics.is_empty(),
                 "{c:?}"
@@ -455,7 +492,7 @@ mod tests {
             &vec![score(0.05, 0.034, 0.0001); 2],
             &vec![score(0.05, 0.034, 0.0001); 2],
             100.0,
-            Z,
+            &crate::Settings::DEFAULT,
         );
         assert!(!short.passes && short.statistics[0].cut, "{short:?}");
         // However wide the fitted interval: the value written must reach the bound.
@@ -465,7 +502,7 @@ mod tests {
             &vec![score(0.05, 0.034, 0.0001); 2],
             &vec![score(0.05, 0.034, 0.0001); 2],
             100.0,
-            Z,
+            &crate::Settings::DEFAULT,
         );
         assert!(!unsure.passes, "{unsure:?}");
         assert!(short.describe().contains("does not reach it"));
@@ -475,7 +512,7 @@ mod tests {
             &vec![score(0.05, 0.05, 0.0001); 2],
             &vec![score(0.05, 0.05, 0.0001); 2],
             100.0,
-            Z,
+            &crate::Settings::DEFAULT,
         );
         assert!(far.passes && far.statistics[0].cut, "{far:?}");
         // Inside the search nothing is cut.
@@ -485,7 +522,7 @@ mod tests {
             &vec![score(0.05, 0.034, 0.0001); 2],
             &vec![score(0.05, 0.034, 0.0001); 2],
             1000.0 / 0.9,
-            Z,
+            &crate::Settings::DEFAULT,
         );
         assert!(!inside.statistics[0].cut, "{inside:?}");
     }

@@ -7,11 +7,11 @@
 //! z-scores of the statistics its signature touches.
 //!
 //! **Floor**: G of simulated runs against ensembles they are not part of: for each run,
-//! [`FLOOR_MEMBERS`] members are taken out in turn and scored against the others. This is
+//! `score.floor_members` members are taken out in turn and scored against the others. This is
 //! the gap between two independent simulated ensembles, the least any model can reach.
 //!
 //! **Likelihood**: each statistic of a run is taken as Student-t with
-//! [`LIKELIHOOD_DOF`] degrees of freedom, located at the ensemble's mean and scaled by its
+//! `score.likelihood_dof` degrees of freedom, located at the ensemble's mean and scaled by its
 //! standard deviation, `ℓ = Σ [−(ν+1)/2 · ln(1 + z²/ν) − ln σ]` ([`loglik`]), statistics
 //! treated as independent (they are not; the bootstrap over runs is what guards the
 //! decision). On a real sensor some statistics sit thousands of σ from any candidate's
@@ -24,10 +24,6 @@
 use super::ensemble::Member;
 use super::stats::{z_scores, Stat, STD_FLOOR_ABS, STD_FLOOR_REL};
 use std::collections::BTreeMap;
-
-/// Members taken out in turn per run for the floor.
-/// The default `score.floor_members` ([`crate::Settings`]), where the settings do not reach yet.
-pub const FLOOR_MEMBERS: usize = crate::Settings::DEFAULT.score.floor_members;
 
 /// One run scored against one ensemble.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -46,12 +42,13 @@ pub struct RunScore {
 }
 
 /// Score `real` statistics against `members`.
-pub fn score(real: &[Stat], members: &[Member]) -> RunScore {
+/// `likelihood_dof`: the setting `score.likelihood_dof` ([`loglik`]).
+pub fn score(real: &[Stat], members: &[Member], likelihood_dof: f64) -> RunScore {
     let ensemble: Vec<Vec<Stat>> = members.iter().map(|m| m.stats.clone()).collect();
-    score_stats(real, &ensemble)
+    score_stats(real, &ensemble, likelihood_dof)
 }
 
-fn score_stats(real: &[Stat], ensemble: &[Vec<Stat>]) -> RunScore {
+fn score_stats(real: &[Stat], ensemble: &[Vec<Stat>], likelihood_dof: f64) -> RunScore {
     let z = z_scores(real, ensemble);
     let mut values: BTreeMap<(&str, &str), (f64, f64, usize)> = BTreeMap::new();
     for run in ensemble {
@@ -84,23 +81,18 @@ fn score_stats(real: &[Stat], ensemble: &[Vec<Stat>]) -> RunScore {
         }
         out.sum_z2 += zv * zv;
         out.count += 1;
-        out.loglik += loglik(*zv, sd);
+        out.loglik += loglik(*zv, sd, likelihood_dof);
     }
     out.z = z;
     out
 }
 
-/// Degrees of freedom of the Student-t likelihood of one statistic.
-/// The default `score.likelihood_dof` ([`crate::Settings`]), where the settings do not reach yet.
-pub const LIKELIHOOD_DOF: f64 = crate::Settings::DEFAULT.score.likelihood_dof;
-
 /// Log-likelihood of a statistic at `z` standard deviations `sd` from its ensemble's
-/// mean: Student-t with [`LIKELIHOOD_DOF`] degrees of freedom, up to a constant. Close to
+/// mean: Student-t with `score.likelihood_dof` degrees of freedom, up to a constant. Close to
 /// Gaussian within a few σ; its heavy tails keep statistics that no candidate model
 /// reproduces (z in the thousands on a real sensor) from outweighing the statistics an
 /// effect does explain.
-pub fn loglik(z: f64, sd: f64) -> f64 {
-    let nu = LIKELIHOOD_DOF;
+pub fn loglik(z: f64, sd: f64, nu: f64) -> f64 {
     -0.5 * (nu + 1.0) * (z * z / nu).ln_1p() - sd.ln()
 }
 
@@ -117,10 +109,10 @@ pub fn gap(scores: &[RunScore]) -> f64 {
 }
 
 /// The floor: members scored against the rest of their ensemble (see the module docs).
-pub fn floor(ensembles: &[Vec<Member>]) -> f64 {
+pub fn floor(ensembles: &[Vec<Member>], settings: &crate::settings::Score) -> f64 {
     let mut scores = Vec::new();
     for members in ensembles {
-        let k = FLOOR_MEMBERS.min(members.len() / 2);
+        let k = settings.floor_members.min(members.len() / 2);
         for i in 0..k {
             let rest: Vec<Vec<Stat>> = members
                 .iter()
@@ -128,7 +120,11 @@ pub fn floor(ensembles: &[Vec<Member>]) -> f64 {
                 .filter(|(j, _)| *j != i)
                 .map(|(_, m)| m.stats.clone())
                 .collect();
-            scores.push(score_stats(&members[i].stats, &rest));
+            scores.push(score_stats(
+                &members[i].stats,
+                &rest,
+                settings.likelihood_dof,
+            ));
         }
     }
     gap(&scores)
@@ -164,6 +160,7 @@ pub fn bootstrap_p(differences: &[f64], resamples: usize, seed: u64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    const NU: f64 = crate::Settings::DEFAULT.score.likelihood_dof;
 
     #[test]
     fn bootstrap_of_clear_and_null_differences() {
@@ -177,15 +174,15 @@ mod tests {
     fn likelihood_is_near_gaussian_close_in_and_heavy_tailed_far_out() {
         let gauss = |z: f64| -0.5 * z * z;
         // Close in: the t's shape differs from a Gaussian's by a factor of (ν+1)/ν.
-        let r = (loglik(0.5, 1.0) - loglik(0.0, 1.0)) / gauss(0.5);
+        let r = (loglik(0.5, 1.0, NU) - loglik(0.0, 1.0, NU)) / gauss(0.5);
         assert!((r - 1.25).abs() < 0.1, "{r}");
         // Far out: bringing one statistic from 5000σ to 1σ outweighs moving ten others
         // from 3000σ to 3500σ.
-        let fixed = loglik(1.0, 1.0) - loglik(5000.0, 1.0);
-        let moved = 10.0 * (loglik(3500.0, 1.0) - loglik(3000.0, 1.0));
+        let fixed = loglik(1.0, 1.0, NU) - loglik(5000.0, 1.0, NU);
+        let moved = 10.0 * (loglik(3500.0, 1.0, NU) - loglik(3000.0, 1.0, NU));
         assert!(fixed + moved > 0.0, "{fixed} {moved}");
         // Widening an ensemble tenfold costs ln 10.
-        assert!((loglik(0.0, 10.0) - loglik(0.0, 1.0) + 10f64.ln()).abs() < 1e-12);
+        assert!((loglik(0.0, 10.0, NU) - loglik(0.0, 1.0, NU) + 10f64.ln()).abs() < 1e-12);
     }
 
     #[test]

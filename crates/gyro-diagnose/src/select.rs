@@ -101,6 +101,7 @@ impl<'a> Scorer<'a> {
             &runs.holdout,
             &baseline.holdout.members,
             baseline.candidate_members,
+            options.settings.score.likelihood_dof,
         );
         let observations = before.iter().map(|s| s.count).sum();
         Self {
@@ -161,13 +162,14 @@ impl<'a> Scorer<'a> {
                     &self.baseline.holdout.members,
                     self.nominal(),
                     self.joint.known(),
+                    &self.options.settings,
                 )
         } else {
             f.passes
                 && !fit::contradicted(f)
                 && held_out_evidence(
                     st,
-                    fit::replicates_beside(f, beside),
+                    fit::replicates_beside(f, beside, self.options.settings.tests.replication_z),
                     self.options.settings.tests.p_value,
                 )
         }
@@ -248,7 +250,10 @@ pub(crate) fn score_alone(scorer: &Scorer, fits: Vec<Fit>) -> Vec<Candidate> {
         ) {
             // A replicated effect whose training estimate lowers the held-out
             // likelihood: scored at the end of its interval nearest the nominal.
-            if fit::replicates(&f) && !fit::contradicted(&f) && a.step.loglik_gain <= 0.0 {
+            if fit::replicates(&f, scorer.options.settings.tests.replication_z)
+                && !fit::contradicted(&f)
+                && a.step.loglik_gain <= 0.0
+            {
                 let at_bound = score(bound);
                 if scorer.qualifies(&f, &at_bound.step, &[]) {
                     let estimate = f.effect.params()[0];
@@ -700,7 +705,7 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
                 &selection.holdout_scores,
                 candidates[i].alone_scores(),
                 scorer.sample_rate_hz(),
-                scorer.options.settings.tests.interval_z,
+                &scorer.options.settings,
             );
             if !check.passes && first_failed.is_none() {
                 first_failed = Some(i);
@@ -723,13 +728,14 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
             .collect();
         // Not refitted, a latency whose interval lies under a tenth of a sample either way
         // is as good as absent too ([`fit::negligible`]).
+        let negligible_delay = scorer.options.settings.fit.negligible_delay_samples;
         let absent = selection
             .selected
             .iter()
             .zip(scorer.joint.fits(&set))
             .find(|(&i, refit)| match refit {
-                Some(f) => fit::interval_holds_absence(f, scorer.nominal()),
-                None => fit::negligible(&candidates[i].fit, scorer.nominal()),
+                Some(f) => fit::interval_holds_absence(f, scorer.nominal(), negligible_delay),
+                None => fit::negligible(&candidates[i].fit, scorer.nominal(), negligible_delay),
             })
             .map(|(&i, _)| i);
         if let Some(i) = absent {
@@ -745,7 +751,7 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
                     &alone.scores,
                     &alone.scores,
                     scorer.sample_rate_hz(),
-                    scorer.options.settings.tests.interval_z,
+                    &scorer.options.settings,
                 ));
             }
         }

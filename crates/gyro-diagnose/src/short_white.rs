@@ -16,14 +16,13 @@
 //! so that a few spikes, a rate step where a log's windows join or a turn's end the
 //! re-simulation does not follow, do not read as white noise; a mean would take them
 //! for it). The short level replaces the 1–10 s one only when
-//! the two agree within [`WHITE_CHECK_Z`] of their combined standard error, the rule of
+//! the two agree within `tests.z_critical` of their combined standard error, the rule of
 //! the rests' whiteness check: a rig's line or a response the model lacks puts more in
 //! the short band than white noise, and then the 1–10 s level stays.
 
 use super::effective::MeasuredNoise;
 use super::ensemble::{simulate_residuals, RealRun};
 use super::features::regression_residual;
-use super::fit::WHITE_CHECK_Z;
 use super::stats::stretches;
 use gyro_analysis::noise::export::{band_white_variance, WHITE_TAUS_S};
 use gyro_analysis::seed::derive_seed;
@@ -44,7 +43,7 @@ pub struct ShortWhite {
     pub long_level_deg_per_rt_h: f64,
     /// (short − long) over the standard error of the difference.
     pub z: f64,
-    /// |z| < [`WHITE_CHECK_Z`]: the short level is the baseline's.
+    /// |z| < `tests.z_critical`: the short level is the baseline's.
     pub agrees: bool,
 }
 
@@ -56,6 +55,7 @@ pub fn short_white(
     prior: &SensorModel,
     long: &MeasuredNoise,
     seed: u64,
+    z_critical: f64,
 ) -> Option<ShortWhite> {
     let fs = train.first()?.sample_rate_hz;
     let runs: Vec<&&RealRun> = train.iter().filter(|r| r.sample_rate_hz == fs).collect();
@@ -83,7 +83,7 @@ pub fn short_white(
         level_deg_per_rt_h: level,
         long_level_deg_per_rt_h: sigma1,
         z,
-        agrees: z.abs() < WHITE_CHECK_Z,
+        agrees: z.abs() < z_critical,
     })
 }
 
@@ -168,6 +168,7 @@ pub fn robust_band_variance(residuals: &[&[f64]], fs: f64) -> Option<(f64, f64)>
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+    const Z: f64 = crate::Settings::DEFAULT.tests.z_critical;
     use super::super::effective::{measure, tests::moving_runs};
     use super::super::fit::{nominal_model, Nominal};
     use super::*;
@@ -175,7 +176,7 @@ mod tests {
 
     fn measured(runs: &[RealRun]) -> (Vec<&RealRun>, MeasuredNoise) {
         let refs: Vec<&RealRun> = runs.iter().collect();
-        let m = measure(&refs, "training").unwrap();
+        let m = measure(&refs, "training", &crate::Settings::DEFAULT.turns).unwrap();
         (refs, m)
     }
 
@@ -186,14 +187,15 @@ mod tests {
         let runs = moving_runs(6.0, &[]);
         let (refs, m) = measured(&runs);
         let prior = SensorModel::default();
-        let w = short_white(&refs, &prior, &m, 7).unwrap();
+        let w = short_white(&refs, &prior, &m, 7, Z).unwrap();
         assert!(w.agrees, "{w:?}");
         assert!(
             (0.96..1.04).contains(&(w.level_deg_per_rt_h / 6.0)),
             "{w:?}"
         );
         assert_eq!(w.long_level_deg_per_rt_h, m.white_level_deg_per_rt_h);
-        let Nominal { model, notes, .. } = nominal_model(&refs, &prior, Some(&m), Some(&w));
+        let Nominal { model, notes, .. } =
+            nominal_model(&refs, &prior, Some(&m), Some(&w), &crate::Settings::DEFAULT);
         assert_eq!(model.arw_deg_per_rt_h, w.level_deg_per_rt_h);
         let text = notes.join("\n");
         assert!(
@@ -213,9 +215,10 @@ mod tests {
         let runs = moving_runs(6.0, &[line]);
         let (refs, m) = measured(&runs);
         let prior = SensorModel::default();
-        let w = short_white(&refs, &prior, &m, 7).unwrap();
-        assert!(!w.agrees && w.z >= WHITE_CHECK_Z, "{w:?}");
-        let Nominal { model, notes, .. } = nominal_model(&refs, &prior, Some(&m), Some(&w));
+        let w = short_white(&refs, &prior, &m, 7, Z).unwrap();
+        assert!(!w.agrees && w.z >= Z, "{w:?}");
+        let Nominal { model, notes, .. } =
+            nominal_model(&refs, &prior, Some(&m), Some(&w), &crate::Settings::DEFAULT);
         assert_eq!(model.arw_deg_per_rt_h, m.white_level_deg_per_rt_h);
         let text = notes.join("\n");
         assert!(text.contains("more there than white noise"), "{text}");

@@ -1,7 +1,8 @@
 //! "Where" statistics: named scalars of the residual rate per segment and stratum, and
 //! their z-scores against an ensemble of simulated runs.
 //!
-//! Definitions (every number below is a constant of this module):
+//! Definitions (every number below is a constant of this module or a setting of
+//! [`crate::settings::Statistics`], carried by [`Residuals::statistics`]):
 //! - **Reference rate**: the centred difference `(θ[i+h] − θ[i−h]) / (2h·dt)` of the
 //!   reference angle with `h = max(1, round(fs · W / 2))`, W =
 //!   [`gyro_analysis::xcorr::SMOOTH_WINDOW_S`] ([`gyro_analysis::xcorr::centred_difference`]). This is exactly
@@ -11,7 +12,7 @@
 //!   statistic.
 //! - **Residual rate**: gyro rate − reference rate (deg/s); the gyro rate is not smoothed.
 //! - **Segments**: `static` = runs of consecutive samples with |reference rate| <
-//!   [`STATIC_RATE_DPS`] lasting at least [`STATIC_MIN_S`]; `dynamic` = every other
+//!   `statistics.static_rate_dps` lasting at least `statistics.static_min_s`; `dynamic` = every other
 //!   sample that has a residual. The white-noise features use the static samples at
 //!   rest for the gyro too ([`Residuals::is_rest`]): a board tilted on a robot sees part
 //!   of the other axes' turns while this axis's reference rests.
@@ -27,7 +28,7 @@
 //! - `slope_vs_rate` (1): least-squares slope of residual on reference rate, with
 //!   intercept: `dynamic`, `dynamic/positive`, `dynamic/negative`.
 //! - `low_band_slope_vs_rate` (1): the same slope with gyro and reference rate both in
-//!   the low band (zero-phase Butterworth at `low_band::LOW_BAND_HZ`), the sign strata by
+//!   the low band (zero-phase Butterworth at `statistics.low_band_hz`), the sign strata by
 //!   the low-band reference rate: `dynamic`, `dynamic/positive`, `dynamic/negative`. A
 //!   gain read where a sensor's dynamics (a latency's phase, a roll-off above a few hertz)
 //!   leave it alone: the signature of `scale_factor` and `scale_asymmetry`.
@@ -44,10 +45,10 @@
 //! - `lag1_autocorrelation` (1): pooled lag-1 autocorrelation of the residual, mean
 //!   removed per contiguous run (whiteness; 0 for white noise): `static`, `dynamic`.
 //! - `xcorr_peak_lag_s` (s): lag of the peak of the cross-correlation of gyro rate and
-//!   reference rate (means removed) within ±[`MAX_LAG_S`], refined by a parabola through
+//!   reference rate (means removed) within ±`statistics.max_lag_s`, refined by a parabola through
 //!   the peak and its neighbours; positive when the gyro lags the reference: `all`.
 //! - `xcorr_lag_trend` (s/s): the slope of the lag line ([`crate::lag_line`]): the lag
-//!   read window by window through the run, tracked beyond ±[`MAX_LAG_S`] (a sample clock
+//!   read window by window through the run, tracked beyond ±`statistics.max_lag_s` (a sample clock
 //!   stamped by its own count lags more and more, up to seconds at 1–3%): `all`; left out
 //!   when fewer than three windows have motion.
 //! - `angle_error_rms_<H>s` (deg): RMS over non-overlapping windows of `H` s
@@ -56,6 +57,7 @@
 //!   run); windows with a sample lacking a residual are skipped: `all`.
 
 use crate::lag_line::lag_line;
+use crate::settings::Statistics;
 use gyro_analysis::noise::{AllanDeviation, ONE_SIGMA};
 pub use gyro_analysis::xcorr::{
     centred_difference, is_at_edge_of, smooth_half_width, xcorr_peak_lag_within, Overlap,
@@ -66,20 +68,6 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt;
 
-/// A sample is still when |reference rate| is below this (deg/s).
-/// The default `statistics.static_rate_dps` ([`crate::Settings`]), where the settings do not reach yet.
-pub const STATIC_RATE_DPS: f64 = crate::Settings::DEFAULT.statistics.static_rate_dps;
-/// Shortest still run counted as static (s).
-/// The default `statistics.static_min_s` ([`crate::Settings`]), where the settings do not reach yet.
-pub const STATIC_MIN_S: f64 = crate::Settings::DEFAULT.statistics.static_min_s;
-/// Averaging window of the gyro's stillness check (s).
-/// The default `statistics.gyro_still_window_s` ([`crate::Settings`]), where the settings do not reach yet.
-pub const GYRO_STILL_WINDOW_S: f64 = crate::Settings::DEFAULT.statistics.gyro_still_window_s;
-/// Left out at each end of a rest for the white-noise features (s): the reference rate is
-/// under [`STATIC_RATE_DPS`] on the first and last ramps of the turns around it, whose
-/// steps would count as noise.
-/// The default `statistics.rest_edge_s` ([`crate::Settings`]), where the settings do not reach yet.
-pub const REST_EDGE_S: f64 = crate::Settings::DEFAULT.statistics.rest_edge_s;
 /// Bins of |reference rate| of the dynamic samples (deg/s): `[lo, hi)`.
 pub const RATE_BINS_DPS: [(f64, f64); 4] = [
     (0.0, 30.0),
@@ -91,9 +79,6 @@ pub const RATE_BINS_DPS: [(f64, f64); 4] = [
 pub const ALLAN_BANDS_S: [(f64, f64); 3] = [(0.01, 0.1), (0.1, 1.0), (1.0, 10.0)];
 /// Averaging factors tried per Allan band (log-spaced, duplicates dropped).
 pub const ALLAN_FACTORS_PER_BAND: usize = 5;
-/// Largest lag searched by the cross-correlation (s).
-/// The default `statistics.max_lag_s` ([`crate::Settings`]), where the settings do not reach yet.
-pub const MAX_LAG_S: f64 = crate::Settings::DEFAULT.statistics.max_lag_s;
 /// Horizons of the angle error growth (s).
 pub const HORIZONS_S: [f64; 3] = [1.0, 5.0, 20.0];
 /// Absolute floor of the ensemble standard deviation in [`z_scores`].
@@ -155,8 +140,8 @@ pub struct Residuals {
     /// Whether the sample belongs to the static segment.
     pub is_static: Vec<bool>,
     /// Whether the sample is at rest for the gyro too: static, and the residual's mean
-    /// over [`GYRO_STILL_WINDOW_S`] within [`STATIC_RATE_DPS`] of its median over the
-    /// reference's rest, for at least [`STATIC_MIN_S`] once [`REST_EDGE_S`] is left out
+    /// over `statistics.gyro_still_window_s` within `statistics.static_rate_dps` of its median over the
+    /// reference's rest, for at least `statistics.static_min_s` once `statistics.rest_edge_s` is left out
     /// at each end (the white-noise statistics).
     pub is_rest: Vec<bool>,
     /// Gyro rate in the low band (deg/s; [`super::low_band`]), NaN where the reference
@@ -164,6 +149,9 @@ pub struct Residuals {
     pub low_rate_dps: Vec<f64>,
     /// Reference rate in the low band (deg/s), filtered on the same stretches.
     pub low_reference_rate_dps: Vec<f64>,
+    /// The settings these residuals were segmented with, and which their statistics and
+    /// features read (a real run and its simulations share them).
+    pub statistics: Statistics,
 }
 
 /// The gain of the reference rate's centred difference at `frequency_hz` (a boxcar of
@@ -181,7 +169,7 @@ pub fn reference_rate_gain(sample_rate_hz: f64, frequency_hz: f64) -> f64 {
 }
 
 /// Residual rate and static/dynamic segmentation of `log` (see the module documentation).
-pub fn residuals(log: &RegularLog) -> Result<Residuals, StatsError> {
+pub fn residuals(log: &RegularLog, statistics: &Statistics) -> Result<Residuals, StatsError> {
     if !log.has_reference {
         return Err(StatsError::NoReference);
     }
@@ -198,7 +186,14 @@ pub fn residuals(log: &RegularLog) -> Result<Residuals, StatsError> {
         .map(|s| s.temperature_c.unwrap_or(f64::NAN))
         .collect();
     let time_s = log.slots.iter().map(|s| s.time_s - t0).collect();
-    residuals_of(log.sample_rate_hz, time_s, rate, &reference, temperature)
+    residuals_of(
+        log.sample_rate_hz,
+        time_s,
+        rate,
+        &reference,
+        temperature,
+        statistics,
+    )
 }
 
 /// [`residuals`] of columns on a regular grid at `fs` (NaN where a reference is absent).
@@ -208,6 +203,7 @@ pub fn residuals_of(
     rate_dps: Vec<f64>,
     reference_deg: &[f64],
     temperature_c: Vec<f64>,
+    statistics: &Statistics,
 ) -> Result<Residuals, StatsError> {
     let n = rate_dps.len();
     let reference_rate_dps = centred_difference(reference_deg, fs);
@@ -223,9 +219,9 @@ pub fn residuals_of(
     }
     let still: Vec<bool> = reference_rate_dps
         .iter()
-        .map(|r| r.abs() < STATIC_RATE_DPS)
+        .map(|r| r.abs() < statistics.static_rate_dps)
         .collect();
-    let min_len = ((STATIC_MIN_S * fs).ceil() as usize).max(1);
+    let min_len = ((statistics.static_min_s * fs).ceil() as usize).max(1);
     let mut is_static = vec![false; n];
     let mut is_rest = vec![false; n];
     for run in runs(&still) {
@@ -233,8 +229,8 @@ pub fn residuals_of(
             continue;
         }
         is_static[run.clone()].iter_mut().for_each(|s| *s = true);
-        let gyro_still = gyro_still(&residual_dps[run.clone()], fs);
-        let edge = (REST_EDGE_S * fs).round() as usize;
+        let gyro_still = gyro_still(&residual_dps[run.clone()], fs, statistics);
+        let edge = (statistics.rest_edge_s * fs).round() as usize;
         for part in runs(&gyro_still) {
             if part.len() >= min_len + 2 * edge {
                 let part = run.start + part.start + edge..run.start + part.end - edge;
@@ -242,16 +238,17 @@ pub fn residuals_of(
             }
         }
     }
-    let (low_rate_dps, low_reference_rate_dps) = match super::low_band::cutoff_hz(fs) {
-        Some(cutoff) => {
-            let both = |i: usize| rate_dps[i].is_finite() && reference_rate_dps[i].is_finite();
-            (
-                super::low_band::zero_phase(&rate_dps, fs, cutoff, both),
-                super::low_band::zero_phase(&reference_rate_dps, fs, cutoff, both),
-            )
-        }
-        None => (vec![f64::NAN; n], vec![f64::NAN; n]),
-    };
+    let (low_rate_dps, low_reference_rate_dps) =
+        match super::low_band::cutoff_hz(fs, statistics.low_band_hz) {
+            Some(cutoff) => {
+                let both = |i: usize| rate_dps[i].is_finite() && reference_rate_dps[i].is_finite();
+                (
+                    super::low_band::zero_phase(&rate_dps, fs, cutoff, both),
+                    super::low_band::zero_phase(&reference_rate_dps, fs, cutoff, both),
+                )
+            }
+            None => (vec![f64::NAN; n], vec![f64::NAN; n]),
+        };
     Ok(Residuals {
         sample_rate_hz: fs,
         time_s,
@@ -264,23 +261,24 @@ pub fn residuals_of(
         is_rest,
         low_rate_dps,
         low_reference_rate_dps,
+        statistics: *statistics,
     })
 }
 
 /// Maximal runs of consecutive `true`.
 /// Per sample of a still reference's run, given the residual there (the gyro less the
 /// reference rate, so that the reference's own slow edges of a turn are not counted): its
-/// mean over [`GYRO_STILL_WINDOW_S`] (centred, inside the run, finite samples only) is
-/// within [`STATIC_RATE_DPS`] of its median over the run. A sample whose window holds no
+/// mean over `statistics.gyro_still_window_s` (centred, inside the run, finite samples only) is
+/// within `statistics.static_rate_dps` of its median over the run. A sample whose window holds no
 /// finite value shows no motion and counts as still.
-fn gyro_still(rate_dps: &[f64], fs: f64) -> Vec<bool> {
+fn gyro_still(rate_dps: &[f64], fs: f64, statistics: &Statistics) -> Vec<bool> {
     let mut finite: Vec<f64> = rate_dps.iter().copied().filter(|v| v.is_finite()).collect();
     if finite.is_empty() {
         return vec![true; rate_dps.len()];
     }
     finite.sort_by(f64::total_cmp);
     let median = finite[finite.len() / 2];
-    let half = ((GYRO_STILL_WINDOW_S * fs / 2.0).round() as usize).max(1);
+    let half = ((statistics.gyro_still_window_s * fs / 2.0).round() as usize).max(1);
     // Prefix sums of the finite values and of their count.
     let mut sum = vec![0.0; rate_dps.len() + 1];
     let mut count = vec![0usize; rate_dps.len() + 1];
@@ -293,7 +291,7 @@ fn gyro_still(rate_dps: &[f64], fs: f64) -> Vec<bool> {
         .map(|i| {
             let (lo, hi) = (i.saturating_sub(half), (i + half + 1).min(rate_dps.len()));
             let k = count[hi] - count[lo];
-            k == 0 || ((sum[hi] - sum[lo]) / k as f64).abs() < STATIC_RATE_DPS
+            k == 0 || ((sum[hi] - sum[lo]) / k as f64).abs() < statistics.static_rate_dps
         })
         .collect()
 }
@@ -325,7 +323,10 @@ pub fn stretches(n: usize, ok: impl Fn(usize) -> bool) -> Vec<std::ops::Range<us
 /// The "where" statistics of `log` (see the module documentation).
 #[cfg(test)]
 pub fn where_stats(log: &RegularLog) -> Result<Vec<Stat>, StatsError> {
-    Ok(stats_of(&residuals(log)?))
+    Ok(stats_of(&residuals(
+        log,
+        &crate::Settings::DEFAULT.statistics,
+    )?))
 }
 
 /// Statistics collector.
@@ -438,25 +439,25 @@ fn lag1(x: &[f64], runs: &[std::ops::Range<usize>]) -> Option<f64> {
 }
 
 /// The lag of `stats`' cross-correlation peak (`all`/`xcorr_peak_lag_s`, at sample rate
-/// `fs`) when it sits on the edge of the search (±[`MAX_LAG_S`]): then the true lag is at
+/// `fs`) when it sits on the edge of the search (±`statistics.max_lag_s`): then the true lag is at
 /// least that, and the value is cut, not measured.
-pub fn lag_at_search_edge(stats: &[Stat], fs: f64) -> Option<f64> {
+pub fn lag_at_search_edge(stats: &[Stat], fs: f64, max_lag_s: f64) -> Option<f64> {
     stats
         .iter()
         .find(|s| s.segment == "all" && s.statistic == "xcorr_peak_lag_s")
         .map(|s| s.value)
-        .filter(|v| is_at_search_edge(*v, fs))
+        .filter(|v| is_at_search_edge(*v, fs, max_lag_s))
 }
 
 /// True if a cross-correlation peak lag `lag_s` (at sample rate `fs`) sits on the edge of
-/// the search, ±[`MAX_LAG_S`] rounded to whole samples: the true lag is at least that.
-pub fn is_at_search_edge(lag_s: f64, fs: f64) -> bool {
-    is_at_edge_of(lag_s, fs, MAX_LAG_S)
+/// the search, ±`statistics.max_lag_s` rounded to whole samples: the true lag is at least that.
+pub fn is_at_search_edge(lag_s: f64, fs: f64, max_lag_s: f64) -> bool {
+    is_at_edge_of(lag_s, fs, max_lag_s)
 }
 
-/// [`xcorr_peak_lag_within`] ±[`MAX_LAG_S`], normalised by the overlap.
-fn xcorr_peak_lag(gyro: &[f64], reference: &[f64], fs: f64) -> Option<f64> {
-    xcorr_peak_lag_within(gyro, reference, fs, MAX_LAG_S, Overlap::Divide)
+/// [`xcorr_peak_lag_within`] ±`statistics.max_lag_s`, normalised by the overlap.
+fn xcorr_peak_lag(gyro: &[f64], reference: &[f64], fs: f64, max_lag_s: f64) -> Option<f64> {
+    xcorr_peak_lag_within(gyro, reference, fs, max_lag_s, Overlap::Divide)
 }
 
 /// Averaging factors for the Allan bands at `fs`.
@@ -685,15 +686,15 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
     if let Some(a) = lag1(&r.residual_dps, &runs(&dynamic)) {
         out.push("dynamic", "lag1_autocorrelation", a);
     }
-    if let Some(lag) = xcorr_peak_lag(&r.rate_dps, &r.reference_rate_dps, fs) {
-        out.push("all", "xcorr_peak_lag_s", lag);
-    }
-    if let Some(line) = lag_line(
+    if let Some(lag) = xcorr_peak_lag(
         &r.rate_dps,
         &r.reference_rate_dps,
         fs,
-        &crate::Settings::DEFAULT,
+        r.statistics.max_lag_s,
     ) {
+        out.push("all", "xcorr_peak_lag_s", lag);
+    }
+    if let Some(line) = lag_line(&r.rate_dps, &r.reference_rate_dps, fs, &r.statistics) {
         out.push("all", "xcorr_lag_trend", line.slope);
     }
 
@@ -766,6 +767,7 @@ mod tests {
     use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions};
 
     const FS: f64 = 200.0;
+    const MAX_LAG_S: f64 = crate::Settings::DEFAULT.statistics.max_lag_s;
 
     fn run(effects: &[Effect], seed: u64) -> Vec<Stat> {
         let model = SensorModel {
@@ -803,7 +805,15 @@ mod tests {
             .collect();
         rate[100] = f64::NAN;
         let time_s = (0..n).map(|i| i as f64 / fs).collect();
-        let r = residuals_of(fs, time_s, rate, &vec![10.0; n], vec![f64::NAN; n]).unwrap();
+        let r = residuals_of(
+            fs,
+            time_s,
+            rate,
+            &vec![10.0; n],
+            vec![f64::NAN; n],
+            &crate::Settings::DEFAULT.statistics,
+        )
+        .unwrap();
         let h = smooth_half_width(fs);
         // The 70 ms mean (±3 samples) leaves the rest 2 samples into the turn's window;
         // 10 samples (0.1 s) are left out at each end of a rest.
@@ -816,7 +826,15 @@ mod tests {
         // Without the turn, the whole reference rest is static, as before.
         let rate = vec![0.3; n];
         let time_s = (0..n).map(|i| i as f64 / fs).collect();
-        let r = residuals_of(fs, time_s, rate, &vec![10.0; n], vec![f64::NAN; n]).unwrap();
+        let r = residuals_of(
+            fs,
+            time_s,
+            rate,
+            &vec![10.0; n],
+            vec![f64::NAN; n],
+            &crate::Settings::DEFAULT.statistics,
+        )
+        .unwrap();
         assert!(r.is_rest[h + 10..n - h - 10].iter().all(|s| *s));
     }
 
@@ -889,9 +907,9 @@ mod tests {
         let slope = get(&late, "dynamic", "slope_vs_acceleration");
         assert!((slope + 0.01).abs() < 1e-3, "acceleration slope {slope}");
         // A lag beyond the search is cut at its edge, and said to be.
-        assert_eq!(lag_at_search_edge(&late, 1000.0), None);
+        assert_eq!(lag_at_search_edge(&late, 1000.0, MAX_LAG_S), None);
         let beyond = run(&[Effect::Latency { delay_s: 0.1 }], 1);
-        let cut = lag_at_search_edge(&beyond, 1000.0);
+        let cut = lag_at_search_edge(&beyond, 1000.0, MAX_LAG_S);
         assert_eq!(
             cut,
             Some(MAX_LAG_S),

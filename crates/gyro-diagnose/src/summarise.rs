@@ -233,7 +233,7 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
             .collect(),
         effective_noise: super::effective::EffectiveNoise {
             training: f.baseline.moving_noise.clone(),
-            holdout: super::effective::measure(&f.runs.holdout, "held-out")
+            holdout: super::effective::measure(&f.runs.holdout, "held-out", &f.settings.turns)
                 .map(|m| m.compared_to(f.baseline.own_noise.0, f.baseline.own_noise.1)),
         },
         motion_lines: [
@@ -329,7 +329,11 @@ fn lag_warnings(runs: &Runs, growing: bool) -> Vec<String> {
         .filter_map(|r| {
             Some((
                 *r,
-                super::stats::lag_at_search_edge(&r.stats, r.sample_rate_hz)?,
+                super::stats::lag_at_search_edge(
+                    &r.stats,
+                    r.sample_rate_hz,
+                    r.statistics.max_lag_s,
+                )?,
             ))
         })
         .collect();

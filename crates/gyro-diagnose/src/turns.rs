@@ -12,7 +12,7 @@
 //!   ±[`gyro_analysis::lag::SEARCH_S`] ([`gyro_analysis::lag::log_lag_s`]), median over the training runs;
 //! - **scale**: the least-squares slope of the training turns' errors on their reference
 //!   turns ([`scale::fit`]), named when it is `tests.z_critical` ([`crate::Settings`]) standard errors from zero, at
-//!   least [`MIN_K`], and the held-out runs' own turns show it too (their slope, before
+//!   least `turns.min_k`, and the held-out runs' own turns show it too (their slope, before
 //!   and after the correction: at most half of it left);
 //! - **untracked**: movements the gyro makes and the reference does not follow (a turn
 //!   about another axis seen through a mount off the reference's axes, or motion the
@@ -27,10 +27,6 @@ use super::compensate::{max_abs_errors, paired_gains};
 use super::ensemble::RealRun;
 use super::fit::t95;
 use super::score::bootstrap_p;
-use super::stats::MAX_LAG_S;
-
-/// Largest lag the per-sample cross-correlation statistic searches (s).
-pub const STATISTIC_LAG_S: f64 = MAX_LAG_S;
 use gyro_analysis::calibrate::scale::{self, MovementTotal};
 use gyro_analysis::model::ModelFile;
 use gyro_analysis::replay::{replay_with, ReplayOptions, RunReport};
@@ -39,12 +35,6 @@ use serde::Serialize;
 
 /// The rule for a movement the reference does not follow is `run`'s too: one home.
 pub use gyro_analysis::findings::{not_followed, UNTRACKED_FRACTION, UNTRACKED_MIN_DEG};
-
-/// Smallest scale error named (1 = 100%): 0.1% is 0.09° on a 90° turn, below what the
-/// totals of real turns resolve, and what the pipeline's own filtering and grid leave on
-/// noise-free turns (about 0.002%) must not be named however small its scatter.
-/// The default `turns.min_k` ([`crate::Settings`]), where the settings do not reach yet.
-pub const MIN_K: f64 = crate::Settings::DEFAULT.turns.min_k;
 
 /// The turn-level evidence of a diagnosis.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -72,7 +62,7 @@ pub struct WideLag {
     pub train_range_s: (f64, f64),
     /// Median over the held-out runs (s), if any has a peak.
     pub holdout_median_s: Option<f64>,
-    /// The lag lies beyond the per-sample statistic's search (±[`MAX_LAG_S`]): the
+    /// The lag lies beyond the per-sample statistic's search (±`statistics.max_lag_s`): the
     /// `latency` and `bandwidth` effects cannot be fitted or checked on it.
     pub beyond_statistic: bool,
     /// Median over the held-out runs of the max abs angle error without and with the lag
@@ -105,7 +95,7 @@ pub struct TurnScale {
     pub holdout_runs_better: (usize, usize),
     /// Bootstrap P over held-out runs that the correction does not lower their turn RMS.
     pub bootstrap_p: f64,
-    /// Named: `|z| ≥ tests.z_critical`, `|k| ≥` [`MIN_K`], and the held-out turns keep at
+    /// Named: `|z| ≥ tests.z_critical`, `|k| ≥` `turns.min_k`, and the held-out turns keep at
     /// most half of their slope with it.
     pub named: bool,
     /// Written into the model file's `config.correction.scale_k`: named, and it lowers
@@ -211,7 +201,7 @@ pub(crate) fn run_lags_s(runs: &[RealRun], growing: bool, settings: &crate::Sett
     runs.par_iter()
         .filter_map(|r| {
             if growing {
-                crate::lag_line::of_log(&r.log, settings).map(|l| l.intercept_s)
+                crate::lag_line::of_log(&r.log, &settings.statistics).map(|l| l.intercept_s)
             } else {
                 gyro_analysis::lag::log_lag_s(&r.log)
             }
@@ -223,8 +213,8 @@ pub(crate) fn run_lags_s(runs: &[RealRun], growing: bool, settings: &crate::Sett
 /// statistic's reach: the per-sample residual during turns is then the rate times the lag,
 /// which a fit of the residual on the rate reads as a scale, and the turns' totals, rest
 /// to rest, measure the scale instead.
-pub(crate) fn lag_beyond_statistic(lags_s: &[f64]) -> bool {
-    median(lags_s).is_some_and(|m| m.abs() > MAX_LAG_S)
+pub(crate) fn lag_beyond_statistic(lags_s: &[f64], max_lag_s: f64) -> bool {
+    median(lags_s).is_some_and(|m| m.abs() > max_lag_s)
 }
 
 /// The lag searched wide; written into `model` (and `changed` set) when it lies beyond
@@ -242,7 +232,7 @@ fn wide_lag(
     let lo = lags.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = lags.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let held = run_lags_s(holdout, growing, &options.settings);
-    let beyond_statistic = lag_beyond_statistic(lags);
+    let beyond_statistic = lag_beyond_statistic(lags, options.settings.statistics.max_lag_s);
     let mut out = WideLag {
         median_s,
         train_range_s: (lo, hi),
@@ -308,8 +298,9 @@ fn turn_scale(
 
     let z = k / se;
     let tests = &options.settings.tests;
-    let named =
-        z.abs() >= tests.z_critical && k.abs() >= MIN_K && k_after.abs() <= 0.5 * k_before.abs();
+    let named = z.abs() >= tests.z_critical
+        && k.abs() >= options.settings.turns.min_k
+        && k_after.abs() <= 0.5 * k_before.abs();
     let written = named && !paired.is_empty() && p < tests.p_value && rms_after < rms_before;
     if written {
         *model = trial;

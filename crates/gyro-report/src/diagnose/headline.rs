@@ -688,7 +688,7 @@ pub fn turn_lines(d: &Diagnosis) -> Vec<String> {
             1e3 * lag.median_s.abs(),
             1e3 * lo,
             1e3 * hi,
-            1e3 * gyro_diagnose::turns::STATISTIC_LAG_S
+            1e3 * gyro_diagnose::Settings::DEFAULT.statistics.max_lag_s
         ));
     }
     if let Some(s) = &t.scale {

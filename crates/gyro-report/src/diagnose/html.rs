@@ -20,7 +20,6 @@ use crate::plot::{render, sig, Figure, ImageFormat, RenderError};
 use gyro_diagnose::envelopes::{
     quantile, Bins, Envelopes, Measures, Moments, SimModel, PSD_BANDS_PER_DECADE,
 };
-use gyro_diagnose::MIN_TEMPERATURE_RANGE_C;
 use gyro_diagnose::{Diagnosis, EffectResult, Options};
 use gyro_sim::EFFECTS;
 use std::collections::BTreeMap;
@@ -351,7 +350,8 @@ fn residual_plot(f: &Envelopes) -> EnvelopePlot {
         ),
         None => Panel {
             empty: Some(format!(
-                "no temperature panel: the runs have no temperature, or it varies by less than {MIN_TEMPERATURE_RANGE_C} °C on static samples"
+                "no temperature panel: the runs have no temperature, or it varies by less than {} °C on static samples",
+                gyro_diagnose::Settings::DEFAULT.statistics.min_temperature_range_c
             )),
             ..Panel::default()
         },
