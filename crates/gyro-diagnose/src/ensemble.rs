@@ -10,7 +10,9 @@ use super::features::{
     coefficients, features, features_with_spectra, real_features, Features, N_REG, REGRESSORS,
     WANDER_TAUS_S,
 };
-use super::stats::{residuals, residuals_of, stats_of, Residuals, Stat, StatsError};
+use super::stats::{
+    residuals, residuals_of, stats_of, Residuals, Segment, Stat, Statistic, StatsError,
+};
 use crate::settings::{Reference as ReferenceSettings, Statistics};
 use gyro_analysis::seed::derive_seed;
 use gyro_log::RegularLog;
@@ -413,20 +415,20 @@ fn filled_reference(log: &RegularLog) -> Vec<f64> {
 /// (`all`, `wander_log10_avar_<τ>s`).
 pub fn feature_stats(f: &Features) -> Vec<Stat> {
     let mut out = Vec::new();
-    for (k, name) in REGRESSORS.iter().enumerate().skip(1) {
+    for k in 1..REGRESSORS.len() {
         if f.coef[k].is_finite() {
             out.push(Stat {
-                segment: "dynamic".into(),
-                statistic: format!("regression_{name}"),
+                segment: Segment::Dynamic,
+                statistic: Statistic::Regression(k),
                 value: f.coef[k],
             });
         }
     }
-    for (k, tau) in WANDER_TAUS_S.iter().enumerate() {
+    for k in 0..WANDER_TAUS_S.len() {
         if f.wander_avar[k] > 0.0 {
             out.push(Stat {
-                segment: "all".into(),
-                statistic: format!("wander_log10_avar_{tau}s"),
+                segment: Segment::All,
+                statistic: Statistic::WanderLog10Avar(k),
                 value: f.wander_avar[k].log10(),
             });
         }
@@ -799,7 +801,7 @@ mod tests {
         let lag = |run: &RealRun| {
             run.stats
                 .iter()
-                .find(|s| s.segment == "all" && s.statistic == "xcorr_peak_lag_s")
+                .find(|s| s.is(Segment::All, Statistic::XcorrPeakLag))
                 .map(|s| s.value)
         };
         let default = late_run(&crate::Settings::DEFAULT);
@@ -826,7 +828,7 @@ mod tests {
         let sim_lag = sim
             .stats
             .iter()
-            .find(|s| s.segment == "all" && s.statistic == "xcorr_peak_lag_s")
+            .find(|s| s.is(Segment::All, Statistic::XcorrPeakLag))
             .map(|s| s.value)
             .unwrap();
         assert!((sim_lag - 0.01).abs() < 0.0015, "{sim_lag}");

@@ -72,7 +72,7 @@ fn combine<'a>(
     for s in scores {
         for (i, (stat, z)) in s.z.iter().enumerate() {
             let e = combined
-                .entry((stat.segment.clone(), stat.statistic.clone()))
+                .entry((stat.segment.to_string(), stat.statistic.to_string()))
                 .or_default();
             if z.is_finite() {
                 e.z_sum += z;
@@ -155,9 +155,15 @@ pub(crate) fn unexplained(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stats::Stat;
+    use crate::stats::{Segment, Stat, Statistic};
 
-    fn run(entries: &[(&str, f64, f64, f64)]) -> RunScore {
+    const WANDER: Statistic = Statistic::WanderLog10Avar(0);
+    const NOISE: Statistic = Statistic::ResidualStd;
+    const SLOPE: Statistic = Statistic::SlopeVsRate;
+    const A: Statistic = Statistic::ResidualMean;
+    const B: Statistic = Statistic::ResidualStd;
+
+    fn run(entries: &[(Statistic, f64, f64, f64)]) -> RunScore {
         // (statistic, real value, ensemble mean, z)
         RunScore {
             z: entries
@@ -165,8 +171,8 @@ mod tests {
                 .map(|(name, value, _, z)| {
                     (
                         Stat {
-                            segment: "all".into(),
-                            statistic: (*name).into(),
+                            segment: Segment::All,
+                            statistic: *name,
                             value: *value,
                         },
                         *z,
@@ -188,19 +194,19 @@ mod tests {
         let after: Vec<RunScore> = (0..4)
             .map(|i| {
                 run(&[
-                    ("wander", 5.0, 2.0, 3.0),
-                    ("noise", 0.1, 0.0, if i % 2 == 0 { 1.5 } else { -1.5 }),
+                    (WANDER, 5.0, 2.0, 3.0),
+                    (NOISE, 0.1, 0.0, if i % 2 == 0 { 1.5 } else { -1.5 }),
                 ])
             })
             .collect();
         let before: Vec<RunScore> = (0..4)
-            .map(|_| run(&[("wander", 5.0, 1.0, 40.0), ("noise", 0.1, 0.0, 1.0)]))
+            .map(|_| run(&[(WANDER, 5.0, 1.0, 40.0), (NOISE, 0.1, 0.0, 1.0)]))
             .collect();
-        let holdout: Vec<RunScore> = (0..2).map(|_| run(&[("wander", 6.0, 2.0, 5.0)])).collect();
+        let holdout: Vec<RunScore> = (0..2).map(|_| run(&[(WANDER, 6.0, 2.0, 5.0)])).collect();
         let u = unexplained(&before, &after, &holdout, &Settings::DEFAULT);
         assert_eq!(u.len(), 1);
         let w = &u[0];
-        assert_eq!(w.statistic, "wander");
+        assert_eq!(w.statistic, "wander_log10_avar_1s");
         assert!((w.z_train - 6.0).abs() < 1e-12);
         assert!((w.z_train_nominal - 80.0).abs() < 1e-12);
         assert!((w.z_holdout - 10.0 / 2f64.sqrt()).abs() < 1e-12);
@@ -213,13 +219,11 @@ mod tests {
     fn the_last_percent_of_a_statistic_is_within_tolerance() {
         // Real 2.00, selected 1.98 with a spread of 0.002: z 10 per run, but 1% of the
         // value, within the 2% tolerance (tolerant z 0.5 per run, 1 over four).
-        let before: Vec<RunScore> = (0..4)
-            .map(|_| run(&[("slope", 2.0, 0.0, 1000.0)]))
-            .collect();
-        let after: Vec<RunScore> = (0..4).map(|_| run(&[("slope", 2.0, 1.98, 10.0)])).collect();
+        let before: Vec<RunScore> = (0..4).map(|_| run(&[(SLOPE, 2.0, 0.0, 1000.0)])).collect();
+        let after: Vec<RunScore> = (0..4).map(|_| run(&[(SLOPE, 2.0, 1.98, 10.0)])).collect();
         assert!(unexplained(&before, &after, &after, &Settings::DEFAULT).is_empty());
         // Selected 1.5: a quarter off (tolerant z 12.5 per run).
-        let after: Vec<RunScore> = (0..4).map(|_| run(&[("slope", 2.0, 1.5, 250.0)])).collect();
+        let after: Vec<RunScore> = (0..4).map(|_| run(&[(SLOPE, 2.0, 1.5, 250.0)])).collect();
         assert_eq!(
             unexplained(&before, &after, &after, &Settings::DEFAULT).len(),
             1
@@ -228,18 +232,18 @@ mod tests {
 
     #[test]
     fn a_model_that_fits_leaves_nothing_unexplained() {
-        let after: Vec<RunScore> = (0..5).map(|_| run(&[("a", 1.0, 1.0, 0.5)])).collect();
+        let after: Vec<RunScore> = (0..5).map(|_| run(&[(A, 1.0, 1.0, 0.5)])).collect();
         assert!(unexplained(&after, &after, &after, &Settings::DEFAULT).is_empty());
     }
 
     #[test]
     fn where_combines_by_stouffer_largest_first() {
         let scores = [
-            run(&[("a", 0.0, 0.0, 1.0), ("b", 0.0, 0.0, -3.0)]),
-            run(&[("a", 0.0, 0.0, 1.0), ("b", 0.0, 0.0, -3.0)]),
+            run(&[(A, 0.0, 0.0, 1.0), (B, 0.0, 0.0, -3.0)]),
+            run(&[(A, 0.0, 0.0, 1.0), (B, 0.0, 0.0, -3.0)]),
         ];
         let w = locate(scores.iter(), &Settings::DEFAULT);
-        assert_eq!(w[0].statistic, "b");
+        assert_eq!(w[0].statistic, "residual_std");
         assert!((w[0].z + 6.0 / 2f64.sqrt()).abs() < 1e-12);
         assert!((w[1].z - 2.0 / 2f64.sqrt()).abs() < 1e-12);
     }

@@ -40,34 +40,40 @@
 
 use super::fit::Fit;
 use super::score::RunScore;
+use super::stats::{Segment, Statistic};
 use serde::Serialize;
 
 /// The statistics (segment, statistic) that identify each effect.
-pub fn signature(id: &str) -> &'static [(&'static str, &'static str)] {
+pub fn signature(id: &str) -> &'static [(Segment, Statistic)] {
     match id {
-        "scale_factor" => &[("dynamic", "low_band_slope_vs_rate")],
+        "scale_factor" => &[(Segment::Dynamic, Statistic::LowBandSlopeVsRate)],
         "scale_asymmetry" => &[
-            ("dynamic/positive", "low_band_slope_vs_rate"),
-            ("dynamic/negative", "low_band_slope_vs_rate"),
+            (Segment::Positive, Statistic::LowBandSlopeVsRate),
+            (Segment::Negative, Statistic::LowBandSlopeVsRate),
         ],
-        "nonlinearity" => &[("dynamic", "cubic_vs_rate")],
-        "nonlinearity_even" => &[("dynamic", "quadratic_vs_rate")],
-        "latency" | "bandwidth" => &[("all", "xcorr_peak_lag_s")],
-        "clock_error_count_stamped" => &[("all", "xcorr_lag_trend")],
-        // Twelve windows per minute-long run: the 20 s rms has three, and its mean over a
-        // few runs is skewed by one run whose bias wandered far.
-        "bias_instability" | "rate_random_walk" => &[("all", "angle_error_rms_5s")],
+        "nonlinearity" => &[(Segment::Dynamic, Statistic::CubicVsRate)],
+        "nonlinearity_even" => &[(Segment::Dynamic, Statistic::QuadraticVsRate)],
+        "latency" | "bandwidth" => &[(Segment::All, Statistic::XcorrPeakLag)],
+        "clock_error_count_stamped" => &[(Segment::All, Statistic::XcorrLagTrend)],
+        // Twelve windows per minute-long run: the 20 s rms (horizon 2) has three, and its
+        // mean over a few runs is skewed by one run whose bias wandered far.
+        "bias_instability" | "rate_random_walk" => {
+            &[(Segment::All, Statistic::AngleErrorRms(FIVE_SECONDS))]
+        }
         _ => &[],
     }
 }
+
+/// The horizon of 5 s in [`crate::stats::HORIZONS_S`].
+const FIVE_SECONDS: usize = 1;
 
 /// One signature statistic checked.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SignatureCheck {
     /// Segment of the statistic.
-    pub segment: &'static str,
+    pub segment: Segment,
     /// The statistic.
-    pub statistic: &'static str,
+    pub statistic: Statistic,
     /// The real held-out runs' mean value.
     pub real: f64,
     /// The nominal ensembles' mean.
@@ -219,14 +225,14 @@ pub fn check(
 /// with the named set, with the effect alone) have it, for an effect whose parameter has
 /// relative standard deviation `relative_sd`.
 fn pooled(
-    (segment, statistic): (&'static str, &'static str),
+    (segment, statistic): (Segment, Statistic),
     [before, after, alone]: [&[RunScore]; 3],
     sample_rate_hz: f64,
     relative_sd: f64,
     settings: &crate::Settings,
 ) -> Option<SignatureCheck> {
     let interval_z = settings.tests.interval_z;
-    let lag = statistic == "xcorr_peak_lag_s";
+    let lag = statistic == Statistic::XcorrPeakLag;
     let find = |s: &RunScore| -> Option<(f64, f64, f64)> {
         let i =
             s.z.iter()
@@ -327,8 +333,8 @@ mod tests {
         RunScore {
             z: vec![(
                 Stat {
-                    segment: "all".into(),
-                    statistic: "xcorr_peak_lag_s".into(),
+                    segment: Segment::All,
+                    statistic: Statistic::XcorrPeakLag,
                     value,
                 },
                 (value - mean) / sd,
@@ -354,6 +360,11 @@ mod tests {
             assert!(EFFECTS.iter().any(|e| e.id == id), "{id}");
             assert!(!signature(id).is_empty(), "{id}");
         }
+        assert_eq!(crate::stats::HORIZONS_S[FIVE_SECONDS], 5.0);
+        assert_eq!(
+            signature("rate_random_walk")[0].1.to_string(),
+            "angle_error_rms_5s"
+        );
     }
 
     #[test]

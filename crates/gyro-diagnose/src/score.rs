@@ -22,7 +22,7 @@
 //! improvement.
 
 use super::ensemble::Member;
-use super::stats::{z_scores, Stat, STD_FLOOR_ABS, STD_FLOOR_REL};
+use super::stats::{z_scores, Segment, Stat, Statistic, STD_FLOOR_ABS, STD_FLOOR_REL};
 use std::collections::BTreeMap;
 
 /// One run scored against one ensemble.
@@ -50,12 +50,12 @@ pub fn score(real: &[Stat], members: &[Member], likelihood_dof: f64) -> RunScore
 
 fn score_stats(real: &[Stat], ensemble: &[Vec<Stat>], likelihood_dof: f64) -> RunScore {
     let z = z_scores(real, ensemble);
-    let mut values: BTreeMap<(&str, &str), (f64, f64, usize)> = BTreeMap::new();
+    let mut values: BTreeMap<(Segment, Statistic), (f64, f64, usize)> = BTreeMap::new();
     for run in ensemble {
         for s in run {
             if s.value.is_finite() {
                 let e = values
-                    .entry((s.segment.as_str(), s.statistic.as_str()))
+                    .entry((s.segment, s.statistic))
                     .or_insert((0.0, 0.0, 0));
                 e.0 += s.value;
                 e.1 += s.value * s.value;
@@ -65,8 +65,7 @@ fn score_stats(real: &[Stat], ensemble: &[Vec<Stat>], likelihood_dof: f64) -> Ru
     }
     let mut out = RunScore::default();
     for (stat, zv) in &z {
-        let Some(&(sum, sum2, n)) = values.get(&(stat.segment.as_str(), stat.statistic.as_str()))
-        else {
+        let Some(&(sum, sum2, n)) = values.get(&(stat.segment, stat.statistic)) else {
             out.moments.push((f64::NAN, f64::NAN));
             continue;
         };

@@ -23,6 +23,9 @@
 //!   only if the log has temperatures) and by time since start in thirds of the run
 //!   (`<seg>/time_1..3`).
 //!
+//! A statistic is keyed by its [`Segment`] and its [`Statistic`] (enums); the names below
+//! are theirs as written (`Display`, and the strings of the JSON).
+//!
 //! Statistics (name: segment(s)):
 //! - `residual_mean`, `residual_std` (deg/s): every segment and stratum with ≥ 2 samples.
 //! - `slope_vs_rate` (1): least-squares slope of residual on reference rate, with
@@ -87,15 +90,165 @@ pub const STD_FLOOR_ABS: f64 = 1e-12;
 /// max(|ensemble mean|, |real|).
 pub const STD_FLOOR_REL: f64 = 1e-3;
 
-/// One named scalar statistic of one segment or stratum.
+/// The samples a statistic reads: a segment or a stratum of one (see the module
+/// documentation). Written as its name (`Display`, and as a string in JSON): `all`,
+/// `static`, `dynamic/rate_30_100`, `static/time_2`, …
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Segment {
+    /// Every sample with a residual: `all`.
+    All,
+    /// `static`.
+    Static,
+    /// `dynamic`.
+    Dynamic,
+    /// `dynamic/rate_<lo>_<hi>`: the dynamic samples in bin `i` of [`RATE_BINS_DPS`].
+    RateBin(usize),
+    /// `dynamic/positive`: the reference turning positive.
+    Positive,
+    /// `dynamic/negative`.
+    Negative,
+    /// `<part>/time_<k + 1>`: third `k` (0–2) of the run.
+    Time(Part, usize),
+    /// `<part>/temperature_<k + 1>`: temperature tercile `k` (0–2) of the run.
+    Temperature(Part, usize),
+}
+
+/// The two parts every sample with a residual falls in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Part {
+    /// `static`.
+    Static,
+    /// `dynamic`.
+    Dynamic,
+}
+
+impl Part {
+    /// Both, in the order the statistics list them.
+    pub const BOTH: [Part; 2] = [Part::Static, Part::Dynamic];
+
+    fn name(self) -> &'static str {
+        match self {
+            Part::Static => "static",
+            Part::Dynamic => "dynamic",
+        }
+    }
+}
+
+impl fmt::Display for Segment {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Segment::All => f.write_str("all"),
+            Segment::Static => f.write_str("static"),
+            Segment::Dynamic => f.write_str("dynamic"),
+            Segment::RateBin(b) => match RATE_BINS_DPS.get(b) {
+                Some((lo, hi)) if hi.is_finite() => write!(f, "dynamic/rate_{lo}_{hi}"),
+                Some((lo, _)) => write!(f, "dynamic/rate_{lo}_inf"),
+                None => write!(f, "dynamic/rate_bin_{b}"),
+            },
+            Segment::Positive => f.write_str("dynamic/positive"),
+            Segment::Negative => f.write_str("dynamic/negative"),
+            Segment::Time(part, k) => write!(f, "{}/time_{}", part.name(), k + 1),
+            Segment::Temperature(part, k) => write!(f, "{}/temperature_{}", part.name(), k + 1),
+        }
+    }
+}
+
+/// What a statistic measures (see the module documentation for each). Written as its
+/// name: `residual_mean`, `allan_log10_adev_0.1_1s`, `regression_abs_rate`, …
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Statistic {
+    /// `residual_mean` (deg/s).
+    ResidualMean,
+    /// `residual_std` (deg/s).
+    ResidualStd,
+    /// `slope_vs_rate` (1).
+    SlopeVsRate,
+    /// `low_band_slope_vs_rate` (1).
+    LowBandSlopeVsRate,
+    /// `slope_vs_acceleration` (s).
+    SlopeVsAcceleration,
+    /// `quadratic_vs_rate` (1/(deg/s)).
+    QuadraticVsRate,
+    /// `cubic_vs_rate` (1/(deg/s)²).
+    CubicVsRate,
+    /// `allan_log10_adev_<lo>_<hi>s`: band `i` of [`ALLAN_BANDS_S`].
+    AllanLog10Adev(usize),
+    /// `lag1_autocorrelation` (1).
+    Lag1Autocorrelation,
+    /// `xcorr_peak_lag_s` (s).
+    XcorrPeakLag,
+    /// `xcorr_lag_trend` (s/s).
+    XcorrLagTrend,
+    /// `angle_error_rms_<h>s` (deg): horizon `i` of [`HORIZONS_S`].
+    AngleErrorRms(usize),
+    /// `regression_<name>`: regressor `k` of [`crate::features::REGRESSORS`].
+    Regression(usize),
+    /// `wander_log10_avar_<tau>s`: τ `i` of [`crate::features::WANDER_TAUS_S`].
+    WanderLog10Avar(usize),
+}
+
+impl fmt::Display for Statistic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use crate::features::{REGRESSORS, WANDER_TAUS_S};
+        match *self {
+            Statistic::ResidualMean => f.write_str("residual_mean"),
+            Statistic::ResidualStd => f.write_str("residual_std"),
+            Statistic::SlopeVsRate => f.write_str("slope_vs_rate"),
+            Statistic::LowBandSlopeVsRate => f.write_str("low_band_slope_vs_rate"),
+            Statistic::SlopeVsAcceleration => f.write_str("slope_vs_acceleration"),
+            Statistic::QuadraticVsRate => f.write_str("quadratic_vs_rate"),
+            Statistic::CubicVsRate => f.write_str("cubic_vs_rate"),
+            Statistic::AllanLog10Adev(i) => match ALLAN_BANDS_S.get(i) {
+                Some((lo, hi)) => write!(f, "allan_log10_adev_{lo}_{hi}s"),
+                None => write!(f, "allan_log10_adev_band_{i}"),
+            },
+            Statistic::Lag1Autocorrelation => f.write_str("lag1_autocorrelation"),
+            Statistic::XcorrPeakLag => f.write_str("xcorr_peak_lag_s"),
+            Statistic::XcorrLagTrend => f.write_str("xcorr_lag_trend"),
+            Statistic::AngleErrorRms(i) => match HORIZONS_S.get(i) {
+                Some(h) => write!(f, "angle_error_rms_{h}s"),
+                None => write!(f, "angle_error_rms_horizon_{i}"),
+            },
+            Statistic::Regression(k) => match REGRESSORS.get(k) {
+                Some(name) => write!(f, "regression_{name}"),
+                None => write!(f, "regression_{k}"),
+            },
+            Statistic::WanderLog10Avar(i) => match WANDER_TAUS_S.get(i) {
+                Some(tau) => write!(f, "wander_log10_avar_{tau}s"),
+                None => write!(f, "wander_log10_avar_tau_{i}"),
+            },
+        }
+    }
+}
+
+/// Written as their names in JSON (the contract of `docs/diagnose-json.md`).
+macro_rules! serialize_as_name {
+    ($($t:ty),*) => {$(
+        impl Serialize for $t {
+            fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+                serializer.collect_str(self)
+            }
+        }
+    )*};
+}
+serialize_as_name!(Segment, Statistic);
+
+/// One scalar statistic of one segment or stratum.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Stat {
     /// Segment or stratum, e.g. `static`, `dynamic/rate_30_100`, `all`.
-    pub segment: String,
+    pub segment: Segment,
     /// Statistic, e.g. `residual_mean`, `slope_vs_rate`.
-    pub statistic: String,
+    pub statistic: Statistic,
     /// Value (units depend on the statistic; see the module documentation).
     pub value: f64,
+}
+
+impl Stat {
+    /// Whether it is `statistic` of `segment`.
+    pub fn is(&self, segment: Segment, statistic: Statistic) -> bool {
+        self.segment == segment && self.statistic == statistic
+    }
 }
 
 /// Why the statistics cannot be computed.
@@ -333,11 +486,11 @@ pub fn where_stats(log: &RegularLog) -> Result<Vec<Stat>, StatsError> {
 struct Out(Vec<Stat>);
 
 impl Out {
-    fn push(&mut self, segment: &str, statistic: &str, value: f64) {
+    fn push(&mut self, segment: Segment, statistic: Statistic, value: f64) {
         if value.is_finite() {
             self.0.push(Stat {
-                segment: segment.to_string(),
-                statistic: statistic.to_string(),
+                segment,
+                statistic,
                 value,
             });
         }
@@ -444,7 +597,7 @@ fn lag1(x: &[f64], runs: &[std::ops::Range<usize>]) -> Option<f64> {
 pub fn lag_at_search_edge(stats: &[Stat], fs: f64, max_lag_s: f64) -> Option<f64> {
     stats
         .iter()
-        .find(|s| s.segment == "all" && s.statistic == "xcorr_peak_lag_s")
+        .find(|s| s.is(Segment::All, Statistic::XcorrPeakLag))
         .map(|s| s.value)
         .filter(|v| is_at_search_edge(*v, fs, max_lag_s))
 }
@@ -478,7 +631,6 @@ fn allan_factors(fs: f64) -> Vec<usize> {
     factors
 }
 
-/// Residual mean and std of `values`, pushed as `segment`.
 /// Running mean and sum of squared deviations (Welford).
 #[derive(Clone, Copy, Default)]
 struct Welford {
@@ -498,6 +650,84 @@ impl Welford {
     /// Mean and sample standard deviation (n − 1), from 2 values on.
     fn mean_std(&self) -> Option<(f64, f64)> {
         (self.n >= 2).then(|| (self.mean, (self.m2 / (self.n - 1) as f64).max(0.0).sqrt()))
+    }
+}
+
+/// Welford accumulators of the residual for every segment and stratum, filled in one pass
+/// over the samples.
+#[derive(Default)]
+struct Moments {
+    all: Welford,
+    /// Static, dynamic.
+    parts: [Welford; 2],
+    rate_bins: [Welford; RATE_BINS_DPS.len()],
+    positive: Welford,
+    negative: Welford,
+    /// Per part, per third of the run.
+    time: [[Welford; 3]; 2],
+    /// Per part, per temperature tercile.
+    temperature: [[Welford; 3]; 2],
+}
+
+impl Part {
+    /// The segment of all its samples.
+    fn segment(self) -> Segment {
+        match self {
+            Part::Static => Segment::Static,
+            Part::Dynamic => Segment::Dynamic,
+        }
+    }
+
+    fn index(self) -> usize {
+        match self {
+            Part::Static => 0,
+            Part::Dynamic => 1,
+        }
+    }
+}
+
+impl Moments {
+    /// The segments, in the order their statistics are listed; the temperature terciles
+    /// only when the run has temperatures.
+    fn segments(temperature: bool) -> Vec<Segment> {
+        let mut out = vec![Segment::All, Segment::Static, Segment::Dynamic];
+        out.extend((0..RATE_BINS_DPS.len()).map(Segment::RateBin));
+        out.extend([Segment::Positive, Segment::Negative]);
+        for part in Part::BOTH {
+            for k in 0..3 {
+                out.push(Segment::Time(part, k));
+                if temperature {
+                    out.push(Segment::Temperature(part, k));
+                }
+            }
+        }
+        out
+    }
+
+    fn get(&self, segment: Segment) -> Option<&Welford> {
+        Some(match segment {
+            Segment::All => &self.all,
+            Segment::Static => &self.parts[0],
+            Segment::Dynamic => &self.parts[1],
+            Segment::RateBin(b) => self.rate_bins.get(b)?,
+            Segment::Positive => &self.positive,
+            Segment::Negative => &self.negative,
+            Segment::Time(part, k) => self.time[part.index()].get(k)?,
+            Segment::Temperature(part, k) => self.temperature[part.index()].get(k)?,
+        })
+    }
+
+    fn get_mut(&mut self, segment: Segment) -> Option<&mut Welford> {
+        Some(match segment {
+            Segment::All => &mut self.all,
+            Segment::Static => &mut self.parts[0],
+            Segment::Dynamic => &mut self.parts[1],
+            Segment::RateBin(b) => self.rate_bins.get_mut(b)?,
+            Segment::Positive => &mut self.positive,
+            Segment::Negative => &mut self.negative,
+            Segment::Time(part, k) => self.time[part.index()].get_mut(k)?,
+            Segment::Temperature(part, k) => self.temperature[part.index()].get_mut(k)?,
+        })
     }
 }
 
@@ -521,15 +751,8 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
     let dynamic: Vec<bool> = (0..n).map(|i| valid[i] && !r.is_static[i]).collect();
     let mut out = Out(Vec::new());
 
-    // Moments of every segment and stratum in one pass (Welford accumulators).
-    const ALL: usize = 0;
-    const STATIC: usize = 1;
-    const DYNAMIC: usize = 2;
-    const BIN0: usize = 3; // 4 rate bins
-    const POSITIVE: usize = 7;
-    const NEGATIVE: usize = 8;
-    const SEGS: usize = 9; // [seg][k]: time at 9 + 6·seg + k, temperature at 12 + 6·seg + k
-    let mut acc = [Welford::default(); 21];
+    // Moments of every segment and stratum in one pass.
+    let mut moments = Moments::default();
     let tercile = |x: f64, (a, b): (f64, f64)| -> usize {
         if x < a {
             0
@@ -552,60 +775,42 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
             continue;
         }
         let x = r.residual_dps[i];
-        acc[ALL].add(x);
-        let seg = if r.is_static[i] {
-            acc[STATIC].add(x);
-            0
+        let mut add = |segment: Segment| {
+            if let Some(a) = moments.get_mut(segment) {
+                a.add(x);
+            }
+        };
+        add(Segment::All);
+        let part = if r.is_static[i] {
+            Part::Static
         } else {
-            acc[DYNAMIC].add(x);
+            Part::Dynamic
+        };
+        add(part.segment());
+        if part == Part::Dynamic {
             let w = r.reference_rate_dps[i];
             let a = w.abs();
             if let Some(b) = RATE_BINS_DPS.iter().position(|&(lo, hi)| a >= lo && a < hi) {
-                acc[BIN0 + b].add(x);
+                add(Segment::RateBin(b));
             }
             if w > 0.0 {
-                acc[POSITIVE].add(x);
+                add(Segment::Positive);
             } else if w < 0.0 {
-                acc[NEGATIVE].add(x);
+                add(Segment::Negative);
             }
-            1
-        };
-        acc[SEGS + 6 * seg + third(i)].add(x);
+        }
+        add(Segment::Time(part, third(i)));
         if let Some(cuts) = temp_cuts {
             let t = r.temperature_c[i];
             if t.is_finite() {
-                acc[SEGS + 3 + 6 * seg + tercile(t, cuts)].add(x);
+                add(Segment::Temperature(part, tercile(t, cuts)));
             }
         }
     }
-    let mut moments = |segment: &str, a: &Welford| {
-        if let Some((mean, std)) = a.mean_std() {
-            out.push(segment, "residual_mean", mean);
-            out.push(segment, "residual_std", std);
-        }
-    };
-    moments("all", &acc[ALL]);
-    moments("static", &acc[STATIC]);
-    moments("dynamic", &acc[DYNAMIC]);
-    for (b, (lo, hi)) in RATE_BINS_DPS.iter().enumerate() {
-        let name = if hi.is_finite() {
-            format!("dynamic/rate_{lo}_{hi}")
-        } else {
-            format!("dynamic/rate_{lo}_inf")
-        };
-        moments(&name, &acc[BIN0 + b]);
-    }
-    moments("dynamic/positive", &acc[POSITIVE]);
-    moments("dynamic/negative", &acc[NEGATIVE]);
-    for (seg, name) in ["static", "dynamic"].iter().enumerate() {
-        for k in 0..3 {
-            moments(&format!("{name}/time_{}", k + 1), &acc[SEGS + 6 * seg + k]);
-            if temp_cuts.is_some() {
-                moments(
-                    &format!("{name}/temperature_{}", k + 1),
-                    &acc[SEGS + 3 + 6 * seg + k],
-                );
-            }
+    for segment in Moments::segments(temp_cuts.is_some()) {
+        if let Some((mean, std)) = moments.get(segment).and_then(Welford::mean_std) {
+            out.push(segment, Statistic::ResidualMean, mean);
+            out.push(segment, Statistic::ResidualStd, std);
         }
     }
 
@@ -618,13 +823,13 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
     };
     let all_points = points(&|_| true);
     if let Some(s) = slope(&all_points) {
-        out.push("dynamic", "slope_vs_rate", s);
+        out.push(Segment::Dynamic, Statistic::SlopeVsRate, s);
     }
     if let Some(s) = slope(&points(&|x| x > 0.0)) {
-        out.push("dynamic/positive", "slope_vs_rate", s);
+        out.push(Segment::Positive, Statistic::SlopeVsRate, s);
     }
     if let Some(s) = slope(&points(&|x| x < 0.0)) {
-        out.push("dynamic/negative", "slope_vs_rate", s);
+        out.push(Segment::Negative, Statistic::SlopeVsRate, s);
     }
     // The same in the low band, where a gain is read (`low_band`).
     let low_points = |keep: &dyn Fn(f64) -> bool| -> Vec<(f64, f64)> {
@@ -636,12 +841,12 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
             .collect()
     };
     for (segment, keep) in [
-        ("dynamic", &(|_| true) as &dyn Fn(f64) -> bool),
-        ("dynamic/positive", &|w| w > 0.0),
-        ("dynamic/negative", &|w| w < 0.0),
+        (Segment::Dynamic, &(|_| true) as &dyn Fn(f64) -> bool),
+        (Segment::Positive, &|w| w > 0.0),
+        (Segment::Negative, &|w| w < 0.0),
     ] {
         if let Some(s) = slope(&low_points(keep)) {
-            out.push(segment, "low_band_slope_vs_rate", s);
+            out.push(segment, Statistic::LowBandSlopeVsRate, s);
         }
     }
     let accel_points: Vec<(f64, f64)> = (0..n)
@@ -649,11 +854,11 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
         .map(|i| (r.reference_acceleration_dps2[i], r.residual_dps[i]))
         .collect();
     if let Some(s) = slope(&accel_points) {
-        out.push("dynamic", "slope_vs_acceleration", s);
+        out.push(Segment::Dynamic, Statistic::SlopeVsAcceleration, s);
     }
     if let Some([c2, c3]) = cubic(&all_points) {
-        out.push("dynamic", "quadratic_vs_rate", c2);
-        out.push("dynamic", "cubic_vs_rate", c3);
+        out.push(Segment::Dynamic, Statistic::QuadraticVsRate, c2);
+        out.push(Segment::Dynamic, Statistic::CubicVsRate, c3);
     }
 
     // Static Allan deviation per τ band.
@@ -664,7 +869,7 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
         .collect();
     if !segments.is_empty() {
         let allan = AllanDeviation::compute(&segments, fs, &allan_factors(fs), ONE_SIGMA);
-        for (lo, hi) in ALLAN_BANDS_S {
+        for (band, (lo, hi)) in ALLAN_BANDS_S.into_iter().enumerate() {
             let logs: Vec<f64> = allan
                 .points
                 .iter()
@@ -674,17 +879,17 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
                 .collect();
             if !logs.is_empty() {
                 let mean = logs.iter().sum::<f64>() / logs.len() as f64;
-                out.push("static", &format!("allan_log10_adev_{lo}_{hi}s"), mean);
+                out.push(Segment::Static, Statistic::AllanLog10Adev(band), mean);
             }
         }
     }
 
     // Whiteness.
     if let Some(a) = lag1(&r.residual_dps, &static_runs) {
-        out.push("static", "lag1_autocorrelation", a);
+        out.push(Segment::Static, Statistic::Lag1Autocorrelation, a);
     }
     if let Some(a) = lag1(&r.residual_dps, &runs(&dynamic)) {
-        out.push("dynamic", "lag1_autocorrelation", a);
+        out.push(Segment::Dynamic, Statistic::Lag1Autocorrelation, a);
     }
     if let Some(lag) = xcorr_peak_lag(
         &r.rate_dps,
@@ -692,18 +897,19 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
         fs,
         r.statistics.max_lag_s,
     ) {
-        out.push("all", "xcorr_peak_lag_s", lag);
+        out.push(Segment::All, Statistic::XcorrPeakLag, lag);
     }
     if let Some(line) = lag_line(&r.rate_dps, &r.reference_rate_dps, fs, &r.statistics) {
-        out.push("all", "xcorr_lag_trend", line.slope);
+        out.push(Segment::All, Statistic::XcorrLagTrend, line.slope);
     }
 
     // Angle error growth.
-    let bias = acc[STATIC]
-        .mean_std()
-        .or_else(|| acc[ALL].mean_std())
+    let bias = moments
+        .get(Segment::Static)
+        .and_then(Welford::mean_std)
+        .or_else(|| moments.get(Segment::All).and_then(Welford::mean_std))
         .map_or(0.0, |(m, _)| m);
-    for h in HORIZONS_S {
+    for (horizon, h) in HORIZONS_S.into_iter().enumerate() {
         let len = (h * fs).round() as usize;
         if len == 0 {
             continue;
@@ -716,7 +922,7 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
             .collect();
         if !errors.is_empty() {
             let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
-            out.push("all", &format!("angle_error_rms_{h}s"), rms);
+            out.push(Segment::All, Statistic::AngleErrorRms(horizon), rms);
         }
     }
     out.0
@@ -732,12 +938,12 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
 ///   so a statistic constant over the ensemble gives z = 0 when real equals it and a large
 ///   but finite z otherwise.
 pub fn z_scores(real: &[Stat], ensemble: &[Vec<Stat>]) -> Vec<(Stat, f64)> {
-    let mut values: BTreeMap<(&str, &str), Vec<f64>> = BTreeMap::new();
+    let mut values: BTreeMap<(Segment, Statistic), Vec<f64>> = BTreeMap::new();
     for run in ensemble {
         for s in run {
             if s.value.is_finite() {
                 values
-                    .entry((s.segment.as_str(), s.statistic.as_str()))
+                    .entry((s.segment, s.statistic))
                     .or_default()
                     .push(s.value);
             }
@@ -746,7 +952,7 @@ pub fn z_scores(real: &[Stat], ensemble: &[Vec<Stat>]) -> Vec<(Stat, f64)> {
     real.iter()
         .map(|s| {
             let z = match values
-                .get(&(s.segment.as_str(), s.statistic.as_str()))
+                .get(&(s.segment, s.statistic))
                 .and_then(|v| mean_std(v))
             {
                 None => f64::NAN,
@@ -787,7 +993,7 @@ mod tests {
     fn get(stats: &[Stat], segment: &str, statistic: &str) -> f64 {
         stats
             .iter()
-            .find(|s| s.segment == segment && s.statistic == statistic)
+            .find(|s| s.segment.to_string() == segment && s.statistic.to_string() == statistic)
             .map(|s| s.value)
             .unwrap_or_else(|| panic!("missing {segment} {statistic}"))
     }
@@ -938,29 +1144,25 @@ mod tests {
         let z = z_scores(&run(&[Effect::ScaleFactor { k: 0.01 }], 1), &ensemble);
         let slope = z
             .iter()
-            .find(|(s, _)| s.segment == "dynamic" && s.statistic == "slope_vs_rate")
+            .find(|(s, _)| s.is(Segment::Dynamic, Statistic::SlopeVsRate))
             .unwrap();
         assert!(slope.1.abs() > 5.0, "slope z {}", slope.1);
     }
 
     #[test]
     fn z_scores_explicit_cases() {
-        let stat = |segment: &str, value: f64| Stat {
-            segment: segment.into(),
-            statistic: "x".into(),
+        let stat = |segment: Segment, value: f64| Stat {
+            segment,
+            statistic: Statistic::ResidualMean,
             value,
         };
+        let (a, b, c) = (Segment::All, Segment::Static, Segment::Dynamic);
         let ensemble = vec![
-            vec![stat("a", 1.0), stat("c", 2.0)],
-            vec![stat("a", 3.0), stat("c", 2.0)],
+            vec![stat(a, 1.0), stat(c, 2.0)],
+            vec![stat(a, 3.0), stat(c, 2.0)],
         ];
         let z = z_scores(
-            &[
-                stat("a", 4.0),
-                stat("b", 1.0),
-                stat("c", 2.0),
-                stat("c", 3.0),
-            ],
+            &[stat(a, 4.0), stat(b, 1.0), stat(c, 2.0), stat(c, 3.0)],
             &ensemble,
         );
         // mean 2, std √2.
