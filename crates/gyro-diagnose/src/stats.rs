@@ -770,8 +770,8 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
         .max(f64::MIN_POSITIVE);
     let third = |i: usize| ((3.0 * r.time_s[i] / duration).floor() as usize).min(2);
     let temp_cuts = terciles(&r.temperature_c);
-    for i in 0..n {
-        if !valid[i] {
+    for (i, &ok) in valid.iter().enumerate() {
+        if !ok {
             continue;
         }
         let x = r.residual_dps[i];
