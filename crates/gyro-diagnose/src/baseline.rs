@@ -3,8 +3,10 @@
 
 use super::effective::{measure, MeasuredNoise};
 use super::ensemble::{ensembles, Member, RealRun};
+use super::features::WANDER_TAUS_S;
 use super::score::{self, gap, score, RunScore};
 use super::short_white::short_white;
+use super::stats::{Segment, Statistic};
 use super::{fit, Options, Progress};
 use gyro_sim::{Effect, SensorModel};
 
@@ -130,7 +132,7 @@ pub(crate) fn baseline(
         ),
         _ => None,
     };
-    let (nominal, notes, white_target, whiteness) = if options.fixed_model {
+    let (mut nominal, mut notes, white_target, whiteness) = if options.fixed_model {
         let mut m = options.prior;
         if let Some(first) = runs.train.first() {
             m.sample_rate_hz = first.sample_rate_hz;
@@ -199,7 +201,7 @@ pub(crate) fn baseline(
         "baseline ensembles",
         (m * (runs.train.len() + runs.holdout.len())) as u64,
     );
-    let train = evaluate(
+    let mut train = evaluate(
         &runs.train,
         &runs.train_ids,
         &nominal,
@@ -208,6 +210,33 @@ pub(crate) fn baseline(
         m,
         progress,
     );
+    let wander = (!options.fixed_model)
+        .then(|| wander_allowed(&train, &nominal, options.settings.tests.z_critical))
+        .flatten();
+    if let Some(w) = wander {
+        notes.push(format!(
+            "bias wander: the training runs' Allan variance at {} s lies below the model's beyond chance (z {:.1}); the part above the white noise is {:.2} of the model's, so the Gauss-Markov sigma is lowered from {:.4} to {:.4} deg/s and the runs simulated again (never raised: a larger wander is an effect to name)",
+            WANDER_TAUS_S[WANDER_TAUS_S.len() - 1],
+            w.z,
+            w.ratio,
+            nominal.gm_sigma_dps,
+            w.sigma_dps
+        ));
+        nominal.gm_sigma_dps = w.sigma_dps;
+        progress.stage(
+            "baseline ensembles, the wander lowered",
+            (m * (runs.train.len() + runs.holdout.len())) as u64,
+        );
+        train = evaluate(
+            &runs.train,
+            &runs.train_ids,
+            &nominal,
+            &[],
+            options,
+            m,
+            progress,
+        );
+    }
     let holdout = evaluate(
         &runs.holdout,
         &runs.holdout_ids,
@@ -239,5 +268,130 @@ pub(crate) fn baseline(
         train,
         holdout,
         floor,
+    }
+}
+
+/// The bias wander the training runs allow, below the nominal model's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct WanderAllowed {
+    /// The Gauss–Markov σ (deg/s) whose wander matches the runs'.
+    sigma_dps: f64,
+    /// The runs' wander part of the longest τ's Allan variance over the model's.
+    ratio: f64,
+    /// Stouffer z of that statistic over the training runs.
+    z: f64,
+}
+
+/// The Gauss–Markov σ the training runs' bias wander allows, when their Allan variance at
+/// the longest τ of [`WANDER_TAUS_S`] lies below the nominal model's beyond chance (the
+/// runs' z against their ensembles, combined by Stouffer, at most `−z_critical`): the
+/// model's σ scaled by the square root of the ratio of the wander parts (each Allan
+/// variance less the white noise's share, read from the shortest τ as `avar(τ₀) τ₀ / τ`),
+/// at most 1. A prior that wanders more than these runs is not this sensor's, and a model
+/// that does says "the model does not explain these runs" of a sensor that is fine.
+/// `None` otherwise (never a larger σ: a wander beyond the model's is the vocabulary's
+/// `bias_instability` or `rate_random_walk` to name).
+fn wander_allowed(
+    train: &Evaluation,
+    nominal: &SensorModel,
+    z_critical: f64,
+) -> Option<WanderAllowed> {
+    let (short, long) = (0, WANDER_TAUS_S.len() - 1);
+    // Per run: (z, real log10 value, ensemble mean of it).
+    let pick = |k: usize| -> Vec<(f64, f64, f64)> {
+        train
+            .scores
+            .iter()
+            .filter_map(|s| {
+                let i =
+                    s.z.iter()
+                        .position(|(st, _)| st.is(Segment::All, Statistic::WanderLog10Avar(k)))?;
+                let (stat, z) = &s.z[i];
+                let (mean, _) = *s.moments.get(i)?;
+                (z.is_finite() && stat.value.is_finite() && mean.is_finite())
+                    .then_some((*z, stat.value, mean))
+            })
+            .collect()
+    };
+    let (at_long, at_short) = (pick(long), pick(short));
+    if at_long.is_empty() || at_short.len() != at_long.len() {
+        return None;
+    }
+    let z = at_long.iter().map(|v| v.0).sum::<f64>() / (at_long.len() as f64).sqrt();
+    if z > -z_critical {
+        return None;
+    }
+    let mean_of = |v: &[(f64, f64, f64)], pick: fn(&(f64, f64, f64)) -> f64| {
+        10f64.powf(v.iter().map(pick).sum::<f64>() / v.len() as f64)
+    };
+    let white_share = WANDER_TAUS_S[short] / WANDER_TAUS_S[long];
+    let part = |pick: fn(&(f64, f64, f64)) -> f64| {
+        mean_of(&at_long, pick) - white_share * mean_of(&at_short, pick)
+    };
+    let (real, model) = (part(|v| v.1).max(0.0), part(|v| v.2));
+    if !(model > 0.0) {
+        return None;
+    }
+    let ratio = (real / model).min(1.0);
+    Some(WanderAllowed {
+        sigma_dps: nominal.gm_sigma_dps * ratio.sqrt(),
+        ratio,
+        z,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stats::Stat;
+
+    /// Training scores of `runs` runs whose Allan variances at 1 s and 16 s are `real` and
+    /// whose ensembles' are `model` ((deg/s)²), the 16 s one at `z` on each run.
+    fn scores(runs: usize, real: (f64, f64), model: (f64, f64), z: f64) -> Evaluation {
+        let stat = |k: usize, value: f64| Stat {
+            segment: Segment::All,
+            statistic: Statistic::WanderLog10Avar(k),
+            value: value.log10(),
+        };
+        let one = RunScore {
+            z: vec![(stat(0, real.0), 0.0), (stat(2, real.1), z)],
+            moments: vec![(model.0.log10(), 0.1), (model.1.log10(), 0.1)],
+            ..RunScore::default()
+        };
+        Evaluation {
+            scores: vec![one; runs],
+            members: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_prior_wandering_more_than_the_runs_comes_down_to_them() {
+        let nominal = SensorModel {
+            gm_sigma_dps: 0.05,
+            ..SensorModel::default()
+        };
+        // White noise 1.6e-3 at 1 s (1e-4 of it at 16 s); the model's wander part at 16 s
+        // 4e-4, the runs' 1e-4: a quarter, so σ halves.
+        let model = (1.6e-3, 1e-4 + 4e-4);
+        let real = (1.6e-3, 1e-4 + 1e-4);
+        let w = wander_allowed(&scores(4, real, model, -2.5), &nominal, 4.0).unwrap();
+        assert!((w.z + 5.0).abs() < 1e-12);
+        assert!((w.ratio - 0.25).abs() < 1e-9, "{w:?}");
+        assert!((w.sigma_dps - 0.025).abs() < 1e-9, "{w:?}");
+        // Within chance (z −1.5 · 2 = −3): kept.
+        assert_eq!(
+            wander_allowed(&scores(4, real, model, -1.5), &nominal, 4.0),
+            None
+        );
+        // Runs that wander more are never a reason to raise it.
+        let more = (1.6e-3, 1e-4 + 9e-4);
+        assert_eq!(
+            wander_allowed(&scores(4, more, model, 5.0), &nominal, 4.0),
+            None
+        );
+        // No wander above the white noise at all: none in the model either.
+        let none = (1.6e-3, 0.9e-4);
+        let w = wander_allowed(&scores(4, none, model, -3.0), &nominal, 4.0).unwrap();
+        assert_eq!(w.sigma_dps, 0.0);
     }
 }
