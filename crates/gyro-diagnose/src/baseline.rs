@@ -329,7 +329,7 @@ fn wander_allowed(
         mean_of(&at_long, pick) - white_share * mean_of(&at_short, pick)
     };
     let (real, model) = (part(|v| v.1).max(0.0), part(|v| v.2));
-    if !(model > 0.0) {
+    if model.is_nan() || model <= 0.0 {
         return None;
     }
     let ratio = (real / model).min(1.0);
