@@ -461,60 +461,77 @@ pub fn nominal_model(
         }
         model.arw_deg_per_rt_h = arw_of(chosen.1, &model);
         target = Some(chosen.0);
-        notes.push(match &whiteness {
-            Some(w) if w.coloured => format!(
-                "angle random walk {:.4} deg/sqrt(h): matched to the Allan variance at {:.3} s of the gyro at rest ({} block differences), not to its first differences ({:.4} deg/sqrt(h)): the rest noise is not white ({:.2}x the first differences' white variance, z {:.1}; {}); the angle integrates the low band, and the simulated noise stays white, so its high band is not the sensor's",
-                model.arw_deg_per_rt_h,
-                w.tau_s,
-                w.block_differences,
-                w.first_difference_arw_deg_per_rt_h,
-                (w.block_arw_deg_per_rt_h / w.first_difference_arw_deg_per_rt_h).powi(2),
-                w.z,
-                if w.z > 0.0 {
-                    "more in the low band than at the top: a low-pass inside the band, such as the sensor's own digital filter, or motion at rest that the reference does not resolve"
-                } else {
-                    "the top of the band holds noise the low band does not, such as a vibration at rest"
-                },
-            ),
-            Some(w) => format!(
-                "angle random walk {:.4} deg/sqrt(h): matched to the first differences of {count} static samples (output rounding included); the rest noise is white at {:.3} s ({:.4} deg/sqrt(h) from the Allan variance there, z {:.1})",
-                model.arw_deg_per_rt_h, w.tau_s, w.block_arw_deg_per_rt_h, w.z
-            ),
-            None => format!(
-                "angle random walk {:.4} deg/sqrt(h): matched to the first differences of {count} static samples (output rounding included)",
-                model.arw_deg_per_rt_h
-            ),
-        });
+        notes.push(rest_white_note(
+            model.arw_deg_per_rt_h,
+            whiteness.as_ref(),
+            count,
+        ));
     } else if let Some(m) = moving.filter(|m| m.white_level_deg_per_rt_h > 0.0) {
-        let (lo, hi) = super::short_white::SHORT_TAUS_S;
-        match short {
-            Some(w) if w.agrees => {
-                model.arw_deg_per_rt_h = w.level_deg_per_rt_h;
-                notes.push(format!(
-                    "angle random walk {:.4} deg/sqrt(h): fewer than 2 s of static samples, so fitted to the moving residual of the training runs, read from {lo} to {hi} s and matched by simulating the runs (the smoothing, the reference's differentiation and the output step shape the residual there); it agrees with the level read from 1 to 10 s, {:.4} (z {:.1}), and has more blocks; it holds what the reference does not resolve as well as the sensor's own noise; the prior's is {:.4}",
-                    model.arw_deg_per_rt_h, w.long_level_deg_per_rt_h, w.z, prior.arw_deg_per_rt_h
-                ));
-            }
-            _ => {
-                model.arw_deg_per_rt_h = m.white_level_deg_per_rt_h;
-                let short_note = short.map_or(String::new(), |w| {
-                    format!(
-                        "; from {lo} to {hi} s, matched by simulation, it reads {:.4} (z {:.1}): more there than white noise, such as a rig's line or a response the model lacks",
-                        w.level_deg_per_rt_h, w.z
-                    )
-                });
-                notes.push(format!(
-                    "angle random walk {:.4} deg/sqrt(h): fewer than 2 s of static samples, so fitted to the moving residual of the training runs (the white level its Allan deviation reads from 1 to 10 s, degrees-of-freedom weighted, at most the largest the curve allows, {:.4}{short_note}; it holds what the reference does not resolve as well as the sensor's own noise; the prior's is {:.4})",
-                    model.arw_deg_per_rt_h, m.arw_deg_per_rt_h, prior.arw_deg_per_rt_h
-                ));
-            }
-        }
+        notes.push(moving_white(&mut model, prior, m, short));
     } else {
         notes.push(format!(
             "angle random walk {:.4} deg/sqrt(h) from the prior model: fewer than 2 s of static samples and no moving residual to measure",
             model.arw_deg_per_rt_h
         ));
     }
+    notes.push(prior_wander(
+        &mut model,
+        prior,
+        moving,
+        settings.fit.wander_prior_floor,
+    ));
+    Nominal {
+        model,
+        notes,
+        white_target: target,
+        whiteness,
+    }
+}
+
+/// The note on the white noise measured at rest: `arw_deg_per_rt_h`, matched to the first
+/// differences of `count` static samples or, when the rests' `whiteness` check finds
+/// their noise coloured, to the Allan variance at its τ.
+fn rest_white_note(
+    arw_deg_per_rt_h: f64,
+    whiteness: Option<&RestWhiteness>,
+    count: usize,
+) -> String {
+    match whiteness {
+        Some(w) if w.coloured => format!(
+            "angle random walk {:.4} deg/sqrt(h): matched to the Allan variance at {:.3} s of the gyro at rest ({} block differences), not to its first differences ({:.4} deg/sqrt(h)): the rest noise is not white ({:.2}x the first differences' white variance, z {:.1}; {}); the angle integrates the low band, and the simulated noise stays white, so its high band is not the sensor's",
+            arw_deg_per_rt_h,
+            w.tau_s,
+            w.block_differences,
+            w.first_difference_arw_deg_per_rt_h,
+            (w.block_arw_deg_per_rt_h / w.first_difference_arw_deg_per_rt_h).powi(2),
+            w.z,
+            if w.z > 0.0 {
+                "more in the low band than at the top: a low-pass inside the band, such as the sensor's own digital filter, or motion at rest that the reference does not resolve"
+            } else {
+                "the top of the band holds noise the low band does not, such as a vibration at rest"
+            },
+        ),
+        Some(w) => format!(
+            "angle random walk {:.4} deg/sqrt(h): matched to the first differences of {count} static samples (output rounding included); the rest noise is white at {:.3} s ({:.4} deg/sqrt(h) from the Allan variance there, z {:.1})",
+            arw_deg_per_rt_h, w.tau_s, w.block_arw_deg_per_rt_h, w.z
+        ),
+        None => format!(
+            "angle random walk {:.4} deg/sqrt(h): matched to the first differences of {count} static samples (output rounding included)",
+            arw_deg_per_rt_h
+        ),
+    }
+}
+
+/// The bias wander of the nominal `model` (the prior's Gauss–Markov σ and τ, its range and
+/// output step), against the bound the training runs' moving residual `moving` allows:
+/// the σ comes down to that bound when it is under `floor` of the prior's (never up: a
+/// larger wander is an effect to name); the note saying so.
+fn prior_wander(
+    model: &mut SensorModel,
+    prior: &SensorModel,
+    moving: Option<&super::effective::MeasuredNoise>,
+    floor: f64,
+) -> String {
     let mut wander = format!(
         "Gauss-Markov bias sigma {} deg/s, T {} s, range {} deg/s: from the prior model",
         model.gm_sigma_dps, model.gm_tau_s, model.range_dps
@@ -531,7 +548,6 @@ pub fn nominal_model(
             model.gm_tau_s,
         );
         let k = m.rate_random_walk_dps_per_rt_s;
-        let floor = settings.fit.wander_prior_floor;
         let verdict = match (m.rate_random_walk_resolved, k >= floor * k_prior) {
             (true, _) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, against {k:.3e} fitted to the training residual (a larger wander is the vocabulary's to name)"),
             (false, true) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, against the bound the training residual allows ({k:.3e}): kept"),
@@ -547,12 +563,40 @@ pub fn nominal_model(
         wander.push_str("; its wander: ");
         wander.push_str(&verdict);
     }
-    notes.push(wander);
-    Nominal {
-        model,
-        notes,
-        white_target: target,
-        whiteness,
+    wander
+}
+
+/// The white noise of runs that never rest, from `m`, the training runs' moving residual
+/// (its short band `short` when that agrees with the 1–10 s level), written into `model`;
+/// the note saying so. `prior` for the comparison.
+fn moving_white(
+    model: &mut SensorModel,
+    prior: &SensorModel,
+    m: &super::effective::MeasuredNoise,
+    short: Option<&super::short_white::ShortWhite>,
+) -> String {
+    let (lo, hi) = super::short_white::SHORT_TAUS_S;
+    match short {
+        Some(w) if w.agrees => {
+            model.arw_deg_per_rt_h = w.level_deg_per_rt_h;
+            format!(
+                "angle random walk {:.4} deg/sqrt(h): fewer than 2 s of static samples, so fitted to the moving residual of the training runs, read from {lo} to {hi} s and matched by simulating the runs (the smoothing, the reference's differentiation and the output step shape the residual there); it agrees with the level read from 1 to 10 s, {:.4} (z {:.1}), and has more blocks; it holds what the reference does not resolve as well as the sensor's own noise; the prior's is {:.4}",
+                model.arw_deg_per_rt_h, w.long_level_deg_per_rt_h, w.z, prior.arw_deg_per_rt_h
+            )
+        }
+        _ => {
+            model.arw_deg_per_rt_h = m.white_level_deg_per_rt_h;
+            let short_note = short.map_or(String::new(), |w| {
+                format!(
+                    "; from {lo} to {hi} s, matched by simulation, it reads {:.4} (z {:.1}): more there than white noise, such as a rig's line or a response the model lacks",
+                    w.level_deg_per_rt_h, w.z
+                )
+            });
+            format!(
+                "angle random walk {:.4} deg/sqrt(h): fewer than 2 s of static samples, so fitted to the moving residual of the training runs (the white level its Allan deviation reads from 1 to 10 s, degrees-of-freedom weighted, at most the largest the curve allows, {:.4}{short_note}; it holds what the reference does not resolve as well as the sensor's own noise; the prior's is {:.4})",
+                model.arw_deg_per_rt_h, m.arw_deg_per_rt_h, prior.arw_deg_per_rt_h
+            )
+        }
     }
 }
 
