@@ -145,49 +145,12 @@ pub(crate) fn baseline(
         )
     } else {
         let fit::Nominal {
-            model: mut nominal,
-            mut notes,
+            model,
+            notes,
             white_target,
             whiteness,
-        } = fit::nominal_model(
-            &runs.train,
-            &options.prior,
-            moving.as_ref(),
-            short.as_ref(),
-            &options.settings,
-        );
-        if !known.is_empty() {
-            let shares: Vec<f64> = runs
-                .train
-                .iter()
-                .map(|r| fit::known_bias_dps(r, &nominal, known))
-                .filter(|b| b.is_finite())
-                .collect();
-            if !shares.is_empty() {
-                let share = shares.iter().sum::<f64>() / shares.len() as f64;
-                nominal.bias_dps -= share;
-                notes.push(format!(
-                    "bias {:.4} deg/s after taking out {share:+.4} deg/s that the count-stamped clock's growing lag leaks into the regression intercepts",
-                    nominal.bias_dps
-                ));
-            }
-        }
-        // The prior's range is the CRM100's: any run, trained on or held out, that reads
-        // beyond it shows it is not this sensor's (it is not fitted, only refused).
-        let largest = gyro_analysis::model::largest_plausible_abs_rate(
-            runs.train
-                .iter()
-                .chain(&runs.holdout)
-                .map(|r| r.features.max_abs_rate_dps),
-            options.base_model.config.max_abs_rate_dps,
-        );
-        if let Some(note) =
-            gyro_analysis::model::contradicted_range_note(nominal.range_dps, largest)
-        {
-            nominal.range_dps = f64::from(gyro_core::Config::default().max_abs_rate_dps);
-            notes.push(note);
-        }
-        (nominal, notes, white_target, whiteness)
+        } = fitted_nominal(runs, known, options, moving.as_ref(), short.as_ref());
+        (model, notes, white_target, whiteness)
     };
     let own_noise = match (options.fixed_model, white_target) {
         (true, _) => (nominal.arw_deg_per_rt_h, "given model"),
@@ -268,6 +231,65 @@ pub(crate) fn baseline(
         train,
         holdout,
         floor,
+    }
+}
+
+/// The nominal model fitted on the training runs ([`fit::nominal_model`]), its bias less
+/// the share the `known` effects leak into it, its range dropped when a run reads beyond
+/// it; with the notes on each.
+fn fitted_nominal(
+    runs: &Runs,
+    known: &[Effect],
+    options: &Options,
+    moving: Option<&MeasuredNoise>,
+    short: Option<&super::short_white::ShortWhite>,
+) -> fit::Nominal {
+    let fit::Nominal {
+        model: mut nominal,
+        mut notes,
+        white_target,
+        whiteness,
+    } = fit::nominal_model(
+        &runs.train,
+        &options.prior,
+        moving,
+        short,
+        &options.settings,
+    );
+    if !known.is_empty() {
+        let shares: Vec<f64> = runs
+            .train
+            .iter()
+            .map(|r| fit::known_bias_dps(r, &nominal, known))
+            .filter(|b| b.is_finite())
+            .collect();
+        if !shares.is_empty() {
+            let share = shares.iter().sum::<f64>() / shares.len() as f64;
+            nominal.bias_dps -= share;
+            notes.push(format!(
+                "bias {:.4} deg/s after taking out {share:+.4} deg/s that the count-stamped clock's growing lag leaks into the regression intercepts",
+                nominal.bias_dps
+            ));
+        }
+    }
+    // The prior's range is the CRM100's: any run, trained on or held out, that reads
+    // beyond it shows it is not this sensor's (it is not fitted, only refused).
+    let largest = gyro_analysis::model::largest_plausible_abs_rate(
+        runs.train
+            .iter()
+            .chain(&runs.holdout)
+            .map(|r| r.features.max_abs_rate_dps),
+        options.base_model.config.max_abs_rate_dps,
+    );
+    if let Some(note) = gyro_analysis::model::contradicted_range_note(nominal.range_dps, largest) {
+        nominal.range_dps = f64::from(gyro_core::Config::default().max_abs_rate_dps);
+        notes.push(note);
+    }
+    fit::Nominal {
+        model: nominal,
+        notes,
+        white_target,
+        whiteness,
     }
 }
 
