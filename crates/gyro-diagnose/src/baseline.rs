@@ -164,15 +164,18 @@ pub(crate) fn baseline(
         "baseline ensembles",
         (m * (runs.train.len() + runs.holdout.len())) as u64,
     );
-    let mut train = evaluate(
-        &runs.train,
-        &runs.train_ids,
-        &nominal,
-        &[],
-        options,
-        m,
-        progress,
-    );
+    let train_against = |model: &SensorModel| {
+        evaluate(
+            &runs.train,
+            &runs.train_ids,
+            model,
+            &[],
+            options,
+            m,
+            progress,
+        )
+    };
+    let mut train = train_against(&nominal);
     let wander = (!options.fixed_model)
         .then(|| wander_allowed(&train, &nominal, options.settings.tests.z_critical))
         .flatten();
@@ -190,15 +193,7 @@ pub(crate) fn baseline(
             "baseline ensembles, the wander lowered",
             (m * (runs.train.len() + runs.holdout.len())) as u64,
         );
-        train = evaluate(
-            &runs.train,
-            &runs.train_ids,
-            &nominal,
-            &[],
-            options,
-            m,
-            progress,
-        );
+        train = train_against(&nominal);
     }
     let holdout = evaluate(
         &runs.holdout,
