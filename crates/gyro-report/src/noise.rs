@@ -2,7 +2,7 @@
 //! PSD as CSV.
 
 use crate::plot::sig;
-use gyro_analysis::noise::{Characterization, FitTerm, NoiseLog, NoiseRun, NoiseType};
+use gyro_analysis::noise::{Characterization, FitTerm, NoiseLog, NoiseRun, NoiseType, Psd};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::io::{self, Write};
@@ -122,6 +122,22 @@ pub fn table(label: &str, c: &Characterization) -> String {
         let _ = writeln!(s, "  {line}");
     }
     let _ = writeln!(s, "details:");
+    allan_table(&mut s, c);
+    fit_lines(&mut s, c);
+    match &c.psd {
+        Some(psd) => psd_lines(&mut s, psd),
+        None => {
+            let _ = writeln!(s, "PSD: no stretch long enough for a window");
+        }
+    }
+    if !c.suggested_effects.is_empty() {
+        suggested_effects_lines(&mut s, c);
+    }
+    s
+}
+
+/// The Allan deviation per τ with its bounds, the noise type and the fitted model.
+fn allan_table(s: &mut String, c: &Characterization) {
     let _ = writeln!(
         s,
         "Allan deviation (overlapping; {:.1}% chi-squared bounds, EDF by the fitted model's noise type; noise: the type the fit takes at that τ):",
@@ -150,6 +166,11 @@ pub fn table(label: &str, c: &Characterization) -> String {
             c.fit.adev(p.tau_s)
         );
     }
+}
+
+/// The fit: each term with its significance and misfit increase, then the Allan floor
+/// and the misfit.
+fn fit_lines(s: &mut String, c: &Characterization) {
     let f = &c.fit;
     let _ = writeln!(
         s,
@@ -188,7 +209,25 @@ pub fn table(label: &str, c: &Characterization) -> String {
         k.value,
         k.delta_cost
     );
-    let gm = &f.gauss_markov;
+    gauss_markov_lines(s, c);
+    let _ = writeln!(
+        s,
+        "  floor: min adev {:.4e} deg/s at τ {:.4} s -> B = min/0.664 = {:.4e} deg/s{}",
+        f.floor.adev_dps,
+        f.floor.tau_s,
+        f.floor.bias_instability_dps,
+        if f.floor.at_longest_tau {
+            " (at the longest τ: an upper bound)"
+        } else {
+            ""
+        }
+    );
+    let _ = writeln!(s, "  misfit {:.1} over {} τ points", f.cost, f.points);
+}
+
+/// The Gauss-Markov term, and whether it is the sensor's bandwidth rather than a bias.
+fn gauss_markov_lines(s: &mut String, c: &Characterization) {
+    let gm = &c.fit.gauss_markov;
     let _ = writeln!(
         s,
         "  {} Gauss-Markov bias    σ {:.4e} deg/s, T {}  (Δ {:.1})",
@@ -206,86 +245,72 @@ pub fn table(label: &str, c: &Characterization) -> String {
             1.0 / (std::f64::consts::TAU * t)
         );
     }
+}
+
+/// The PSD's settings, its white density and one line per half decade.
+fn psd_lines(s: &mut String, psd: &Psd) {
     let _ = writeln!(
         s,
-        "  floor: min adev {:.4e} deg/s at τ {:.4} s -> B = min/0.664 = {:.4e} deg/s{}",
-        f.floor.adev_dps,
-        f.floor.tau_s,
-        f.floor.bias_instability_dps,
-        if f.floor.at_longest_tau {
-            " (at the longest τ: an upper bound)"
-        } else {
-            ""
-        }
+        "PSD (Welch, Hann, 50% overlap, {} samples per segment, {} averaged, {:.4} Hz resolution):",
+        psd.segment_len, psd.segments, psd.resolution_hz
     );
-    let _ = writeln!(s, "  misfit {:.1} over {} τ points", f.cost, f.points);
-    match &c.psd {
-        Some(psd) => {
+    let _ = writeln!(
+        s,
+        "  white density {:.4e} deg/s/√Hz = {:.4} deg/√h (over {:.3}–{:.3} Hz)",
+        psd.white_density_dps_per_rt_hz,
+        psd.white_arw_deg_per_rt_h,
+        psd.white_band_hz.0,
+        psd.white_band_hz.1
+    );
+    let _ = writeln!(s, "  {:>22} {:>16}", "band_hz", "psd_dps2_per_hz");
+    // One line per half decade of the ten-per-decade bands.
+    for chunk in psd.bands.chunks(5) {
+        let bins: usize = chunk.iter().map(|b| b.bins).sum();
+        let mean = chunk
+            .iter()
+            .map(|b| b.psd_dps2_per_hz * b.bins as f64)
+            .sum::<f64>()
+            / bins.max(1) as f64;
+        if let (Some(first), Some(last)) = (chunk.first(), chunk.last()) {
             let _ = writeln!(
                 s,
-                "PSD (Welch, Hann, 50% overlap, {} samples per segment, {} averaged, {:.4} Hz resolution):",
-                psd.segment_len, psd.segments, psd.resolution_hz
+                "  {:>10.4}–{:<11.4} {:>16.4e}",
+                first.low_hz, last.high_hz, mean
             );
-            let _ = writeln!(
-                s,
-                "  white density {:.4e} deg/s/√Hz = {:.4} deg/√h (over {:.3}–{:.3} Hz)",
-                psd.white_density_dps_per_rt_hz,
-                psd.white_arw_deg_per_rt_h,
-                psd.white_band_hz.0,
-                psd.white_band_hz.1
-            );
-            let _ = writeln!(s, "  {:>22} {:>16}", "band_hz", "psd_dps2_per_hz");
-            // One line per half decade of the ten-per-decade bands.
-            for chunk in psd.bands.chunks(5) {
-                let bins: usize = chunk.iter().map(|b| b.bins).sum();
-                let mean = chunk
-                    .iter()
-                    .map(|b| b.psd_dps2_per_hz * b.bins as f64)
-                    .sum::<f64>()
-                    / bins.max(1) as f64;
-                if let (Some(first), Some(last)) = (chunk.first(), chunk.last()) {
-                    let _ = writeln!(
-                        s,
-                        "  {:>10.4}–{:<11.4} {:>16.4e}",
-                        first.low_hz, last.high_hz, mean
-                    );
-                }
-            }
-        }
-        None => {
-            let _ = writeln!(s, "PSD: no stretch long enough for a window");
         }
     }
-    if !c.suggested_effects.is_empty() {
-        let specs: Vec<String> = c
-            .suggested_effects
-            .iter()
-            .map(|e| {
-                let params: Vec<String> = e
-                    .info()
-                    .params
-                    .iter()
-                    .zip(e.params())
-                    .map(|(spec, v)| format!("{}={v:.4e}", spec.name))
-                    .collect();
-                format!("--effect {}:{}", e.id(), params.join(","))
-            })
-            .collect();
+}
+
+/// The effects outside the sensor model's form that would simulate this noise, as
+/// `--effect` options, and what else the rate random walk may be.
+fn suggested_effects_lines(s: &mut String, c: &Characterization) {
+    let specs: Vec<String> = c
+        .suggested_effects
+        .iter()
+        .map(|e| {
+            let params: Vec<String> = e
+                .info()
+                .params
+                .iter()
+                .zip(e.params())
+                .map(|(spec, v)| format!("{}={v:.4e}", spec.name))
+                .collect();
+            format!("--effect {}:{}", e.id(), params.join(","))
+        })
+        .collect();
+    let _ = writeln!(
+        s,
+        "Not in the sensor model's form; to simulate: {}",
+        specs.join(" ")
+    );
+    if let Some((t, sigma)) = gyro_analysis::noise::rate_random_walk_look_alike(c) {
         let _ = writeln!(
             s,
-            "Not in the sensor model's form; to simulate: {}",
-            specs.join(" ")
+            "  it may also be the sensor model's own Gauss-Markov bias seen on too short a log: one of correlation time T near or beyond the longest averaging time here ({} s) and σ = K·√(T/2) ({} deg/s at that T) gives the same Allan deviation; a log several T long tells them apart",
+            sig(t, 3),
+            sig(sigma, 3)
         );
-        if let Some((t, sigma)) = gyro_analysis::noise::rate_random_walk_look_alike(c) {
-            let _ = writeln!(
-                s,
-                "  it may also be the sensor model's own Gauss-Markov bias seen on too short a log: one of correlation time T near or beyond the longest averaging time here ({} s) and σ = K·√(T/2) ({} deg/s at that T) gives the same Allan deviation; a log several T long tells them apart",
-                sig(t, 3),
-                sig(sigma, 3)
-            );
-        }
     }
-    s
 }
 
 /// The full PSD as CSV rows `label,frequency_hz,psd_dps2_per_hz` (no header).

@@ -1,8 +1,8 @@
 //! Rendering a [`RunReport`]: a human table, JSON, or CSV; and the 50 Hz series as CSV.
 
 use gyro_analysis::findings::Finding;
-use gyro_analysis::replay::{MovementResult, RunReport, SeriesPoint};
-use gyro_core::Verdict;
+use gyro_analysis::replay::{MovementResult, RunReport, SeriesPoint, Summary};
+use gyro_core::{Tightening, Verdict};
 use std::fmt::Write as _;
 use std::io::{self, Write};
 
@@ -14,10 +14,27 @@ fn opt(value: Option<f64>, decimals: usize) -> String {
 /// after the summary, one `warning:` line each.
 pub fn table(file: &str, report: &RunReport, findings: &[Finding]) -> String {
     let mut s = String::new();
-    let q = &report.input;
-    let c = &report.config;
     let _ = writeln!(s, "file: {file}");
-    s.push_str(&crate::input::table(q));
+    s.push_str(&crate::input::table(&report.input));
+    processing_lines(&mut s, report);
+    let _ = writeln!(s, "movements: {}", report.movements.len());
+    if !report.movements.is_empty() {
+        movements_table(&mut s, report);
+        if let Some(t) = &report.config.tightening {
+            tightening_line(&mut s, t, &report.movements);
+        }
+    }
+    summary_lines(&mut s, &report.summary);
+    for f in findings {
+        let _ = writeln!(s, "warning: {}", f.message);
+    }
+    s
+}
+
+/// How the run was processed: the pipeline, then (where they apply) the offline mode, the
+/// correction, the reference's shift and the rejected samples.
+fn processing_lines(s: &mut String, report: &RunReport) {
+    let c = &report.config;
     let _ = writeln!(
         s,
         "pipeline: decimate x{} -> {} Hz{}, Butterworth order {} at {} Hz, compensation {}{}",
@@ -70,103 +87,99 @@ pub fn table(file: &str, report: &RunReport, findings: &[Finding]) -> String {
             report.summary.rejected_samples
         );
     }
-    let _ = writeln!(s, "movements: {}", report.movements.len());
-    if !report.movements.is_empty() {
-        let with_std = report.movements.iter().any(|m| m.angle_std_deg.is_some());
-        let with_verdict = c.tightening.is_some();
+}
+
+/// The movements, one row each: the σ column only when some movement has one, the
+/// verdict column only for a tightening.
+fn movements_table(s: &mut String, report: &RunReport) {
+    let with_std = report.movements.iter().any(|m| m.angle_std_deg.is_some());
+    let with_verdict = report.config.tightening.is_some();
+    let _ = write!(
+        s,
+        "  {:>4} {:>10} {:>10} {:>8} {:>11} {:>11} {:>11} {:>10} {:>10}",
+        "#", "start_s", "end_s", "dur_s", "angle_deg", "raw_deg", "ref_deg", "error_deg", "raw_err"
+    );
+    if with_std {
+        let _ = write!(s, " {:>8}", "std_deg");
+    }
+    if with_verdict {
+        let _ = write!(s, " {:>8}", "verdict");
+    }
+    let _ = writeln!(s);
+    for m in &report.movements {
         let _ = write!(
             s,
-            "  {:>4} {:>10} {:>10} {:>8} {:>11} {:>11} {:>11} {:>10} {:>10}",
-            "#",
-            "start_s",
-            "end_s",
-            "dur_s",
-            "angle_deg",
-            "raw_deg",
-            "ref_deg",
-            "error_deg",
-            "raw_err"
+            "  {:>4} {:>10.3} {:>10.3} {:>8.3} {:>11.3} {:>11.3} {:>11} {:>10} {:>10}",
+            m.index,
+            m.start_time_s,
+            m.end_time_s,
+            m.duration_s,
+            m.angle_deg,
+            m.raw_angle_deg,
+            opt(m.reference_deg, 3),
+            opt(m.error_deg, 3),
+            opt(m.raw_error_deg, 3),
         );
         if with_std {
-            let _ = write!(s, " {:>8}", "std_deg");
+            let _ = write!(s, " {:>8}", opt(m.angle_std_deg.map(f64::from), 3));
         }
         if with_verdict {
-            let _ = write!(s, " {:>8}", "verdict");
+            let _ = write!(s, " {:>8}", m.verdict.map_or("-", verdict_name));
         }
-        let _ = writeln!(s);
-        for m in &report.movements {
-            let _ = write!(
-                s,
-                "  {:>4} {:>10.3} {:>10.3} {:>8.3} {:>11.3} {:>11.3} {:>11} {:>10} {:>10}",
-                m.index,
-                m.start_time_s,
-                m.end_time_s,
-                m.duration_s,
-                m.angle_deg,
-                m.raw_angle_deg,
-                opt(m.reference_deg, 3),
-                opt(m.error_deg, 3),
-                opt(m.raw_error_deg, 3),
-            );
-            if with_std {
-                let _ = write!(s, " {:>8}", opt(m.angle_std_deg.map(f64::from), 3));
-            }
-            if with_verdict {
-                let _ = write!(s, " {:>8}", m.verdict.map_or("-", verdict_name));
-            }
-            let mut marks = Vec::new();
-            if m.saturated {
-                marks.push("SATURATED".to_string());
-            }
-            if m.filled_samples > 0 {
-                marks.push(format!("GAP ({} samples filled)", m.filled_samples));
-            }
-            if !m.complete {
-                marks.push("(log ends while moving)".to_string());
-            }
-            if marks.is_empty() {
-                let _ = writeln!(s);
-            } else {
-                let _ = writeln!(s, "  {}", marks.join(" "));
-            }
-        }
-        if let Some(t) = &c.tightening {
-            let count = |v: Verdict| {
-                report
-                    .movements
-                    .iter()
-                    .filter(|m| m.verdict == Some(v))
-                    .count()
-            };
-            let other_way = report
-                .movements
-                .iter()
-                .filter(|m| m.verdict.is_none())
-                .count();
-            let _ = writeln!(
-                s,
-                "tightening {} ± {} deg ({} direction, guard band {} σ{}): ok {}, nok {}, recheck {}, invalid {}; {} turned the other way",
-                t.target_deg,
-                t.tolerance_deg,
-                match t.direction {
-                    gyro_core::Direction::Positive => "positive",
-                    gyro_core::Direction::Negative => "negative",
-                },
-                t.k_sigma,
-                if t.scale_sigma > 0.0 {
-                    format!(", scale uncertainty {}%", 100.0 * t.scale_sigma)
-                } else {
-                    String::new()
-                },
-                count(Verdict::Ok),
-                count(Verdict::Nok),
-                count(Verdict::Recheck),
-                count(Verdict::Invalid),
-                other_way
-            );
+        let marks = movement_marks(m);
+        if marks.is_empty() {
+            let _ = writeln!(s);
+        } else {
+            let _ = writeln!(s, "  {}", marks.join(" "));
         }
     }
-    let sm = &report.summary;
+}
+
+/// What makes a movement's figures doubtful: saturation, filled gaps, a cut-off end.
+fn movement_marks(m: &MovementResult) -> Vec<String> {
+    let mut marks = Vec::new();
+    if m.saturated {
+        marks.push("SATURATED".to_string());
+    }
+    if m.filled_samples > 0 {
+        marks.push(format!("GAP ({} samples filled)", m.filled_samples));
+    }
+    if !m.complete {
+        marks.push("(log ends while moving)".to_string());
+    }
+    marks
+}
+
+/// The tightening's settings and how many movements got each verdict.
+fn tightening_line(s: &mut String, t: &Tightening, movements: &[MovementResult]) {
+    let count = |v: Option<Verdict>| movements.iter().filter(|m| m.verdict == v).count();
+    // A movement against the tightening's direction gets no verdict.
+    let other_way = count(None);
+    let _ = writeln!(
+        s,
+        "tightening {} ± {} deg ({} direction, guard band {} σ{}): ok {}, nok {}, recheck {}, invalid {}; {} turned the other way",
+        t.target_deg,
+        t.tolerance_deg,
+        match t.direction {
+            gyro_core::Direction::Positive => "positive",
+            gyro_core::Direction::Negative => "negative",
+        },
+        t.k_sigma,
+        if t.scale_sigma > 0.0 {
+            format!(", scale uncertainty {}%", 100.0 * t.scale_sigma)
+        } else {
+            String::new()
+        },
+        count(Some(Verdict::Ok)),
+        count(Some(Verdict::Nok)),
+        count(Some(Verdict::Recheck)),
+        count(Some(Verdict::Invalid)),
+        other_way
+    );
+}
+
+/// The run's duration and final angle, and its errors against the reference if any.
+fn summary_lines(s: &mut String, sm: &Summary) {
     let _ = writeln!(
         s,
         "summary: {:.1} s, final angle {:.3} deg (uncompensated {:.3} deg)",
@@ -190,10 +203,6 @@ pub fn table(file: &str, report: &RunReport, findings: &[Finding]) -> String {
     } else {
         let _ = writeln!(s, "  no reference_deg column: no error figures");
     }
-    for f in findings {
-        let _ = writeln!(s, "warning: {}", f.message);
-    }
-    s
 }
 
 /// The JSON name of a verdict.

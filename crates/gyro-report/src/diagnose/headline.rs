@@ -488,6 +488,23 @@ pub const MISSED_LINES: usize = 5;
 
 /// The diagnosis's findings below the verdict ([`Findings`]).
 pub fn findings(d: &Diagnosis) -> Findings {
+    Findings {
+        named: named_lines(d),
+        missed: missed_lines(d),
+        notes: note_lines(d),
+    }
+}
+
+/// [`Findings::notes`]: how the references were quantised, then the warnings.
+fn note_lines(d: &Diagnosis) -> Vec<String> {
+    let mut notes = reference_grid_lines(&d.runs);
+    notes.extend(d.warnings.iter().map(|w| format!("warning: {w}")));
+    notes
+}
+
+/// [`Findings::named`]: the named effects (or that none is), what no run shows, the
+/// turns, then what the written model corrects.
+fn named_lines(d: &Diagnosis) -> Vec<String> {
     let mut named: Vec<String> = d
         .effects
         .iter()
@@ -507,53 +524,67 @@ pub fn findings(d: &Diagnosis) -> Findings {
     named.extend(not_seen_line(d));
     named.extend(turn_lines(d));
     if let Some(c) = &d.compensation {
-        let (before, after, better) = held_out_error(c);
-        if c.corrected.is_empty() {
-            let what = if turns_wrote(d) {
-                "no correction of the per-sample effects is written (the written model holds only the turns' corrections above)"
-            } else {
-                "no correction is written"
-            };
-            named.push(format!(
-                "{what}: none lowered the held-out angle error (median max |error| {before:.2} deg)"
+        named.extend(correction_lines(d, c));
+    }
+    named
+}
+
+/// What the written model corrects and how that changes the held-out angle error, then
+/// each named effect it does not correct, and why.
+fn correction_lines(d: &Diagnosis, c: &gyro_diagnose::CompensationSummary) -> Vec<String> {
+    let mut lines = Vec::new();
+    let (before, after, better) = held_out_error(c);
+    if c.corrected.is_empty() {
+        let what = if turns_wrote(d) {
+            "no correction of the per-sample effects is written (the written model holds only the turns' corrections above)"
+        } else {
+            "no correction is written"
+        };
+        lines.push(format!(
+            "{what}: none lowered the held-out angle error (median max |error| {before:.2} deg)"
+        ));
+    } else {
+        let ids: Vec<String> = c
+            .corrected
+            .iter()
+            .map(|id| {
+                if *id == gyro_diagnose::BIAS_ID {
+                    format!(
+                        "the bias ({:.3} deg/s, fitted on the training runs)",
+                        d.model.sensor.bias_dps
+                    )
+                } else {
+                    id.to_string()
+                }
+            })
+            .collect();
+        lines.push(format!(
+            "the written model corrects {}: held-out median max |angle error| {before:.2} -> {after:.2} deg, better on {better} of {} runs",
+            ids.join(", "),
+            c.runs.len()
+        ));
+    }
+    for n in &c.not_corrected {
+        if n.id == gyro_diagnose::BIAS_ID {
+            lines.push(format!(
+                "the bias ({:.3} deg/s, fitted on the training runs) is not written: it did not lower the held-out error",
+                d.model.sensor.bias_dps
             ));
         } else {
-            let ids: Vec<String> = c
-                .corrected
-                .iter()
-                .map(|id| {
-                    if *id == gyro_diagnose::BIAS_ID {
-                        format!(
-                            "the bias ({:.3} deg/s, fitted on the training runs)",
-                            d.model.sensor.bias_dps
-                        )
-                    } else {
-                        id.to_string()
-                    }
-                })
-                .collect();
-            named.push(format!(
-                "the written model corrects {}: held-out median max |angle error| {before:.2} -> {after:.2} deg, better on {better} of {} runs",
-                ids.join(", "),
-                c.runs.len()
+            lines.push(format!(
+                "{}: named, not corrected ({})",
+                n.id,
+                n.reason
+                    .unwrap_or("its correction did not lower the held-out error")
             ));
         }
-        for n in &c.not_corrected {
-            if n.id == gyro_diagnose::BIAS_ID {
-                named.push(format!(
-                    "the bias ({:.3} deg/s, fitted on the training runs) is not written: it did not lower the held-out error",
-                    d.model.sensor.bias_dps
-                ));
-            } else {
-                named.push(format!(
-                    "{}: named, not corrected ({})",
-                    n.id,
-                    n.reason
-                        .unwrap_or("its correction did not lower the held-out error")
-                ));
-            }
-        }
     }
+    lines
+}
+
+/// [`Findings::missed`]: the unexplained statistics (if the model does not fit), the
+/// effective noise on moving data and the lines in the motion; "nothing" if none.
+fn missed_lines(d: &Diagnosis) -> Vec<String> {
     let mut missed = Vec::new();
     if !d.verdict.model_fits {
         missed.push(unexplained_line(d));
@@ -568,37 +599,34 @@ pub fn findings(d: &Diagnosis) -> Findings {
             None => line,
         });
     }
-    for m in &d.motion_lines {
-        let response = if m.gyro_gain.is_finite() && m.gyro_lag_s.is_finite() {
-            format!(
-                "; the gyro passes {:.2} of it, {:.1} ms behind (a pure delay passes all of it)",
-                m.gyro_gain,
-                1e3 * m.gyro_lag_s
-            )
-        } else {
-            String::new()
-        };
-        missed.push(format!(
-            "seen in the data, not a sensor effect: the motion of the {} runs has a line at {:.1} Hz ({} deg/s in the motion's rate, {:.0} times its local floor): the rig vibrates and both sensors see it{response}",
-            m.runs,
-            m.frequency_hz,
-            rounded(m.amplitude_dps, 0.05 * m.amplitude_dps),
-            m.ratio
-        ));
-    }
+    missed.extend(d.motion_lines.iter().map(motion_line));
     if missed.is_empty() {
         missed.push(format!(
             "nothing: every statistic of the training runs is within |z| < {} of its simulation with the selected model",
             gyro_diagnose::locate::UNEXPLAINED_Z
         ));
     }
-    let mut notes = reference_grid_lines(&d.runs);
-    notes.extend(d.warnings.iter().map(|w| format!("warning: {w}")));
-    Findings {
-        named,
-        missed,
-        notes,
-    }
+    missed
+}
+
+/// A line in the motion (the rig vibrating), and how much of it the gyro passes.
+fn motion_line(m: &gyro_diagnose::line::MotionLine) -> String {
+    let response = if m.gyro_gain.is_finite() && m.gyro_lag_s.is_finite() {
+        format!(
+            "; the gyro passes {:.2} of it, {:.1} ms behind (a pure delay passes all of it)",
+            m.gyro_gain,
+            1e3 * m.gyro_lag_s
+        )
+    } else {
+        String::new()
+    };
+    format!(
+        "seen in the data, not a sensor effect: the motion of the {} runs has a line at {:.1} Hz ({} deg/s in the motion's rate, {:.0} times its local floor): the rig vibrates and both sensors see it{response}",
+        m.runs,
+        m.frequency_hz,
+        rounded(m.amplitude_dps, 0.05 * m.amplitude_dps),
+        m.ratio
+    )
 }
 
 /// Every line of the diagnosis in words: the [`verdict`], then the [`findings`].

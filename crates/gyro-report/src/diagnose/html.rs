@@ -779,6 +779,14 @@ fn summary(s: &mut String, d: &Diagnosis, page: &Path) -> Result<(), ReportError
 
 /// The gap G with its explanation, the ensembles, the turns and the nominal model.
 fn header(s: &mut String, d: &Diagnosis, options: &Options) {
+    gap_section(s, d);
+    ensembles_line(s, options);
+    turns_section(s, d);
+    nominal_model_section(s, d);
+}
+
+/// The verdict in the statistics' terms, the gap G's table and what G is.
+fn gap_section(s: &mut String, d: &Diagnosis) {
     let g = &d.gap;
     let verdict = if d.verdict.unmodelled.is_empty() {
         "nothing significant: no candidate effect closes the held-out gap".to_string()
@@ -815,6 +823,10 @@ with the model); G near the floor means the simulation explains the data as well
 explains itself. The <b>floor</b> is G between two independent simulated ensembles. \
 Effects are fitted on the training runs only and scored on the held-out runs.</p>"
     );
+}
+
+/// The ensembles' sizes, seed and bootstrap resamples (with a warning when small).
+fn ensembles_line(s: &mut String, options: &Options) {
     let _ = writeln!(
         s,
         "<p>Ensembles: {} members per run (baseline), {} per held-out run for each candidate whose test passes; seed {}; {} bootstrap resamples.{}</p>",
@@ -828,9 +840,10 @@ Effects are fitted on the training runs only and scored on the held-out runs.</p
             ""
         }
     );
+}
 
-    turns_section(s, d);
-
+/// The nominal sensor model, where its values come from and the effects added to it.
+fn nominal_model_section(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(s, "<h2>Nominal model</h2>");
     let m = &d.model.sensor;
     let _ = writeln!(
@@ -850,6 +863,11 @@ Effects are fitted on the training runs only and scored on the held-out runs.</p
         let _ = writeln!(s, "<li>{}</li>", esc(n));
     }
     let _ = writeln!(s, "</ul>");
+    model_effects_list(s, d);
+}
+
+/// The selected effects added to the model, each with its parameters and units.
+fn model_effects_list(s: &mut String, d: &Diagnosis) {
     if d.model.effects.is_empty() {
         let _ = writeln!(s, "<p>No effect was added to the model.</p>");
     } else {
@@ -1173,6 +1191,8 @@ fn read(s: &mut String, text: &str) {
     let _ = writeln!(s, "<p class=\"read\"><b>How to read this.</b> {text}</p>");
 }
 
+/// The figures: the real data against its simulations (if any run was drawn), then
+/// the gap map.
 fn figures(
     s: &mut String,
     d: &Diagnosis,
@@ -1185,102 +1205,135 @@ fn figures(
             let _ = writeln!(s, "<p>No run to draw.</p>");
         }
         Some(f) => {
-            let _ = writeln!(
-                s,
-                "<p>Real data (black) against {} simulated sets of the same runs (shaded: their range, median dashed; a 95% band for the cross-correlation): blue with the nominal model{}. {}</p>",
-                f.members,
-                if f.models.len() > 1 {
-                    ", orange with the selected effects added"
-                } else {
-                    ""
-                },
-                if f.runs_used < f.runs_total {
-                    format!(
-                        "To keep the report fast, the figures use {} of the {} runs (evenly spaced, training and held-out); the tables and the gap map use all.",
-                        f.runs_used, f.runs_total
-                    )
-                } else {
-                    format!("All {} runs are pooled.", f.runs_total)
-                }
-            );
-            for e in &f.real_errors {
-                let _ = writeln!(s, "<p class=\"warn\">left out: {}</p>", esc(e));
-            }
-            let _ = writeln!(s, "<h3>Allan deviation</h3>");
-            if drawn(s, &allan_plot(f), "Allan deviation", page)? {
-                read(
-                s,
-                &format!(
-                    "White rate noise falls with slope −½; the nominal Gauss-Markov bias bends the curve \
+            envelopes_intro(s, f);
+            allan_figure(s, f, page)?;
+            psd_figure(s, f, page)?;
+            residual_figure(s, f, page)?;
+            xcorr_figure(s, f, page)?;
+        }
+    }
+    gap_map_figure(s, d, page)
+}
+
+/// What the envelope figures show and which runs they pool, and the runs left out.
+fn envelopes_intro(s: &mut String, f: &Envelopes) {
+    let _ = writeln!(
+        s,
+        "<p>Real data (black) against {} simulated sets of the same runs (shaded: their range, median dashed; a 95% band for the cross-correlation): blue with the nominal model{}. {}</p>",
+        f.members,
+        if f.models.len() > 1 {
+            ", orange with the selected effects added"
+        } else {
+            ""
+        },
+        if f.runs_used < f.runs_total {
+            format!(
+                "To keep the report fast, the figures use {} of the {} runs (evenly spaced, training and held-out); the tables and the gap map use all.",
+                f.runs_used, f.runs_total
+            )
+        } else {
+            format!("All {} runs are pooled.", f.runs_total)
+        }
+    );
+    for e in &f.real_errors {
+        let _ = writeln!(s, "<p class=\"warn\">left out: {}</p>", esc(e));
+    }
+}
+
+/// The Allan deviation, and how to read it (if drawn).
+fn allan_figure(s: &mut String, f: &Envelopes, page: &Path) -> Result<(), ReportError> {
+    let _ = writeln!(s, "<h3>Allan deviation</h3>");
+    if drawn(s, &allan_plot(f), "Allan deviation", page)? {
+        read(
+            s,
+            &format!(
+                "White rate noise falls with slope −½; the nominal Gauss-Markov bias bends the curve \
 at long τ. Real above the band at short τ: more white noise or a coarser output than modelled — \
 {}. Real above the band at long τ: bias wander the model lacks — {}; {}. Below the band: the \
 model's noise is too large.",
-                    signature("quantization"),
-                    signature("bias_instability"),
-                    signature("rate_random_walk")
-                ),
-            );
-            }
-            let _ = writeln!(s, "<h3>Power spectral density</h3>");
-            if drawn(s, &psd_plot(f), "PSD", page)? {
-                read(
-                s,
-                &format!(
-                    "The residual's spectrum over whole runs (still and moving). The flat level is the \
+                signature("quantization"),
+                signature("bias_instability"),
+                signature("rate_random_walk")
+            ),
+        );
+    }
+    Ok(())
+}
+
+/// The PSD of the residual, and how to read it (if drawn).
+fn psd_figure(s: &mut String, f: &Envelopes, page: &Path) -> Result<(), ReportError> {
+    let _ = writeln!(s, "<h3>Power spectral density</h3>");
+    if drawn(s, &psd_plot(f), "PSD", page)? {
+        read(
+            s,
+            &format!(
+                "The residual's spectrum over whole runs (still and moving). The flat level is the \
 white noise; where the motion has power the residual picks up any rate-dependent error. \
 Real below the band at high frequency: {}. Real above the band where the motion has power: \
 an error that scales with the motion — {}; {}.",
-                    signature("bandwidth"),
-                    signature("latency"),
-                    signature("scale_factor")
-                ),
-            );
-            }
-            let _ = writeln!(
-                s,
-                "<h3>Residual against rate, temperature and acceleration</h3>"
-            );
-            s.push_str(&inline_svg(
-                &residual_plot(f),
-                "residual vs rate, temperature, acceleration",
-                page,
-            )?);
-            read(
-                s,
-                &format!(
-                    "Top: a straight line through the bias is {}; different slopes for the two signs: {}; \
+                signature("bandwidth"),
+                signature("latency"),
+                signature("scale_factor")
+            ),
+        );
+    }
+    Ok(())
+}
+
+/// The residual against rate, temperature and acceleration, and how to read it.
+fn residual_figure(s: &mut String, f: &Envelopes, page: &Path) -> Result<(), ReportError> {
+    let _ = writeln!(
+        s,
+        "<h3>Residual against rate, temperature and acceleration</h3>"
+    );
+    s.push_str(&inline_svg(
+        &residual_plot(f),
+        "residual vs rate, temperature, acceleration",
+        page,
+    )?);
+    read(
+        s,
+        &format!(
+            "Top: a straight line through the bias is {}; different slopes for the two signs: {}; \
 an S-shaped curve: {}; a residual that turns at the largest rates: {}. Middle (still samples): a slope \
 with the temperature change is {} ({} shows instead as a rate slope that changes with temperature: \
 see the “where” statistics by temperature tercile). Bottom: a slope against angular acceleration is \
 {}; {}.",
-                    signature("scale_factor"),
-                    signature("scale_asymmetry"),
-                    signature("nonlinearity"),
-                    signature("saturation"),
-                    signature("temperature_bias"),
-                    signature("temperature_scale"),
-                    signature("latency"),
-                    signature("bandwidth")
-                ),
-            );
-            let _ = writeln!(s, "<h3>Cross-correlation</h3>");
-            let (plot, peaks) = xcorr_plot(f);
-            s.push_str(&inline_svg(&plot, "cross-correlation", page)?);
-            let _ = writeln!(s, "<p>{peaks}</p>");
-            read(
-                s,
-                &format!(
-                    "The correlation of the gyro with the reference rate peaks where the two line up; the \
+            signature("scale_factor"),
+            signature("scale_asymmetry"),
+            signature("nonlinearity"),
+            signature("saturation"),
+            signature("temperature_bias"),
+            signature("temperature_scale"),
+            signature("latency"),
+            signature("bandwidth")
+        ),
+    );
+    Ok(())
+}
+
+/// The cross-correlation with the reference rate, its peaks, and how to read it.
+fn xcorr_figure(s: &mut String, f: &Envelopes, page: &Path) -> Result<(), ReportError> {
+    let _ = writeln!(s, "<h3>Cross-correlation</h3>");
+    let (plot, peaks) = xcorr_plot(f);
+    s.push_str(&inline_svg(&plot, "cross-correlation", page)?);
+    let _ = writeln!(s, "<p>{peaks}</p>");
+    read(
+        s,
+        &format!(
+            "The correlation of the gyro with the reference rate peaks where the two line up; the \
 simulation has the same reference smoothing, so its peak is where a sensor without delay peaks. A \
 real peak shifted from the band's (below: a real curve leaving the band, odd about lag 0) is {}, \
 or {}. A real curve below the band at every lag is a scale or noise difference, not a delay.",
-                    signature("latency"),
-                    signature("bandwidth")
-                ),
-            );
-        }
-    }
+            signature("latency"),
+            signature("bandwidth")
+        ),
+    );
+    Ok(())
+}
 
+/// The gap map of every run's z-scores, and how to read it (if there are any).
+fn gap_map_figure(s: &mut String, d: &Diagnosis, page: &Path) -> Result<(), ReportError> {
     let _ = writeln!(s, "<h3>Gap map</h3>");
     if d.runs.iter().all(|r| r.z.is_empty()) {
         let _ = writeln!(s, "<p>No per-run z-scores to map.</p>");
@@ -1299,7 +1352,6 @@ warm-up: {}.",
             ),
         );
     }
-
     Ok(())
 }
 

@@ -212,6 +212,34 @@ fn angle_error_lines(d: &Diagnosis) -> (String, Vec<String>) {
 /// checks, the nominal model), each with its explanation.
 pub fn table(d: &Diagnosis) -> String {
     let mut s = String::new();
+    answer_lines(&mut s, d);
+    let _ = writeln!(
+        s,
+        "\n---- details (the statistics behind the answer; docs/diagnose.md explains each) ----\n"
+    );
+    s.push_str(&crate::input::tables(
+        d.inputs.iter().map(|i| (i.file.as_str(), &i.input)),
+    ));
+    gap_lines(&mut s, d);
+    where_lines(&mut s, d);
+    if !d.unexplained.is_empty() {
+        unexplained_table(&mut s, d);
+    }
+    effects_table(&mut s, d);
+    posterior_lines(&mut s, d);
+    if let Some(c) = &d.compensation {
+        not_corrected_lines(&mut s, c);
+    }
+    let _ = writeln!(s, "\nnominal model:");
+    for n in &d.model.notes {
+        let _ = writeln!(s, "  {n}");
+    }
+    s
+}
+
+/// The answer: the verdict, then the held-out angle error per run, what is named, what
+/// the model misses and the notes (each section only if it has lines).
+fn answer_lines(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(
         s,
         "diagnosis (held out: {}):",
@@ -239,13 +267,10 @@ pub fn table(d: &Diagnosis) -> String {
             let _ = writeln!(s, "  {line}");
         }
     }
-    let _ = writeln!(
-        s,
-        "\n---- details (the statistics behind the answer; docs/diagnose.md explains each) ----\n"
-    );
-    s.push_str(&crate::input::tables(
-        d.inputs.iter().map(|i| (i.file.as_str(), &i.input)),
-    ));
+}
+
+/// The gap G before and after, with its floor, and the verdict in the statistics' terms.
+fn gap_lines(s: &mut String, d: &Diagnosis) {
     let g = &d.gap;
     let _ = writeln!(
         s,
@@ -270,6 +295,10 @@ pub fn table(d: &Diagnosis) -> String {
         },
         num(d.verdict.fraction_closed_holdout)
     );
+}
+
+/// The ten statistics furthest from the nominal model.
+fn where_lines(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(s, "\nwhere the runs differ from the nominal model most (z: the real statistic's distance from its simulations, in their standard deviations; positive: real above):");
     for w in d.r#where.iter().take(10) {
         let _ = writeln!(
@@ -281,32 +310,38 @@ pub fn table(d: &Diagnosis) -> String {
             super::described(&w.segment, &w.statistic)
         );
     }
-    if !d.unexplained.is_empty() {
+}
+
+/// The statistics the selected model leaves unexplained on the training runs.
+fn unexplained_table(s: &mut String, d: &Diagnosis) {
+    let _ = writeln!(
+        s,
+        "\nunexplained by the selected model (training runs, |z| >= {}; real vs simulated, means over the runs):",
+        gyro_diagnose::locate::UNEXPLAINED_Z
+    );
+    let _ = writeln!(
+        s,
+        "  {:>9} {:>9} {:>9}  {:<28} {:<28} {:>11} {:>11} {:>11}",
+        "z", "nominal z", "held-out z", "segment", "statistic", "real", "nominal", "selected"
+    );
+    for u in &d.unexplained {
         let _ = writeln!(
             s,
-            "\nunexplained by the selected model (training runs, |z| >= {}; real vs simulated, means over the runs):",
-            gyro_diagnose::locate::UNEXPLAINED_Z
+            "  {:>9.1} {:>9.1} {:>9.1}  {:<28} {:<28} {:>11} {:>11} {:>11}",
+            u.z_train,
+            u.z_train_nominal,
+            u.z_holdout,
+            u.segment,
+            u.statistic,
+            super::sig3(u.real),
+            super::sig3(u.nominal),
+            super::sig3(u.simulated)
         );
-        let _ = writeln!(
-            s,
-            "  {:>9} {:>9} {:>9}  {:<28} {:<28} {:>11} {:>11} {:>11}",
-            "z", "nominal z", "held-out z", "segment", "statistic", "real", "nominal", "selected"
-        );
-        for u in &d.unexplained {
-            let _ = writeln!(
-                s,
-                "  {:>9.1} {:>9.1} {:>9.1}  {:<28} {:<28} {:>11} {:>11} {:>11}",
-                u.z_train,
-                u.z_train_nominal,
-                u.z_holdout,
-                u.segment,
-                u.statistic,
-                super::sig3(u.real),
-                super::sig3(u.nominal),
-                super::sig3(u.simulated)
-            );
-        }
     }
+}
+
+/// The candidate effects ranked, one row each, then those that could not be tested.
+fn effects_table(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(
         s,
         "\neffects (ranked; gap on held-out runs before -> after adding the fitted effect)"
@@ -317,17 +352,6 @@ pub fn table(d: &Diagnosis) -> String {
         "effect", "sig", "z", "held-out z", "held-out evidence", "gap", "closed"
     );
     for e in &d.effects {
-        let params: Vec<String> = e
-            .params
-            .iter()
-            .map(|(k, v)| {
-                let ci = e.ci95.get(k).map_or(String::new(), |[a, b]| {
-                    let f = |x: &Option<f64>| x.map_or("inf".to_string(), |v| format!("{v:.4e}"));
-                    format!(" [{}, {}]", f(a), f(b))
-                });
-                format!("{k}={v:.4e}{ci}")
-            })
-            .collect();
         let _ = writeln!(
             s,
             "  {:<18} {:>4} {:>9} {:>10} {:>24} {:>9} {:>9}  {}{}",
@@ -338,7 +362,7 @@ pub fn table(d: &Diagnosis) -> String {
             e.delta_bic.map_or(super::NOT_SCORED, super::evidence),
             num(e.holdout_gap_after.unwrap_or(f64::NAN)),
             num(e.fraction_closed.unwrap_or(f64::NAN)),
-            params.join(", "),
+            params_with_intervals(e).join(", "),
             if e.confounded_with.is_empty() {
                 String::new()
             } else {
@@ -353,45 +377,61 @@ pub fn table(d: &Diagnosis) -> String {
     for u in &d.untestable {
         let _ = writeln!(s, "  {:<18} untestable: {}", u.id, u.reason);
     }
+}
+
+/// Each fitted parameter of `e` as `name=value [lo, hi]` (the 95% interval, where known).
+fn params_with_intervals(e: &gyro_diagnose::EffectResult) -> Vec<String> {
+    e.params
+        .iter()
+        .map(|(k, v)| {
+            let ci = e.ci95.get(k).map_or(String::new(), |[a, b]| {
+                let f = |x: &Option<f64>| x.map_or("inf".to_string(), |v| format!("{v:.4e}"));
+                format!(" [{}, {}]", f(a), f(b))
+            });
+            format!("{k}={v:.4e}{ci}")
+        })
+        .collect()
+}
+
+/// The posterior checks worth listing ([`shows_posterior`]), if any.
+fn posterior_lines(s: &mut String, d: &Diagnosis) {
     let checks: Vec<_> = d
         .effects
         .iter()
         .filter_map(|e| e.posterior_check.as_ref().map(|c| (e, c)))
         .filter(|(e, c)| shows_posterior(e, c))
         .collect();
-    if !checks.is_empty() {
+    if checks.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "\nposterior checks (held-out runs; an effect is named only if the simulation with it covers its signature statistics or leaves at most half of the nominal discrepancy)"
+    );
+    for (e, c) in checks {
         let _ = writeln!(
             s,
-            "\nposterior checks (held-out runs; an effect is named only if the simulation with it covers its signature statistics or leaves at most half of the nominal discrepancy)"
+            "  {:<18} {:<6} {}",
+            e.id,
+            if c.passes { "passes" } else { "fails" },
+            c.describe()
         );
-        for (e, c) in checks {
-            let _ = writeln!(
-                s,
-                "  {:<18} {:<6} {}",
-                e.id,
-                if c.passes { "passes" } else { "fails" },
-                c.describe()
-            );
-        }
     }
-    if let Some(c) = &d.compensation {
-        for n in &c.not_corrected {
-            let _ = writeln!(
-                s,
-                "\n{}: named, not corrected: {}its correction gives a median held-out max abs angle error of {:.2} deg against {:.2} without, better on {} of {} runs (bootstrap P {:.2})",
-                n.id,
-                n.reason.map_or(String::new(), |r| format!("{r}; ")),
-                n.median_max_abs_error_with_deg,
-                n.median_max_abs_error_without_deg,
-                n.runs_better,
-                n.runs,
-                n.bootstrap_p
-            );
-        }
+}
+
+/// Why each named effect left out of the written model is not corrected.
+fn not_corrected_lines(s: &mut String, c: &gyro_diagnose::CompensationSummary) {
+    for n in &c.not_corrected {
+        let _ = writeln!(
+            s,
+            "\n{}: named, not corrected: {}its correction gives a median held-out max abs angle error of {:.2} deg against {:.2} without, better on {} of {} runs (bootstrap P {:.2})",
+            n.id,
+            n.reason.map_or(String::new(), |r| format!("{r}; ")),
+            n.median_max_abs_error_with_deg,
+            n.median_max_abs_error_without_deg,
+            n.runs_better,
+            n.runs,
+            n.bootstrap_p
+        );
     }
-    let _ = writeln!(s, "\nnominal model:");
-    for n in &d.model.notes {
-        let _ = writeln!(s, "  {n}");
-    }
-    s
 }

@@ -9,15 +9,16 @@
 //!   compensation, as grouped bars.
 
 use super::calibrate_plot::short_name;
-use super::noise_plot::{line_swatch, log_chart, log_range, note};
+use super::noise_plot::{log_chart, log_range, note};
 use super::{
-    colour, draw_err, legend_corner, legend_size, padded, sig, tick, titled, DrawResult, Figure,
-    RenderError, LABEL_PX, TICK_PX,
+    colour, corner_legend, draw_err, draw_segments, legend_at, line_swatch, padded, sig, tick,
+    titled, DrawResult, Figure, RenderError, Stroke, LABEL_PX, TICK_PX,
 };
 use gyro_diagnose::stretches;
 use plotters::coord::combinators::BindKeyPoints;
+use plotters::coord::combinators::WithKeyPoints;
 use plotters::coord::ranged1d::Ranged;
-use plotters::coord::types::RangedCoordf64;
+use plotters::coord::types::{RangedCoordf64, RangedCoordi32};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -199,140 +200,185 @@ fn linear_chart<'a, DB: DrawingBackend>(
     Ok(chart)
 }
 
+/// An envelope panel's chart: linear or log axes, x and y both `f64`.
+type PanelChart<'a, DB, X, Y> = ChartContext<'a, DB, Cartesian2d<X, Y>>;
+
+/// Maps a data point to [0, 1]² of the plotting area (for the legend's placement).
+type Norm<'n> = &'n dyn Fn((f64, f64)) -> (f64, f64);
+
 /// Draw the bands, the real data and the legend on `chart`; `norm` maps a data point to
 /// [0, 1]² of the plotting area.
 fn draw_contents<'a, DB, X, Y>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    chart: &mut PanelChart<'a, DB, X, Y>,
     p: &Panel,
     (x, y): ((f64, f64), (f64, f64)),
-    norm: &dyn Fn((f64, f64)) -> (f64, f64),
+    norm: Norm,
 ) -> DrawResult
 where
     DB: DrawingBackend + 'a,
     X: Ranged<ValueType = f64>,
     Y: Ranged<ValueType = f64>,
 {
-    let clamp_y = |v: f64| v.clamp(y.0, y.1);
+    if p.zero_lines && !p.log {
+        draw_zero_lines(chart, (x, y))?;
+    }
     let mut lines: Vec<Vec<(f64, f64)>> = Vec::new();
     let mut labels: Vec<String> = Vec::new();
-    if p.zero_lines && !p.log {
-        let axis = colour::GREY.mix(0.7).stroke_width(1);
-        if y.0 < 0.0 && y.1 > 0.0 {
-            chart
-                .draw_series(LineSeries::new([(x.0, 0.0), (x.1, 0.0)], axis))
-                .map_err(draw_err)?;
-        }
-        if x.0 < 0.0 && x.1 > 0.0 {
-            chart
-                .draw_series(LineSeries::new([(0.0, y.0), (0.0, y.1)], axis))
-                .map_err(draw_err)?;
-        }
-    }
     for (k, band) in p.bands.iter().enumerate() {
-        let (fill, line) = BAND_COLOURS[k % BAND_COLOURS.len()];
-        let n = band.x.len().min(band.lo.len()).min(band.hi.len());
-        let ok = |i: usize| p.valid(band.x[i]) && p.valid(band.lo[i]) && p.valid(band.hi[i]);
-        for run in stretches(n, ok) {
-            let mut poly: Vec<(f64, f64)> = run
-                .clone()
-                .map(|i| (band.x[i], clamp_y(band.hi[i])))
-                .collect();
-            poly.extend(run.clone().rev().map(|i| (band.x[i], clamp_y(band.lo[i]))));
-            if run.len() == 1 {
-                // A single x: a short vertical stroke.
-                chart
-                    .draw_series(std::iter::once(PathElement::new(
-                        poly,
-                        fill.mix(0.6).stroke_width(6),
-                    )))
-                    .map_err(draw_err)?;
-            } else {
-                chart
-                    .draw_series(std::iter::once(Polygon::new(poly, fill.mix(0.3).filled())))
-                    .map_err(draw_err)?;
-            }
-            lines.push(run.clone().map(|i| norm((band.x[i], band.hi[i]))).collect());
-            lines.push(run.map(|i| norm((band.x[i], band.lo[i]))).collect());
-        }
-        let mid: Vec<(f64, f64)> = (0..n.min(band.mid.len()))
-            .filter(|&i| p.valid(band.x[i]) && p.valid(band.mid[i]))
-            .map(|i| (band.x[i], clamp_y(band.mid[i])))
-            .collect();
-        let drawn = chart
-            .draw_series(DashedLineSeries::new(
-                mid.iter().copied(),
-                7,
-                4,
-                line.stroke_width(2),
-            ))
-            .map_err(draw_err)?;
-        drawn.label(band.label.clone()).legend(move |(x, y)| {
-            EmptyElement::at((x, y))
-                + Rectangle::new([(0, -7), (22, 7)], fill.mix(0.3).filled())
-                + PathElement::new(vec![(0, 0), (22, 0)], line.stroke_width(2))
-        });
+        let colours = BAND_COLOURS[k % BAND_COLOURS.len()];
+        lines.extend(draw_band(chart, p, band, colours, y, norm)?);
         labels.push(band.label.clone());
     }
     if let Some(m) = &p.measured {
-        let n = m.x.len().min(m.y.len());
-        let pts: Vec<(f64, f64)> = (0..n)
-            .filter(|&i| p.valid(m.x[i]) && p.valid(m.y[i]))
-            .map(|i| (m.x[i], m.y[i]))
-            .collect();
-        if let Some((lo, hi)) = &m.bars {
-            let bars: Vec<(f64, f64, f64, f64)> = (0..n.min(lo.len()).min(hi.len()))
-                .filter(|&i| p.valid(m.x[i]) && p.valid(m.y[i]))
-                .map(|i| {
-                    let l = if p.valid(lo[i]) { lo[i] } else { m.y[i] };
-                    let h = if p.valid(hi[i]) { hi[i] } else { m.y[i] };
-                    (m.x[i], clamp_y(l), m.y[i], clamp_y(h))
-                })
-                .collect();
-            chart
-                .draw_series(bars.iter().map(|&(x, l, v, h)| {
-                    ErrorBar::new_vertical(x, l, v, h, colour::INK.mix(0.7).stroke_width(1), 6)
-                }))
-                .map_err(draw_err)?;
-        }
-        if m.markers {
-            chart
-                .draw_series(
-                    pts.iter()
-                        .map(|&pt| Circle::new(pt, 3, colour::INK.filled())),
-                )
-                .map_err(draw_err)?
-                .label(m.label.clone())
-                .legend(|(x, y)| {
-                    EmptyElement::at((x + 11, y))
-                        + Circle::new((0, 0), 3, colour::INK.filled())
-                        + PathElement::new(vec![(0, -7), (0, 7)], colour::INK.stroke_width(1))
-                });
-        } else {
-            chart
-                .draw_series(LineSeries::new(
-                    pts.iter().copied(),
-                    colour::INK.stroke_width(2),
-                ))
-                .map_err(draw_err)?
-                .label(m.label.clone())
-                .legend(line_swatch(colour::INK, 2));
-        }
+        lines.push(draw_measured(chart, p, m, y, norm)?);
         labels.push(m.label.clone());
-        lines.push(pts.iter().map(|&pt| norm(pt)).collect());
     }
     if labels.is_empty() {
         return Ok(());
     }
     let label_refs: Vec<&str> = labels.iter().map(String::as_str).collect();
-    let size = legend_size(&label_refs, chart.plotting_area().dim_in_pixel());
-    chart
-        .configure_series_labels()
-        .position(legend_corner(lines.iter().map(Vec::as_slice), size))
-        .label_font(("sans-serif", TICK_PX))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK.mix(0.3))
-        .draw()
-        .map_err(draw_err)
+    corner_legend(chart, &lines, &label_refs, 0.9)
+}
+
+/// The lines x = 0 and y = 0, where they are in range.
+fn draw_zero_lines<'a, DB, X, Y>(
+    chart: &mut PanelChart<'a, DB, X, Y>,
+    (x, y): ((f64, f64), (f64, f64)),
+) -> DrawResult
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let axis = colour::GREY.mix(0.7).stroke_width(1);
+    if y.0 < 0.0 && y.1 > 0.0 {
+        chart
+            .draw_series(LineSeries::new([(x.0, 0.0), (x.1, 0.0)], axis))
+            .map_err(draw_err)?;
+    }
+    if x.0 < 0.0 && x.1 > 0.0 {
+        chart
+            .draw_series(LineSeries::new([(0.0, y.0), (0.0, y.1)], axis))
+            .map_err(draw_err)?;
+    }
+    Ok(())
+}
+
+/// One simulated band: its range shaded (per stretch of drawable points) and its median
+/// dashed, in `(fill, line)` colours; returns its edges normalised by `norm`.
+fn draw_band<'a, DB, X, Y>(
+    chart: &mut PanelChart<'a, DB, X, Y>,
+    p: &Panel,
+    band: &Band,
+    (fill, line): (RGBColor, RGBColor),
+    y: (f64, f64),
+    norm: Norm,
+) -> Result<Vec<Vec<(f64, f64)>>, RenderError>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let clamp_y = |v: f64| v.clamp(y.0, y.1);
+    let n = band.x.len().min(band.lo.len()).min(band.hi.len());
+    let ok = |i: usize| p.valid(band.x[i]) && p.valid(band.lo[i]) && p.valid(band.hi[i]);
+    let mut edges = Vec::new();
+    for run in stretches(n, ok) {
+        let mut poly: Vec<(f64, f64)> = run
+            .clone()
+            .map(|i| (band.x[i], clamp_y(band.hi[i])))
+            .collect();
+        poly.extend(run.clone().rev().map(|i| (band.x[i], clamp_y(band.lo[i]))));
+        if run.len() == 1 {
+            // A single x: a short vertical stroke.
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    poly,
+                    fill.mix(0.6).stroke_width(6),
+                )))
+                .map_err(draw_err)?;
+        } else {
+            chart
+                .draw_series(std::iter::once(Polygon::new(poly, fill.mix(0.3).filled())))
+                .map_err(draw_err)?;
+        }
+        edges.push(run.clone().map(|i| norm((band.x[i], band.hi[i]))).collect());
+        edges.push(run.map(|i| norm((band.x[i], band.lo[i]))).collect());
+    }
+    let mid: Vec<(f64, f64)> = (0..n.min(band.mid.len()))
+        .filter(|&i| p.valid(band.x[i]) && p.valid(band.mid[i]))
+        .map(|i| (band.x[i], clamp_y(band.mid[i])))
+        .collect();
+    let dashed = (line.stroke_width(2), Stroke::Dashed(7, 4));
+    let swatch = move |(x, y)| {
+        EmptyElement::at((x, y))
+            + Rectangle::new([(0, -7), (22, 7)], fill.mix(0.3).filled())
+            + PathElement::new(vec![(0, 0), (22, 0)], line.stroke_width(2))
+    };
+    draw_segments(
+        chart,
+        std::slice::from_ref(&mid),
+        dashed,
+        &band.label,
+        swatch,
+    )?;
+    Ok(edges)
+}
+
+/// The real data, as markers or a line, with its error bars if any; returns its points
+/// normalised by `norm`.
+fn draw_measured<'a, DB, X, Y>(
+    chart: &mut PanelChart<'a, DB, X, Y>,
+    p: &Panel,
+    m: &Measured,
+    y: (f64, f64),
+    norm: Norm,
+) -> Result<Vec<(f64, f64)>, RenderError>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let n = m.x.len().min(m.y.len());
+    let pts: Vec<(f64, f64)> = (0..n)
+        .filter(|&i| p.valid(m.x[i]) && p.valid(m.y[i]))
+        .map(|i| (m.x[i], m.y[i]))
+        .collect();
+    if let Some((lo, hi)) = &m.bars {
+        let clamp_y = |v: f64| v.clamp(y.0, y.1);
+        let bars: Vec<(f64, f64, f64, f64)> = (0..n.min(lo.len()).min(hi.len()))
+            .filter(|&i| p.valid(m.x[i]) && p.valid(m.y[i]))
+            .map(|i| {
+                let l = if p.valid(lo[i]) { lo[i] } else { m.y[i] };
+                let h = if p.valid(hi[i]) { hi[i] } else { m.y[i] };
+                (m.x[i], clamp_y(l), m.y[i], clamp_y(h))
+            })
+            .collect();
+        chart
+            .draw_series(bars.iter().map(|&(x, l, v, h)| {
+                ErrorBar::new_vertical(x, l, v, h, colour::INK.mix(0.7).stroke_width(1), 6)
+            }))
+            .map_err(draw_err)?;
+    }
+    if m.markers {
+        chart
+            .draw_series(
+                pts.iter()
+                    .map(|&pt| Circle::new(pt, 3, colour::INK.filled())),
+            )
+            .map_err(draw_err)?
+            .label(m.label.clone())
+            .legend(|(x, y)| {
+                EmptyElement::at((x + 11, y))
+                    + Circle::new((0, 0), 3, colour::INK.filled())
+                    + PathElement::new(vec![(0, -7), (0, 7)], colour::INK.stroke_width(1))
+            });
+    } else {
+        let solid = (colour::INK.stroke_width(2), Stroke::Solid);
+        let swatch = line_swatch(colour::INK, 2);
+        draw_segments(chart, std::slice::from_ref(&pts), solid, &m.label, swatch)?;
+    }
+    Ok(pts.iter().map(|&pt| norm(pt)).collect())
 }
 
 fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> DrawResult {
@@ -478,16 +524,61 @@ impl Figure for GapMapPlot {
             return Err(RenderError::Empty("no run or no statistic"));
         }
         let body = titled(root, &self.title, &self.subtitle)?;
+        let grid = self.grid();
+        self.draw_cells(&body, grid)?;
+        self.draw_row_labels(&body, grid)?;
+        self.draw_column_labels(&body, grid)?;
+        self.draw_colour_bar(&body, grid)
+    }
+}
+
+/// Where the gap map's grid lies in its body (px): the top-left corner and a cell's size.
+#[derive(Clone, Copy, Debug)]
+struct Grid {
+    x0: i32,
+    y0: i32,
+    cell_w: i32,
+    cell_h: i32,
+}
+
+/// Ink text of `size_px`, anchored at its vertical centre and horizontally at `h`.
+fn ink(size_px: u32, h: HPos) -> TextStyle<'static> {
+    TextStyle::from(("sans-serif", size_px).into_font())
+        .color(&colour::INK)
+        .pos(Pos::new(h, VPos::Center))
+}
+
+/// The colour bar's label of `v` in [-1, 1] (a fraction of the clip `clip`): the z, with
+/// "≥"/"≤" at the ends where colours saturate.
+fn bar_label(v: f64, clip: f64) -> String {
+    let z = v * clip;
+    let value = if z == z.round() {
+        format!("{z:.0}")
+    } else {
+        sig(z, 2)
+    };
+    if v == 1.0 {
+        format!("≥ {value}")
+    } else if v == -1.0 {
+        format!("≤ {value}")
+    } else {
+        value
+    }
+}
+
+impl GapMapPlot {
+    fn grid(&self) -> Grid {
         let (cw, ch, left, top) = self.layout();
-        let (cw, ch, left, top) = (cw as i32, ch as i32, left as i32, top as i32);
-        let x0 = left;
-        let y0 = top + 6;
-        let ink = |size: u32, h: HPos| {
-            TextStyle::from(("sans-serif", size).into_font())
-                .color(&colour::INK)
-                .pos(Pos::new(h, VPos::Center))
-        };
-        // Cells.
+        Grid {
+            x0: left as i32,
+            y0: top as i32 + 6,
+            cell_w: cw as i32,
+            cell_h: ch as i32,
+        }
+    }
+
+    /// One cell per run and statistic, coloured by z (grey without a value).
+    fn draw_cells<DB: DrawingBackend>(&self, body: &DrawingArea<DB, Shift>, g: Grid) -> DrawResult {
         for (r, row) in self.z.iter().enumerate().take(self.rows.len()) {
             for c in 0..self.columns.len() {
                 let z = row.get(c).copied().unwrap_or(f64::NAN);
@@ -496,34 +587,50 @@ impl Figure for GapMapPlot {
                 } else {
                     NO_VALUE
                 };
-                let (cx, cy) = (x0 + cw * c as i32, y0 + ch * r as i32);
+                let (cx, cy) = (g.x0 + g.cell_w * c as i32, g.y0 + g.cell_h * r as i32);
                 body.draw(&Rectangle::new(
-                    [(cx, cy), (cx + cw - 1, cy + ch - 1)],
+                    [(cx, cy), (cx + g.cell_w - 1, cy + g.cell_h - 1)],
                     fill.filled(),
                 ))
                 .map_err(draw_err)?;
             }
         }
-        // Row labels, and the line between training and held-out runs.
+        Ok(())
+    }
+
+    /// Row labels, and the line between training and held-out runs.
+    fn draw_row_labels<DB: DrawingBackend>(
+        &self,
+        body: &DrawingArea<DB, Shift>,
+        g: Grid,
+    ) -> DrawResult {
         let row_style = ink(TICK_PX, HPos::Right);
         for (r, label) in self.rows.iter().enumerate() {
             body.draw_text(
                 &short_name(label),
                 &row_style,
-                (x0 - 6, y0 + ch * r as i32 + ch / 2),
+                (g.x0 - 6, g.y0 + g.cell_h * r as i32 + g.cell_h / 2),
             )
             .map_err(draw_err)?;
         }
-        let grid_w = cw * self.columns.len() as i32;
+        let grid_w = g.cell_w * self.columns.len() as i32;
         if self.holdout_from > 0 && self.holdout_from < self.rows.len() {
-            let y = y0 + ch * self.holdout_from as i32 - 1;
+            let y = g.y0 + g.cell_h * self.holdout_from as i32 - 1;
             body.draw(&PathElement::new(
-                vec![(x0 - 4, y), (x0 + grid_w + 4, y)],
+                vec![(g.x0 - 4, y), (g.x0 + grid_w + 4, y)],
                 colour::INK.stroke_width(2),
             ))
             .map_err(draw_err)?;
         }
-        // Column labels, rotated, above the grid.
+        Ok(())
+    }
+
+    /// Column labels, rotated, above the grid (shortened from the left past 60 characters).
+    fn draw_column_labels<DB: DrawingBackend>(
+        &self,
+        body: &DrawingArea<DB, Shift>,
+        g: Grid,
+    ) -> DrawResult {
         let col_style = TextStyle::from(
             ("sans-serif", TICK_PX)
                 .into_font()
@@ -538,12 +645,21 @@ impl Figure for GapMapPlot {
             } else {
                 label.clone()
             };
-            body.draw_text(&text, &col_style, (x0 + cw * c as i32 + cw / 2, y0 - 4))
+            let x = g.x0 + g.cell_w * c as i32 + g.cell_w / 2;
+            body.draw_text(&text, &col_style, (x, g.y0 - 4))
                 .map_err(draw_err)?;
         }
-        // Colour bar.
-        let bar_x = x0 + grid_w + 40;
-        let bar_h = (ch * self.rows.len() as i32).clamp(200, 400);
+        Ok(())
+    }
+
+    /// The colour bar right of the grid, with its ticks and the swatch of "no value".
+    fn draw_colour_bar<DB: DrawingBackend>(
+        &self,
+        body: &DrawingArea<DB, Shift>,
+        g: Grid,
+    ) -> DrawResult {
+        let (bar_x, y0) = (g.x0 + g.cell_w * self.columns.len() as i32 + 40, g.y0);
+        let bar_h = (g.cell_h * self.rows.len() as i32).clamp(200, 400);
         let steps = 80;
         for k in 0..steps {
             let t = 1.0 - 2.0 * (k as f64 + 0.5) / steps as f64;
@@ -562,26 +678,13 @@ impl Figure for GapMapPlot {
         .map_err(draw_err)?;
         let label_style = ink(TICK_PX, HPos::Left);
         for v in [-1.0, -0.5, -0.2, 0.0, 0.2, 0.5, 1.0] {
-            let z = v * self.clip;
             let y = y0 + ((1.0 - v) * 0.5 * f64::from(bar_h)).round() as i32;
             body.draw(&PathElement::new(
                 vec![(bar_x + 16, y), (bar_x + 20, y)],
                 colour::INK.stroke_width(1),
             ))
             .map_err(draw_err)?;
-            let value = if z == z.round() {
-                format!("{z:.0}")
-            } else {
-                sig(z, 2)
-            };
-            let text = if v == 1.0 {
-                format!("≥ {value}")
-            } else if v == -1.0 {
-                format!("≤ {value}")
-            } else {
-                value
-            };
-            body.draw_text(&text, &label_style, (bar_x + 24, y))
+            body.draw_text(&bar_label(v, self.clip), &label_style, (bar_x + 24, y))
                 .map_err(draw_err)?;
         }
         body.draw_text("z", &ink(LABEL_PX, HPos::Left), (bar_x, y0 - 14))
@@ -640,102 +743,173 @@ impl Figure for AngleErrorPlot {
         if self.rows.is_empty() {
             return Err(RenderError::Empty("no run"));
         }
+        let hi_deg = self.axis_max_deg();
+        let names: Vec<String> = self.rows.iter().map(|r| short_name(&r.name)).collect();
+        let body = titled(root, &self.title, &self.subtitle)?;
+        let mut chart = bar_chart(&body, &names, hi_deg)?;
+        self.draw_bars(&mut chart, Bar::Before, hi_deg)?;
+        self.draw_bars(&mut chart, Bar::After, hi_deg)?;
+        legend_at(&mut chart, SeriesLabelPosition::LowerRight, 0.9)
+    }
+}
+
+/// Run k (from the top) of the bar chart spans y in [n-1-k, n-k] × `BAR_UNIT`; its name
+/// at the middle.
+const BAR_UNIT: i32 = 100;
+
+/// The bar chart: error across (deg), runs down (units of [`BAR_UNIT`] per run).
+type BarChart<'a, DB> =
+    ChartContext<'a, DB, Cartesian2d<RangedCoordf64, WithKeyPoints<RangedCoordi32>>>;
+
+/// The bottom of run `k`'s row (from the top) of `n`.
+fn row_bottom(n: usize, k: usize) -> i32 {
+    (n as i32 - 1 - k as i32) * BAR_UNIT
+}
+
+/// The chart with its mesh: errors up to `hi_deg` across, one row per name, the first at
+/// the top.
+fn bar_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    names: &[String],
+    hi_deg: f64,
+) -> Result<BarChart<'a, DB>, RenderError> {
+    let n = names.len();
+    let name_px = (names.iter().map(|s| s.chars().count()).max().unwrap_or(0) as f64
+        * 0.6
+        * f64::from(TICK_PX)) as u32;
+    let n_i = n as i32;
+    let centres: Vec<i32> = (0..n).map(|k| row_bottom(n, k) + BAR_UNIT / 2).collect();
+    let mut chart = ChartBuilder::on(area)
+        .margin_left(10)
+        .margin_right(30)
+        .margin_top(10)
+        .x_label_area_size(50)
+        .y_label_area_size(name_px + 24)
+        .build_cartesian_2d(0.0..hi_deg, (0..n_i * BAR_UNIT).with_key_points(centres))
+        .map_err(draw_err)?;
+    let y_label = |v: &i32| {
+        let from_top = n_i - 1 - (v - BAR_UNIT / 2) / BAR_UNIT;
+        if (v - BAR_UNIT / 2) % BAR_UNIT == 0 && from_top >= 0 {
+            usize::try_from(from_top)
+                .ok()
+                .and_then(|k| names.get(k).cloned())
+                .unwrap_or_default()
+        } else {
+            String::new()
+        }
+    };
+    chart
+        .configure_mesh()
+        .disable_y_mesh()
+        .x_labels(10)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&y_label)
+        .light_line_style(BLACK.mix(0.04))
+        .bold_line_style(BLACK.mix(0.12))
+        .label_style(("sans-serif", TICK_PX))
+        .axis_desc_style(("sans-serif", LABEL_PX))
+        .x_desc("max abs angle error over the run (deg)")
+        .draw()
+        .map_err(draw_err)?;
+    Ok(chart)
+}
+
+/// Which of a run's two bars: without or with compensation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Bar {
+    Before,
+    After,
+}
+
+impl Bar {
+    fn colour(self) -> RGBColor {
+        match self {
+            Bar::Before => colour::GREY,
+            Bar::After => colour::BLUE,
+        }
+    }
+
+    /// Where the bar lies in its run's row (from, to; of [`BAR_UNIT`]): before above
+    /// after.
+    fn span(self) -> (i32, i32) {
+        match self {
+            Bar::Before => (52, 88),
+            Bar::After => (12, 48),
+        }
+    }
+
+    /// The run's error this bar shows (deg).
+    fn value_deg(self, r: &AngleErrorRow) -> f64 {
+        match self {
+            Bar::Before => r.before_deg,
+            Bar::After => r.after_deg,
+        }
+    }
+}
+
+impl AngleErrorPlot {
+    /// The error axis' end (deg): room on the right for the values' labels and the legend.
+    fn axis_max_deg(&self) -> f64 {
         let hi = self
             .rows
             .iter()
             .flat_map(|r| [r.before_deg, r.after_deg])
             .filter(|v| v.is_finite())
             .fold(0.0, f64::max);
-        // Room on the right for the values' labels and the legend.
-        let hi = if hi > 0.0 { hi * 1.45 } else { 1.0 };
-        let n = self.rows.len();
-        let names: Vec<String> = self.rows.iter().map(|r| short_name(&r.name)).collect();
-        let name_px = (names.iter().map(|s| s.chars().count()).max().unwrap_or(0) as f64
-            * 0.6
-            * f64::from(TICK_PX)) as u32;
-        let body = titled(root, &self.title, &self.subtitle)?;
-        // Run k (from the top) spans y in [n-1-k, n-k] × UNIT; its name at the middle.
-        const UNIT: i32 = 100;
-        let n_i = n as i32;
-        let y_of = |k: usize| (n_i - 1 - k as i32) * UNIT;
-        let centres: Vec<i32> = (0..n).map(|k| y_of(k) + UNIT / 2).collect();
-        let mut chart = ChartBuilder::on(&body)
-            .margin_left(10)
-            .margin_right(30)
-            .margin_top(10)
-            .x_label_area_size(50)
-            .y_label_area_size(name_px + 24)
-            .build_cartesian_2d(0.0..hi, (0..n_i * UNIT).with_key_points(centres))
-            .map_err(draw_err)?;
-        let y_label = |v: &i32| {
-            let from_top = n_i - 1 - (v - UNIT / 2) / UNIT;
-            if (v - UNIT / 2) % UNIT == 0 && from_top >= 0 {
-                usize::try_from(from_top)
-                    .ok()
-                    .and_then(|k| names.get(k).cloned())
-                    .unwrap_or_default()
-            } else {
-                String::new()
-            }
+        if hi > 0.0 {
+            hi * 1.45
+        } else {
+            1.0
+        }
+    }
+
+    /// `bar` of every run (with its legend entry), then each bar's value beside it.
+    fn draw_bars<'a, DB: DrawingBackend + 'a>(
+        &self,
+        chart: &mut BarChart<'a, DB>,
+        bar: Bar,
+        hi_deg: f64,
+    ) -> DrawResult {
+        let label = match bar {
+            Bar::Before => &self.before_label,
+            Bar::After => &self.after_label,
         };
+        let (c, (a, b)) = (bar.colour(), bar.span());
+        let value = |r: &AngleErrorRow| bar.value_deg(r);
+        let n = self.rows.len();
         chart
-            .configure_mesh()
-            .disable_y_mesh()
-            .x_labels(10)
-            .x_label_formatter(&tick)
-            .y_label_formatter(&y_label)
-            .light_line_style(BLACK.mix(0.04))
-            .bold_line_style(BLACK.mix(0.12))
-            .label_style(("sans-serif", TICK_PX))
-            .axis_desc_style(("sans-serif", LABEL_PX))
-            .x_desc("max abs angle error over the run (deg)")
-            .draw()
-            .map_err(draw_err)?;
+            .draw_series(self.rows.iter().enumerate().filter_map(|(k, r)| {
+                let v = value(r);
+                v.is_finite().then(|| {
+                    Rectangle::new(
+                        [
+                            (0.0, row_bottom(n, k) + a),
+                            (v.min(hi_deg), row_bottom(n, k) + b),
+                        ],
+                        c.mix(0.85).filled(),
+                    )
+                })
+            }))
+            .map_err(draw_err)?
+            .label(label.clone())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 22, y + 6)], c.filled()));
         let value_style = TextStyle::from(("sans-serif", TICK_PX - 2).into_font())
             .color(&colour::INK)
             .pos(Pos::new(HPos::Left, VPos::Center));
-        // Before above after within each run's row.
-        let bars = [
-            (&self.before_label, colour::GREY, 52, 88),
-            (&self.after_label, colour::BLUE, 12, 48),
-        ];
-        for (i, (label, c, a, b)) in bars.into_iter().enumerate() {
-            let value = |r: &AngleErrorRow| if i == 0 { r.before_deg } else { r.after_deg };
-            chart
-                .draw_series(self.rows.iter().enumerate().filter_map(|(k, r)| {
-                    let v = value(r);
-                    v.is_finite().then(|| {
-                        Rectangle::new(
-                            [(0.0, y_of(k) + a), (v.min(hi), y_of(k) + b)],
-                            c.mix(0.85).filled(),
-                        )
-                    })
-                }))
-                .map_err(draw_err)?
-                .label(label.clone())
-                .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 22, y + 6)], c.filled()));
-            chart
-                .draw_series(self.rows.iter().enumerate().map(|(k, r)| {
-                    let v = value(r);
-                    let text = if v.is_finite() {
-                        format!("{} deg", sig(v, 3))
-                    } else {
-                        "-".to_string()
-                    };
-                    let at = if v.is_finite() { v.min(hi) } else { 0.0 };
-                    EmptyElement::at((at, y_of(k) + (a + b) / 2))
-                        + Text::new(text, (5, 0), value_style.clone())
-                }))
-                .map_err(draw_err)?;
-        }
         chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .label_font(("sans-serif", TICK_PX))
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK.mix(0.3))
-            .draw()
-            .map_err(draw_err)
+            .draw_series(self.rows.iter().enumerate().map(|(k, r)| {
+                let v = value(r);
+                let text = if v.is_finite() {
+                    format!("{} deg", sig(v, 3))
+                } else {
+                    "-".to_string()
+                };
+                let at = if v.is_finite() { v.min(hi_deg) } else { 0.0 };
+                EmptyElement::at((at, row_bottom(n, k) + (a + b) / 2))
+                    + Text::new(text, (5, 0), value_style.clone())
+            }))
+            .map_err(draw_err)?;
+        Ok(())
     }
 }
 

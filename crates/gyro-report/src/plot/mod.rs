@@ -26,7 +26,8 @@ pub use calibrate_plot::{calibrate_plot, CalibrationPlot};
 pub use noise_plot::{noise_plot, NoisePlot};
 pub use run_plot::{run_plot, RunPlot};
 
-use plotters::coord::Shift;
+use plotters::coord::{CoordTranslate, Shift};
+use plotters::element::{DashedPathElement, IntoDynElement};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{FontStyle, RGBColor};
@@ -369,6 +370,89 @@ pub(crate) fn legend_corner<'a>(
         }
     }
     boxes[best].0.clone()
+}
+
+/// Draw `chart`'s legend at `position`, on white of `background_opacity`.
+pub(crate) fn legend_at<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    background_opacity: f64,
+) -> DrawResult {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font(("sans-serif", TICK_PX))
+        .background_style(WHITE.mix(background_opacity))
+        .border_style(BLACK.mix(0.3))
+        .draw()
+        .map_err(draw_err)
+}
+
+/// Draw the legend of `labels` in the corner where `normalised` lines (as for
+/// [`legend_corner`]) leave the most room, on white of `background_opacity`.
+pub(crate) fn corner_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    normalised: &[Vec<(f64, f64)>],
+    labels: &[&str],
+    background_opacity: f64,
+) -> DrawResult {
+    let size = legend_size(labels, chart.plotting_area().dim_in_pixel());
+    let position = legend_corner(normalised.iter().map(Vec::as_slice), size);
+    legend_at(chart, position, background_opacity)
+}
+
+/// How a line is stroked: solid, or dashed with dashes and gaps of these lengths (px).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Stroke {
+    Solid,
+    Dashed(i32, i32),
+}
+
+/// Draw each of `segments` as a line of `style`; only the first carries the legend
+/// entry, `label` with its `swatch`.
+pub(crate) fn draw_segments<'a, DB, CT, E>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    segments: &[Vec<(f64, f64)>],
+    (style, stroke): (ShapeStyle, Stroke),
+    label: &str,
+    swatch: impl Fn((i32, i32)) -> E + 'a,
+) -> DrawResult
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate<From = (f64, f64)>,
+    E: IntoDynElement<'a, DB, (i32, i32)>,
+{
+    let mut swatch = Some(swatch);
+    for line in segments {
+        let points = line.iter().copied();
+        let drawn = match stroke {
+            Stroke::Solid => chart.draw_series(LineSeries::new(points, style)),
+            Stroke::Dashed(dash, gap) => {
+                chart.draw_series(DashedLineSeries::new(points, dash, gap, style))
+            }
+        }
+        .map_err(draw_err)?;
+        if let Some(swatch) = swatch.take() {
+            drawn.label(label).legend(swatch);
+        }
+    }
+    Ok(())
+}
+
+/// A legend swatch: a short line of colour `c`, `width` px wide.
+pub(crate) fn line_swatch(
+    c: RGBColor,
+    width: u32,
+) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(width))
+}
+
+/// A legend swatch: a short dashed line of colour `c`, `width` px wide.
+pub(crate) fn dashed_swatch(
+    c: RGBColor,
+    width: u32,
+) -> impl Fn((i32, i32)) -> DashedPathElement<std::array::IntoIter<(i32, i32), 2>, i32> {
+    move |(x, y)| DashedPathElement::new([(x, y), (x + 22, y)], 6, 3, c.stroke_width(width))
 }
 
 /// Size of a legend with `labels` in `area_px` (plotting area), as fractions.

@@ -2,12 +2,14 @@
 //! model and each significant term; below it the Welch PSD with the white-noise density.
 
 use super::{
-    colour, draw_err, legend_corner, legend_size, log_tick, save, sig, tick, titled, DrawResult,
-    Figure, PlotError, RenderError, LABEL_PX, TICK_PX,
+    colour, corner_legend, dashed_swatch, draw_err, draw_segments, line_swatch, log_tick, save,
+    sig, tick, titled, DrawResult, Figure, PlotError, RenderError, Stroke, LABEL_PX, TICK_PX,
 };
-use gyro_analysis::noise::{Characterization, FitTerm, GaussMarkovFit, NoiseFit, Psd};
+use gyro_analysis::noise::{
+    AllanDeviation, AllanPoint, Characterization, FitTerm, GaussMarkovFit, NoiseFit, Psd,
+};
 use plotters::coord::Shift;
-use plotters::element::DashedPathElement;
+use plotters::element::IntoDynElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::cell::Cell;
@@ -234,15 +236,7 @@ fn log_legend<'a, DB: DrawingBackend + 'a>(
         .iter()
         .map(|l| l.iter().map(|&(a, b)| (norm(a, x), norm(b, y))).collect())
         .collect();
-    let size = legend_size(labels, chart.plotting_area().dim_in_pixel());
-    chart
-        .configure_series_labels()
-        .position(legend_corner(normalised.iter().map(Vec::as_slice), size))
-        .label_font(("sans-serif", TICK_PX))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK.mix(0.3))
-        .draw()
-        .map_err(draw_err)
+    corner_legend(chart, &normalised, labels, 0.9)
 }
 
 /// A message in the middle of `area`, in place of a panel.
@@ -255,104 +249,67 @@ pub(super) fn note<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, text: &str
         .map_err(draw_err)
 }
 
-pub(super) fn line_swatch(
-    c: RGBColor,
-    width: u32,
-) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
-    move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(width))
+/// Positive and finite: drawable on a log axis.
+fn positive(v: f64) -> bool {
+    v.is_finite() && v > 0.0
 }
 
-impl NoisePlot<'_> {
-    fn has_psd(&self) -> bool {
-        self.result
-            .psd
-            .as_ref()
-            .is_some_and(|p| p.frequency_hz.iter().skip(1).any(|f| *f > 0.0))
-    }
+/// A log-log panel being drawn: its chart and ranges, and what its legend needs (every
+/// line, for the legend's placement, and every label).
+struct LogPanel<'a, DB: DrawingBackend> {
+    chart: LogChart<'a, DB>,
+    x: (f64, f64),
+    y: (f64, f64),
+    lines: Vec<Vec<(f64, f64)>>,
+    labels: Vec<String>,
+}
 
-    fn draw_allan<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult {
-        let r = self.result;
-        let points = &r.allan.points;
-        let fit = &r.fit;
-        let positive = |v: f64| v.is_finite() && v > 0.0;
-        if !points.iter().any(|p| positive(p.adev_dps)) {
-            return note(
-                area,
-                "The Allan deviation is zero at every τ: the rate is constant.",
-            );
-        }
-        let tau_lo = points.iter().map(|p| p.tau_s).fold(f64::INFINITY, f64::min);
-        let tau_hi = points.iter().map(|p| p.tau_s).fold(0.0, f64::max);
-        let x = log_range(tau_lo, tau_hi, 1.4);
-        let lows = points
-            .iter()
-            .flat_map(|p| [p.lower_dps, p.adev_dps])
-            .filter(|v| positive(*v));
-        let y_lo = lows.fold(f64::INFINITY, f64::min);
-        let y_hi = points
-            .iter()
-            .flat_map(|p| [p.upper_dps, p.adev_dps])
-            .filter(|v| positive(*v))
-            .fold(0.0, f64::max);
-        // Some room above for the legend.
-        let y = log_range(y_lo, y_hi * 2.5, 1.6);
-        let mut chart = log_chart(
-            area,
+impl<'a, DB: DrawingBackend + 'a> LogPanel<'a, DB> {
+    fn new(chart: LogChart<'a, DB>, x: (f64, f64), y: (f64, f64)) -> Self {
+        LogPanel {
+            chart,
             x,
             y,
-            ("averaging time τ (s)", "Allan deviation σ(τ) (deg/s)"),
-        )?;
-        let mut lines: Vec<Vec<(f64, f64)>> = Vec::new();
-        let mut labels: Vec<String> = Vec::new();
-
-        // Terms, dashed, under the total.
-        for (label, one, c) in terms(fit) {
-            let segs = curve(x, y, |t| one.adev(t));
-            for (i, seg) in segs.iter().enumerate() {
-                let drawn = chart
-                    .draw_series(DashedLineSeries::new(
-                        seg.iter().copied(),
-                        9,
-                        5,
-                        c.stroke_width(2),
-                    ))
-                    .map_err(draw_err)?;
-                if i == 0 {
-                    drawn.label(label.clone()).legend(move |(x, y)| {
-                        DashedPathElement::new([(x, y), (x + 22, y)], 6, 3, c.stroke_width(2))
-                    });
-                }
-            }
-            if !segs.is_empty() {
-                labels.push(label);
-            }
-            lines.extend(segs);
+            lines: Vec::new(),
+            labels: Vec::new(),
         }
-        // The fitted total.
-        let total = curve(x, y, |t| fit.adev(t));
-        for (i, seg) in total.iter().enumerate() {
-            let drawn = chart
-                .draw_series(LineSeries::new(
-                    seg.iter().copied(),
-                    colour::BLUE.stroke_width(3),
-                ))
-                .map_err(draw_err)?;
-            if i == 0 {
-                drawn
-                    .label("fitted model (sum of the terms)")
-                    .legend(line_swatch(colour::BLUE, 3));
-                labels.push("fitted model (sum of the terms)".into());
-            }
-        }
-        lines.extend(total);
+    }
 
-        // Measured, with bounds.
+    /// Draw `segments` with `label` in the legend (nothing, and no label, if empty).
+    fn segments<E: IntoDynElement<'a, DB, (i32, i32)>>(
+        &mut self,
+        segments: Vec<Vec<(f64, f64)>>,
+        line: (ShapeStyle, Stroke),
+        label: String,
+        swatch: impl Fn((i32, i32)) -> E + 'a,
+    ) -> DrawResult {
+        draw_segments(&mut self.chart, &segments, line, &label, swatch)?;
+        if !segments.is_empty() {
+            self.labels.push(label);
+        }
+        self.lines.extend(segments);
+        Ok(())
+    }
+
+    /// Draw the legend in the corner the lines leave emptiest.
+    fn legend(mut self) -> DrawResult {
+        let labels: Vec<&str> = self.labels.iter().map(String::as_str).collect();
+        log_legend(&mut self.chart, &self.lines, (self.x, self.y), &labels)
+    }
+
+    /// The measured Allan deviation: a dot with its confidence bounds per τ.
+    fn measured_allan(&mut self, allan: &AllanDeviation) -> DrawResult {
+        let y = self.y;
         let conf = format!(
             "measured (overlapping), {:.0}% bounds",
-            100.0 * r.allan.confidence
+            100.0 * allan.confidence
         );
-        let measured: Vec<_> = points.iter().filter(|p| positive(p.adev_dps)).collect();
-        chart
+        let measured: Vec<_> = allan
+            .points
+            .iter()
+            .filter(|p| positive(p.adev_dps))
+            .collect();
+        self.chart
             .draw_series(measured.iter().map(|p| {
                 ErrorBar::new_vertical(
                     p.tau_s,
@@ -364,7 +321,7 @@ impl NoisePlot<'_> {
                 )
             }))
             .map_err(draw_err)?;
-        chart
+        self.chart
             .draw_series(
                 measured
                     .iter()
@@ -377,20 +334,125 @@ impl NoisePlot<'_> {
                     + Circle::new((0, 0), 3, colour::INK.filled())
                     + PathElement::new(vec![(0, -7), (0, 7)], colour::INK.stroke_width(1))
             });
-        labels.push(conf);
-        lines.push(measured.iter().map(|p| (p.tau_s, p.adev_dps)).collect());
-        let label_refs: Vec<&str> = labels.iter().map(String::as_str).collect();
-        log_legend(&mut chart, &lines, (x, y), &label_refs)
+        self.labels.push(conf);
+        self.lines
+            .push(measured.iter().map(|p| (p.tau_s, p.adev_dps)).collect());
+        Ok(())
     }
 
+    /// The band the white density is read over, shaded (nothing if empty).
+    fn white_band(&mut self, (band_lo, band_hi): (f64, f64)) -> DrawResult {
+        if !(band_hi > band_lo && band_lo > 0.0) {
+            return Ok(());
+        }
+        let (x, y) = (self.x, self.y);
+        let band_label = format!("white band {}–{} Hz", sig(band_lo, 2), sig(band_hi, 2));
+        self.chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [(band_lo.max(x.0), y.0), (band_hi.min(x.1), y.1)],
+                colour::GREEN.mix(0.08).filled(),
+            )))
+            .map_err(draw_err)?
+            .label(band_label.clone())
+            .legend(|(x, y)| {
+                Rectangle::new(
+                    [(x, y - 6), (x + 22, y + 6)],
+                    colour::GREEN.mix(0.15).filled(),
+                )
+            });
+        self.labels.push(band_label);
+        Ok(())
+    }
+}
+
+/// The Allan panel's ranges (τ, σ): the measured points with their bounds, with some
+/// room above for the legend.
+fn allan_ranges(points: &[AllanPoint]) -> ((f64, f64), (f64, f64)) {
+    let tau_lo = points.iter().map(|p| p.tau_s).fold(f64::INFINITY, f64::min);
+    let tau_hi = points.iter().map(|p| p.tau_s).fold(0.0, f64::max);
+    let y_lo = points
+        .iter()
+        .flat_map(|p| [p.lower_dps, p.adev_dps])
+        .filter(|v| positive(*v))
+        .fold(f64::INFINITY, f64::min);
+    let y_hi = points
+        .iter()
+        .flat_map(|p| [p.upper_dps, p.adev_dps])
+        .filter(|v| positive(*v))
+        .fold(0.0, f64::max);
+    (
+        log_range(tau_lo, tau_hi, 1.4),
+        log_range(y_lo, y_hi * 2.5, 1.6),
+    )
+}
+
+/// The PSD's positive bins `(frequency_hz, psd)`, the zero frequency left out.
+fn psd_bins(psd: &Psd) -> Vec<(f64, f64)> {
+    psd.frequency_hz
+        .iter()
+        .zip(&psd.psd_dps2_per_hz)
+        .filter(|(f, p)| **f > 0.0 && p.is_finite() && **p > 0.0)
+        .map(|(f, p)| (*f, *p))
+        .collect()
+}
+
+/// The PSD panel's vertical range: the bins and the white level `white` (if positive),
+/// with room above for the legend.
+fn psd_range(bins: &[(f64, f64)], white: f64) -> (f64, f64) {
+    let y_lo = bins.iter().map(|b| b.1).fold(f64::INFINITY, f64::min);
+    let y_hi = bins.iter().map(|b| b.1).fold(0.0, f64::max);
+    let y_lo = if white > 0.0 { y_lo.min(white) } else { y_lo };
+    log_range(y_lo, y_hi.max(white) * 8.0, 1.5)
+}
+
+/// The label of the white density line.
+fn white_label(psd: &Psd) -> String {
+    format!(
+        "white density 2N², N = {} deg/s/√Hz ({} deg/√h)",
+        sig(psd.white_density_dps_per_rt_hz, 2),
+        sig(psd.white_arw_deg_per_rt_h, 2)
+    )
+}
+
+impl NoisePlot<'_> {
+    fn has_psd(&self) -> bool {
+        self.result
+            .psd
+            .as_ref()
+            .is_some_and(|p| p.frequency_hz.iter().skip(1).any(|f| *f > 0.0))
+    }
+
+    /// The Allan deviation: each significant term dashed, the fitted total, then the
+    /// measured points with their bounds.
+    fn draw_allan<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult {
+        let r = self.result;
+        let fit = &r.fit;
+        if !r.allan.points.iter().any(|p| positive(p.adev_dps)) {
+            return note(
+                area,
+                "The Allan deviation is zero at every τ: the rate is constant.",
+            );
+        }
+        let (x, y) = allan_ranges(&r.allan.points);
+        let descs = ("averaging time τ (s)", "Allan deviation σ(τ) (deg/s)");
+        let mut panel = LogPanel::new(log_chart(area, x, y, descs)?, x, y);
+        // Terms, dashed, under the total.
+        for (label, one, c) in terms(fit) {
+            let dashed = (c.stroke_width(2), Stroke::Dashed(9, 5));
+            let segments = curve(x, y, |t| one.adev(t));
+            panel.segments(segments, dashed, label, dashed_swatch(c, 2))?;
+        }
+        let total = curve(x, y, |t| fit.adev(t));
+        let solid = (colour::BLUE.stroke_width(3), Stroke::Solid);
+        let label = "fitted model (sum of the terms)".to_string();
+        panel.segments(total, solid, label, line_swatch(colour::BLUE, 3))?;
+        panel.measured_allan(&r.allan)?;
+        panel.legend()
+    }
+
+    /// The Welch PSD over the white band, its band averages and the white density.
     fn draw_psd<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, psd: &Psd) -> DrawResult {
-        let bins: Vec<(f64, f64)> = psd
-            .frequency_hz
-            .iter()
-            .zip(&psd.psd_dps2_per_hz)
-            .filter(|(f, p)| **f > 0.0 && p.is_finite() && **p > 0.0)
-            .map(|(f, p)| (*f, *p))
-            .collect();
+        let bins = psd_bins(psd);
         let (Some(first), Some(last)) = (bins.first(), bins.last()) else {
             return note(
                 area,
@@ -399,45 +461,16 @@ impl NoisePlot<'_> {
         };
         let x = (first.0, last.0 * 1.05);
         let white = 2.0 * psd.white_density_dps_per_rt_hz.powi(2);
-        let y_lo = bins.iter().map(|b| b.1).fold(f64::INFINITY, f64::min);
-        let y_hi = bins.iter().map(|b| b.1).fold(0.0, f64::max);
-        let y_lo = if white > 0.0 { y_lo.min(white) } else { y_lo };
-        let y = log_range(y_lo, y_hi.max(white) * 8.0, 1.5);
-        let mut chart = log_chart(area, x, y, ("frequency (Hz)", "PSD ((deg/s)²/Hz)"))?;
-        let mut labels: Vec<String> = Vec::new();
-
-        // The band the white density is read over.
-        let (band_lo, band_hi) = psd.white_band_hz;
-        if band_hi > band_lo && band_lo > 0.0 {
-            let band_label = format!("white band {}–{} Hz", sig(band_lo, 2), sig(band_hi, 2));
-            chart
-                .draw_series(std::iter::once(Rectangle::new(
-                    [(band_lo.max(x.0), y.0), (band_hi.min(x.1), y.1)],
-                    colour::GREEN.mix(0.08).filled(),
-                )))
-                .map_err(draw_err)?
-                .label(band_label.clone())
-                .legend(|(x, y)| {
-                    Rectangle::new(
-                        [(x, y - 6), (x + 22, y + 6)],
-                        colour::GREEN.mix(0.15).filled(),
-                    )
-                });
-            labels.push(band_label);
-        }
+        let y = psd_range(&bins, white);
+        let descs = ("frequency (Hz)", "PSD ((deg/s)²/Hz)");
+        let mut panel = LogPanel::new(log_chart(area, x, y, descs)?, x, y);
+        panel.white_band(psd.white_band_hz)?;
         let raw_label = format!(
             "Welch PSD ({} samples × {} windows)",
             psd.segment_len, psd.segments
         );
-        chart
-            .draw_series(LineSeries::new(
-                bins.iter().copied(),
-                colour::SKY.stroke_width(1),
-            ))
-            .map_err(draw_err)?
-            .label(raw_label.clone())
-            .legend(line_swatch(colour::SKY, 2));
-        labels.push(raw_label);
+        let raw = (colour::SKY.stroke_width(1), Stroke::Solid);
+        panel.segments(vec![bins], raw, raw_label, line_swatch(colour::SKY, 2))?;
         let bands: Vec<(f64, f64)> = psd
             .bands
             .iter()
@@ -445,46 +478,20 @@ impl NoisePlot<'_> {
             .map(|b| ((b.low_hz * b.high_hz).sqrt(), b.psd_dps2_per_hz))
             .collect();
         if bands.len() >= 2 {
-            chart
-                .draw_series(LineSeries::new(
-                    bands.iter().copied(),
-                    colour::BLUE.stroke_width(2),
-                ))
-                .map_err(draw_err)?
-                .label("band average (10 per decade)")
-                .legend(line_swatch(colour::BLUE, 2));
-            labels.push("band average (10 per decade)".into());
+            let solid = (colour::BLUE.stroke_width(2), Stroke::Solid);
+            let label = "band average (10 per decade)".to_string();
+            panel.segments(vec![bands], solid, label, line_swatch(colour::BLUE, 2))?;
+        } else {
+            // Not drawn, but a lone band still counts where the legend goes.
+            panel.lines.push(bands);
         }
-        let mut lines = vec![bins.clone(), bands];
         if white > 0.0 {
-            let white_label = format!(
-                "white density 2N², N = {} deg/s/√Hz ({} deg/√h)",
-                sig(psd.white_density_dps_per_rt_hz, 2),
-                sig(psd.white_arw_deg_per_rt_h, 2)
-            );
             let line = vec![(x.0, white), (x.1, white)];
-            chart
-                .draw_series(DashedLineSeries::new(
-                    line.iter().copied(),
-                    9,
-                    5,
-                    colour::GREEN.stroke_width(2),
-                ))
-                .map_err(draw_err)?
-                .label(white_label.clone())
-                .legend(|(x, y)| {
-                    DashedPathElement::new(
-                        [(x, y), (x + 22, y)],
-                        6,
-                        3,
-                        colour::GREEN.stroke_width(2),
-                    )
-                });
-            labels.push(white_label);
-            lines.push(line);
+            let dashed = (colour::GREEN.stroke_width(2), Stroke::Dashed(9, 5));
+            let swatch = dashed_swatch(colour::GREEN, 2);
+            panel.segments(vec![line], dashed, white_label(psd), swatch)?;
         }
-        let label_refs: Vec<&str> = labels.iter().map(String::as_str).collect();
-        log_legend(&mut chart, &lines, (x, y), &label_refs)
+        panel.legend()
     }
 }
 

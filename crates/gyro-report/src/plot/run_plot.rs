@@ -2,10 +2,10 @@
 //! angle error (with the Kalman ±1σ band), the motion state and the filtered rate.
 
 use super::{
-    colour, draw_err, envelope, legend_corner, legend_size, padded, save, thin, tick, titled,
-    DrawResult, Figure, PlotError, RenderError, LABEL_PX, TICK_PX,
+    colour, corner_legend, draw_err, draw_segments, envelope, line_swatch, padded, save, thin,
+    tick, titled, DrawResult, Figure, PlotError, RenderError, Stroke, LABEL_PX, TICK_PX,
 };
-use gyro_analysis::replay::{RunReport, SeriesPoint};
+use gyro_analysis::replay::{RunReport, SeriesPoint, Summary};
 use gyro_core::{Compensation, MotionState};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
@@ -151,20 +151,322 @@ fn legend<'a, DB: DrawingBackend + 'a>(
                 .collect()
         })
         .collect();
-    let size = legend_size(labels, chart.plotting_area().dim_in_pixel());
-    let position = legend_corner(normalised.iter().map(Vec::as_slice), size);
-    chart
-        .configure_series_labels()
-        .position(position)
-        .label_font(("sans-serif", TICK_PX))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.3))
-        .draw()
-        .map_err(draw_err)
+    corner_legend(chart, &normalised, labels, 0.85)
 }
 
-fn line_legend(c: RGBColor, width: u32) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
-    move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(width))
+/// Several segments of one quantity over time (gaps where it is missing).
+type Segments = Vec<Vec<(f64, f64)>>;
+
+/// Each segment thinned to its share of [`MAX_POINTS`] (at least 2 points).
+fn thin_all(lines: Segments) -> Segments {
+    let total: usize = lines.iter().map(Vec::len).sum::<usize>().max(1);
+    lines
+        .into_iter()
+        .map(|l| {
+            let keep = (MAX_POINTS * l.len() / total).max(2);
+            thin(&l, keep)
+        })
+        .collect()
+}
+
+/// The run's series as thinned lines, ready to draw.
+struct Lines {
+    angle_deg: Segments,
+    reference_deg: Segments,
+    error_deg: Segments,
+    /// The upper edge of the Kalman ±1σ band.
+    sigma_deg: Segments,
+    rate_dps: Segments,
+}
+
+impl Lines {
+    fn of(series: &[SeriesPoint]) -> Self {
+        Lines {
+            angle_deg: thin_all(segments(series, |p| Some(f64::from(p.angle_deg)))),
+            reference_deg: thin_all(segments(series, |p| p.reference_deg)),
+            error_deg: thin_all(segments(series, SeriesPoint::error_deg)),
+            // The band's edge: the largest σ per bucket (min/max thinning would notch it).
+            sigma_deg: segments(series, |p| p.angle_std_deg.map(f64::from))
+                .iter()
+                .map(|l| envelope(l, MAX_POINTS / 2))
+                .collect(),
+            rate_dps: thin_all(segments(series, |p| Some(f64::from(p.rate_dps)))),
+        }
+    }
+}
+
+/// How the angle was compensated, in words.
+fn mode_text(compensation: Compensation) -> &'static str {
+    match compensation {
+        Compensation::None => "no compensation",
+        Compensation::Paper => "paper error model",
+        Compensation::Kalman => "Kalman form",
+    }
+}
+
+/// The subtitle: the compensation, the error figures and the movements.
+fn subtitle(s: &Summary) -> String {
+    let errors = match (s.max_abs_error_deg, s.rms_error_deg, s.final_error_deg) {
+        (Some(max), Some(rms), Some(fin)) => {
+            format!("max |error| {max:.3}°, RMS {rms:.3}°, final {fin:+.3}°")
+        }
+        _ => "no reference in the log: errors not available".to_string(),
+    };
+    format!(
+        "{}  ·  {errors}  ·  {} movement{} in {:.1} s",
+        mode_text(s.compensation),
+        s.movements,
+        if s.movements == 1 { "" } else { "s" },
+        s.duration_s
+    )
+}
+
+/// Where the body is cut into panels (px from its top): angle, error (if any), motion,
+/// rate.
+fn panel_cuts(body_h_px: u32, has_error: bool) -> Vec<i32> {
+    let h = body_h_px as i32;
+    if has_error {
+        vec![h * 33 / 100, h * 59 / 100, h * 68 / 100]
+    } else {
+        vec![h * 50 / 100, h * 60 / 100]
+    }
+}
+
+/// The stretches of `time_s` outside the movements `moving_s` (sorted, disjoint).
+fn static_spans(time_s: (f64, f64), moving_s: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut statics = Vec::new();
+    let mut t = time_s.0;
+    for &(a, b) in moving_s {
+        if a > t {
+            statics.push((t, a));
+        }
+        t = b;
+    }
+    if t < time_s.1 {
+        statics.push((t, time_s.1));
+    }
+    statics
+}
+
+/// One quantity drawn as a line: its segments, stroke and legend entry (swatch colour
+/// and width).
+struct Trace<'l> {
+    segments: &'l Segments,
+    style: ShapeStyle,
+    label: &'l str,
+    swatch: (RGBColor, u32),
+}
+
+/// Draw every segment of `trace`; only the first carries the legend entry.
+fn draw_trace<'a, DB: DrawingBackend + 'a>(chart: &mut Chart<'a, DB>, trace: &Trace) -> DrawResult {
+    let swatch = line_swatch(trace.swatch.0, trace.swatch.1);
+    draw_segments(
+        chart,
+        trace.segments,
+        (trace.style, Stroke::Solid),
+        trace.label,
+        swatch,
+    )
+}
+
+/// What every panel shares: the time axis, the movements to shade and the line widths.
+struct Frame {
+    time_s: (f64, f64),
+    moving_s: Vec<(f64, f64)>,
+    /// Stroke of the data lines (px).
+    width_px: u32,
+    /// Stroke of the wide reference line (px).
+    wide_px: u32,
+}
+
+impl Frame {
+    /// A panel of `traces` (drawn in order, the last on top) over the shaded movements,
+    /// with its legend.
+    fn line_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        y_desc: &str,
+        bottom: bool,
+        traces: &[Trace],
+    ) -> DrawResult {
+        // Lines from the topmost (last drawn) trace down.
+        let lines: Vec<&Vec<(f64, f64)>> = traces.iter().rev().flat_map(|t| t.segments).collect();
+        let (lo, hi) = range_of(lines.iter().copied());
+        let y = padded(lo, hi, 0.08);
+        let mut chart = panel(area, self.time_s, y, y_desc, bottom)?;
+        shade_movements(&mut chart, &self.moving_s, y)?;
+        for trace in traces {
+            draw_trace(&mut chart, trace)?;
+        }
+        let lines: Vec<&[(f64, f64)]> = lines.into_iter().map(Vec::as_slice).collect();
+        let labels: Vec<&str> = traces.iter().map(|t| t.label).collect();
+        legend(&mut chart, &lines, (self.time_s, y), &labels)
+    }
+
+    /// The angle against the (wide, grey) reference.
+    fn angle_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        lines: &Lines,
+        mode: &str,
+    ) -> DrawResult {
+        let angle_label = format!("angle ({mode})");
+        let traces = [
+            Trace {
+                segments: &lines.reference_deg,
+                style: colour::GREY.mix(0.55).stroke_width(self.wide_px),
+                label: REFERENCE_LABEL,
+                swatch: (RGBColor(180, 180, 180), self.wide_px),
+            },
+            Trace {
+                segments: &lines.angle_deg,
+                style: colour::BLUE.stroke_width(self.width_px),
+                label: &angle_label,
+                swatch: (colour::BLUE, 2),
+            },
+        ];
+        self.line_panel(area, "angle (deg)", false, &traces)
+    }
+
+    /// The angle error, with the Kalman ±1σ band about zero.
+    fn error_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        lines: &Lines,
+    ) -> DrawResult {
+        let (error, sigma) = (&lines.error_deg, &lines.sigma_deg);
+        let y = error_range(error, sigma);
+        let mut chart = panel(area, self.time_s, y, "error (deg)", false)?;
+        shade_movements(&mut chart, &self.moving_s, y)?;
+        draw_sigma_band(&mut chart, sigma)?;
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(self.time_s.0, 0.0), (self.time_s.1, 0.0)],
+                BLACK.mix(0.5).stroke_width(1),
+            )))
+            .map_err(draw_err)?;
+        let trace = Trace {
+            segments: error,
+            style: colour::VERMILLION.stroke_width(self.width_px),
+            label: ERROR_LABEL,
+            swatch: (colour::VERMILLION, 2),
+        };
+        draw_trace(&mut chart, &trace)?;
+        let negated_sigma: Segments = sigma
+            .iter()
+            .map(|l| l.iter().map(|&(t, s)| (t, -s)).collect())
+            .collect();
+        let mut lines: Vec<&[(f64, f64)]> = error.iter().map(Vec::as_slice).collect();
+        let mut labels = vec![ERROR_LABEL];
+        if !sigma.is_empty() {
+            lines.extend(sigma.iter().map(Vec::as_slice));
+            lines.extend(negated_sigma.iter().map(Vec::as_slice));
+            labels.push(SIGMA_LABEL);
+        }
+        legend(&mut chart, &lines, (self.time_s, y), &labels)
+    }
+
+    /// The motion state as a two-row timeline: static below, dynamic above.
+    fn motion_panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult {
+        let time = self.time_s;
+        let mut chart = ChartBuilder::on(area)
+            .margin_left(10)
+            .margin_right(25)
+            .margin_top(8)
+            .x_label_area_size(0)
+            .y_label_area_size(85)
+            .build_cartesian_2d(time.0..time.1, (0..1).into_segmented())
+            .map_err(draw_err)?;
+        let label = |v: &SegmentValue<i32>| match v {
+            SegmentValue::CenterOf(0) => "static".to_string(),
+            SegmentValue::CenterOf(1) => "dynamic".to_string(),
+            _ => String::new(),
+        };
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .y_labels(2)
+            .y_label_formatter(&label)
+            .label_style(("sans-serif", TICK_PX))
+            .axis_desc_style(("sans-serif", LABEL_PX))
+            .y_desc("motion")
+            .draw()
+            .map_err(draw_err)?;
+        let statics = static_spans(time, &self.moving_s);
+        let row = |row: i32, (a, b): (f64, f64), c: RGBColor| {
+            Rectangle::new(
+                [
+                    (a, SegmentValue::Exact(row)),
+                    (b, SegmentValue::Exact(row + 1)),
+                ],
+                c.filled(),
+            )
+        };
+        chart
+            .draw_series(statics.iter().map(|&s| row(0, s, RGBColor(200, 200, 200))))
+            .map_err(draw_err)?;
+        chart
+            .draw_series(self.moving_s.iter().map(|&s| row(1, s, colour::ORANGE)))
+            .map_err(draw_err)?;
+        Ok(())
+    }
+
+    /// The filtered rate, with the time axis below it.
+    fn rate_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        lines: &Lines,
+    ) -> DrawResult {
+        let trace = Trace {
+            segments: &lines.rate_dps,
+            style: colour::GREEN.stroke_width(self.width_px),
+            label: RATE_LABEL,
+            swatch: (colour::GREEN, 2),
+        };
+        self.line_panel(area, "rate (deg/s)", true, &[trace])
+    }
+}
+
+/// The error panel's y range: the error and the ±1σ band, with zero, and headroom above
+/// for the legend.
+fn error_range(error: &Segments, sigma: &Segments) -> (f64, f64) {
+    let (mut lo, mut hi) = range_of(error.iter());
+    let (_, smax) = range_of(sigma.iter());
+    if smax.is_finite() {
+        lo = lo.min(-smax);
+        hi = hi.max(smax);
+    }
+    let (a, b) = padded(lo.min(0.0), hi.max(0.0), 0.1);
+    (a, b + 0.22 * (b - a))
+}
+
+/// The Kalman ±1σ band about zero, one polygon per segment of its upper edge `sigma`.
+fn draw_sigma_band<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    sigma: &Segments,
+) -> DrawResult {
+    for (i, band) in sigma.iter().enumerate() {
+        let outline: Vec<(f64, f64)> = band
+            .iter()
+            .copied()
+            .chain(band.iter().rev().map(|&(t, s)| (t, -s)))
+            .collect();
+        let drawn = chart
+            .draw_series(std::iter::once(Polygon::new(
+                outline,
+                colour::SKY.mix(0.35).filled(),
+            )))
+            .map_err(draw_err)?;
+        if i == 0 {
+            drawn.label(SIGMA_LABEL).legend(|(x, y)| {
+                Rectangle::new(
+                    [(x, y - 6), (x + 22, y + 6)],
+                    colour::SKY.mix(0.35).filled(),
+                )
+            });
+        }
+    }
+    Ok(())
 }
 
 impl Figure for RunPlot<'_> {
@@ -173,259 +475,37 @@ impl Figure for RunPlot<'_> {
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
-        let report = self.report;
-        let series = &report.series;
+        let series = &self.report.series;
         let (Some(first), Some(last)) = (series.first(), series.last()) else {
             return Err(RenderError::Empty("the run has no output samples"));
         };
-        let time = padded(first.time_s, last.time_s, 0.0);
-        let s = &report.summary;
-        let mode = match s.compensation {
-            Compensation::None => "no compensation",
-            Compensation::Paper => "paper error model",
-            Compensation::Kalman => "Kalman form",
-        };
-        let errors = match (s.max_abs_error_deg, s.rms_error_deg, s.final_error_deg) {
-            (Some(max), Some(rms), Some(fin)) => {
-                format!("max |error| {max:.3}°, RMS {rms:.3}°, final {fin:+.3}°")
-            }
-            _ => "no reference in the log: errors not available".to_string(),
-        };
-        let subtitle = format!(
-            "{mode}  ·  {errors}  ·  {} movement{} in {:.1} s",
-            s.movements,
-            if s.movements == 1 { "" } else { "s" },
-            s.duration_s
-        );
-        let body = titled(root, &format!("run: {}", self.title), &subtitle)?;
-
-        let spans = dynamic_spans(series);
-        let thin_all = |lines: Vec<Vec<(f64, f64)>>| -> Vec<Vec<(f64, f64)>> {
-            let total: usize = lines.iter().map(Vec::len).sum::<usize>().max(1);
-            lines
-                .into_iter()
-                .map(|l| {
-                    let keep = (MAX_POINTS * l.len() / total).max(2);
-                    thin(&l, keep)
-                })
-                .collect()
-        };
-        let angle = thin_all(segments(series, |p| Some(f64::from(p.angle_deg))));
-        let reference = thin_all(segments(series, |p| p.reference_deg));
-        let error = thin_all(segments(series, SeriesPoint::error_deg));
-        // The band's edge: the largest σ per bucket (min/max thinning would notch it).
-        let sigma: Vec<Vec<(f64, f64)>> = segments(series, |p| p.angle_std_deg.map(f64::from))
-            .iter()
-            .map(|l| envelope(l, MAX_POINTS / 2))
-            .collect();
-        let rate = thin_all(segments(series, |p| Some(f64::from(p.rate_dps))));
-        let has_error = !error.is_empty();
+        let summary = &self.report.summary;
+        let title = format!("run: {}", self.title);
+        let body = titled(root, &title, &subtitle(summary))?;
+        let lines = Lines::of(series);
         // Thinned lines are drawn thin: plotters' bitmap backend leaves gaps in thick,
         // near-vertical segments.
-        let (width, wide) = if series.len() > MAX_POINTS {
+        let (width_px, wide_px) = if series.len() > MAX_POINTS {
             (1, 3)
         } else {
             (2, 5)
         };
-
-        // Panel heights (px) of the body.
-        let (_, h) = body.dim_in_pixel();
-        let h = h as i32;
-        let cuts: Vec<i32> = if has_error {
-            vec![h * 33 / 100, h * 59 / 100, h * 68 / 100]
-        } else {
-            vec![h * 50 / 100, h * 60 / 100]
+        let frame = Frame {
+            time_s: padded(first.time_s, last.time_s, 0.0),
+            moving_s: dynamic_spans(series),
+            width_px,
+            wide_px,
         };
+        let has_error = !lines.error_deg.is_empty();
+        let cuts = panel_cuts(body.dim_in_pixel().1, has_error);
         let areas = body.split_by_breakpoints::<i32, i32, _, _>([], cuts);
         let mut areas = areas.iter();
         let mut next = || areas.next().ok_or(RenderError::Draw("layout".into()));
-
-        // Angle and reference.
-        {
-            let angle_label = format!("angle ({mode})");
-            let (lo, hi) = range_of(angle.iter().chain(&reference));
-            let y = padded(lo, hi, 0.08);
-            let mut chart = panel(next()?, time, y, "angle (deg)", false)?;
-            shade_movements(&mut chart, &spans, y)?;
-            for (i, line) in reference.iter().enumerate() {
-                let drawn = chart
-                    .draw_series(LineSeries::new(
-                        line.iter().copied(),
-                        colour::GREY.mix(0.55).stroke_width(wide),
-                    ))
-                    .map_err(draw_err)?;
-                if i == 0 {
-                    drawn
-                        .label(REFERENCE_LABEL)
-                        .legend(line_legend(RGBColor(180, 180, 180), wide));
-                }
-            }
-            for (i, line) in angle.iter().enumerate() {
-                let drawn = chart
-                    .draw_series(LineSeries::new(
-                        line.iter().copied(),
-                        colour::BLUE.stroke_width(width),
-                    ))
-                    .map_err(draw_err)?;
-                if i == 0 {
-                    drawn
-                        .label(&angle_label)
-                        .legend(line_legend(colour::BLUE, 2));
-                }
-            }
-            let lines: Vec<&[(f64, f64)]> =
-                angle.iter().chain(&reference).map(Vec::as_slice).collect();
-            legend(
-                &mut chart,
-                &lines,
-                (time, y),
-                &[REFERENCE_LABEL, &angle_label],
-            )?;
-        }
-
-        // Error, with the Kalman ±1σ band about zero.
+        frame.angle_panel(next()?, &lines, mode_text(summary.compensation))?;
         if has_error {
-            let (mut lo, mut hi) = range_of(error.iter());
-            let (_, smax) = range_of(sigma.iter());
-            if smax.is_finite() {
-                lo = lo.min(-smax);
-                hi = hi.max(smax);
-            }
-            // Headroom above for the legend.
-            let (a, b) = padded(lo.min(0.0), hi.max(0.0), 0.1);
-            let y = (a, b + 0.22 * (b - a));
-            let negated_sigma: Vec<Vec<(f64, f64)>> = sigma
-                .iter()
-                .map(|l| l.iter().map(|&(t, s)| (t, -s)).collect())
-                .collect();
-            let mut chart = panel(next()?, time, y, "error (deg)", false)?;
-            shade_movements(&mut chart, &spans, y)?;
-            for (i, band) in sigma.iter().enumerate() {
-                let outline: Vec<(f64, f64)> = band
-                    .iter()
-                    .copied()
-                    .chain(band.iter().rev().map(|&(t, s)| (t, -s)))
-                    .collect();
-                let drawn = chart
-                    .draw_series(std::iter::once(Polygon::new(
-                        outline,
-                        colour::SKY.mix(0.35).filled(),
-                    )))
-                    .map_err(draw_err)?;
-                if i == 0 {
-                    drawn.label(SIGMA_LABEL).legend(|(x, y)| {
-                        Rectangle::new(
-                            [(x, y - 6), (x + 22, y + 6)],
-                            colour::SKY.mix(0.35).filled(),
-                        )
-                    });
-                }
-            }
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    vec![(time.0, 0.0), (time.1, 0.0)],
-                    BLACK.mix(0.5).stroke_width(1),
-                )))
-                .map_err(draw_err)?;
-            for (i, line) in error.iter().enumerate() {
-                let drawn = chart
-                    .draw_series(LineSeries::new(
-                        line.iter().copied(),
-                        colour::VERMILLION.stroke_width(width),
-                    ))
-                    .map_err(draw_err)?;
-                if i == 0 {
-                    drawn
-                        .label(ERROR_LABEL)
-                        .legend(line_legend(colour::VERMILLION, 2));
-                }
-            }
-            let mut lines: Vec<&[(f64, f64)]> = error.iter().map(Vec::as_slice).collect();
-            let mut labels = vec![ERROR_LABEL];
-            if !sigma.is_empty() {
-                lines.extend(sigma.iter().map(Vec::as_slice));
-                lines.extend(negated_sigma.iter().map(Vec::as_slice));
-                labels.push(SIGMA_LABEL);
-            }
-            legend(&mut chart, &lines, (time, y), &labels)?;
+            frame.error_panel(next()?, &lines)?;
         }
-
-        // Motion state as a two-row timeline.
-        {
-            let area = next()?;
-            let mut chart = ChartBuilder::on(area)
-                .margin_left(10)
-                .margin_right(25)
-                .margin_top(8)
-                .x_label_area_size(0)
-                .y_label_area_size(85)
-                .build_cartesian_2d(time.0..time.1, (0..1).into_segmented())
-                .map_err(draw_err)?;
-            let label = |v: &SegmentValue<i32>| match v {
-                SegmentValue::CenterOf(0) => "static".to_string(),
-                SegmentValue::CenterOf(1) => "dynamic".to_string(),
-                _ => String::new(),
-            };
-            chart
-                .configure_mesh()
-                .disable_mesh()
-                .y_labels(2)
-                .y_label_formatter(&label)
-                .label_style(("sans-serif", TICK_PX))
-                .axis_desc_style(("sans-serif", LABEL_PX))
-                .y_desc("motion")
-                .draw()
-                .map_err(draw_err)?;
-            let mut statics = Vec::new();
-            let mut t = time.0;
-            for &(a, b) in &spans {
-                if a > t {
-                    statics.push((t, a));
-                }
-                t = b;
-            }
-            if t < time.1 {
-                statics.push((t, time.1));
-            }
-            let row = |row: i32, (a, b): (f64, f64), c: RGBColor| {
-                Rectangle::new(
-                    [
-                        (a, SegmentValue::Exact(row)),
-                        (b, SegmentValue::Exact(row + 1)),
-                    ],
-                    c.filled(),
-                )
-            };
-            chart
-                .draw_series(statics.iter().map(|&s| row(0, s, RGBColor(200, 200, 200))))
-                .map_err(draw_err)?;
-            chart
-                .draw_series(spans.iter().map(|&s| row(1, s, colour::ORANGE)))
-                .map_err(draw_err)?;
-        }
-
-        // Filtered rate.
-        {
-            let (lo, hi) = range_of(rate.iter());
-            let y = padded(lo, hi, 0.08);
-            let mut chart = panel(next()?, time, y, "rate (deg/s)", true)?;
-            shade_movements(&mut chart, &spans, y)?;
-            for (i, line) in rate.iter().enumerate() {
-                let drawn = chart
-                    .draw_series(LineSeries::new(
-                        line.iter().copied(),
-                        colour::GREEN.stroke_width(width),
-                    ))
-                    .map_err(draw_err)?;
-                if i == 0 {
-                    drawn
-                        .label(RATE_LABEL)
-                        .legend(line_legend(colour::GREEN, 2));
-                }
-            }
-            let lines: Vec<&[(f64, f64)]> = rate.iter().map(Vec::as_slice).collect();
-            legend(&mut chart, &lines, (time, y), &[RATE_LABEL])?;
-        }
-        Ok(())
+        frame.motion_panel(next()?)?;
+        frame.rate_panel(next()?, &lines)
     }
 }
