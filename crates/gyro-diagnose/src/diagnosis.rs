@@ -152,6 +152,11 @@ pub struct Diagnosis {
     /// ([`gyro_log::sense`]); left out when empty. The headline leads with them.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub reference_warnings: Vec<String>,
+    /// Why a named effect may be a look-alike of another cause, one sentence each (a
+    /// latency beside rests whose noise is low-passed); left out when empty. The verdict
+    /// says them right after what it names.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub doubts: Vec<String>,
     /// What makes part of the diagnosis unreliable, one sentence each (e.g. a gyro–reference
     /// lag beyond the cross-correlation's search); left out when empty.
     #[serde(skip_serializing_if = "Vec::is_empty")]

@@ -449,7 +449,7 @@ fn wander_by_shape(ok: &[(usize, Step, Vec<RunScore>)], candidates: &[Candidate]
 /// differences') point to it; white rests point to a pure `latency`, which delays the
 /// motion and leaves the noise as it is. `None` when the rests were not checked, or the
 /// effect is neither.
-fn rests_delay(whiteness: Option<&fit::RestWhiteness>) -> Option<&'static str> {
+pub(crate) fn rests_delay(whiteness: Option<&fit::RestWhiteness>) -> Option<&'static str> {
     let w = whiteness?;
     Some(if w.coloured && w.z > 0.0 {
         "bandwidth"

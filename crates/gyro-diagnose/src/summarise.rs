@@ -191,6 +191,11 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         &f.selection.holdout_scores,
         f.settings,
     );
+    let delay_doubt = delay_doubt(
+        &f.selected_effects,
+        f.baseline.whiteness.as_ref(),
+        f.baseline.nominal.sample_rate_hz,
+    );
     let runs = run_summaries(
         f.runs,
         (&f.baseline.train.scores, &f.train_after.0),
@@ -227,6 +232,7 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         runs,
         compensation: f.compensation,
         reference_warnings: sense_warnings(f.runs),
+        doubts: delay_doubt.into_iter().collect(),
         warnings: lag_warnings(f.runs, growing)
             .into_iter()
             .chain(f.baseline.whiteness.as_ref().and_then(colour_warning))
@@ -301,6 +307,44 @@ fn sense_warnings(runs: &Runs) -> Vec<String> {
     out
 }
 
+/// The doubt when a `latency` is named although the rests' noise is low-passed, which
+/// points to the gyro's own filter ([`super::select::rests_delay`]): selection keeps the
+/// bandwidth when it qualifies, so a latency named beside such rests is one the bandwidth
+/// effect could not match, most often because a two-pole low-pass of that delay has its
+/// cutoff above the Nyquist frequency, where the effect cannot reach.
+fn delay_doubt(
+    selected: &[Effect],
+    whiteness: Option<&super::fit::RestWhiteness>,
+    sample_rate_hz: f64,
+) -> Option<String> {
+    let delay_s = selected.iter().find_map(|e| match e {
+        Effect::Latency { delay_s } if *delay_s > 0.0 => Some(*delay_s),
+        _ => None,
+    })?;
+    let w = whiteness?;
+    if super::select::rests_delay(Some(w)) != Some("bandwidth") {
+        return None;
+    }
+    let cutoff_hz = gyro_sim::low_pass_delay_s(1.0) / delay_s;
+    let nyquist_hz = 0.5 * sample_rate_hz;
+    let why = if cutoff_hz > nyquist_hz {
+        format!(
+            ": a two-pole low-pass that delays slow motion by {:.1} ms has its cutoff at {cutoff_hz:.0} Hz, above the {nyquist_hz:.0} Hz this sample rate allows the bandwidth effect",
+            delay_s * 1e3
+        )
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "The lag of {:.1} ms named latency may be the gyro's own low-pass filter, not a delay: the training rests' noise is low-passed (their {:.2} s blocks read {:.3} deg/sqrt(h), their first differences {:.3}; z {:.0}), which a delay alone does not do, and the bandwidth effect could not match the lag{why}",
+        delay_s * 1e3,
+        w.tau_s,
+        w.block_arw_deg_per_rt_h,
+        w.first_difference_arw_deg_per_rt_h,
+        w.z
+    ))
+}
+
 /// The warning a coloured rest noise gives: the nominal model's white noise cannot be the
 /// rests' at every frequency.
 fn colour_warning(w: &super::fit::RestWhiteness) -> Option<String> {
@@ -371,4 +415,43 @@ fn lag_warnings(runs: &Runs, growing: bool) -> Vec<String> {
         all.len(),
         1e3 * edge.abs()
     )]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::RestWhiteness;
+    use crate::settings::Settings;
+
+    fn rests(z: f64) -> RestWhiteness {
+        RestWhiteness {
+            tau_s: 0.05,
+            first_difference_arw_deg_per_rt_h: 1.405,
+            block_arw_deg_per_rt_h: 1.762,
+            block_differences: 4000,
+            z,
+            coloured: z.abs() >= Settings::DEFAULT.tests.z_critical,
+        }
+    }
+
+    #[test]
+    fn a_latency_beside_low_passed_rests_is_doubted() {
+        let latency = [Effect::Latency { delay_s: 0.0023 }];
+        // At 100 Hz: a 2.3 ms two-pole delay is a cutoff near 98 Hz, above Nyquist.
+        let w = delay_doubt(&latency, Some(&rests(19.0)), 100.0).expect("a warning");
+        assert!(
+            w.contains("The lag of 2.3 ms named latency may be the gyro's own low-pass"),
+            "{w}"
+        );
+        assert!(w.contains("above the 50 Hz"), "{w}");
+        // At 1 kHz the cutoff is below Nyquist: the warning without that clause.
+        let w = delay_doubt(&latency, Some(&rests(19.0)), 1000.0).expect("a warning");
+        assert!(!w.contains("Nyquist") && !w.contains("above the"), "{w}");
+        // White rests, rests not checked, a negative latency, or no latency: none.
+        assert_eq!(delay_doubt(&latency, Some(&rests(0.5)), 100.0), None);
+        assert_eq!(delay_doubt(&latency, None, 100.0), None);
+        let ahead = [Effect::Latency { delay_s: -0.01 }];
+        assert_eq!(delay_doubt(&ahead, Some(&rests(19.0)), 100.0), None);
+        assert_eq!(delay_doubt(&[], Some(&rests(19.0)), 100.0), None);
+    }
 }

@@ -382,6 +382,8 @@ pub fn verdict(d: &Diagnosis) -> Vec<String> {
     } else {
         format!("The gyro {}.", and_list(&differs))
     });
+    // Why a named effect may be a look-alike: right after it, before what correcting it does.
+    out.extend(d.doubts.iter().map(|doubt| format!("{doubt}.")));
     if let Some(c) = &d.compensation {
         let (before, after, better) = held_out_error(c);
         let turns_wrote = turns_wrote(d);

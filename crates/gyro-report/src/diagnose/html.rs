@@ -1472,6 +1472,7 @@ mod tests {
                 }],
             }),
             reference_warnings: Vec::new(),
+            doubts: Vec::new(),
             warnings: Vec::new(),
             effective_noise: Default::default(),
             motion_lines: Vec::new(),
@@ -1698,6 +1699,7 @@ mod tests {
             confounded_with: Vec::new(),
             posterior_check: None,
         }];
+        d.doubts = vec!["The clock may be another cause's look-alike".into()];
         let (_scratch, dir) = temp("verdict_first");
         write_report(&dir, &d, None, &Options::default()).unwrap();
         let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
@@ -1707,6 +1709,7 @@ mod tests {
         };
         let verdict = at("<div class=\"verdict\">");
         let said = at("The gyro samples 500 ppm fast against the declared sample rate");
+        let doubt = at("The clock may be another cause&#39;s look-alike.");
         let error = at("Correcting the clock cuts the held-out angle error from 1.5° to 0.20°");
         let missed =
             at("The model does not explain these runs: in motion, the rate noise is 3.6 times");
@@ -1715,6 +1718,8 @@ mod tests {
         let first_fold = at("<details");
         // The model not fitting comes first: what is named is at most part of the answer.
         assert!(verdict < missed && missed < said && said < error, "{html}");
+        // A doubt on what is named follows it at once.
+        assert!(said < doubt && doubt < error, "{html}");
         assert!(error < figure, "the figure follows the verdict");
         assert!(figure < first_table && figure < first_fold, "{html}");
         assert!(
