@@ -12,7 +12,7 @@
 //! Checksum: `!(b0 + b1 + b2 + b3 + b4)`, the ones' complement of the 8-bit wrapping sum.
 //! The rate word is an `i16`, big-endian; the temperature word a `u16`, big-endian.
 //!
-//! What the checksum catches (tested in `tests/frame.rs`): a single flipped bit changes the
+//! What the checksum catches (tested in `tests/all/frame.rs`): a single flipped bit changes the
 //! sum by ±2^k (k < 8), never 0 mod 256, so **every single-bit error is detected**, as are
 //! all-zero and all-`0xFF` frames (a stuck MISO line). Two flipped bits are **not** always
 //! detected: bit 7 flipped in two bytes changes the sum by ±256 ≡ 0, and the same bit going

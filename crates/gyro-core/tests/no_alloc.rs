@@ -3,6 +3,8 @@
 // A counting `#[global_allocator]` needs `unsafe impl GlobalAlloc`; it only forwards to `System`.
 #![allow(unsafe_code)]
 
+// The helpers of the other tests (`all/`), shared with this binary of its own.
+#[path = "all/common/mod.rs"]
 mod common;
 
 use common::{BenchSpec, Profile, Rng};

@@ -108,9 +108,9 @@
 //! Nothing in this crate can panic, and the checks of gyro-core it links (slices bounded by
 //! the filter's section count) guard the pipeline's own invariants, not its input.
 //!
-//! The header is committed and checked: `cargo test -p gyro-ffi --test header` fails when
+//! The header is committed and checked: `cargo test -p gyro-ffi --test all header::` fails when
 //! `include/gyro.h` differs from what cbindgen makes of this crate, and
-//! `GYRO_FFI_BLESS=1 cargo test -p gyro-ffi --test header` rewrites it.
+//! `GYRO_FFI_BLESS=1 cargo test -p gyro-ffi --test all header::` rewrites it.
 #![no_std]
 // The API is raw pointers from C: checked, then dereferenced in `unsafe` blocks, each with
 // its reason (`SAFETY:`).

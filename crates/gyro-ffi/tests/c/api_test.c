@@ -1,6 +1,6 @@
 /*
  * The C API from C: built with the system `cc` against the host libgyro_ffi.a and run by
- * tests/c_api.rs. Exit status 0 when every check passes; each failed check is printed.
+ * tests/all/c_api.rs. Exit status 0 when every check passes; each failed check is printed.
  */
 #include <math.h>
 #include <stdio.h>
