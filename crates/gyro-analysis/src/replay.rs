@@ -827,48 +827,10 @@ impl Replayer {
 
     /// One slot, scored against `reference` (deg; the origin is set).
     fn push_scored(&mut self, slot: &Slot, reference: Option<f64>) -> Option<SeriesPoint> {
-        let reference = match (reference, self.reference_origin) {
-            (Some(r), Some(origin)) => {
-                self.ref_last = (r - origin) as f32;
-                Some(self.ref_last)
-            }
-            _ => {
-                self.ref_block_complete = false;
-                None
-            }
-        };
-        let ref_mean = self.ref_decimator.push(reference.unwrap_or(self.ref_last));
-        let magnitude = slot.rate_dps.abs();
-        // NaN fails the test: an implausible reading is the pipeline's to reject.
-        if magnitude <= f64::from(self.config.max_abs_rate_dps) {
-            self.largest_abs_rate_dps = self.largest_abs_rate_dps.max(magnitude);
-        }
-        self.filled_total = self.filled_total.saturating_add(u32::from(slot.filled));
-        // A slot without temperature in a log that has them (a filled gap) keeps the last
-        // valid temperature: NaN tells the pipeline so.
-        let out = if self.has_temperature || slot.temperature_c.is_some() {
-            let temperature_c = slot.temperature_c.map_or(f32::NAN, |t| t as f32);
-            self.pipeline
-                .push_with_temperature(slot.time_s, slot.rate_dps as f32, temperature_c)
-        } else {
-            self.pipeline.push(slot.time_s, slot.rate_dps as f32)
-        }?;
-        let reference_deg = match ref_mean {
-            Some(mean) => {
-                let complete = self.ref_block_complete;
-                if !self.ref_started {
-                    if complete {
-                        self.start_reference(mean, out.rate_dps, out.angle_deg);
-                    } else if self.outputs == 0 {
-                        self.ref_sos.settle(&mut self.ref_state, mean);
-                    }
-                }
-                let filtered = self.ref_sos.process(&mut self.ref_state, mean) - self.ref_start;
-                self.ref_block_complete = true;
-                complete.then_some(f64::from(filtered))
-            }
-            None => None,
-        };
+        let ref_mean = self.decimate_reference(reference);
+        self.count_input(slot);
+        let out = self.run_pipeline(slot)?;
+        let reference_deg = self.filter_reference(ref_mean, out.rate_dps, out.angle_deg);
         let point = SeriesPoint {
             time_s: out.time_s,
             rate_dps: out.rate_dps,
@@ -887,68 +849,142 @@ impl Replayer {
             Some(Event::MovementStarted {
                 start_time_s,
                 start_index,
-            }) => {
-                let start_index = start_index as usize;
-                let mut open = OpenMovement {
-                    start_time_s,
-                    start_index,
-                    start: self.held(start_index).copied(),
-                    reference_at_start: None,
-                };
-                if point.time_s >= start_time_s {
-                    open.reference_at_start = Some(self.reference_near(start_time_s));
-                }
-                self.open = Some(open);
-                if self.mode == Mode::Offline {
-                    let smoothed = self.smoother.movement_started(start_index);
-                    self.apply(smoothed);
-                }
-            }
-            Some(Event::MovementEnded(m)) => {
-                let open = self.open.take();
-                let samples = (m.start_index as usize, m.end_index as usize);
-                // The core ends the movement it started: its start was read then.
-                let (start_filled, start_reference) = match open {
-                    Some(open)
-                        if open.start_index == samples.0
-                            && open.start_time_s.to_bits() == m.start_time_s.to_bits() =>
-                    {
-                        (
-                            open.start.map_or(0, |h| h.filled_before),
-                            open.reference_at_start
-                                .unwrap_or_else(|| self.reference_near(open.start_time_s)),
-                        )
-                    }
-                    _ => (
-                        self.held(samples.0).map_or(0, |h| h.filled_before),
-                        self.reference_near(m.start_time_s),
-                    ),
-                };
-                let filled_samples =
-                    self.held(samples.1).map_or(0, |h| h.filled_before) - start_filled;
-                let end_reference = self.reference_near(m.end_time_s);
-                self.movements.push(movement_result(
-                    self.movements.len() + 1,
-                    (m.start_time_s, m.end_time_s),
-                    (m.angle_deg, m.raw_angle_deg),
-                    Flags {
-                        complete: true,
-                        saturated: m.saturated,
-                        filled_samples,
-                        angle_std_deg: m.angle_std_deg,
-                    },
-                    samples,
-                    reference_change(start_reference, end_reference),
-                    self.config.tightening.as_ref(),
-                ));
-                if self.mode == Mode::Offline {
-                    self.smoother
-                        .movement_ended(self.movements.len() - 1, samples.1);
-                }
-            }
+            }) => self.movement_started(&point, start_time_s, start_index as usize),
+            Some(Event::MovementEnded(m)) => self.movement_ended(&m),
             None => {}
         }
         Some(point)
+    }
+
+    /// The slot's `reference` (deg) relative to the origin into the reference's block
+    /// decimator (the last one again when absent, the block then incomplete); the block's
+    /// mean when the slot completes a block.
+    fn decimate_reference(&mut self, reference: Option<f64>) -> Option<f32> {
+        let reference = match (reference, self.reference_origin) {
+            (Some(r), Some(origin)) => {
+                self.ref_last = (r - origin) as f32;
+                Some(self.ref_last)
+            }
+            _ => {
+                self.ref_block_complete = false;
+                None
+            }
+        };
+        self.ref_decimator.push(reference.unwrap_or(self.ref_last))
+    }
+
+    /// Counts the slot into the largest plausible |rate| and the filled samples.
+    fn count_input(&mut self, slot: &Slot) {
+        let magnitude = slot.rate_dps.abs();
+        // NaN fails the test: an implausible reading is the pipeline's to reject.
+        if magnitude <= f64::from(self.config.max_abs_rate_dps) {
+            self.largest_abs_rate_dps = self.largest_abs_rate_dps.max(magnitude);
+        }
+        self.filled_total = self.filled_total.saturating_add(u32::from(slot.filled));
+    }
+
+    /// The slot into the pipeline, with its temperature when the log has them; the output
+    /// sample it completed, if any.
+    fn run_pipeline(&mut self, slot: &Slot) -> Option<gyro_core::Output> {
+        // A slot without temperature in a log that has them (a filled gap) keeps the last
+        // valid temperature: NaN tells the pipeline so.
+        if self.has_temperature || slot.temperature_c.is_some() {
+            let temperature_c = slot.temperature_c.map_or(f32::NAN, |t| t as f32);
+            self.pipeline
+                .push_with_temperature(slot.time_s, slot.rate_dps as f32, temperature_c)
+        } else {
+            self.pipeline.push(slot.time_s, slot.rate_dps as f32)
+        }
+    }
+
+    /// The low-passed reference angle (deg) at an output whose block's reference mean is
+    /// `ref_mean`, started on the output's `rate_dps` and `angle_deg` at the first
+    /// complete block ([`Self::start_reference`]); None while the block is incomplete.
+    fn filter_reference(
+        &mut self,
+        ref_mean: Option<f32>,
+        rate_dps: f32,
+        angle_deg: f32,
+    ) -> Option<f64> {
+        match ref_mean {
+            Some(mean) => {
+                let complete = self.ref_block_complete;
+                if !self.ref_started {
+                    if complete {
+                        self.start_reference(mean, rate_dps, angle_deg);
+                    } else if self.outputs == 0 {
+                        self.ref_sos.settle(&mut self.ref_state, mean);
+                    }
+                }
+                let filtered = self.ref_sos.process(&mut self.ref_state, mean) - self.ref_start;
+                self.ref_block_complete = true;
+                complete.then_some(f64::from(filtered))
+            }
+            None => None,
+        }
+    }
+
+    /// A movement started at `start_time_s` (output `start_index`): open it, with its
+    /// reference when `point` has reached its time; offline, the smoother restarts there.
+    fn movement_started(&mut self, point: &SeriesPoint, start_time_s: f64, start_index: usize) {
+        let mut open = OpenMovement {
+            start_time_s,
+            start_index,
+            start: self.held(start_index).copied(),
+            reference_at_start: None,
+        };
+        if point.time_s >= start_time_s {
+            open.reference_at_start = Some(self.reference_near(start_time_s));
+        }
+        self.open = Some(open);
+        if self.mode == Mode::Offline {
+            let smoothed = self.smoother.movement_started(start_index);
+            self.apply(smoothed);
+        }
+    }
+
+    /// The movement `m` ended: score it against the reference's change over it, with the
+    /// samples filled within it.
+    fn movement_ended(&mut self, m: &gyro_core::Movement) {
+        let open = self.open.take();
+        let samples = (m.start_index as usize, m.end_index as usize);
+        // The core ends the movement it started: its start was read then.
+        let (start_filled, start_reference) = match open {
+            Some(open)
+                if open.start_index == samples.0
+                    && open.start_time_s.to_bits() == m.start_time_s.to_bits() =>
+            {
+                (
+                    open.start.map_or(0, |h| h.filled_before),
+                    open.reference_at_start
+                        .unwrap_or_else(|| self.reference_near(open.start_time_s)),
+                )
+            }
+            _ => (
+                self.held(samples.0).map_or(0, |h| h.filled_before),
+                self.reference_near(m.start_time_s),
+            ),
+        };
+        let filled_samples = self.held(samples.1).map_or(0, |h| h.filled_before) - start_filled;
+        let end_reference = self.reference_near(m.end_time_s);
+        self.movements.push(movement_result(
+            self.movements.len() + 1,
+            (m.start_time_s, m.end_time_s),
+            (m.angle_deg, m.raw_angle_deg),
+            Flags {
+                complete: true,
+                saturated: m.saturated,
+                filled_samples,
+                angle_std_deg: m.angle_std_deg,
+            },
+            samples,
+            reference_change(start_reference, end_reference),
+            self.config.tightening.as_ref(),
+        ));
+        if self.mode == Mode::Offline {
+            self.smoother
+                .movement_ended(self.movements.len() - 1, samples.1);
+        }
     }
 
     /// Count `point` into the summary and hold it (dropping the oldest held output past

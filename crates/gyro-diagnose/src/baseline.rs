@@ -132,26 +132,12 @@ pub(crate) fn baseline(
         ),
         _ => None,
     };
-    let (mut nominal, mut notes, white_target, whiteness) = if options.fixed_model {
-        let mut m = options.prior;
-        if let Some(first) = runs.train.first() {
-            m.sample_rate_hz = first.sample_rate_hz;
-        }
-        (
-            m,
-            vec!["the --model sensor model as given".to_string()],
-            None,
-            None,
-        )
-    } else {
-        let fit::Nominal {
-            model,
-            notes,
-            white_target,
-            whiteness,
-        } = fitted_nominal(runs, known, options, moving.as_ref(), short.as_ref());
-        (model, notes, white_target, whiteness)
-    };
+    let fit::Nominal {
+        model: mut nominal,
+        mut notes,
+        white_target,
+        whiteness,
+    } = starting_model(runs, known, options, moving.as_ref(), short.as_ref());
     let own_noise = match (options.fixed_model, white_target) {
         (true, _) => (nominal.arw_deg_per_rt_h, "given model"),
         (false, Some(_)) => (nominal.arw_deg_per_rt_h, "rests"),
@@ -164,6 +150,69 @@ pub(crate) fn baseline(
         "baseline ensembles",
         (m * (runs.train.len() + runs.holdout.len())) as u64,
     );
+    let train = train_evaluation(runs, &mut nominal, &mut notes, options, m, progress);
+    let holdout = evaluate(
+        &runs.holdout,
+        &runs.holdout_ids,
+        &nominal,
+        &[],
+        options,
+        m,
+        progress,
+    );
+    let floor = ensemble_floor(&train, &holdout, options);
+    Baseline {
+        nominal,
+        notes,
+        white_target,
+        whiteness,
+        moving_noise,
+        own_noise,
+        candidate_members: mc,
+        train_gap: gap(&train.scores),
+        holdout_gap: gap(&holdout.scores),
+        train,
+        holdout,
+        floor,
+    }
+}
+
+/// The nominal model to start from: the `--model` one as given (at the runs' sample rate)
+/// when the model is fixed, else the one fitted on the training runs ([`fitted_nominal`]).
+fn starting_model(
+    runs: &Runs,
+    known: &[Effect],
+    options: &Options,
+    moving: Option<&MeasuredNoise>,
+    short: Option<&super::short_white::ShortWhite>,
+) -> fit::Nominal {
+    if options.fixed_model {
+        let mut m = options.prior;
+        if let Some(first) = runs.train.first() {
+            m.sample_rate_hz = first.sample_rate_hz;
+        }
+        fit::Nominal {
+            model: m,
+            notes: vec!["the --model sensor model as given".to_string()],
+            white_target: None,
+            whiteness: None,
+        }
+    } else {
+        fitted_nominal(runs, known, options, moving, short)
+    }
+}
+
+/// The training runs' ensembles of `m` members against the `nominal` model; when their
+/// Allan variance at long τ lies below the model's beyond chance, the model's
+/// Gauss-Markov sigma is lowered (noted in `notes`) and the runs simulated again.
+fn train_evaluation(
+    runs: &Runs,
+    nominal: &mut SensorModel,
+    notes: &mut Vec<String>,
+    options: &Options,
+    m: usize,
+    progress: &dyn Progress,
+) -> Evaluation {
     let train_against = |model: &SensorModel| {
         evaluate(
             &runs.train,
@@ -175,9 +224,9 @@ pub(crate) fn baseline(
             progress,
         )
     };
-    let mut train = train_against(&nominal);
+    let mut train = train_against(nominal);
     let wander = (!options.fixed_model)
-        .then(|| wander_allowed(&train, &nominal, options.settings.tests.z_critical))
+        .then(|| wander_allowed(&train, nominal, options.settings.tests.z_critical))
         .flatten();
     if let Some(w) = wander {
         notes.push(format!(
@@ -193,40 +242,21 @@ pub(crate) fn baseline(
             "baseline ensembles, the wander lowered",
             (m * (runs.train.len() + runs.holdout.len())) as u64,
         );
-        train = train_against(&nominal);
+        train = train_against(nominal);
     }
-    let holdout = evaluate(
-        &runs.holdout,
-        &runs.holdout_ids,
-        &nominal,
-        &[],
-        options,
-        m,
-        progress,
-    );
-    let floor = {
-        let all: Vec<Vec<Member>> = train
-            .members
-            .iter()
-            .chain(&holdout.members)
-            .cloned()
-            .collect();
-        score::floor(&all, &options.settings.score)
-    };
-    Baseline {
-        nominal,
-        notes,
-        white_target,
-        whiteness,
-        moving_noise,
-        own_noise,
-        candidate_members: mc,
-        train_gap: gap(&train.scores),
-        holdout_gap: gap(&holdout.scores),
-        train,
-        holdout,
-        floor,
-    }
+    train
+}
+
+/// The floor of the gap between independent simulated ensembles: [`score::floor`] over
+/// every baseline member of the training and held-out runs.
+fn ensemble_floor(train: &Evaluation, holdout: &Evaluation, options: &Options) -> f64 {
+    let all: Vec<Vec<Member>> = train
+        .members
+        .iter()
+        .chain(&holdout.members)
+        .cloned()
+        .collect();
+    score::floor(&all, &options.settings.score)
 }
 
 /// The nominal model fitted on the training runs ([`fit::nominal_model`]), its bias less

@@ -230,9 +230,18 @@ impl Measures {
     /// The measures of one run's residuals.
     pub(crate) fn of(r: &Residuals, setup: &Setup) -> Self {
         let mut out = Self::new(setup);
+        out.add_static_allan(r, setup);
+        out.add_psd(r, setup);
+        out.add_binned(r, setup);
+        out.set_xcorr(r, setup);
+        out
+    }
+
+    /// Adds the Allan variance sums of `r`'s static residual, each static stretch a
+    /// segment.
+    fn add_static_allan(&mut self, r: &Residuals, setup: &Setup) {
         let n = r.residual_dps.len();
         let res = &r.residual_dps;
-
         // Allan deviation of the static residual, each static stretch a segment.
         let statics: Vec<&[f64]> = stretches(n, |i| r.is_static[i] && res[i].is_finite())
             .into_iter()
@@ -242,11 +251,17 @@ impl Measures {
             let allan =
                 AllanDeviation::compute(&statics, setup.fs, &setup.allan_factors, ONE_SIGMA);
             for p in &allan.points {
-                out.allan
+                self.allan
                     .insert(p.m, (p.avar() * p.terms as f64, p.terms as f64));
             }
         }
+    }
 
+    /// Adds the Welch PSD of `r`'s residual (weighted by its segments) over every stretch
+    /// long enough for a segment.
+    fn add_psd(&mut self, r: &Residuals, setup: &Setup) {
+        let n = r.residual_dps.len();
+        let res = &r.residual_dps;
         // Welch PSD of the residual over every stretch with one.
         let all: Vec<&[f64]> = stretches(n, |i| res[i].is_finite())
             .into_iter()
@@ -259,13 +274,18 @@ impl Measures {
         };
         if let Some(psd) = welch(&all, setup.fs, &psd_options) {
             let k = psd.segments as f64;
-            out.psd
+            self.psd
                 .iter_mut()
                 .zip(&psd.psd_dps2_per_hz)
                 .for_each(|(a, p)| *a += p * k);
-            out.psd_segments += k;
+            self.psd_segments += k;
         }
+    }
 
+    /// Adds `r`'s residuals to the bins of reference rate, of acceleration (in motion) and
+    /// of temperature change (at rest).
+    fn add_binned(&mut self, r: &Residuals, setup: &Setup) {
+        let res = &r.residual_dps;
         // Binned residuals.
         let t0 = r.temperature_c.iter().copied().find(|t| t.is_finite());
         for (i, &v) in res.iter().enumerate() {
@@ -273,19 +293,24 @@ impl Measures {
                 continue;
             }
             if let Some(k) = setup.rate.index(r.reference_rate_dps[i]) {
-                out.rate[k].add(v);
+                self.rate[k].add(v);
             }
             if !r.is_static[i] {
                 if let Some(k) = setup.acceleration.index(r.reference_acceleration_dps2[i]) {
-                    out.acceleration[k].add(v);
+                    self.acceleration[k].add(v);
                 }
             } else if let (Some(bins), Some(t0)) = (&setup.temperature, t0) {
                 if let Some(k) = bins.index(r.temperature_c[i] - t0) {
-                    out.temperature[k].add(v);
+                    self.temperature[k].add(v);
                 }
             }
         }
+    }
 
+    /// Sets the cross-correlation sums of `r`'s gyro and reference rate (means removed)
+    /// at the setup's lags, and their energies.
+    fn set_xcorr(&mut self, r: &Residuals, setup: &Setup) {
+        let n = r.residual_dps.len();
         // Cross-correlation of gyro and reference rate, means removed.
         let both = |i: usize| r.rate_dps[i].is_finite() && r.reference_rate_dps[i].is_finite();
         let count = (0..n).filter(|&i| both(i)).count();
@@ -305,9 +330,9 @@ impl Measures {
                     }
                 })
                 .collect();
-            out.g2 = g.iter().map(|v| v * v).sum();
-            out.r2 = rr.iter().map(|v| v * v).sum();
-            for (c, &lag) in out.xcorr.iter_mut().zip(&setup.lags) {
+            self.g2 = g.iter().map(|v| v * v).sum();
+            self.r2 = rr.iter().map(|v| v * v).sum();
+            for (c, &lag) in self.xcorr.iter_mut().zip(&setup.lags) {
                 let l = lag.unsigned_abs() as usize;
                 if l >= n {
                     continue;
@@ -320,7 +345,6 @@ impl Measures {
                 *c = dot(a, b);
             }
         }
-        out
     }
 
     /// Pooled Allan deviation: (τ, σ).

@@ -296,95 +296,20 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
     let fs = r.sample_rate_hz;
     let h = smooth_half_width(fs);
 
-    // Plateau: samples at the largest |rate| while the reference is beyond it, and moves
-    // on: a clip holds the output while the reference's rate rises past it and falls
-    // back, but the rounded peak of a smooth turn (a low-passed gyro whose noise no
-    // longer dithers its output step) sits where the reference turns too.
-    let max_abs = r
-        .rate_dps
-        .iter()
-        .filter(|v| v.is_finite())
-        .fold(0.0f64, |m, v| m.max(v.abs()));
-    let tol = plateau_tol_dps.max(1e-9);
-    let on_plateau = |i: usize| r.rate_dps[i].abs() >= max_abs - tol;
-    // One pass, no allocation: this runs for every ensemble member.
-    let (count, lowest, highest) = (0..n)
-        .filter(|&i| on_plateau(i) && r.reference_rate_dps[i].abs() > max_abs + tol)
-        .map(|i| r.reference_rate_dps[i].abs())
-        .fold((0, f64::INFINITY, f64::NEG_INFINITY), |(c, lo, hi), v| {
-            (c + 1, lo.min(v), hi.max(v))
-        });
-    let plateau_samples = if highest - lowest >= r.statistics.plateau_reference_share * max_abs {
-        count
+    let plateau = Plateau::of(r, plateau_tol_dps);
+    let smooth = smoothed_rate_dps(&r.rate_dps, h);
+    let regressors = Regressors::of(r);
+    let used: usize = if regressors.temperature_varies {
+        N_REG
     } else {
-        0
+        N_REG - 2
     };
-    let clipped = plateau_samples >= 3;
-
-    // Smoothed gyro: trapezoid mean over [i − h, i + h], like the reference rate.
-    let mut smooth = vec![f64::NAN; n];
-    if n > 2 * h {
-        let mut prefix = Vec::with_capacity(n + 1);
-        prefix.push(0.0);
-        for v in &r.rate_dps {
-            prefix.push(prefix.last().copied().unwrap_or(0.0) + v);
-        }
-        for (i, s) in smooth.iter_mut().enumerate().take(n - h).skip(h) {
-            let inner = prefix[i + h] - prefix[i - h + 1];
-            *s = (inner + 0.5 * (r.rate_dps[i - h] + r.rate_dps[i + h])) / (2 * h) as f64;
-        }
-    }
-
-    let t_first = r.temperature_c.iter().copied().find(|t| t.is_finite());
-    let (t_min, t_max) = r
-        .temperature_c
-        .iter()
-        .filter(|t| t.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
-            (a.min(t), b.max(t))
-        });
-    let temperature_varies =
-        t_first.is_some() && t_max - t_min >= r.statistics.min_temperature_range_c;
-    let used: usize = if temperature_varies { N_REG } else { N_REG - 2 };
-    let t_mid = match (r.time_s.first(), r.time_s.last()) {
-        (Some(a), Some(b)) => 0.5 * (a + b),
-        _ => 0.0,
-    };
-
-    // Jerk: the centred difference of the acceleration, like the acceleration of the rate.
-    let mut jerk = vec![f64::NAN; n];
-    for i in h..n.saturating_sub(h) {
-        jerk[i] = (r.reference_acceleration_dps2[i + h] - r.reference_acceleration_dps2[i - h])
-            * fs
-            / (2 * h) as f64;
-    }
-    // One regression row from gyro g, reference rate w, acceleration a, jerk j at i.
-    let row_of = |i: usize, g: f64, w: f64, a: f64, j: f64| -> Option<([f64; N_REG], f64)> {
-        if !(g.is_finite() && w.is_finite() && a.is_finite() && j.is_finite()) {
-            return None;
-        }
-        let dt = match t_first {
-            Some(t0) if temperature_varies => {
-                let t = r.temperature_c[i];
-                if !t.is_finite() {
-                    return None;
-                }
-                t - t0
-            }
-            _ => 0.0,
-        };
-        let u = w / CUBIC_SCALE_DPS;
-        let tau = r.time_s[i] - t_mid;
-        Some((
-            [1.0, w, w.abs(), u * u * u, a, j, u * u, tau * a, dt, w * dt],
-            g - w,
-        ))
-    };
+    let jerk = jerk_dps3(&r.reference_acceleration_dps2, fs, h);
     let row = |i: usize| -> Option<([f64; N_REG], f64)> {
-        if clipped && on_plateau(i) {
+        if plateau.clipped && plateau.holds(r.rate_dps[i]) {
             return None;
         }
-        row_of(
+        regressors.row(
             i,
             smooth[i],
             r.reference_rate_dps[i],
@@ -395,18 +320,217 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
     let all: Vec<usize> = (0..used).collect();
     let (mut coef, samples) = regress(n, &all, row);
 
+    let low_coef = low_band_coefficients(r, &regressors, &plateau, &all, &coef);
+
+    // Regression residual → wander.
+    let mut wander_avar = [f64::NAN; 3];
+    let mut residual = Vec::new();
+    if wander && coef[0].is_finite() {
+        residual = regression_residual_of(n, row, &coef, used);
+        wander_avar = wander_avar_of(&residual, fs);
+    }
+
+    let full_band_intercept = coef[reg::INTERCEPT];
+    take_low_band_gains(&mut coef, &low_coef);
+
+    let static_diff_var = rest_difference_variance(r);
+    // Of the raw gyro, as the first differences (the reference's own noise stays out).
+    let static_block_var = static_allan_variance(
+        &r.rate_dps,
+        |i| r.is_rest[i],
+        white_check_block(fs, r.statistics.white_check_tau_s),
+    );
+
+    let features = Features {
+        coef,
+        samples,
+        wander_avar,
+        max_abs_rate_dps: plateau.max_abs_rate_dps,
+        plateau_samples: plateau.samples,
+        temperature_varies: regressors.temperature_varies,
+        static_diff_var,
+        static_block_var,
+        bias_dps: run_bias(r, full_band_intercept),
+        incoherent_psd: Vec::new(),
+        reference_psd: Vec::new(),
+        cross_psd: Vec::new(),
+    };
+    (features, residual)
+}
+
+/// A run's clip plateau (`saturation`): the largest |rate| and the samples held on it.
+struct Plateau {
+    /// Largest finite |rate| (deg/s).
+    max_abs_rate_dps: f64,
+    /// How far below the largest |rate| a sample still sits on the plateau (deg/s).
+    tol_dps: f64,
+    /// Samples on the plateau while the reference is beyond it (0 unless the reference
+    /// moves on).
+    samples: usize,
+    /// At least 3 such samples: the run is clipped, and its plateau samples stay out of
+    /// the regressions.
+    clipped: bool,
+}
+
+impl Plateau {
+    /// The plateau of `r` at tolerance `plateau_tol_dps`.
+    fn of(r: &Residuals, plateau_tol_dps: f64) -> Self {
+        // Plateau: samples at the largest |rate| while the reference is beyond it, and moves
+        // on: a clip holds the output while the reference's rate rises past it and falls
+        // back, but the rounded peak of a smooth turn (a low-passed gyro whose noise no
+        // longer dithers its output step) sits where the reference turns too.
+        let max_abs = r
+            .rate_dps
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let tol = plateau_tol_dps.max(1e-9);
+        let on_plateau = |i: usize| r.rate_dps[i].abs() >= max_abs - tol;
+        // One pass, no allocation: this runs for every ensemble member.
+        let (count, lowest, highest) = (0..r.rate_dps.len())
+            .filter(|&i| on_plateau(i) && r.reference_rate_dps[i].abs() > max_abs + tol)
+            .map(|i| r.reference_rate_dps[i].abs())
+            .fold((0, f64::INFINITY, f64::NEG_INFINITY), |(c, lo, hi), v| {
+                (c + 1, lo.min(v), hi.max(v))
+            });
+        let samples = if highest - lowest >= r.statistics.plateau_reference_share * max_abs {
+            count
+        } else {
+            0
+        };
+        Plateau {
+            max_abs_rate_dps: max_abs,
+            tol_dps: tol,
+            samples,
+            clipped: samples >= 3,
+        }
+    }
+
+    /// Whether a sample of rate `rate_dps` sits at the largest |rate|.
+    fn holds(&self, rate_dps: f64) -> bool {
+        rate_dps.abs() >= self.max_abs_rate_dps - self.tol_dps
+    }
+}
+
+/// The gyro rate smoothed like the reference rate (deg/s), so that their difference has
+/// no lag: trapezoid mean over [i − h, i + h]; NaN within `h` of either end, and
+/// everywhere when the run has no more than `2h` samples.
+fn smoothed_rate_dps(rate_dps: &[f64], h: usize) -> Vec<f64> {
+    let n = rate_dps.len();
+    // Smoothed gyro: trapezoid mean over [i − h, i + h], like the reference rate.
+    let mut smooth = vec![f64::NAN; n];
+    if n > 2 * h {
+        let mut prefix = Vec::with_capacity(n + 1);
+        prefix.push(0.0);
+        for v in rate_dps {
+            prefix.push(prefix.last().copied().unwrap_or(0.0) + v);
+        }
+        for (i, s) in smooth.iter_mut().enumerate().take(n - h).skip(h) {
+            let inner = prefix[i + h] - prefix[i - h + 1];
+            *s = (inner + 0.5 * (rate_dps[i - h] + rate_dps[i + h])) / (2 * h) as f64;
+        }
+    }
+    smooth
+}
+
+/// The reference jerk (deg/s³): the centred difference of the acceleration over ±`h`
+/// samples, like the acceleration of the rate; NaN within `h` of either end.
+fn jerk_dps3(acceleration_dps2: &[f64], fs: f64, h: usize) -> Vec<f64> {
+    let n = acceleration_dps2.len();
+    // Jerk: the centred difference of the acceleration, like the acceleration of the rate.
+    let mut jerk = vec![f64::NAN; n];
+    for i in h..n.saturating_sub(h) {
+        jerk[i] = (acceleration_dps2[i + h] - acceleration_dps2[i - h]) * fs / (2 * h) as f64;
+    }
+    jerk
+}
+
+/// What a regression row needs of a run beyond the sample's signals: its starting
+/// temperature, whether the temperature columns are used, and its middle time.
+struct Regressors<'a> {
+    r: &'a Residuals,
+    /// The run's first finite temperature (°C).
+    t_first_c: Option<f64>,
+    /// The temperature varied enough for the temperature regressors.
+    temperature_varies: bool,
+    /// Middle of the run (s), the origin of the t·α column.
+    t_mid_s: f64,
+}
+
+impl<'a> Regressors<'a> {
+    /// The row context of `r`.
+    fn of(r: &'a Residuals) -> Self {
+        let t_first = r.temperature_c.iter().copied().find(|t| t.is_finite());
+        let (t_min, t_max) = r
+            .temperature_c
+            .iter()
+            .filter(|t| t.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
+                (a.min(t), b.max(t))
+            });
+        let temperature_varies =
+            t_first.is_some() && t_max - t_min >= r.statistics.min_temperature_range_c;
+        let t_mid = match (r.time_s.first(), r.time_s.last()) {
+            (Some(a), Some(b)) => 0.5 * (a + b),
+            _ => 0.0,
+        };
+        Regressors {
+            r,
+            t_first_c: t_first,
+            temperature_varies,
+            t_mid_s: t_mid,
+        }
+    }
+
+    /// One regression row from gyro g, reference rate w, acceleration a, jerk j at i.
+    fn row(&self, i: usize, g: f64, w: f64, a: f64, j: f64) -> Option<([f64; N_REG], f64)> {
+        if !(g.is_finite() && w.is_finite() && a.is_finite() && j.is_finite()) {
+            return None;
+        }
+        let dt = match self.t_first_c {
+            Some(t0) if self.temperature_varies => {
+                let t = self.r.temperature_c[i];
+                if !t.is_finite() {
+                    return None;
+                }
+                t - t0
+            }
+            _ => 0.0,
+        };
+        let u = w / CUBIC_SCALE_DPS;
+        let tau = self.r.time_s[i] - self.t_mid_s;
+        Some((
+            [1.0, w, w.abs(), u * u * u, a, j, u * u, tau * a, dt, w * dt],
+            g - w,
+        ))
+    }
+}
+
+/// The regression in the low band (`low_band`), which the gain columns are read from:
+/// every column the full band `coef` resolved, and the ω column from the straight line
+/// alone; all NaN when the run has no low band or no full-band fit.
+fn low_band_coefficients(
+    r: &Residuals,
+    regressors: &Regressors,
+    plateau: &Plateau,
+    all: &[usize],
+    coef: &[f64; N_REG],
+) -> [f64; N_REG] {
+    let n = r.rate_dps.len();
+    let fs = r.sample_rate_hz;
     // The gain columns in the low band (`low_band`), away from clip plateaus by the
     // filter's reach.
-    let low_coef = match low_band::cutoff_hz(fs, r.statistics.low_band_hz) {
+    match low_band::cutoff_hz(fs, r.statistics.low_band_hz) {
         Some(cutoff) if coef[0].is_finite() => {
             let accel = low_band::derivative(&r.low_reference_rate_dps, fs);
             let low_jerk = low_band::derivative(&accel, fs);
             let reach = (fs / cutoff).ceil() as usize;
+            let clipped = plateau.clipped;
             // Plateau samples before each index (only for a clipped run).
             let plateau_before: Vec<usize> = if clipped {
                 std::iter::once(0)
                     .chain((0..n).scan(0, |count, i| {
-                        *count += usize::from(on_plateau(i));
+                        *count += usize::from(plateau.holds(r.rate_dps[i]));
                         Some(*count)
                     }))
                     .collect()
@@ -422,7 +546,7 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
                 if near_plateau(i) {
                     return None;
                 }
-                row_of(
+                regressors.row(
                     i,
                     r.low_rate_dps[i],
                     r.low_reference_rate_dps[i],
@@ -450,43 +574,58 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
             low
         }
         _ => [f64::NAN; N_REG],
-    };
+    }
+}
 
-    // Regression residual → wander.
-    let mut wander_avar = [f64::NAN; 3];
-    let mut residual = Vec::new();
-    if wander && coef[0].is_finite() {
-        residual = (0..n)
-            .map(|i| match row(i) {
-                // An aliased column (NaN) adds nothing to the fit.
-                Some((x, y)) => {
-                    y - (0..used)
-                        .filter(|&k| coef[k].is_finite())
-                        .map(|k| coef[k] * x[k])
-                        .sum::<f64>()
-                }
-                None => f64::NAN,
-            })
-            .collect();
-        let segments: Vec<&[f64]> = stretches(residual.len(), |i| residual[i].is_finite())
-            .into_iter()
-            .map(|run| &residual[run])
-            .collect();
-        let factors: Vec<usize> = WANDER_TAUS_S
-            .iter()
-            .map(|t| ((t * fs).round() as usize).max(1))
-            .collect();
-        let allan = AllanDeviation::compute(&segments, fs, &factors, 0.683);
-        for (k, m) in factors.iter().enumerate() {
-            if let Some(p) = allan.points.iter().find(|p| p.m == *m) {
-                wander_avar[k] = p.adev_dps * p.adev_dps;
+/// What the full-band regression `coef` (its first `used` columns) leaves of each row
+/// `row(i)`, `i < n` (deg/s; NaN where the sample is not in the regression).
+fn regression_residual_of(
+    n: usize,
+    row: impl Fn(usize) -> Option<([f64; N_REG], f64)>,
+    coef: &[f64; N_REG],
+    used: usize,
+) -> Vec<f64> {
+    (0..n)
+        .map(|i| match row(i) {
+            // An aliased column (NaN) adds nothing to the fit.
+            Some((x, y)) => {
+                y - (0..used)
+                    .filter(|&k| coef[k].is_finite())
+                    .map(|k| coef[k] * x[k])
+                    .sum::<f64>()
             }
+            None => f64::NAN,
+        })
+        .collect()
+}
+
+/// Allan variance of the regression residual at [`WANDER_TAUS_S`] ((deg/s)²; NaN where
+/// the residual's stretches are too short), the bias wander the regressors leave.
+fn wander_avar_of(residual: &[f64], fs: f64) -> [f64; 3] {
+    let mut wander_avar = [f64::NAN; 3];
+    let segments: Vec<&[f64]> = stretches(residual.len(), |i| residual[i].is_finite())
+        .into_iter()
+        .map(|run| &residual[run])
+        .collect();
+    let factors: Vec<usize> = WANDER_TAUS_S
+        .iter()
+        .map(|t| ((t * fs).round() as usize).max(1))
+        .collect();
+    let allan = AllanDeviation::compute(&segments, fs, &factors, 0.683);
+    for (k, m) in factors.iter().enumerate() {
+        if let Some(p) = allan.points.iter().find(|p| p.m == *m) {
+            wander_avar[k] = p.adev_dps * p.adev_dps;
         }
     }
+    wander_avar
+}
 
-    let full_band_intercept = coef[reg::INTERCEPT];
+/// Replaces the full-band gain columns of `coef` by the low band's `low_coef`; a run
+/// turning one way (a rate-shape column aliased in the full band) reads none of the
+/// rate-shape columns (NaN).
+fn take_low_band_gains(coef: &mut [f64; N_REG], low_coef: &[f64; N_REG]) {
     let one_way =
-        full_band_intercept.is_finite() && RATE_SHAPE_COLUMNS.iter().any(|&k| coef[k].is_nan());
+        coef[reg::INTERCEPT].is_finite() && RATE_SHAPE_COLUMNS.iter().any(|&k| coef[k].is_nan());
     for k in GAIN_COLUMNS {
         coef[k] = low_coef[k];
     }
@@ -495,10 +634,15 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
             coef[k] = f64::NAN;
         }
     }
+}
 
+/// White-noise level at rest ([`Features::static_diff_var`]): half the mean squared first
+/// difference of the raw gyro between consecutive rest samples ((deg/s)²), and how many
+/// differences (NaN and 0 when none).
+fn rest_difference_variance(r: &Residuals) -> (f64, usize) {
     // White-noise level at rest: first differences of the raw gyro.
     let (mut sum, mut count) = (0.0, 0usize);
-    for i in 1..n {
+    for i in 1..r.rate_dps.len() {
         if r.is_rest[i] && r.is_rest[i - 1] {
             let d = r.rate_dps[i] - r.rate_dps[i - 1];
             if d.is_finite() {
@@ -507,33 +651,11 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
             }
         }
     }
-    let static_diff_var = if count > 0 {
+    if count > 0 {
         (sum / count as f64 / 2.0, count)
     } else {
         (f64::NAN, 0)
-    };
-    // Of the raw gyro, as the first differences (the reference's own noise stays out).
-    let static_block_var = static_allan_variance(
-        &r.rate_dps,
-        |i| r.is_rest[i],
-        white_check_block(fs, r.statistics.white_check_tau_s),
-    );
-
-    let features = Features {
-        coef,
-        samples,
-        wander_avar,
-        max_abs_rate_dps: max_abs,
-        plateau_samples,
-        temperature_varies,
-        static_diff_var,
-        static_block_var,
-        bias_dps: run_bias(r, full_band_intercept),
-        incoherent_psd: Vec::new(),
-        reference_psd: Vec::new(),
-        cross_psd: Vec::new(),
-    };
-    (features, residual)
+    }
 }
 
 /// Allan variance at `block` samples of the finite samples of `x` where `ok`: half the

@@ -410,55 +410,11 @@ pub fn nominal_model(
         model.lsb_dps = lsb_dps;
         notes.push(note);
     }
-    let pooled = |pick: fn(&RealRun) -> (f64, usize)| {
-        let (sum, count) = train.iter().fold((0.0, 0usize), |(s, c), r| {
-            let (v, n) = pick(r);
-            if n > 0 && v.is_finite() {
-                (s + v * n as f64, c + n)
-            } else {
-                (s, c)
-            }
-        });
-        (sum / count.max(1) as f64, count)
-    };
-    let (diff_var, count) = pooled(|r| r.features.static_diff_var);
-    let (block_var, block_count) = pooled(|r| r.features.static_block_var);
     let mut target = None;
     let mut whiteness = None;
-    let arw_of = |sigma: f64, model: &SensorModel| sigma * 60.0 / model.sample_rate_hz.sqrt();
     if rests_suffice(train) {
-        let diff_target = WhiteTarget {
-            avar_dps2: diff_var,
-            block: 1,
-        };
-        let diff_sigma = solve_white_sigma(diff_target, &model, &[model.lsb_dps], None);
-        let mut chosen = (diff_target, diff_sigma);
-        let block = super::features::white_check_block(
-            model.sample_rate_hz,
-            settings.statistics.white_check_tau_s,
-        );
-        if block_count >= settings.fit.min_white_check_diffs && diff_sigma > 0.0 {
-            let block_target = WhiteTarget {
-                avar_dps2: block_var,
-                block,
-            };
-            let block_sigma = solve_white_sigma(block_target, &model, &[model.lsb_dps], None);
-            let ratio = (block_sigma / diff_sigma).powi(2);
-            let z = (ratio - 1.0) / (3.0 / block_count as f64).sqrt();
-            let coloured = z.abs() >= settings.tests.z_critical
-                && (ratio - 1.0).abs() >= settings.fit.white_check_min;
-            if coloured {
-                chosen = (block_target, block_sigma);
-            }
-            whiteness = Some(RestWhiteness {
-                tau_s: block as f64 / model.sample_rate_hz,
-                first_difference_arw_deg_per_rt_h: arw_of(diff_sigma, &model),
-                block_arw_deg_per_rt_h: arw_of(block_sigma, &model),
-                block_differences: block_count,
-                z,
-                coloured,
-            });
-        }
+        let (chosen, rest_whiteness, count) = rest_white_target(train, &model, settings);
+        whiteness = rest_whiteness;
         model.arw_deg_per_rt_h = arw_of(chosen.1, &model);
         target = Some(chosen.0);
         notes.push(rest_white_note(
@@ -486,6 +442,72 @@ pub fn nominal_model(
         white_target: target,
         whiteness,
     }
+}
+
+/// Angle random walk (deg/√h) of a white noise of `sigma_dps` (deg/s) per sample of `model`.
+fn arw_of(sigma_dps: f64, model: &SensorModel) -> f64 {
+    sigma_dps * 60.0 / model.sample_rate_hz.sqrt()
+}
+
+/// Mean over the `train` runs of a rest statistic `pick` gives as (value, count),
+/// weighted by the count, and the total count.
+fn pooled_rest(train: &[&RealRun], pick: fn(&RealRun) -> (f64, usize)) -> (f64, usize) {
+    let (sum, count) = train.iter().fold((0.0, 0usize), |(s, c), r| {
+        let (v, n) = pick(r);
+        if n > 0 && v.is_finite() {
+            (s + v * n as f64, c + n)
+        } else {
+            (s, c)
+        }
+    });
+    (sum / count.max(1) as f64, count)
+}
+
+/// The white noise matched at rest ([`nominal_model`]): the target and the per-sample σ
+/// (deg/s) solved for `model`, from the first differences unless the rests' whiteness
+/// check finds them coloured (then from the block's Allan variance), the check when it
+/// ran, and how many first differences the rests hold.
+fn rest_white_target(
+    train: &[&RealRun],
+    model: &SensorModel,
+    settings: &Settings,
+) -> ((WhiteTarget, f64), Option<RestWhiteness>, usize) {
+    let (diff_var, count) = pooled_rest(train, |r| r.features.static_diff_var);
+    let (block_var, block_count) = pooled_rest(train, |r| r.features.static_block_var);
+    let mut whiteness = None;
+    let diff_target = WhiteTarget {
+        avar_dps2: diff_var,
+        block: 1,
+    };
+    let diff_sigma = solve_white_sigma(diff_target, model, &[model.lsb_dps], None);
+    let mut chosen = (diff_target, diff_sigma);
+    let block = super::features::white_check_block(
+        model.sample_rate_hz,
+        settings.statistics.white_check_tau_s,
+    );
+    if block_count >= settings.fit.min_white_check_diffs && diff_sigma > 0.0 {
+        let block_target = WhiteTarget {
+            avar_dps2: block_var,
+            block,
+        };
+        let block_sigma = solve_white_sigma(block_target, model, &[model.lsb_dps], None);
+        let ratio = (block_sigma / diff_sigma).powi(2);
+        let z = (ratio - 1.0) / (3.0 / block_count as f64).sqrt();
+        let coloured = z.abs() >= settings.tests.z_critical
+            && (ratio - 1.0).abs() >= settings.fit.white_check_min;
+        if coloured {
+            chosen = (block_target, block_sigma);
+        }
+        whiteness = Some(RestWhiteness {
+            tau_s: block as f64 / model.sample_rate_hz,
+            first_difference_arw_deg_per_rt_h: arw_of(diff_sigma, model),
+            block_arw_deg_per_rt_h: arw_of(block_sigma, model),
+            block_differences: block_count,
+            z,
+            coloured,
+        });
+    }
+    (chosen, whiteness, count)
 }
 
 /// The note on the white noise measured at rest: `arw_deg_per_rt_h`, matched to the first
@@ -1599,14 +1621,6 @@ fn wander_fit(
     shape: WanderShape,
 ) -> Result<Fit, FitError> {
     let single = single_param(info)?;
-    let shape_at = |tau: f64| -> f64 {
-        match shape {
-            WanderShape::RandomWalk => tau / 3.0,
-            WanderShape::Flicker => (0..6)
-                .map(|i| gauss_markov_avar_continuous(tau, 1.0, 10f64.powf(0.6 * i as f64)) / 6.0)
-                .sum(),
-        }
-    };
     let usable = input
         .train
         .iter()
@@ -1617,25 +1631,12 @@ fn wander_fit(
             min_s: 2.0 * WANDER_TAUS_S[2],
         });
     }
-    let mut per_tau = Vec::new();
-    for (k, &tau) in WANDER_TAUS_S.iter().enumerate() {
-        let (real, replicas) = input.pooled(&|f| f.wander_avar[k]);
-        let (m0, s0) = mean_sd(&replicas);
-        per_tau.push((real, m0, s0, shape_at(tau)));
-    }
-    // Weighted least squares of the excess on the shape: θ = σ² or K².
-    let solve = |excess: &dyn Fn(usize) -> f64| -> f64 {
-        let (mut num, mut den) = (0.0, 0.0);
-        for (k, (_, _, s0, f)) in per_tau.iter().enumerate() {
-            let w = 1.0 / (s0 * s0).max(1e-30);
-            num += w * f * excess(k);
-            den += w * f * f;
-        }
-        num / den
-    };
+    let per_tau = wander_per_tau(input, shape);
     // Per run: the excess over that run's own ensemble mean.
     let per_run = |avar: &[f64; 3], members: &[Member]| {
-        solve(&|k| avar[k] - mean(members.iter().map(|m| m.features.wander_avar[k])))
+        wander_shape_solve(&per_tau, &|k| {
+            avar[k] - mean(members.iter().map(|m| m.features.wander_avar[k]))
+        })
     };
     let (thetas, s_theta) = wander_excess(input.train, input.null, &per_run);
     let (mut theta, sd) = mean_sd(&thetas);
@@ -1652,40 +1653,8 @@ fn wander_fit(
     let mut overshoot = None;
     let mut shape_loglik = None;
     if z >= input.settings.tests.z_critical && theta > 0.0 {
-        // Gain: the same estimator on the training runs simulated with the
-        // effect, against the same seeds without it.
-        let effect = [make(theta)];
-        let sims: Vec<Vec<Member>> = (0..input.train.len())
-            .into_par_iter()
-            .map(|r| {
-                (0..input
-                    .settings
-                    .fit
-                    .wander_gain_members
-                    .min(input.null[r].len()))
-                    .map(|j| {
-                        simulate_member(
-                            input.train[r],
-                            input.model,
-                            &effect,
-                            super::ensemble::member_seed(input.seed, r, j),
-                        )
-                    })
-                    .collect()
-            })
-            .collect();
-        let gains: Vec<f64> = (0..input.train.len())
-            .flat_map(|r| {
-                let sims = &sims[r];
-                (0..sims.len()).map(move |j| (r, j))
-            })
-            .map(|(r, j)| {
-                let k_sim = per_run(&sims[r][j].features.wander_avar, &input.null[r]);
-                let k_null = per_run(&input.null[r][j].features.wander_avar, &input.null[r]);
-                k_sim - k_null
-            })
-            .collect();
-        let gain = mean(gains.into_iter()) / theta;
+        let sims = simulate_train_with(input, &[make(theta)]);
+        let gain = mean_wander_response(input, &sims, &per_run) / theta;
         let ratio = input.settings.fit.wander_gain_ratio_max;
         let gain = if gain.is_finite() && gain > 1.0 / ratio && gain < ratio {
             theta /= gain;
@@ -1725,6 +1694,89 @@ fn wander_fit(
         );
     }
     Ok(fit)
+}
+
+/// Per τ of [`WANDER_TAUS_S`]: the training runs' pooled Allan variance of the residual,
+/// the mean and standard deviation of their null replicas' ((deg/s)²), and the Allan
+/// variance of a unit wander of `shape` at that τ.
+fn wander_per_tau(input: &FitInput, shape: WanderShape) -> Vec<(f64, f64, f64, f64)> {
+    let shape_at = |tau: f64| -> f64 {
+        match shape {
+            WanderShape::RandomWalk => tau / 3.0,
+            WanderShape::Flicker => (0..6)
+                .map(|i| gauss_markov_avar_continuous(tau, 1.0, 10f64.powf(0.6 * i as f64)) / 6.0)
+                .sum(),
+        }
+    };
+    let mut per_tau = Vec::new();
+    for (k, &tau) in WANDER_TAUS_S.iter().enumerate() {
+        let (real, replicas) = input.pooled(&|f| f.wander_avar[k]);
+        let (m0, s0) = mean_sd(&replicas);
+        per_tau.push((real, m0, s0, shape_at(tau)));
+    }
+    per_tau
+}
+
+/// The wander's size θ (σ² or K²) that the Allan variance `excess` over the null at each
+/// τ of `per_tau` reads: the weighted least squares of the excess on the shape.
+fn wander_shape_solve(per_tau: &[(f64, f64, f64, f64)], excess: &dyn Fn(usize) -> f64) -> f64 {
+    // Weighted least squares of the excess on the shape: θ = σ² or K².
+    let (mut num, mut den) = (0.0, 0.0);
+    for (k, (_, _, s0, f)) in per_tau.iter().enumerate() {
+        let w = 1.0 / (s0 * s0).max(1e-30);
+        num += w * f * excess(k);
+        den += w * f * f;
+    }
+    num / den
+}
+
+/// The training runs simulated with `effect` on the nominal model: per run, as many
+/// members as `fit.wander_gain_members` allows (and its null ensemble holds), on the null
+/// members' seeds.
+fn simulate_train_with(input: &FitInput, effect: &[Effect]) -> Vec<Vec<Member>> {
+    (0..input.train.len())
+        .into_par_iter()
+        .map(|r| {
+            (0..input
+                .settings
+                .fit
+                .wander_gain_members
+                .min(input.null[r].len()))
+                .map(|j| {
+                    simulate_member(
+                        input.train[r],
+                        input.model,
+                        effect,
+                        super::ensemble::member_seed(input.seed, r, j),
+                    )
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The wander estimator's mean response to the simulated members `sims` ([`simulate_train_with`]):
+/// the mean over members of `per_run` on the simulation minus `per_run` on the null member
+/// of the same seed (divided by θ, it is the estimator's gain).
+fn mean_wander_response(
+    input: &FitInput,
+    sims: &[Vec<Member>],
+    per_run: &dyn Fn(&[f64; 3], &[Member]) -> f64,
+) -> f64 {
+    // Gain: the same estimator on the training runs simulated with the
+    // effect, against the same seeds without it.
+    let gains: Vec<f64> = (0..input.train.len())
+        .flat_map(|r| {
+            let sims = &sims[r];
+            (0..sims.len()).map(move |j| (r, j))
+        })
+        .map(|(r, j)| {
+            let k_sim = per_run(&sims[r][j].features.wander_avar, &input.null[r]);
+            let k_null = per_run(&input.null[r][j].features.wander_avar, &input.null[r]);
+            k_sim - k_null
+        })
+        .collect();
+    mean(gains.into_iter())
 }
 
 /// One τ of a wander's shape evidence ([`wander_shape_loglik`]).

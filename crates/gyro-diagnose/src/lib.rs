@@ -328,10 +328,31 @@ pub fn diagnose(
         Some((t, h)) => (t.as_slice(), h.as_slice()),
         None => (train, holdout),
     };
+    Ok(diagnose_prepared(
+        train,
+        holdout,
+        grown_clock.as_ref(),
+        &known,
+        options,
+        progress,
+    ))
+}
+
+/// Stages 1 to 6 of [`diagnose`] on runs prepared with the options' settings (and
+/// trimmed to the reference), `known` the effects held as known from the start (the
+/// `grown_clock`, when its test passed).
+fn diagnose_prepared(
+    train: &[RealRun],
+    holdout: &[RealRun],
+    grown_clock: Option<&fit::Fit>,
+    known: &[gyro_sim::Effect],
+    options: &Options,
+    progress: &dyn Progress,
+) -> Diagnosis {
     let runs = Runs::new(train, holdout);
 
     // 1. Baseline, and 2. where.
-    let base = baseline::baseline(&runs, &known, options, progress);
+    let base = baseline::baseline(&runs, known, options, progress);
     let r#where = locate::locate(
         base.train.scores.iter().chain(&base.holdout.scores),
         &options.settings,
@@ -347,7 +368,7 @@ pub fn diagnose(
         holdout: &runs.holdout,
         holdout_null: &base.holdout.members,
         settings: &options.settings,
-        grown_clock: grown_clock.as_ref(),
+        grown_clock,
     };
     let (fits, untestable, joint) = fit::fit_all(&input);
 
@@ -359,33 +380,15 @@ pub fn diagnose(
     let selected_effects = select::joint_refit(&joint, &mut candidates, &selection.selected);
     let selected_sensor = fit::model_with(&base.nominal, &selected_effects, base.white_target);
 
-    // 5. Compensate the correctable effects (scales from the turns when the reference
-    // lags beyond the per-sample statistic).
-    // A count-stamped clock named: the lag grows by its doing, and what is left is the
-    // lag line's start.
-    let growing = selected_effects.iter().any(summarise::is_count_clock);
-    let train_lags_s = turns::run_lags_s(train, growing, &options.settings);
-    let (compensation, corrected_model) = compensate::compensate(
+    // 5. and 5b.
+    let (compensation, corrected_model, turns) = compensate_and_turns(
+        train,
         holdout,
-        options,
-        turns::lag_beyond_statistic(&train_lags_s, options.settings.statistics.max_lag_s),
-        // The nominal model's bias is fitted on the training runs unless it was given.
-        if options.fixed_model {
-            0.0
-        } else {
-            base.nominal.bias_dps
-        },
         &selected_effects,
+        base.nominal.bias_dps,
+        options,
         progress,
     );
-
-    // 5b. What the turns show, rest to rest, on top of what was written.
-    let turn_base = corrected_model
-        .clone()
-        .unwrap_or_else(|| options.base_model.clone());
-    let (turns, turn_model) =
-        turns::turn_evidence(train, &train_lags_s, growing, holdout, &turn_base, options);
-    let corrected_model = turn_model.or(corrected_model);
 
     // 6. Summarise.
     let train_after = summarise::train_after(
@@ -396,7 +399,7 @@ pub fn diagnose(
         options,
         progress,
     );
-    Ok(summarise::summarise(summarise::Findings {
+    summarise::summarise(summarise::Findings {
         runs: &runs,
         baseline: base,
         r#where,
@@ -411,7 +414,52 @@ pub fn diagnose(
         corrected_model,
         turns,
         settings: &options.settings,
-    }))
+    })
+}
+
+/// Stages 5 and 5b of [`diagnose`]: the compensation of the `selected_effects` on the
+/// held-out runs (`nominal_bias_dps` the nominal model's fitted bias), the corrected
+/// model, and what the turns show.
+fn compensate_and_turns(
+    train: &[RealRun],
+    holdout: &[RealRun],
+    selected_effects: &[gyro_sim::Effect],
+    nominal_bias_dps: f64,
+    options: &Options,
+    progress: &dyn Progress,
+) -> (
+    Option<CompensationSummary>,
+    Option<ModelFile>,
+    Option<turns::TurnEvidence>,
+) {
+    // 5. Compensate the correctable effects (scales from the turns when the reference
+    // lags beyond the per-sample statistic).
+    // A count-stamped clock named: the lag grows by its doing, and what is left is the
+    // lag line's start.
+    let growing = selected_effects.iter().any(summarise::is_count_clock);
+    let train_lags_s = turns::run_lags_s(train, growing, &options.settings);
+    let (compensation, corrected_model) = compensate::compensate(
+        holdout,
+        options,
+        turns::lag_beyond_statistic(&train_lags_s, options.settings.statistics.max_lag_s),
+        // The nominal model's bias is fitted on the training runs unless it was given.
+        if options.fixed_model {
+            0.0
+        } else {
+            nominal_bias_dps
+        },
+        selected_effects,
+        progress,
+    );
+
+    // 5b. What the turns show, rest to rest, on top of what was written.
+    let turn_base = corrected_model
+        .clone()
+        .unwrap_or_else(|| options.base_model.clone());
+    let (turns, turn_model) =
+        turns::turn_evidence(train, &train_lags_s, growing, holdout, &turn_base, options);
+    let corrected_model = turn_model.or(corrected_model);
+    (compensation, corrected_model, turns)
 }
 
 #[cfg(test)]

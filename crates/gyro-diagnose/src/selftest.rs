@@ -393,15 +393,16 @@ fn plan_of(plan: Plan) -> (Vec<Planned>, &'static str) {
     }
 }
 
-/// Run the self-check (only the cases injecting `only`, or the null cases for `none`,
-/// when given); `progress` is told each case as it starts.
-pub fn run(
+/// Diagnose each case of `plan` (only those injecting `only`, or the null cases for
+/// `none`, when given) on runs simulated from its own seed, and score the diagnosis;
+/// `progress` is told each case as it starts.
+fn run_cases(
     seed: u64,
     plan: Plan,
     only: Option<&str>,
     options: &Options,
     progress: &dyn Fn(usize, usize, &str),
-) -> Result<SelfTest, super::DiagnoseError> {
+) -> Result<Vec<CaseResult>, super::DiagnoseError> {
     let (planned, seed_label) = plan_of(plan);
     // Case seeds follow the position in the whole plan, so a case run alone is the same.
     let planned: Vec<(usize, Planned)> = planned
@@ -437,6 +438,34 @@ pub fn run(
         case.magnitude_index = magnitude_index;
         cases.push(case);
     }
+    Ok(cases)
+}
+
+/// The confusion of the single-effect cases: (injected, named first, how many cases), in
+/// the order the pairs first occur ("none" where nothing was named).
+fn confusion_of(cases: &[CaseResult]) -> Vec<(String, String, usize)> {
+    let mut confusion: Vec<(String, String, usize)> = Vec::new();
+    for c in cases.iter().filter(|c| c.kind == "single") {
+        let truth = c.injected.first().map_or("none", |e| e.id()).to_string();
+        let got = c.named.first().copied().unwrap_or("none").to_string();
+        match confusion.iter_mut().find(|x| x.0 == truth && x.1 == got) {
+            Some(x) => x.2 += 1,
+            None => confusion.push((truth, got, 1)),
+        }
+    }
+    confusion
+}
+
+/// Run the self-check (only the cases injecting `only`, or the null cases for `none`,
+/// when given); `progress` is told each case as it starts.
+pub fn run(
+    seed: u64,
+    plan: Plan,
+    only: Option<&str>,
+    options: &Options,
+    progress: &dyn Fn(usize, usize, &str),
+) -> Result<SelfTest, super::DiagnoseError> {
+    let cases = run_cases(seed, plan, only, options, progress)?;
     let frac = |f: &dyn Fn(&CaseResult) -> Option<bool>| -> f64 {
         let v: Vec<bool> = cases.iter().filter_map(f).collect();
         if v.is_empty() {
@@ -466,15 +495,7 @@ pub fn run(
         .map(|c| c.fraction_closed)
         .collect();
     let mean_fraction_closed = closed.iter().sum::<f64>() / closed.len().max(1) as f64;
-    let mut confusion: Vec<(String, String, usize)> = Vec::new();
-    for c in cases.iter().filter(|c| c.kind == "single") {
-        let truth = c.injected.first().map_or("none", |e| e.id()).to_string();
-        let got = c.named.first().copied().unwrap_or("none").to_string();
-        match confusion.iter_mut().find(|x| x.0 == truth && x.1 == got) {
-            Some(x) => x.2 += 1,
-            None => confusion.push((truth, got, 1)),
-        }
-    }
+    let confusion = confusion_of(&cases);
     let (matrix, detection_limits) = matrix_of(&cases);
     Ok(SelfTest {
         seed,

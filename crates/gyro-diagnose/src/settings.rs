@@ -436,6 +436,7 @@ impl Settings {
     };
 
     /// Every setting with its unit, valid range and reason, in the order of the table.
+    // Longer than a screen because it is the table itself: one row per setting, in order.
     pub fn entries(&self) -> Vec<Entry> {
         let (t, l, f, s, r, e) = (
             &self.tests,

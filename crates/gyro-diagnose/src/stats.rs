@@ -745,12 +745,29 @@ fn terciles(values: &[f64]) -> Option<(f64, f64)> {
 
 /// The "where" statistics of `residuals` (see the module documentation).
 pub fn stats_of(r: &Residuals) -> Vec<Stat> {
-    let fs = r.sample_rate_hz;
     let n = r.residual_dps.len();
     let valid: Vec<bool> = r.residual_dps.iter().map(|x| x.is_finite()).collect();
     let dynamic: Vec<bool> = (0..n).map(|i| valid[i] && !r.is_static[i]).collect();
     let mut out = Out(Vec::new());
 
+    let (moments, temp_cuts) = segment_moments(r, &valid);
+    for segment in Moments::segments(temp_cuts.is_some()) {
+        if let Some((mean, std)) = moments.get(segment).and_then(Welford::mean_std) {
+            out.push(segment, Statistic::ResidualMean, mean);
+            out.push(segment, Statistic::ResidualStd, std);
+        }
+    }
+    push_rate_shape(r, &dynamic, &mut out);
+    let static_runs: Vec<_> = runs(&r.is_static);
+    push_static_allan(r, &static_runs, &mut out);
+    push_whiteness(r, &static_runs, &dynamic, &mut out);
+    push_angle_error_growth(r, &moments, &mut out);
+    out.0
+}
+
+/// Moments of every segment and stratum of the `valid` residuals of `r`, in one pass, and
+/// the temperature's tercile thresholds (None: no temperature strata).
+fn segment_moments(r: &Residuals, valid: &[bool]) -> (Moments, Option<(f64, f64)>) {
     // Moments of every segment and stratum in one pass.
     let mut moments = Moments::default();
     let tercile = |x: f64, (a, b): (f64, f64)| -> usize {
@@ -807,13 +824,14 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
             }
         }
     }
-    for segment in Moments::segments(temp_cuts.is_some()) {
-        if let Some((mean, std)) = moments.get(segment).and_then(Welford::mean_std) {
-            out.push(segment, Statistic::ResidualMean, mean);
-            out.push(segment, Statistic::ResidualStd, std);
-        }
-    }
+    (moments, temp_cuts)
+}
 
+/// The residual against rate and acceleration on the `dynamic` samples: slopes in the
+/// full band (all, positive, negative rates), in the low band, against acceleration, and
+/// the quadratic and cubic terms.
+fn push_rate_shape(r: &Residuals, dynamic: &[bool], out: &mut Out) {
+    let n = r.residual_dps.len();
     // Residual against rate, in motion.
     let points = |keep: &dyn Fn(f64) -> bool| -> Vec<(f64, f64)> {
         (0..n)
@@ -860,9 +878,13 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
         out.push(Segment::Dynamic, Statistic::QuadraticVsRate, c2);
         out.push(Segment::Dynamic, Statistic::CubicVsRate, c3);
     }
+}
 
+/// The static residual's Allan deviation over the `static_runs`: the mean log10 deviation
+/// in each τ band of [`ALLAN_BANDS_S`].
+fn push_static_allan(r: &Residuals, static_runs: &[std::ops::Range<usize>], out: &mut Out) {
+    let fs = r.sample_rate_hz;
     // Static Allan deviation per τ band.
-    let static_runs: Vec<_> = runs(&r.is_static);
     let segments: Vec<&[f64]> = static_runs
         .iter()
         .map(|run| &r.residual_dps[run.clone()])
@@ -883,12 +905,22 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
             }
         }
     }
+}
 
+/// Whiteness and timing: the residual's lag-1 autocorrelation at rest and in motion, and
+/// the gyro-reference cross-correlation's peak lag (s) and its trend over the run.
+fn push_whiteness(
+    r: &Residuals,
+    static_runs: &[std::ops::Range<usize>],
+    dynamic: &[bool],
+    out: &mut Out,
+) {
+    let fs = r.sample_rate_hz;
     // Whiteness.
-    if let Some(a) = lag1(&r.residual_dps, &static_runs) {
+    if let Some(a) = lag1(&r.residual_dps, static_runs) {
         out.push(Segment::Static, Statistic::Lag1Autocorrelation, a);
     }
-    if let Some(a) = lag1(&r.residual_dps, &runs(&dynamic)) {
+    if let Some(a) = lag1(&r.residual_dps, &runs(dynamic)) {
         out.push(Segment::Dynamic, Statistic::Lag1Autocorrelation, a);
     }
     if let Some(lag) = xcorr_peak_lag(
@@ -902,7 +934,12 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
     if let Some(line) = lag_line(&r.rate_dps, &r.reference_rate_dps, fs, &r.statistics) {
         out.push(Segment::All, Statistic::XcorrLagTrend, line.slope);
     }
+}
 
+/// Angle error growth: the RMS of the bias-free residual integrated over windows of each
+/// of [`HORIZONS_S`] (deg), the bias the static mean (else the mean of every sample).
+fn push_angle_error_growth(r: &Residuals, moments: &Moments, out: &mut Out) {
+    let fs = r.sample_rate_hz;
     // Angle error growth.
     let bias = moments
         .get(Segment::Static)
@@ -925,7 +962,6 @@ pub fn stats_of(r: &Residuals) -> Vec<Stat> {
             out.push(Segment::All, Statistic::AngleErrorRms(horizon), rms);
         }
     }
-    out.0
 }
 
 /// Z-score of each `real` statistic against the `ensemble` (one `Vec<Stat>` per simulated

@@ -1146,58 +1146,22 @@ pub fn calibrate(
     options: &CalibrateOptions,
     progress: &mut dyn FnMut(&str, usize, f64),
 ) -> Result<Calibration, CalibrateError> {
-    if train.is_empty() {
-        return Err(CalibrateError::NoRuns);
-    }
-    for run in train.iter().chain(holdout) {
-        if !run.log.has_reference {
-            return Err(CalibrateError::NoReference(run.name.clone()));
-        }
-    }
+    check_runs(train, holdout)?;
     let runs: Vec<&BenchRun> = train.iter().collect();
-    let tau_for = |runs: &[&BenchRun]| match options.initial_tau_s {
-        Some(tau_s) => (tau_s, "option"),
-        None => match rest_correlation_time(runs, base) {
-            Some(tau_s) => (tau_s, "rest_allan"),
-            None => (100.0, "default"),
-        },
-    };
-    let initial_tau = tau_for(&runs);
-    let reference_delay = match options.reference_delay_s {
-        Some(delay_s) => ReferenceDelay::given(delay_s),
-        None => delay::measure(&runs),
-    };
-    let scoring = ReplayOptions {
-        reference_delay_s: reference_delay.delay_s,
-        ..ReplayOptions::default()
-    };
+    let initial_tau = initial_tau(&runs, base, options);
+    let (reference_delay, scoring) = reference_scoring(&runs, options);
     // The scale first: when it is written, every candidate is fitted and scored with it
     // (each fold with the scale fitted on its own runs), so that the compensation is
     // chosen with the corrections the file holds.
-    let start_errors = train
-        .iter()
-        .map(|run| replay_errors(run, base, &scoring))
-        .collect::<Result<Vec<_>, _>>()?;
-    let scale = decide_scale(
-        train,
-        holdout,
-        base,
-        &scoring,
-        &start_errors,
-        options.leave_one_out,
-    )?;
-    let scaled = |k: Option<f64>| k.and_then(|k| scale::with_scale(base, k)).unwrap_or(*base);
+    let scale = scale_first(train, holdout, base, &scoring, options.leave_one_out)?;
+    let given = base;
     let base = &if scale.fit.written {
-        scaled(scale.fit.k)
+        scaled_config(given, scale.fit.k)
     } else {
-        *base
+        *given
     };
     let start = *base;
-    let base_traces = traces_for(&runs, base, &scoring)?;
-    if base_traces.iter().all(|t| t.spans.is_empty()) {
-        let names: Vec<&str> = runs.iter().map(|r| r.name.as_str()).collect();
-        return Err(CalibrateError::NoMovement(names.join(", ")));
-    }
+    let base_traces = moving_traces(&runs, base, &scoring)?;
     let dof = SpreadDof::of(&base_traces);
     let (full, _) = fit(
         &runs,
@@ -1212,50 +1176,225 @@ pub fn calibrate(
         progress,
     )?;
 
+    let folds = Folds {
+        given,
+        base,
+        base_traces: &base_traces,
+        fold_k: &scale.fold_k,
+        dof,
+        options,
+        scoring: &scoring,
+    };
+    let (fold_fits, held_out) = if options.leave_one_out && train.len() >= 2 {
+        leave_one_out(&runs, &folds, progress)?
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let spread = fold_spread(&fold_fits);
+
+    let train_errors = errors_of(train, base, &full.fitted, &scoring)?;
+    let holdout_errors = errors_of(holdout, base, &full.fitted, &scoring)?;
+    let holdout_scores = run_scores(holdout, &holdout_errors);
+    let choice = choice_of(
+        candidate_scores(&held_out, &train_errors, options.objective),
+        &full.fitted.paper,
+    );
+    let config = full.fitted.config(base, choice.written);
+    Ok(Calibration {
+        fitted: full.fitted,
+        objective: options.objective,
+        objective_deg: full.objective_deg,
+        initial_tau,
+        termination: format!("{:?}", full.termination),
+        evaluations: full.evaluations,
+        start,
+        choice,
+        scale: scale.fit,
+        reference_delay,
+        config,
+        train: run_scores(train, &train_errors),
+        holdout: holdout_scores,
+        spread,
+    })
+}
+
+/// Checks there are training runs and that every run has a reference.
+fn check_runs(train: &[BenchRun], holdout: &[BenchRun]) -> Result<(), CalibrateError> {
+    if train.is_empty() {
+        return Err(CalibrateError::NoRuns);
+    }
+    for run in train.iter().chain(holdout) {
+        if !run.log.has_reference {
+            return Err(CalibrateError::NoReference(run.name.clone()));
+        }
+    }
+    Ok(())
+}
+
+/// The reference's delay (the option's, else measured on `runs`) and the replay options
+/// every run is scored with, which take it.
+fn reference_scoring(
+    runs: &[&BenchRun],
+    options: &CalibrateOptions,
+) -> (ReferenceDelay, ReplayOptions) {
+    let reference_delay = match options.reference_delay_s {
+        Some(delay_s) => ReferenceDelay::given(delay_s),
+        None => delay::measure(runs),
+    };
+    let scoring = ReplayOptions {
+        reference_delay_s: reference_delay.delay_s,
+        ..ReplayOptions::default()
+    };
+    (reference_delay, scoring)
+}
+
+/// The traces of `runs` under `base` ([`traces_for`]); an error when no run moves.
+fn moving_traces(
+    runs: &[&BenchRun],
+    base: &Config,
+    scoring: &ReplayOptions,
+) -> Result<Vec<Trace>, CalibrateError> {
+    let base_traces = traces_for(runs, base, scoring)?;
+    if base_traces.iter().all(|t| t.spans.is_empty()) {
+        let names: Vec<&str> = runs.iter().map(|r| r.name.as_str()).collect();
+        return Err(CalibrateError::NoMovement(names.join(", ")));
+    }
+    Ok(base_traces)
+}
+
+/// The scale decision ([`decide_scale`]) from the training runs' errors under the
+/// starting configuration `base`.
+fn scale_first(
+    train: &[BenchRun],
+    holdout: &[BenchRun],
+    base: &Config,
+    scoring: &ReplayOptions,
+    leave_one_out: bool,
+) -> Result<ScaleDecision, CalibrateError> {
+    let start_errors = train
+        .iter()
+        .map(|run| replay_errors(run, base, scoring))
+        .collect::<Result<Vec<_>, _>>()?;
+    decide_scale(train, holdout, base, scoring, &start_errors, leave_one_out)
+}
+
+/// The candidate written, chosen among the `scores` ([`choose_among`]), the paper
+/// candidate left out when its fitted `paper` parameters sit at a bound.
+fn choice_of(scores: Vec<CandidateScore>, paper: &GaussMarkov) -> Choice {
+    let paper_at_bound = paper_at_bound(paper);
+    let excluded: &[Candidate] = if paper_at_bound {
+        &[Candidate::Paper]
+    } else {
+        &[]
+    };
+    let (written, reason) = choose_among(&scores, excluded);
+    Choice {
+        written,
+        reason,
+        scores,
+        paper_at_bound,
+    }
+}
+
+/// The starting bias correlation time (s) of a fit on `runs` and where it came from: the
+/// option, else the rests' Allan deviation under `base`, else 100 s.
+fn initial_tau(
+    runs: &[&BenchRun],
+    base: &Config,
+    options: &CalibrateOptions,
+) -> (f64, &'static str) {
+    match options.initial_tau_s {
+        Some(tau_s) => (tau_s, "option"),
+        None => match rest_correlation_time(runs, base) {
+            Some(tau_s) => (tau_s, "rest_allan"),
+            None => (100.0, "default"),
+        },
+    }
+}
+
+/// `given` with the scale factor `k` when there is one (and it applies), else `given`.
+fn scaled_config(given: &Config, k: Option<f64>) -> Config {
+    k.and_then(|k| scale::with_scale(given, k))
+        .unwrap_or(*given)
+}
+
+/// What every leave-one-run-out refit shares ([`leave_one_out`]).
+struct Folds<'a> {
+    /// The starting configuration as given (each fold's own scale is added to it).
+    given: &'a Config,
+    /// The starting configuration of the full fit (with the scale when written).
+    base: &'a Config,
+    /// The training runs' traces under `base`.
+    base_traces: &'a [Trace],
+    /// The scale fitted leaving each run out ([`ScaleDecision::fold_k`]).
+    fold_k: &'a [Option<f64>],
+    /// The degrees of freedom of the Kalman candidate's spread bounds.
+    dof: SpreadDof,
+    options: &'a CalibrateOptions,
+    scoring: &'a ReplayOptions,
+}
+
+/// Leave-one-run-out: each fold's fitted paper parameters, and each left-out run's errors
+/// under every candidate of its fold.
+fn leave_one_out(
+    runs: &[&BenchRun],
+    folds: &Folds,
+    progress: &mut dyn FnMut(&str, usize, f64),
+) -> Result<(Vec<GaussMarkov>, Vec<[RunErrors; 4]>), CalibrateError> {
     // Leave-one-run-out: refit everything on the other runs, from their own start, and
     // score the left-out run with each candidate.
     let mut fold_fits = Vec::new();
     let mut held_out: Vec<[RunErrors; 4]> = Vec::new();
-    if options.leave_one_out && train.len() >= 2 {
-        for (i, run) in train.iter().enumerate() {
-            let others: Vec<&BenchRun> = runs
+    for (i, run) in runs.iter().enumerate() {
+        let others: Vec<&BenchRun> = runs
+            .iter()
+            .enumerate()
+            .filter_map(|(j, r)| (j != i).then_some(*r))
+            .collect();
+        // The fold's own scale, when the scale is written.
+        let fold_base = match folds.fold_k.get(i) {
+            Some(k) => scaled_config(folds.given, *k),
+            None => *folds.base,
+        };
+        let traces: Vec<Trace> = if fold_base == *folds.base {
+            folds
+                .base_traces
                 .iter()
                 .enumerate()
-                .filter_map(|(j, r)| (j != i).then_some(*r))
-                .collect();
-            // The fold's own scale, when the scale is written.
-            let fold_base = match scale.fold_k.get(i) {
-                Some(k) => scaled(*k),
-                None => *base,
-            };
-            let traces: Vec<Trace> = if fold_base == *base {
-                base_traces
-                    .iter()
-                    .enumerate()
-                    .filter(|(j, _)| *j != i)
-                    .map(|(_, t)| t.clone())
-                    .collect()
-            } else {
-                traces_for(&others, &fold_base, &scoring)?
-            };
-            let stage = format!("leave-one-out {}/{}", i + 1, train.len());
-            let (fold, _) = fit(
-                &others,
-                traces,
-                &fold_base,
-                options,
-                FitStart {
-                    tau_s: tau_for(&others).0,
-                    dof,
-                },
-                &scoring,
-                &mut |_, n, best| progress(&stage, n, best),
-            )?;
-            held_out.push(candidate_errors(run, &fold_base, &fold.fitted, &scoring)?);
-            fold_fits.push(fold.fitted.paper);
-        }
+                .filter(|(j, _)| *j != i)
+                .map(|(_, t)| t.clone())
+                .collect()
+        } else {
+            traces_for(&others, &fold_base, folds.scoring)?
+        };
+        let stage = format!("leave-one-out {}/{}", i + 1, runs.len());
+        let (fold, _) = fit(
+            &others,
+            traces,
+            &fold_base,
+            folds.options,
+            FitStart {
+                tau_s: initial_tau(&others, folds.given, folds.options).0,
+                dof: folds.dof,
+            },
+            folds.scoring,
+            &mut |_, n, best| progress(&stage, n, best),
+        )?;
+        held_out.push(candidate_errors(
+            run,
+            &fold_base,
+            &fold.fitted,
+            folds.scoring,
+        )?);
+        fold_fits.push(fold.fitted.paper);
     }
-    let spread = (fold_fits.len() >= 3).then(|| {
+    Ok((fold_fits, held_out))
+}
+
+/// The spread of the paper parameters over the leave-one-run-out refits `fold_fits`
+/// (None under 3 refits).
+fn fold_spread(fold_fits: &[GaussMarkov]) -> Option<Spread> {
+    (fold_fits.len() >= 3).then(|| {
         let pick = |f: fn(&GaussMarkov) -> f32| {
             param_spread(
                 &fold_fits
@@ -1270,70 +1409,47 @@ pub fn calibrate(
             b0_dps: pick(|g| g.b0_dps),
             o0_deg: pick(|g| g.o0_deg),
         }
-    });
+    })
+}
 
-    let train_errors = train
-        .iter()
-        .map(|run| candidate_errors(run, base, &full.fitted, &scoring))
-        .collect::<Result<Vec<_>, _>>()?;
-    let holdout_errors = holdout
-        .iter()
-        .map(|run| candidate_errors(run, base, &full.fitted, &scoring))
-        .collect::<Result<Vec<_>, _>>()?;
-    let holdout_scores = holdout
-        .iter()
-        .zip(&holdout_errors)
+/// Each run's errors under every candidate of the fit `fitted` from `base`.
+fn errors_of(
+    runs: &[BenchRun],
+    base: &Config,
+    fitted: &Fitted,
+    scoring: &ReplayOptions,
+) -> Result<Vec<[RunErrors; 4]>, CalibrateError> {
+    runs.iter()
+        .map(|run| candidate_errors(run, base, fitted, scoring))
+        .collect::<Result<Vec<_>, _>>()
+}
+
+/// Each run's score from its `errors`, in run order.
+fn run_scores(runs: &[BenchRun], errors: &[[RunErrors; 4]]) -> Vec<RunScore> {
+    runs.iter()
+        .zip(errors)
         .map(|(run, e)| run_score(&run.name, e))
-        .collect();
-    let scores: Vec<CandidateScore> = Candidate::ALL
+        .collect()
+}
+
+/// Each candidate's `objective` over the left-out runs (`held_out`, when refitted) and
+/// over the training runs.
+fn candidate_scores(
+    held_out: &[[RunErrors; 4]],
+    train_errors: &[[RunErrors; 4]],
+    objective: Objective,
+) -> Vec<CandidateScore> {
+    Candidate::ALL
         .iter()
         .enumerate()
         .map(|(k, &candidate)| CandidateScore {
             candidate,
             leave_one_out_deg: (!held_out.is_empty())
-                .then(|| options.objective.aggregate(held_out.iter().map(|e| &e[k]))),
-            leave_one_out_runs_deg: held_out
-                .iter()
-                .map(|e| options.objective.per_run(&e[k]))
-                .collect(),
-            training_deg: options
-                .objective
-                .aggregate(train_errors.iter().map(|e| &e[k])),
+                .then(|| objective.aggregate(held_out.iter().map(|e| &e[k]))),
+            leave_one_out_runs_deg: held_out.iter().map(|e| objective.per_run(&e[k])).collect(),
+            training_deg: objective.aggregate(train_errors.iter().map(|e| &e[k])),
         })
-        .collect();
-    let paper_at_bound = paper_at_bound(&full.fitted.paper);
-    let excluded: &[Candidate] = if paper_at_bound {
-        &[Candidate::Paper]
-    } else {
-        &[]
-    };
-    let (written, reason) = choose_among(&scores, excluded);
-    let config = full.fitted.config(base, written);
-    Ok(Calibration {
-        fitted: full.fitted,
-        objective: options.objective,
-        objective_deg: full.objective_deg,
-        initial_tau,
-        termination: format!("{:?}", full.termination),
-        evaluations: full.evaluations,
-        start,
-        choice: Choice {
-            written,
-            reason,
-            scores,
-            paper_at_bound,
-        },
-        scale: scale.fit,
-        reference_delay,
-        config,
-        train: train
-            .iter()
-            .zip(&train_errors)
-            .map(|(run, e)| run_score(&run.name, e))
-            .collect(),
-        holdout: holdout_scores,
-        spread,
-    })
+        .collect()
 }
 
 #[cfg(test)]

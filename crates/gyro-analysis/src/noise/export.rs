@@ -426,6 +426,99 @@ fn random_walk(c: &Characterization, min_gm_tau_s: f64, notes: &mut Vec<String>)
     }
 }
 
+/// The effective white noise density (deg/s/√Hz) of `sensor` with the `effects` at `fs`
+/// Hz: its white noise per sample and the output rounding steps (lsb²/12 per sample), and
+/// the note saying so.
+fn model_noise_density(sensor: &SensorModel, effects: &[Effect], fs: f64) -> (f64, String) {
+    // White noise per sample, and the rounding steps that add lsb²/12 in motion.
+    let white = sensor.white_sigma_dps();
+    let steps: Vec<f64> = std::iter::once(sensor.lsb_dps)
+        .chain(effects.iter().filter_map(|e| match *e {
+            Effect::Quantization { lsb_dps } => Some(lsb_dps),
+            _ => None,
+        }))
+        .filter(|&lsb| lsb > 0.0)
+        .collect();
+    let rounding: f64 = steps.iter().map(|lsb| lsb * lsb / 12.0).sum();
+    let n_dps = ((white * white + rounding) / fs).sqrt();
+    let mut text = format!(
+        "gyroscope_noise_density: white noise ARW {:.4} deg/sqrt(h) ({} deg/s per sample at {} Hz)",
+        sensor.arw_deg_per_rt_h,
+        sci(white),
+        fs
+    );
+    for lsb in &steps {
+        let _ = write!(
+            text,
+            " + output rounding to {} deg/s (lsb^2/12 per sample)",
+            sci(*lsb)
+        );
+    }
+    let _ = write!(
+        text,
+        " = {} deg/s/sqrt(Hz) ({:.4} deg/sqrt(h))",
+        sci(n_dps),
+        n_dps * 60.0
+    );
+    (n_dps, text)
+}
+
+/// The effective rate random walk K (deg/s/√s) of `sensor` with the `effects`: its
+/// Gauss-Markov bias, rate random walk and bias instability read at τ = 3 s, added in
+/// quadrature; the notes on each, and on the biases left out, go to `notes`.
+fn model_random_walk(sensor: &SensorModel, effects: &[Effect], notes: &mut Vec<String>) -> f64 {
+    let mut parts = Vec::new();
+    let mut k2 = 0.0;
+    let k_gm = gauss_markov_random_walk(sensor.gm_sigma_dps, sensor.gm_tau_s);
+    if k_gm > 0.0 {
+        k2 += k_gm * k_gm;
+        parts.push(format!(
+            "the model's Gauss-Markov bias (sigma {} deg/s, T {} s) read at tau = 3 s, K = {} deg/s/sqrt(s)",
+            sci(sensor.gm_sigma_dps),
+            sensor.gm_tau_s,
+            sci(k_gm)
+        ));
+    }
+    let mut left_out = Vec::new();
+    for e in effects {
+        match *e {
+            Effect::RateRandomWalk { k_dps_per_rt_s } if k_dps_per_rt_s > 0.0 => {
+                k2 += k_dps_per_rt_s * k_dps_per_rt_s;
+                parts.push(format!(
+                    "rate_random_walk K = {} deg/s/sqrt(s)",
+                    sci(k_dps_per_rt_s)
+                ));
+            }
+            Effect::BiasInstability { sigma_dps } if sigma_dps > 0.0 => {
+                let k = bias_instability_random_walk(sigma_dps);
+                k2 += k * k;
+                parts.push(format!(
+                    "bias_instability sigma {} deg/s (six Gauss-Markov processes, T 1-1000 s) read at tau = 3 s, K = {} deg/s/sqrt(s)",
+                    sci(sigma_dps),
+                    sci(k)
+                ));
+            }
+            Effect::TurnOnBias { .. } | Effect::TemperatureBias { .. } => {
+                left_out.push(e.id());
+            }
+            _ => {}
+        }
+    }
+    let k_dps = k2.sqrt();
+    notes.push(if parts.is_empty() {
+        "gyroscope_random_walk: 0: the model has no bias wander (no Gauss-Markov bias, rate random walk or bias instability)".to_string()
+    } else {
+        format!("gyroscope_random_walk: {}", parts.join(" + "))
+    });
+    if !left_out.is_empty() {
+        notes.push(format!(
+            "not included: {} (a constant or temperature-driven bias, not a random walk)",
+            left_out.join(", ")
+        ));
+    }
+    k_dps
+}
+
 impl NoiseParams {
     /// The effective values of a sensor model and the effects selected with it (module
     /// docs), e.g. a diagnosis's `selected_sensor` and `model.effects`; `provenance` (the
@@ -441,87 +534,9 @@ impl NoiseParams {
             return Err(ExportError::UpdateRate(fs));
         }
         let mut notes = Vec::new();
-        // White noise per sample, and the rounding steps that add lsb²/12 in motion.
-        let white = sensor.white_sigma_dps();
-        let steps: Vec<f64> = std::iter::once(sensor.lsb_dps)
-            .chain(effects.iter().filter_map(|e| match *e {
-                Effect::Quantization { lsb_dps } => Some(lsb_dps),
-                _ => None,
-            }))
-            .filter(|&lsb| lsb > 0.0)
-            .collect();
-        let rounding: f64 = steps.iter().map(|lsb| lsb * lsb / 12.0).sum();
-        let n_dps = ((white * white + rounding) / fs).sqrt();
-        let mut text = format!(
-            "gyroscope_noise_density: white noise ARW {:.4} deg/sqrt(h) ({} deg/s per sample at {} Hz)",
-            sensor.arw_deg_per_rt_h,
-            sci(white),
-            fs
-        );
-        for lsb in &steps {
-            let _ = write!(
-                text,
-                " + output rounding to {} deg/s (lsb^2/12 per sample)",
-                sci(*lsb)
-            );
-        }
-        let _ = write!(
-            text,
-            " = {} deg/s/sqrt(Hz) ({:.4} deg/sqrt(h))",
-            sci(n_dps),
-            n_dps * 60.0
-        );
-        notes.push(text);
-
-        let mut parts = Vec::new();
-        let mut k2 = 0.0;
-        let k_gm = gauss_markov_random_walk(sensor.gm_sigma_dps, sensor.gm_tau_s);
-        if k_gm > 0.0 {
-            k2 += k_gm * k_gm;
-            parts.push(format!(
-                "the model's Gauss-Markov bias (sigma {} deg/s, T {} s) read at tau = 3 s, K = {} deg/s/sqrt(s)",
-                sci(sensor.gm_sigma_dps),
-                sensor.gm_tau_s,
-                sci(k_gm)
-            ));
-        }
-        let mut left_out = Vec::new();
-        for e in effects {
-            match *e {
-                Effect::RateRandomWalk { k_dps_per_rt_s } if k_dps_per_rt_s > 0.0 => {
-                    k2 += k_dps_per_rt_s * k_dps_per_rt_s;
-                    parts.push(format!(
-                        "rate_random_walk K = {} deg/s/sqrt(s)",
-                        sci(k_dps_per_rt_s)
-                    ));
-                }
-                Effect::BiasInstability { sigma_dps } if sigma_dps > 0.0 => {
-                    let k = bias_instability_random_walk(sigma_dps);
-                    k2 += k * k;
-                    parts.push(format!(
-                        "bias_instability sigma {} deg/s (six Gauss-Markov processes, T 1-1000 s) read at tau = 3 s, K = {} deg/s/sqrt(s)",
-                        sci(sigma_dps),
-                        sci(k)
-                    ));
-                }
-                Effect::TurnOnBias { .. } | Effect::TemperatureBias { .. } => {
-                    left_out.push(e.id());
-                }
-                _ => {}
-            }
-        }
-        let k_dps = k2.sqrt();
-        notes.push(if parts.is_empty() {
-            "gyroscope_random_walk: 0: the model has no bias wander (no Gauss-Markov bias, rate random walk or bias instability)".to_string()
-        } else {
-            format!("gyroscope_random_walk: {}", parts.join(" + "))
-        });
-        if !left_out.is_empty() {
-            notes.push(format!(
-                "not included: {} (a constant or temperature-driven bias, not a random walk)",
-                left_out.join(", ")
-            ));
-        }
+        let (n_dps, density_note) = model_noise_density(sensor, effects, fs);
+        notes.push(density_note);
+        let k_dps = model_random_walk(sensor, effects, &mut notes);
         notes.extend(provenance.iter().map(|p| format!("model: {p}")));
         Self::of_dps(n_dps, k_dps, fs, source, notes)
     }

@@ -510,25 +510,67 @@ pub fn fit(allan: &AllanDeviation, options: &FitOptions) -> NoiseFit {
     if tau_s.is_empty() || max_avar <= 0.0 {
         return result;
     }
-    let tiny = max_avar * 1e-30;
-    let weights = |reference: &[f64], noise: &[NoiseType]| -> Vec<f64> {
-        allan
-            .points
-            .iter()
-            .zip(reference)
-            .zip(noise)
-            .map(|((p, r), kind)| (allan.edf(*kind, p.m) / 2.0).sqrt() / r.max(tiny))
-            .collect()
+    let data = reweighted_data(allan, &tau_s, &avar, max_avar * 1e-30, options.iterations);
+    let (current, mask, delta) = backward_elimination(&data, &tau_s, options.significance);
+    let term = |j: usize| FitTerm {
+        value: current.coef[j].max(0.0).sqrt(),
+        significant: mask & (1 << j) != 0,
+        delta_cost: delta[j],
     };
-    let mut reference = avar.clone();
+    result.quantization_deg = term(Q);
+    result.arw_dps_per_rt_hz = term(N);
+    result.arw_deg_per_rt_h = 60.0 * result.arw_dps_per_rt_hz.value;
+    result.bias_instability_dps = term(B);
+    result.rate_random_walk_dps_per_rt_s = term(K);
+    let gm = term(GM);
+    result.gauss_markov = GaussMarkovFit {
+        sigma_dps: gm.value,
+        corr_time_s: (gm.significant && current.corr_time_s.is_finite())
+            .then_some(current.corr_time_s),
+        significant: gm.significant,
+        delta_cost: gm.delta_cost,
+    };
+    result.cost = final_cost(allan, &current, tau0_s);
+    result
+}
+
+/// The weight of each point of `allan`: √(edf/2) of its `noise` type over its
+/// `reference` variance (floored at `tiny`).
+fn edf_weights(
+    allan: &AllanDeviation,
+    reference: &[f64],
+    noise: &[NoiseType],
+    tiny: f64,
+) -> Vec<f64> {
+    allan
+        .points
+        .iter()
+        .zip(reference)
+        .zip(noise)
+        .map(|((p, r), kind)| (allan.edf(*kind, p.m) / 2.0).sqrt() / r.max(tiny))
+        .collect()
+}
+
+/// The fit's data: the Allan variances `avar` at `tau_s`, weighted after `iterations`
+/// rounds (at least one) of fitting every term and weighting each point by the noise type
+/// and level of the model there (`tiny`: the least variance a weight divides by).
+fn reweighted_data(
+    allan: &AllanDeviation,
+    tau_s: &[f64],
+    avar: &[f64],
+    tiny: f64,
+    iterations: usize,
+) -> Data {
+    let tau0_s = allan.tau0_s();
+    let mut reference = avar.to_vec();
     let mut noise = vec![NoiseType::WhiteFm; tau_s.len()];
     let mut data = Data {
-        tau_s: tau_s.clone(),
-        avar: avar.clone(),
-        sqrt_w: weights(&reference, &noise),
+        tau_s: tau_s.to_vec(),
+        avar: avar.to_vec(),
+        sqrt_w: edf_weights(allan, &reference, &noise, tiny),
         tau0_s,
     };
-    for _ in 0..options.iterations.max(1) {
+    for _ in 0..iterations.max(1) {
         let full = solve(&data, ALL);
         for (i, t) in tau_s.iter().enumerate() {
             let value = model(&full.coef, full.corr_time_s, *t, tau0_s);
@@ -543,16 +585,23 @@ pub fn fit(allan: &AllanDeviation, options: &FitOptions) -> NoiseFit {
             noise[i] =
                 NoiseType::from_avar_slope(model_slope(&full.coef, full.corr_time_s, *t, tau0_s));
         }
-        data.sqrt_w = weights(&reference, &noise);
+        data.sqrt_w = edf_weights(allan, &reference, &noise, tiny);
     }
+    data
+}
 
+/// Backward elimination of the terms: drop the weakest term while its cost is below its
+/// threshold (`significance` per octave of `tau_s`, twice for the Gauss-Markov term's
+/// two parameters). The final solution, the mask of the terms kept, and each term's
+/// cost when last dropped (0 if never tried).
+fn backward_elimination(data: &Data, tau_s: &[f64], significance: f64) -> (Solution, u8, [f64; 5]) {
     // Backward elimination.
     let octaves = (tau_s[tau_s.len() - 1] / tau_s[0]).log2().max(1.0);
     let per_octave = (tau_s.len() as f64 / octaves).max(1.0);
     // σ and T for the Gauss-Markov term, one parameter for the others.
-    let threshold = |j: usize| options.significance * per_octave * if j == GM { 2.0 } else { 1.0 };
+    let threshold = |j: usize| significance * per_octave * if j == GM { 2.0 } else { 1.0 };
     let mut mask = ALL;
-    let mut current = solve(&data, mask);
+    let mut current = solve(data, mask);
     let mut delta = [0.0_f64; 5];
     // Terms with a zero coefficient add nothing: drop them first.
     for j in 0..5 {
@@ -560,11 +609,11 @@ pub fn fit(allan: &AllanDeviation, options: &FitOptions) -> NoiseFit {
             mask &= !(1 << j);
         }
     }
-    current = solve(&data, mask);
+    current = solve(data, mask);
     loop {
         let mut weakest: Option<(usize, f64, Solution)> = None;
         for j in (0..5).filter(|j| mask & (1 << j) != 0) {
-            let without = solve(&data, mask & !(1 << j));
+            let without = solve(data, mask & !(1 << j));
             let d = (without.cost - current.cost).max(0.0);
             delta[j] = d;
             // The weakest term relative to its threshold.
@@ -586,26 +635,14 @@ pub fn fit(allan: &AllanDeviation, options: &FitOptions) -> NoiseFit {
             _ => break,
         }
     }
-    let term = |j: usize| FitTerm {
-        value: current.coef[j].max(0.0).sqrt(),
-        significant: mask & (1 << j) != 0,
-        delta_cost: delta[j],
-    };
-    result.quantization_deg = term(Q);
-    result.arw_dps_per_rt_hz = term(N);
-    result.arw_deg_per_rt_h = 60.0 * result.arw_dps_per_rt_hz.value;
-    result.bias_instability_dps = term(B);
-    result.rate_random_walk_dps_per_rt_s = term(K);
-    let gm = term(GM);
-    result.gauss_markov = GaussMarkovFit {
-        sigma_dps: gm.value,
-        corr_time_s: (gm.significant && current.corr_time_s.is_finite())
-            .then_some(current.corr_time_s),
-        significant: gm.significant,
-        delta_cost: gm.delta_cost,
-    };
+    (current, mask, delta)
+}
+
+/// The final misfit of the solution `current` to `allan`, with weights from the final
+/// model.
+fn final_cost(allan: &AllanDeviation, current: &Solution, tau0_s: f64) -> f64 {
     // The final misfit with weights from the final model.
-    result.cost = allan
+    allan
         .points
         .iter()
         .map(|p| {
@@ -625,8 +662,7 @@ pub fn fit(allan: &AllanDeviation, options: &FitOptions) -> NoiseFit {
                 0.0
             }
         })
-        .sum();
-    result
+        .sum()
 }
 
 #[cfg(test)]

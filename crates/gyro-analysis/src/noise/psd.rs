@@ -94,6 +94,49 @@ pub fn welch(segments: &[&[f64]], sample_rate_hz: f64, options: &PsdOptions) -> 
     if len < 2 || !len.is_power_of_two() || len > longest {
         return None;
     }
+    let (psd, count) = welch_average(segments, len, sample_rate_hz);
+    let resolution_hz = sample_rate_hz / len as f64;
+    let frequency_hz: Vec<f64> = (0..len / 2 + 1).map(|k| k as f64 * resolution_hz).collect();
+
+    let nyquist = 0.5 * sample_rate_hz;
+    let band = (
+        options.white_band.0 * nyquist,
+        options.white_band.1 * nyquist,
+    );
+    let mean_over = |lo: f64, hi: f64| {
+        let (sum, n) = frequency_hz
+            .iter()
+            .zip(&psd)
+            .filter(|(f, _)| **f > 0.0 && **f >= lo && **f <= hi)
+            .fold((0.0, 0usize), |(s, n), (_, p)| (s + p, n + 1));
+        (n > 0).then(|| (sum / n as f64, n))
+    };
+    let (white, white_band_hz) = match mean_over(band.0, band.1) {
+        Some((p, _)) => (p, band),
+        None => (
+            mean_over(resolution_hz, nyquist).map_or(0.0, |(p, _)| p),
+            (resolution_hz, nyquist),
+        ),
+    };
+    let white_density = (white / 2.0).sqrt();
+    let bands = decade_bands(&frequency_hz, &psd, resolution_hz, nyquist);
+    Some(Psd {
+        segment_len: len,
+        segments: count,
+        resolution_hz,
+        white_density_dps_per_rt_hz: white_density,
+        white_arw_deg_per_rt_h: 60.0 * white_density,
+        white_band_hz,
+        bands,
+        frequency_hz,
+        psd_dps2_per_hz: psd,
+    })
+}
+
+/// The one-sided PSD ((deg/s)²/Hz per bin, 0 to Nyquist) averaged over every Hann-windowed,
+/// half-overlapping, mean-removed window of `len` samples of the `segments`, and how many
+/// windows.
+fn welch_average(segments: &[&[f64]], len: usize, sample_rate_hz: f64) -> (Vec<f64>, usize) {
     let window = hann(len);
     let window_power: f64 = window.iter().map(|w| w * w).sum();
     let bins = len / 2 + 1;
@@ -129,38 +172,24 @@ pub fn welch(segments: &[&[f64]], sample_rate_hz: f64, options: &PsdOptions) -> 
             a * scale * one_sided
         })
         .collect();
-    let resolution_hz = sample_rate_hz / len as f64;
-    let frequency_hz: Vec<f64> = (0..bins).map(|k| k as f64 * resolution_hz).collect();
+    (psd, count)
+}
 
-    let nyquist = 0.5 * sample_rate_hz;
-    let band = (
-        options.white_band.0 * nyquist,
-        options.white_band.1 * nyquist,
-    );
-    let mean_over = |lo: f64, hi: f64| {
-        let (sum, n) = frequency_hz
-            .iter()
-            .zip(&psd)
-            .filter(|(f, _)| **f > 0.0 && **f >= lo && **f <= hi)
-            .fold((0.0, 0usize), |(s, n), (_, p)| (s + p, n + 1));
-        (n > 0).then(|| (sum / n as f64, n))
-    };
-    let (white, white_band_hz) = match mean_over(band.0, band.1) {
-        Some((p, _)) => (p, band),
-        None => (
-            mean_over(resolution_hz, nyquist).map_or(0.0, |(p, _)| p),
-            (resolution_hz, nyquist),
-        ),
-    };
-    let white_density = (white / 2.0).sqrt();
-
+/// The PSD averaged over ten bands per decade from `resolution_hz` to `nyquist` (Hz),
+/// the bands holding no bin left out.
+fn decade_bands(
+    frequency_hz: &[f64],
+    psd: &[f64],
+    resolution_hz: f64,
+    nyquist: f64,
+) -> Vec<PsdBand> {
     let mut bands = Vec::new();
     let mut low = resolution_hz;
     while low <= nyquist {
         let high = low * 10f64.powf(0.1);
         let (sum, n) = frequency_hz
             .iter()
-            .zip(&psd)
+            .zip(psd)
             .filter(|(f, _)| **f >= low && **f < high || (high > nyquist && **f == nyquist))
             .fold((0.0, 0usize), |(s, n), (_, p)| (s + p, n + 1));
         if n > 0 {
@@ -173,17 +202,7 @@ pub fn welch(segments: &[&[f64]], sample_rate_hz: f64, options: &PsdOptions) -> 
         }
         low = high;
     }
-    Some(Psd {
-        segment_len: len,
-        segments: count,
-        resolution_hz,
-        white_density_dps_per_rt_hz: white_density,
-        white_arw_deg_per_rt_h: 60.0 * white_density,
-        white_band_hz,
-        bands,
-        frequency_hz,
-        psd_dps2_per_hz: psd,
-    })
+    bands
 }
 
 #[cfg(test)]

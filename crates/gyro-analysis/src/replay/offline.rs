@@ -192,98 +192,146 @@ impl Smoother {
     fn close(&mut self, until: usize) -> Option<Smoothed> {
         let end = *self.at(until)?;
         let pending = self.pending.take();
-        let mut smoothed = None;
         match pending {
             None => {
-                // The rest before the first movement: its smoothed angle is the one at its
-                // end.
-                self.offset_deg = 0.0;
-                self.variance_offset = 0.0;
-                let (angle, variance) = (f64::from(end.angle_deg), variance_of(&end));
-                while self.first < until {
-                    let Some(p) = self.held.pop_front() else {
-                        break;
-                    };
-                    let mut q = p;
-                    q.angle_deg = angle as f32;
-                    if let Some(v) = variance {
-                        q.angle_std_deg = Some(v.max(0.0).sqrt() as f32);
-                    }
-                    self.ready.push(q);
-                    self.first += 1;
-                }
-                // From here the smoothed angle is the causal one.
-                self.anchored = true;
+                self.close_first_rest(until, &end);
+                None
             }
-            Some(p) => {
-                let start = *self.at(p.start_index)?;
-                let (end_index, movement) = match (p.end_index, p.movement) {
-                    (Some(e), Some(m)) if e <= until => (e, Some(m)),
-                    // Not ended (cannot happen: the core ends a movement before it starts
-                    // another): the causal angles, shifted.
-                    _ => (until, None),
-                };
-                let moved_end = *self.at(end_index)?;
-                // The angle the rest after added: the correction of the movement's bias.
-                let correction = f64::from(end.angle_deg - moved_end.angle_deg);
-                let angle = f64::from(end.angle_deg - start.angle_deg);
-                // The filter's variance gained, its white-noise part as the rests measure it.
-                let steps = (end_index - p.start_index) as f64;
-                let white = steps * self.step_variance();
-                let white_prior = steps * self.prior_step_variance;
-                let variance = match (variance_of(&start), variance_of(&end)) {
-                    (Some(a), Some(b)) => Some((b - a - white_prior).max(0.0) + white),
-                    _ => None,
-                };
-                let (t0, t1) = (start.time_s, moved_end.time_s);
-                let (offset, variance_offset) = (self.offset_deg, self.variance_offset);
-                let base_angle = f64::from(start.angle_deg);
-                let base_variance = variance_of(&start).unwrap_or(0.0);
-                while self.first < until {
-                    let Some(q) = self.held.pop_front() else {
-                        break;
-                    };
-                    let index = self.first;
-                    self.first += 1;
-                    let share = if index >= end_index {
-                        1.0
-                    } else if t1 > t0 {
-                        ((q.time_s - t0) / (t1 - t0)).clamp(0.0, 1.0)
-                    } else {
-                        1.0
-                    };
-                    let mut s = q;
-                    if index > end_index {
-                        // The rest after: the smoothed angle at its end.
-                        s.angle_deg = (offset + base_angle + angle) as f32;
-                    } else {
-                        s.angle_deg = (offset + f64::from(q.angle_deg) + share * correction) as f32;
-                    }
-                    if let Some(v) = variance {
-                        s.angle_std_deg = Some(
-                            (variance_offset + base_variance + share * v)
-                                .max(0.0)
-                                .sqrt() as f32,
-                        );
-                    }
-                    self.ready.push(s);
-                }
-                // From `until` on the smoothed angle is the causal one plus this offset.
-                self.offset_deg = offset + base_angle + angle - f64::from(end.angle_deg);
-                if let Some(v) = variance {
-                    self.variance_offset =
-                        variance_offset + base_variance + v - variance_of(&end).unwrap_or(0.0);
-                }
-                if let Some(movement) = movement {
-                    smoothed = Some(Smoothed {
-                        movement,
-                        angle_deg: angle as f32,
-                        angle_std_deg: variance.map(|v| v.sqrt() as f32),
-                    });
-                }
-            }
+            Some(p) => self.close_movement(p, until, &end),
         }
-        smoothed
+    }
+
+    /// The rest before the first movement, which ends at output `until` (the point `end`):
+    /// release its outputs with the angle and variance at its end.
+    fn close_first_rest(&mut self, until: usize, end: &SeriesPoint) {
+        // The rest before the first movement: its smoothed angle is the one at its
+        // end.
+        self.offset_deg = 0.0;
+        self.variance_offset = 0.0;
+        let (angle, variance) = (f64::from(end.angle_deg), variance_of(end));
+        while self.first < until {
+            let Some(p) = self.held.pop_front() else {
+                break;
+            };
+            let mut q = p;
+            q.angle_deg = angle as f32;
+            if let Some(v) = variance {
+                q.angle_std_deg = Some(v.max(0.0).sqrt() as f32);
+            }
+            self.ready.push(q);
+            self.first += 1;
+        }
+        // From here the smoothed angle is the causal one.
+        self.anchored = true;
+    }
+
+    /// The pending movement `p` and the rest after it, which ends at output `until` (the
+    /// point `end`): release their outputs smoothed (the rest's bias correction spread
+    /// over the movement by time), and the movement's smoothed angle once it has ended.
+    fn close_movement(&mut self, p: Pending, until: usize, end: &SeriesPoint) -> Option<Smoothed> {
+        let start = *self.at(p.start_index)?;
+        let (end_index, movement) = match (p.end_index, p.movement) {
+            (Some(e), Some(m)) if e <= until => (e, Some(m)),
+            // Not ended (cannot happen: the core ends a movement before it starts
+            // another): the causal angles, shifted.
+            _ => (until, None),
+        };
+        let moved_end = *self.at(end_index)?;
+        // The angle the rest after added: the correction of the movement's bias.
+        let correction = f64::from(end.angle_deg - moved_end.angle_deg);
+        let angle = f64::from(end.angle_deg - start.angle_deg);
+        // The filter's variance gained, its white-noise part as the rests measure it.
+        let steps = (end_index - p.start_index) as f64;
+        let white = steps * self.step_variance();
+        let white_prior = steps * self.prior_step_variance;
+        let variance = match (variance_of(&start), variance_of(end)) {
+            (Some(a), Some(b)) => Some((b - a - white_prior).max(0.0) + white),
+            _ => None,
+        };
+        let shift = Shift {
+            end_index,
+            t0_s: start.time_s,
+            t1_s: moved_end.time_s,
+            offset_deg: self.offset_deg,
+            variance_offset: self.variance_offset,
+            base_angle_deg: f64::from(start.angle_deg),
+            base_variance: variance_of(&start).unwrap_or(0.0),
+            angle_deg: angle,
+            correction_deg: correction,
+            variance,
+        };
+        while self.first < until {
+            let Some(q) = self.held.pop_front() else {
+                break;
+            };
+            let index = self.first;
+            self.first += 1;
+            self.ready.push(shift.smoothed(index, &q));
+        }
+        // From `until` on the smoothed angle is the causal one plus this offset.
+        self.offset_deg =
+            shift.offset_deg + shift.base_angle_deg + angle - f64::from(end.angle_deg);
+        if let Some(v) = variance {
+            self.variance_offset =
+                shift.variance_offset + shift.base_variance + v - variance_of(end).unwrap_or(0.0);
+        }
+        movement.map(|movement| Smoothed {
+            movement,
+            angle_deg: angle as f32,
+            angle_std_deg: variance.map(|v| v.sqrt() as f32),
+        })
+    }
+}
+
+/// How a movement and the rest after it are smoothed ([`Smoother::close_movement`]).
+struct Shift {
+    /// Output index of the movement's end.
+    end_index: usize,
+    /// Times of the movement's start and end (s).
+    t0_s: f64,
+    t1_s: f64,
+    /// The smoothing so far: angle (deg) and variance (deg²) offsets.
+    offset_deg: f64,
+    variance_offset: f64,
+    /// The causal angle (deg) and variance (deg²) at the movement's start.
+    base_angle_deg: f64,
+    base_variance: f64,
+    /// The movement's smoothed angle (deg).
+    angle_deg: f64,
+    /// The angle the rest after added (deg): the correction of the movement's bias.
+    correction_deg: f64,
+    /// The movement's variance gained (deg²), when both ends have one.
+    variance: Option<f64>,
+}
+
+impl Shift {
+    /// The output `q` at `index` smoothed: within the movement, the causal angle plus the
+    /// correction's share by time; in the rest after, the smoothed angle at its end.
+    fn smoothed(&self, index: usize, q: &SeriesPoint) -> SeriesPoint {
+        let (t0, t1) = (self.t0_s, self.t1_s);
+        let share = if index >= self.end_index {
+            1.0
+        } else if t1 > t0 {
+            ((q.time_s - t0) / (t1 - t0)).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let mut s = *q;
+        if index > self.end_index {
+            // The rest after: the smoothed angle at its end.
+            s.angle_deg = (self.offset_deg + self.base_angle_deg + self.angle_deg) as f32;
+        } else {
+            s.angle_deg =
+                (self.offset_deg + f64::from(q.angle_deg) + share * self.correction_deg) as f32;
+        }
+        if let Some(v) = self.variance {
+            s.angle_std_deg = Some(
+                (self.variance_offset + self.base_variance + share * v)
+                    .max(0.0)
+                    .sqrt() as f32,
+            );
+        }
+        s
     }
 }
 
