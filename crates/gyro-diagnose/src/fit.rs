@@ -106,15 +106,16 @@ pub fn direct_evidence(
 fn runs_output_step(
     train: &[&RealRun],
     prior_lsb_dps: f64,
-    quant_ratio: f64,
+    settings: &crate::settings::Fit,
 ) -> Option<(f64, String)> {
+    let (quant_ratio, step_match_rel) = (settings.quant_ratio, settings.step_match_rel);
     let values: Vec<f64> = train
         .iter()
         .flat_map(|r| r.measured_rates_dps.iter().copied())
         .collect();
     match rate_step(&values) {
         Some(step) if step < quant_ratio * prior_lsb_dps => {
-            ((step - prior_lsb_dps).abs() > 0.01 * prior_lsb_dps).then(|| {
+            ((step - prior_lsb_dps).abs() > step_match_rel * prior_lsb_dps).then(|| {
                 (
                     step,
                     format!(
@@ -405,8 +406,7 @@ pub fn nominal_model(
             model.bias_dps
         ));
     }
-    if let Some((lsb_dps, note)) = runs_output_step(train, prior.lsb_dps, settings.fit.quant_ratio)
-    {
+    if let Some((lsb_dps, note)) = runs_output_step(train, prior.lsb_dps, &settings.fit) {
         model.lsb_dps = lsb_dps;
         notes.push(note);
     }

@@ -137,7 +137,9 @@ pub struct SelfTest {
     pub detection_limits: Vec<DetectionLimit>,
 }
 
-/// Share of a matrix cell's cases named first for its magnitude to count as detected.
+/// Share of a matrix cell's cases named first for its magnitude to count as detected: the
+/// definition of the detection limit the self-check reports (the smallest magnitude named
+/// first in at least 90% of its cases), not a setting of any diagnosis.
 pub const DETECTED_SHARE: f64 = 0.9;
 
 /// One effect at one magnitude of the matrix, over its repeats.

@@ -85,6 +85,12 @@ pub struct Fit {
     /// nominal step. Unit 1 (a ratio of steps), valid (1, 100]. 1.5: halfway to a step
     /// twice the nominal one.
     pub quant_ratio: f64,
+    /// The output step the training runs' rates lie on counts as the prior's within this
+    /// relative difference (`fit::runs_output_step`). Unit 1, valid (0, 1). 0.01: the step is
+    /// a least-squares fit over many grid values (`gyro_analysis::noise::rate_step`), which
+    /// rounding to a few decimals moves by far less; the LSBs of other sensors differ by
+    /// tens of percent (1/131 against 1/24 °/s).
+    pub step_match_rel: f64,
     /// Fewest clipped samples over the training runs for saturation. Unit samples, valid
     /// [1, 10⁶]. 10: a clip holds for several samples; fewer is a single peak.
     pub min_clipped: usize,
@@ -273,6 +279,10 @@ pub struct Score {
     /// Share of the nominal discrepancy of a signature statistic an effect may leave and
     /// still pass its posterior check. Unit 1, valid [0, 1]. 0.5: it explains most of it.
     pub remaining_share: f64,
+    /// A gap G above the floor of at most this share of the floor is no gap: the share of
+    /// it an effect closes is then 0 (`summarise`), not a ratio of two small differences.
+    /// Unit 1, valid [0, 10]. 0.1: a tenth of the floor is within the floor's own spread.
+    pub no_gap_share: f64,
 }
 
 /// The turns, rest to rest, and the effective noise.
@@ -372,6 +382,7 @@ impl Settings {
         },
         fit: Fit {
             quant_ratio: 1.5,
+            step_match_rel: 0.01,
             min_clipped: 10,
             systematic_rel: 0.02,
             min_gaps: 3,
@@ -427,6 +438,7 @@ impl Settings {
             floor_members: 10,
             likelihood_dof: 4.0,
             remaining_share: 0.5,
+            no_gap_share: 0.1,
         },
         turns: Turns {
             min_k: 1e-3,
@@ -460,6 +472,8 @@ impl Settings {
                 "least spread of a statistic in the unexplained test, as a share of its size: the parameters' 2% systematic uncertainty"),
             entry("fit.quant_ratio", f.quant_ratio, "1", (OPEN, 1.0, 100.0, CLOSED),
                 "output grid over the nominal step at which quantisation is named"),
+            entry("fit.step_match_rel", f.step_match_rel, "1", (OPEN, 0.0, 1.0, OPEN),
+                "relative difference within which the runs' output step is the prior's"),
             count("fit.min_clipped", f.min_clipped as f64, "samples", 1.0, 1e6,
                 "fewest clipped samples over the training runs for saturation"),
             entry("fit.systematic_rel", f.systematic_rel, "1", (CLOSED, 0.0, 1.0, OPEN),
@@ -550,6 +564,8 @@ impl Settings {
                 "degrees of freedom of the Student-t likelihood of one statistic: heavy tails"),
             entry("score.remaining_share", sc.remaining_share, "1", (CLOSED, 0.0, 1.0, CLOSED),
                 "share of a signature statistic's nominal discrepancy an effect may leave and pass its posterior check"),
+            entry("score.no_gap_share", sc.no_gap_share, "1", (CLOSED, 0.0, 10.0, CLOSED),
+                "gap above the floor, as a share of the floor, that counts as no gap (nothing to close)"),
             entry("turns.min_k", tu.min_k, "1", (CLOSED, 0.0, 1.0, CLOSED),
                 "smallest scale error named from the turns: 0.09° on a 90° turn"),
             entry("turns.min_stretch_s", tu.min_stretch_s, "s", (OPEN, 0.0, 3600.0, CLOSED),

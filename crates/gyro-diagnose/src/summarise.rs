@@ -42,10 +42,11 @@ pub(crate) fn train_after(
     (e.scores, g)
 }
 
-/// (before − after) / (before − floor); 0 with no gap above the floor (within 10% of it).
-fn closed(floor: f64, before: f64, after: f64) -> f64 {
+/// (before − after) / (before − floor); 0 with no gap above the floor (within
+/// `no_gap_share` of it: `score.no_gap_share`).
+fn closed(floor: f64, no_gap_share: f64, before: f64, after: f64) -> f64 {
     let span = before - floor;
-    if span <= 0.1 * floor {
+    if span <= no_gap_share * floor {
         0.0
     } else {
         (before - after) / span
@@ -56,7 +57,7 @@ fn closed(floor: f64, before: f64, after: f64) -> f64 {
 /// rest by held-out gap reduction when added alone, then those not scored on the
 /// held-out runs (`gap_before`: the nominal model's held-out G with the candidate seeds).
 fn effect_results(
-    floor: f64,
+    (floor, no_gap_share): (f64, f64),
     gap_before: f64,
     candidates: &[Candidate],
     selection: &Selection,
@@ -88,7 +89,8 @@ fn effect_results(
                     delta_bic: st.map(|st| st.delta_bic),
                     holdout_gap_before: st.map_or(gap_before, |st| st.gap_before),
                     holdout_gap_after: st.map(|st| st.gap_after),
-                    fraction_closed: st.map(|st| closed(floor, st.gap_before, st.gap_after)),
+                    fraction_closed: st
+                        .map(|st| closed(floor, no_gap_share, st.gap_before, st.gap_after)),
                     significant: order.is_some(),
                     ci95,
                     z: c.fit.z.is_finite().then_some(c.fit.z),
@@ -178,7 +180,12 @@ pub(crate) struct Findings<'a> {
 pub(crate) fn summarise(f: Findings) -> Diagnosis {
     let floor = f.baseline.floor;
     let growing = f.selected_effects.iter().any(is_count_clock);
-    let effects = effect_results(floor, gap(&f.holdout_before), &f.candidates, &f.selection);
+    let effects = effect_results(
+        (floor, f.settings.score.no_gap_share),
+        gap(&f.holdout_before),
+        &f.candidates,
+        &f.selection,
+    );
     let unmodelled: Vec<&'static str> = effects
         .iter()
         .filter(|e| e.significant)
@@ -213,7 +220,12 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         effects,
         verdict: Verdict {
             unmodelled: unmodelled.clone(),
-            fraction_closed_holdout: closed(floor, gap(&f.holdout_before), holdout_after),
+            fraction_closed_holdout: closed(
+                floor,
+                f.settings.score.no_gap_share,
+                gap(&f.holdout_before),
+                holdout_after,
+            ),
             model_fits: unexplained.is_empty(),
         },
         not_seen: super::detection::not_seen(&unmodelled),
