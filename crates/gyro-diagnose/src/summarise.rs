@@ -179,7 +179,6 @@ pub(crate) struct Findings<'a> {
 /// Stage 6: the diagnosis.
 pub(crate) fn summarise(f: Findings) -> Diagnosis {
     let floor = f.baseline.floor;
-    let growing = f.selected_effects.iter().any(is_count_clock);
     let effects = effect_results(
         (floor, f.settings.score.no_gap_share),
         gap(&f.holdout_before),
@@ -191,6 +190,12 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         .filter(|e| e.significant)
         .map(|e| e.id)
         .collect();
+    let closed_holdout = closed(
+        floor,
+        f.settings.score.no_gap_share,
+        gap(&f.holdout_before),
+        gap(&f.selection.holdout_scores),
+    );
     let holdout_after = gap(&f.selection.holdout_scores);
     let unexplained = super::locate::unexplained(
         &f.baseline.train.scores,
@@ -198,11 +203,8 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         &f.selection.holdout_scores,
         f.settings,
     );
-    let delay_doubt = delay_doubt(
-        &f.selected_effects,
-        f.baseline.whiteness.as_ref(),
-        f.baseline.nominal.sample_rate_hz,
-    );
+    let (reference_warnings, doubts, warnings) = warnings(&f);
+    let effective_noise = effective_noise(&f);
     let runs = run_summaries(
         f.runs,
         (&f.baseline.train.scores, &f.train_after.0),
@@ -220,12 +222,7 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         effects,
         verdict: Verdict {
             unmodelled: unmodelled.clone(),
-            fraction_closed_holdout: closed(
-                floor,
-                f.settings.score.no_gap_share,
-                gap(&f.holdout_before),
-                holdout_after,
-            ),
+            fraction_closed_holdout: closed_holdout,
             model_fits: unexplained.is_empty(),
         },
         not_seen: super::detection::not_seen(&unmodelled),
@@ -243,17 +240,10 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         },
         runs,
         compensation: f.compensation,
-        reference_warnings: sense_warnings(f.runs),
-        doubts: delay_doubt.into_iter().collect(),
-        warnings: lag_warnings(f.runs, growing)
-            .into_iter()
-            .chain(f.baseline.whiteness.as_ref().and_then(colour_warning))
-            .collect(),
-        effective_noise: super::effective::EffectiveNoise {
-            training: f.baseline.moving_noise.clone(),
-            holdout: super::effective::measure(&f.runs.holdout, "held-out", &f.settings.turns)
-                .map(|m| m.compared_to(f.baseline.own_noise.0, f.baseline.own_noise.1)),
-        },
+        reference_warnings,
+        doubts,
+        warnings,
+        effective_noise,
         motion_lines: [
             super::line::motion_line(&f.runs.train, "training"),
             super::line::motion_line(&f.runs.holdout, "held-out"),
@@ -265,6 +255,38 @@ pub(crate) fn summarise(f: Findings) -> Diagnosis {
         turns: f.turns,
         corrected_model: f.corrected_model,
         selected_sensor: f.selected_sensor,
+    }
+}
+
+/// What the diagnosis says beside its findings, one sentence each: a reference that does
+/// not measure the gyro's motion ([`sense_warnings`]), the doubts on a named effect
+/// ([`delay_doubt`]), and what makes part of the diagnosis unreliable (a lag beyond the
+/// search, [`lag_warnings`]; coloured rests, [`colour_warning`]).
+fn warnings(f: &Findings) -> (Vec<String>, Vec<String>, Vec<String>) {
+    let growing = f.selected_effects.iter().any(is_count_clock);
+    let doubts = delay_doubt(
+        &f.selected_effects,
+        f.baseline.whiteness.as_ref(),
+        f.baseline.nominal.sample_rate_hz,
+    );
+    let warnings = lag_warnings(f.runs, growing)
+        .into_iter()
+        .chain(f.baseline.whiteness.as_ref().and_then(colour_warning))
+        .collect();
+    (
+        sense_warnings(f.runs),
+        doubts.into_iter().collect(),
+        warnings,
+    )
+}
+
+/// The effective noise on moving data: the training runs' (measured with the baseline)
+/// and the held-out runs', each against the rests' own.
+fn effective_noise(f: &Findings) -> super::effective::EffectiveNoise {
+    super::effective::EffectiveNoise {
+        training: f.baseline.moving_noise.clone(),
+        holdout: super::effective::measure(&f.runs.holdout, "held-out", &f.settings.turns)
+            .map(|m| m.compared_to(f.baseline.own_noise.0, f.baseline.own_noise.1)),
     }
 }
 
