@@ -699,50 +699,23 @@ pub fn record<R: Read>(
     stop: &AtomicBool,
     status: &mut dyn FnMut(&LiveStatus),
 ) -> Result<RecordSummary, LogError> {
-    let start = Instant::now();
-    let checks = options.checks();
-    let mut stats = RecordStats::default();
-    let mut last_ns = 0_u64;
-    let mut last_data = start;
-    let mut last_flush = start;
-    let mut last_status = start;
-    let mut frames_at_status = 0_u64;
-    let mut last_rate = None;
-    let mut last_temperature = None;
-    let mut dirty = false;
-    let mut skipped_reported = 0_u64;
+    let mut rec = Recording::new(Instant::now(), options.checks());
     let stop_reason = loop {
         if stop.load(Ordering::Relaxed) {
             break StopReason::Interrupted;
         }
         let now = Instant::now();
-        if options.duration.is_some_and(|d| now - start >= d) {
+        if options.duration.is_some_and(|d| now - rec.start >= d) {
             break StopReason::Duration;
         }
-        if options.idle_stop.is_some_and(|d| now - last_data >= d) {
+        if options.idle_stop.is_some_and(|d| now - rec.last_data >= d) {
             break StopReason::Idle;
         }
-        if now - last_flush >= options.flush_interval {
-            stats.absorb(&reader.stats());
-            if dirty {
-                sink.stats(last_ns, &stats)?;
-                dirty = false;
-            }
-            sink.flush()?;
-            last_flush = now;
+        if now - rec.last_flush >= options.flush_interval {
+            rec.flush(now, reader, &mut *sink)?;
         }
-        if now - last_status >= options.status_interval {
-            stats.absorb(&reader.stats());
-            let dt = (now - last_status).as_secs_f64();
-            status(&LiveStatus {
-                stats,
-                rate_dps: last_rate,
-                temperature_c: last_temperature,
-                frames_per_s: (stats.frames - frames_at_status) as f64 / dt,
-                elapsed_s: (now - start).as_secs_f64(),
-            });
-            frames_at_status = stats.frames;
-            last_status = now;
+        if now - rec.last_status >= options.status_interval {
+            rec.report_status(now, reader, status);
         }
         let event = match reader.next_event() {
             Ok(Some(event)) => event,
@@ -750,50 +723,152 @@ pub fn record<R: Read>(
             Err(e) if e.kind() == ErrorKind::BrokenPipe => break StopReason::PortClosed,
             Err(e) => break StopReason::PortError(e.to_string()),
         };
+        rec.event(event, now, options, &mut *sink)?;
+    };
+    rec.finish(reader, sink, stop_reason)
+}
+
+/// The state of a recording from one event to the next: counters, when things were last
+/// done, and the last values for the status.
+struct Recording {
+    start: Instant,
+    checks: Checks,
+    stats: RecordStats,
+    /// Log time of the last frame (ns), which events and counters are stamped with.
+    last_ns: u64,
+    last_data: Instant,
+    last_flush: Instant,
+    last_status: Instant,
+    frames_at_status: u64,
+    last_rate: Option<f64>,
+    last_temperature: Option<f64>,
+    /// Something happened since the counters were last written.
+    dirty: bool,
+    /// Skipped bytes already written as events.
+    skipped_reported: u64,
+}
+
+impl Recording {
+    fn new(start: Instant, checks: Checks) -> Self {
+        Self {
+            start,
+            checks,
+            stats: RecordStats::default(),
+            last_ns: 0,
+            last_data: start,
+            last_flush: start,
+            last_status: start,
+            frames_at_status: 0,
+            last_rate: None,
+            last_temperature: None,
+            dirty: false,
+            skipped_reported: 0,
+        }
+    }
+
+    /// Write the counters (if they changed) and flush the sink.
+    fn flush<R: Read>(
+        &mut self,
+        now: Instant,
+        reader: &BridgeReader<R>,
+        sink: &mut dyn RecordSink,
+    ) -> Result<(), LogError> {
+        self.stats.absorb(&reader.stats());
+        if self.dirty {
+            sink.stats(self.last_ns, &self.stats)?;
+            self.dirty = false;
+        }
+        sink.flush()?;
+        self.last_flush = now;
+        Ok(())
+    }
+
+    /// Give `status` the counters, the last values and the frame rate since the last call.
+    fn report_status<R: Read>(
+        &mut self,
+        now: Instant,
+        reader: &BridgeReader<R>,
+        status: &mut dyn FnMut(&LiveStatus),
+    ) {
+        self.stats.absorb(&reader.stats());
+        let dt = (now - self.last_status).as_secs_f64();
+        status(&LiveStatus {
+            stats: self.stats,
+            rate_dps: self.last_rate,
+            temperature_c: self.last_temperature,
+            frames_per_s: (self.stats.frames - self.frames_at_status) as f64 / dt,
+            elapsed_s: (now - self.start).as_secs_f64(),
+        });
+        self.frames_at_status = self.stats.frames;
+        self.last_status = now;
+    }
+
+    /// One event read at `now`: a frame recorded, a CRC error or skipped bytes written.
+    fn event(
+        &mut self,
+        event: ReadEvent,
+        now: Instant,
+        options: &RecordOptions,
+        sink: &mut dyn RecordSink,
+    ) -> Result<(), LogError> {
         match event {
-            ReadEvent::Timeout | ReadEvent::Interrupted => continue,
+            ReadEvent::Timeout | ReadEvent::Interrupted => {}
             ReadEvent::Frame(received) => {
-                last_data = now;
-                dirty = true;
-                let d = handle_frame(&received, options, checks, &mut stats, &mut *sink)?;
-                last_ns = timestamp_ns(received.frame.timestamp_us);
+                self.last_data = now;
+                self.dirty = true;
+                let d = handle_frame(&received, options, self.checks, &mut self.stats, sink)?;
+                self.last_ns = timestamp_ns(received.frame.timestamp_us);
                 if d.checksum_ok {
-                    last_rate = d.rate_dps;
-                    last_temperature = d.temperature_c;
+                    self.last_rate = d.rate_dps;
+                    self.last_temperature = d.temperature_c;
                 }
             }
             ReadEvent::Crc(error) => {
-                last_data = now;
-                dirty = true;
+                self.last_data = now;
+                self.dirty = true;
                 if let crm100_driver::BridgeError::Crc { expected, found } = error {
-                    sink.event(last_ns, &RecordEvent::CrcError { expected, found })?;
+                    sink.event(self.last_ns, &RecordEvent::CrcError { expected, found })?;
                 }
             }
             ReadEvent::Skipped { bytes } => {
-                last_data = now;
-                dirty = true;
-                skipped_reported += bytes;
-                sink.event(last_ns, &RecordEvent::SkippedBytes { bytes })?;
+                self.last_data = now;
+                self.dirty = true;
+                self.skipped_reported += bytes;
+                sink.event(self.last_ns, &RecordEvent::SkippedBytes { bytes })?;
             }
         }
-    };
-    // A partial frame left in the decoder can no longer complete: report it with any
-    // skipped bytes not reported yet.
-    reader.discard_partial();
-    stats.absorb(&reader.stats());
-    if stats.bytes_skipped > skipped_reported {
-        let bytes = stats.bytes_skipped - skipped_reported;
-        sink.event(last_ns, &RecordEvent::SkippedBytes { bytes })?;
+        Ok(())
     }
-    sink.stats(last_ns, &stats)?;
-    sink.finish()?;
-    Ok(RecordSummary {
-        stats,
-        elapsed_s: start.elapsed().as_secs_f64(),
-        stop: stop_reason,
-    })
+
+    /// End the recording stopped for `stop`: the skipped bytes not yet reported, the final
+    /// counters, the sink finished.
+    fn finish<R: Read>(
+        mut self,
+        reader: &mut BridgeReader<R>,
+        mut sink: Box<dyn RecordSink>,
+        stop: StopReason,
+    ) -> Result<RecordSummary, LogError> {
+        let last_ns = self.last_ns;
+        // A partial frame left in the decoder can no longer complete: report it with any
+        // skipped bytes not reported yet.
+        reader.discard_partial();
+        self.stats.absorb(&reader.stats());
+        if self.stats.bytes_skipped > self.skipped_reported {
+            let bytes = self.stats.bytes_skipped - self.skipped_reported;
+            sink.event(last_ns, &RecordEvent::SkippedBytes { bytes })?;
+        }
+        sink.stats(last_ns, &self.stats)?;
+        sink.finish()?;
+        Ok(RecordSummary {
+            stats: self.stats,
+            elapsed_s: self.start.elapsed().as_secs_f64(),
+            stop,
+        })
+    }
 }
 
+/// One frame: the bridge clock and the sequence tracked, the frame decoded and written,
+/// each fault written as an event and counted.
 fn handle_frame(
     received: &Received,
     options: &RecordOptions,
@@ -804,48 +879,8 @@ fn handle_frame(
     let frame = received.frame;
     let time_ns = timestamp_ns(frame.timestamp_us);
     stats.frames += 1;
-    stats.first_timestamp_us.get_or_insert(frame.timestamp_us);
-    if let Some(last) = stats.last_timestamp_us {
-        match frame.timestamp_us.checked_sub(last) {
-            Some(step) => stats.bridge_time_us = stats.bridge_time_us.saturating_add(step),
-            None => {
-                // Said in `/crm100/events` and the summary; the frame is kept, at its own
-                // stamp (a reader refuses or re-times what goes back, and says so).
-                let back_us = last - frame.timestamp_us;
-                stats.clock_steps_back += 1;
-                stats.largest_clock_step_back_us = stats.largest_clock_step_back_us.max(back_us);
-                sink.event(
-                    time_ns,
-                    &RecordEvent::ClockBack {
-                        sequence: frame.sequence,
-                        from_us: last,
-                        to_us: frame.timestamp_us,
-                    },
-                )?;
-            }
-        }
-    }
-    stats.last_timestamp_us = Some(frame.timestamp_us);
-    match received.sequence {
-        SeqEvent::Gap(gap) => sink.event(
-            time_ns,
-            &RecordEvent::Gap {
-                from: gap.from,
-                to: gap.to,
-                lost: gap.lost,
-            },
-        )?,
-        SeqEvent::Duplicate => sink.event(
-            time_ns,
-            &RecordEvent::Duplicate {
-                sequence: frame.sequence,
-            },
-        )?,
-        SeqEvent::Backwards { from, to } => {
-            sink.event(time_ns, &RecordEvent::Backwards { from, to })?
-        }
-        SeqEvent::First | SeqEvent::InOrder => {}
-    }
+    track_bridge_clock(&frame, time_ns, stats, sink)?;
+    write_sequence_event(received, time_ns, sink)?;
     if Range::from_command(frame.command).is_some_and(|r| r != options.range) {
         stats.command_mismatches += 1;
         sink.event(
@@ -875,4 +910,67 @@ fn handle_frame(
         stats.samples_with_rate += u64::from(d.rate_dps.is_some());
     }
     Ok(d)
+}
+
+/// The bridge clock at `frame` (logged at `time_ns`): its forward steps added to the
+/// bridge time, a step back counted and written as an event.
+fn track_bridge_clock(
+    frame: &BridgeFrame,
+    time_ns: u64,
+    stats: &mut RecordStats,
+    sink: &mut dyn RecordSink,
+) -> Result<(), LogError> {
+    stats.first_timestamp_us.get_or_insert(frame.timestamp_us);
+    if let Some(last) = stats.last_timestamp_us {
+        match frame.timestamp_us.checked_sub(last) {
+            Some(step) => stats.bridge_time_us = stats.bridge_time_us.saturating_add(step),
+            None => {
+                // Said in `/crm100/events` and the summary; the frame is kept, at its own
+                // stamp (a reader refuses or re-times what goes back, and says so).
+                let back_us = last - frame.timestamp_us;
+                stats.clock_steps_back += 1;
+                stats.largest_clock_step_back_us = stats.largest_clock_step_back_us.max(back_us);
+                sink.event(
+                    time_ns,
+                    &RecordEvent::ClockBack {
+                        sequence: frame.sequence,
+                        from_us: last,
+                        to_us: frame.timestamp_us,
+                    },
+                )?;
+            }
+        }
+    }
+    stats.last_timestamp_us = Some(frame.timestamp_us);
+    Ok(())
+}
+
+/// A gap, duplicate or step back in the sequence of `received`, written as an event.
+fn write_sequence_event(
+    received: &Received,
+    time_ns: u64,
+    sink: &mut dyn RecordSink,
+) -> Result<(), LogError> {
+    let frame = received.frame;
+    match received.sequence {
+        SeqEvent::Gap(gap) => sink.event(
+            time_ns,
+            &RecordEvent::Gap {
+                from: gap.from,
+                to: gap.to,
+                lost: gap.lost,
+            },
+        )?,
+        SeqEvent::Duplicate => sink.event(
+            time_ns,
+            &RecordEvent::Duplicate {
+                sequence: frame.sequence,
+            },
+        )?,
+        SeqEvent::Backwards { from, to } => {
+            sink.event(time_ns, &RecordEvent::Backwards { from, to })?
+        }
+        SeqEvent::First | SeqEvent::InOrder => {}
+    }
+    Ok(())
 }

@@ -260,87 +260,113 @@ impl MotionDetector {
         self.previous_dps = rate_dps;
         let bias_known = self.rest.count >= u32::from(self.min_rest);
         match self.state {
-            MotionState::Static if quiet => {
-                let aborted = self.run > 0;
-                if aborted {
-                    self.end_run();
-                }
-                self.add_rest(rate_dps);
-                if aborted {
-                    Phase::Aborted
-                } else {
-                    Phase::Rest
-                }
-            }
-            MotionState::Static => {
-                self.run = self.run.saturating_add(1);
-                self.run_reached_enter |= deviation > self.enter_dps;
-                self.run_mean.add(rate_dps);
-                self.track_level(rate_dps);
-                let steady = self.level.count >= self.steady_samples();
-                let level_dps = self.level.mean().unwrap_or(rate_dps);
-                let level_near = libm::fabsf(level_dps - self.bias_dps) <= near_dps;
-                let power_up = !bias_known
-                    && libm::fabsf(level_dps) <= POWER_UP_BIAS_PER_ENTER * self.enter_dps;
-                // Before the first rest a run that is one steady level so far may still be
-                // the power-up bias: it is not confirmed as a movement yet.
-                let may_be_bias = power_up && self.level.count == u32::from(self.run);
-                if steady && (level_near && !self.run_reached_enter || power_up) {
-                    // A bias change (or the power-up bias), not a movement: the new level
-                    // is the rest.
-                    self.rest = self.level;
-                    self.clear_run();
-                    self.refresh_bias();
-                    Phase::Aborted
-                } else if self.run >= self.min_motion
-                    && (self.run_reached_enter && !may_be_bias || steady && !level_near)
-                {
-                    let run = self.run;
-                    self.state = MotionState::Dynamic;
-                    self.clear_run();
-                    Phase::Started { run }
-                } else {
-                    Phase::Onset
-                }
-            }
-            MotionState::Dynamic if quiet => {
-                self.run = self.run.saturating_add(1);
-                self.run_mean.add(rate_dps);
-                self.track_level(rate_dps);
-                if self.run >= self.min_rest {
-                    let quiet = self.run;
-                    self.state = MotionState::Static;
-                    self.rest = self.run_mean;
-                    self.clear_run();
-                    self.refresh_bias();
-                    Phase::Ended { quiet }
-                } else if self.run == 1 {
-                    Phase::SettleFirst
-                } else {
-                    Phase::Settling
-                }
-            }
-            MotionState::Dynamic => {
-                self.run = 0;
-                self.run_mean = Mean::default();
-                self.track_level(rate_dps);
-                let level_dps = self.level.mean().unwrap_or(rate_dps);
-                if self.level.count >= self.steady_samples()
-                    && libm::fabsf(level_dps - self.bias_dps) <= near_dps
-                {
-                    // A steady level near the bias, though not within `exit_dps` of it:
-                    // the rest after the movement, on a bias that moved or a noisy sensor.
-                    // This sample is the movement's end (the level was integrated: its
-                    // residual is small by `near`).
-                    self.state = MotionState::Static;
-                    self.rest = self.level;
-                    self.clear_run();
-                    self.refresh_bias();
-                    Phase::Ended { quiet: 1 }
-                } else {
-                    Phase::Moving
-                }
-            }
+            MotionState::Static if quiet => self.static_quiet(rate_dps),
+            MotionState::Static => self.static_run(rate_dps, deviation, near_dps, bias_known),
+            MotionState::Dynamic if quiet => self.dynamic_quiet(rate_dps),
+            MotionState::Dynamic => self.dynamic_moving(rate_dps, near_dps),
+        }
+    }
+
+    /// A quiet sample while static: a rest sample, ending a run that was not a movement.
+    #[inline]
+    fn static_quiet(&mut self, rate_dps: f32) -> Phase {
+        let aborted = self.run > 0;
+        if aborted {
+            self.end_run();
+        }
+        self.add_rest(rate_dps);
+        if aborted {
+            Phase::Aborted
+        } else {
+            Phase::Rest
+        }
+    }
+
+    /// A sample beyond `exit_dps` (by `deviation`) while static: the run goes on, and may
+    /// turn out a bias change (a steady level within `near_dps`, or the power-up bias
+    /// while the bias is not `bias_known`) or a movement.
+    #[inline]
+    fn static_run(
+        &mut self,
+        rate_dps: f32,
+        deviation: f32,
+        near_dps: f32,
+        bias_known: bool,
+    ) -> Phase {
+        self.run = self.run.saturating_add(1);
+        self.run_reached_enter |= deviation > self.enter_dps;
+        self.run_mean.add(rate_dps);
+        self.track_level(rate_dps);
+        let steady = self.level.count >= self.steady_samples();
+        let level_dps = self.level.mean().unwrap_or(rate_dps);
+        let level_near = libm::fabsf(level_dps - self.bias_dps) <= near_dps;
+        let power_up =
+            !bias_known && libm::fabsf(level_dps) <= POWER_UP_BIAS_PER_ENTER * self.enter_dps;
+        // Before the first rest a run that is one steady level so far may still be
+        // the power-up bias: it is not confirmed as a movement yet.
+        let may_be_bias = power_up && self.level.count == u32::from(self.run);
+        if steady && (level_near && !self.run_reached_enter || power_up) {
+            // A bias change (or the power-up bias), not a movement: the new level
+            // is the rest.
+            self.rest = self.level;
+            self.clear_run();
+            self.refresh_bias();
+            Phase::Aborted
+        } else if self.run >= self.min_motion
+            && (self.run_reached_enter && !may_be_bias || steady && !level_near)
+        {
+            let run = self.run;
+            self.state = MotionState::Dynamic;
+            self.clear_run();
+            Phase::Started { run }
+        } else {
+            Phase::Onset
+        }
+    }
+
+    /// A quiet sample while moving: the quiet run goes on, and ends the movement once it
+    /// is `min_rest` long.
+    #[inline]
+    fn dynamic_quiet(&mut self, rate_dps: f32) -> Phase {
+        self.run = self.run.saturating_add(1);
+        self.run_mean.add(rate_dps);
+        self.track_level(rate_dps);
+        if self.run >= self.min_rest {
+            let quiet = self.run;
+            self.state = MotionState::Static;
+            self.rest = self.run_mean;
+            self.clear_run();
+            self.refresh_bias();
+            Phase::Ended { quiet }
+        } else if self.run == 1 {
+            Phase::SettleFirst
+        } else {
+            Phase::Settling
+        }
+    }
+
+    /// A sample beyond `exit_dps` while moving: still moving, unless the level has been
+    /// steady within `near_dps` of the bias long enough to be the rest after it.
+    #[inline]
+    fn dynamic_moving(&mut self, rate_dps: f32, near_dps: f32) -> Phase {
+        self.run = 0;
+        self.run_mean = Mean::default();
+        self.track_level(rate_dps);
+        let level_dps = self.level.mean().unwrap_or(rate_dps);
+        if self.level.count >= self.steady_samples()
+            && libm::fabsf(level_dps - self.bias_dps) <= near_dps
+        {
+            // A steady level near the bias, though not within `exit_dps` of it:
+            // the rest after the movement, on a bias that moved or a noisy sensor.
+            // This sample is the movement's end (the level was integrated: its
+            // residual is small by `near`).
+            self.state = MotionState::Static;
+            self.rest = self.level;
+            self.clear_run();
+            self.refresh_bias();
+            Phase::Ended { quiet: 1 }
+        } else {
+            Phase::Moving
         }
     }
 

@@ -1174,7 +1174,44 @@ impl Pipeline {
         }
         let rate_dps = self.sos.process(&mut self.sos_state, mean_dps);
         let phase = self.detector.update(rate_dps);
+        self.integrate(phase, rate_dps);
+        self.hand_over_saturation(phase);
+        let event = match phase {
+            Phase::Rest => {
+                self.observe_rest(rate_dps);
+                None
+            }
+            Phase::Onset | Phase::Settling => None,
+            Phase::Aborted => {
+                self.discard();
+                None
+            }
+            Phase::Started { run } => Some(self.start_movement(run, time_s)),
+            Phase::Moving => {
+                self.commit();
+                if let Some(track) = self.track.as_mut() {
+                    track.set_settle(None);
+                }
+                None
+            }
+            Phase::SettleFirst => {
+                self.commit();
+                if let Some(track) = self.track.as_mut() {
+                    track.set_settle(Some((self.index, time_s)));
+                }
+                None
+            }
+            Phase::Ended { quiet } => self.end_movement(quiet, time_s),
+        };
+        let output = self.output(time_s, rate_dps, event);
+        self.index = self.index.saturating_add(1);
+        output
+    }
 
+    /// Predict the filter over this step, and integrate `rate_dps` (raw and corrected)
+    /// if `phase` integrates.
+    #[inline]
+    fn integrate(&mut self, phase: Phase, rate_dps: f32) {
         // With `min_rest` of one sample, `Ended` comes on the first quiet sample, which is
         // the movement's last: it is integrated like `SettleFirst`.
         let integrates = match phase {
@@ -1199,7 +1236,11 @@ impl Pipeline {
                 .step(half_dt_s, previous_corrected, corrected_dps);
         }
         self.previous = (rate_dps, corrected_dps);
+    }
 
+    /// Hand the clip flags pending from this block on, as `phase` decides.
+    #[inline]
+    fn hand_over_saturation(&mut self, phase: Phase) {
         // Saturation seen in this block goes to the movement in progress; during a run that
         // may become one it waits; at rest, or when the run is dropped, it is forgotten.
         if !matches!(phase, Phase::Onset | Phase::Started { .. }) {
@@ -1211,79 +1252,66 @@ impl Pipeline {
                 track.saturation |= pending;
             }
         }
+    }
 
-        let event = match phase {
-            Phase::Rest => {
-                if let Some((mean_dps, samples, next_mean_dps, first)) =
-                    self.rest_blocks.push(rate_dps)
-                {
-                    if first {
-                        self.kalman.observe_after_movement(mean_dps);
-                    }
-                    self.kalman.observe_block_pair(mean_dps, next_mean_dps);
-                    let correction = self.kalman.update_at_rest(mean_dps, u32::from(samples));
-                    self.kalman_correction.add(correction);
-                }
-                None
+    /// A rest sample `rate_dps`: when it completes a block pair, observe the bias with it.
+    #[inline]
+    fn observe_rest(&mut self, rate_dps: f32) {
+        if let Some((mean_dps, samples, next_mean_dps, first)) = self.rest_blocks.push(rate_dps) {
+            if first {
+                self.kalman.observe_after_movement(mean_dps);
             }
-            Phase::Onset | Phase::Settling => None,
-            Phase::Aborted => {
-                self.discard();
-                None
+            self.kalman.observe_block_pair(mean_dps, next_mean_dps);
+            let correction = self.kalman.update_at_rest(mean_dps, u32::from(samples));
+            self.kalman_correction.add(correction);
+        }
+    }
+
+    /// A movement confirmed by a run of `run` samples ending at `time_s`: start tracking
+    /// it from the quiet sample before the run.
+    fn start_movement(&mut self, run: u16, time_s: f64) -> Event {
+        self.kalman.add_motion(u32::from(run).saturating_sub(1));
+        // The movement starts at the quiet sample before the run.
+        let start_index = self.index.saturating_sub(u32::from(run));
+        let start_time_s =
+            time_s - f64::from(run) * f64::from(self.output_period_s()) - self.filter_delay_s;
+        // The rest samples still held back lead into the movement: drop them.
+        self.rest_blocks.clear();
+        // The run so far is still pending: it belongs to the movement.
+        self.track = Some(Track {
+            start_time_s,
+            start_index,
+            raw_at_start_deg: self.raw.committed_deg(),
+            angle_at_start_deg: self.committed_angle_deg(),
+            settle_time_s: 0.0,
+            settle_index: None,
+            saturation: self.take_pending(),
+        });
+        self.commit();
+        Event::MovementStarted {
+            start_time_s,
+            start_index,
+        }
+    }
+
+    /// Rest confirmed after `quiet` quiet samples (the last at `time_s`): end the movement.
+    fn end_movement(&mut self, quiet: u16, time_s: f64) -> Option<Event> {
+        if quiet <= 1 {
+            // This first quiet sample is the end (see `integrates`).
+            self.commit();
+            if let Some(track) = self.track.as_mut() {
+                track.set_settle(Some((self.index, time_s)));
             }
-            Phase::Started { run } => {
-                self.kalman.add_motion(u32::from(run).saturating_sub(1));
-                // The movement starts at the quiet sample before the run.
-                let start_index = self.index.saturating_sub(u32::from(run));
-                let start_time_s = time_s
-                    - f64::from(run) * f64::from(self.output_period_s())
-                    - self.filter_delay_s;
-                // The rest samples still held back lead into the movement: drop them.
-                self.rest_blocks.clear();
-                // The run so far is still pending: it belongs to the movement.
-                self.track = Some(Track {
-                    start_time_s,
-                    start_index,
-                    raw_at_start_deg: self.raw.committed_deg(),
-                    angle_at_start_deg: self.committed_angle_deg(),
-                    settle_time_s: 0.0,
-                    settle_index: None,
-                    saturation: self.take_pending(),
-                });
-                self.commit();
-                Some(Event::MovementStarted {
-                    start_time_s,
-                    start_index,
-                })
-            }
-            Phase::Moving => {
-                self.commit();
-                if let Some(track) = self.track.as_mut() {
-                    track.set_settle(None);
-                }
-                None
-            }
-            Phase::SettleFirst => {
-                self.commit();
-                if let Some(track) = self.track.as_mut() {
-                    track.set_settle(Some((self.index, time_s)));
-                }
-                None
-            }
-            Phase::Ended { quiet } => {
-                if quiet <= 1 {
-                    // This first quiet sample is the end (see `integrates`).
-                    self.commit();
-                    if let Some(track) = self.track.as_mut() {
-                        track.set_settle(Some((self.index, time_s)));
-                    }
-                } else {
-                    self.discard();
-                }
-                self.finish_movement(time_s).map(Event::MovementEnded)
-            }
-        };
-        let output = Output {
+        } else {
+            self.discard();
+        }
+        self.finish_movement(time_s).map(Event::MovementEnded)
+    }
+
+    /// The output of this step: `rate_dps` at `time_s`, `event`, and the angles and bias now.
+    #[inline]
+    fn output(&self, time_s: f64, rate_dps: f32, event: Option<Event>) -> Output {
+        Output {
             time_s,
             rate_dps,
             motion: self.detector.state(),
@@ -1296,9 +1324,7 @@ impl Pipeline {
                 Compensation::Kalman => self.kalman.bias_dps(),
                 _ => self.detector.bias_dps(),
             },
-        };
-        self.index = self.index.saturating_add(1);
-        output
+        }
     }
 
     fn commit(&mut self) {

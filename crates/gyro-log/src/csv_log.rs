@@ -246,11 +246,7 @@ impl CsvRows {
         columns: &ColumnOptions,
         split_lines: bool,
     ) -> Result<Self, LogError> {
-        let io_err = |cause| LogError::Io {
-            path: path.to_path_buf(),
-            cause,
-        };
-        let file = File::open(path).map_err(io_err)?;
+        let file = File::open(path).map_err(io_error(path))?;
         // Lines are split here only in a regular file: the data is read again from the
         // header's end.
         let lines_file = if split_lines && file.metadata().is_ok_and(|m| m.is_file()) {
@@ -259,150 +255,23 @@ impl CsvRows {
             None
         };
         let mut reader = BufReader::with_capacity(1 << 20, file);
-
-        // Metadata: `# key: value` lines before the header.
-        let mut metadata = BTreeMap::new();
-        let mut prelude_lines = 0_u64;
-        let mut prelude_bytes = 0_u64;
-        // UTF-16 (a byte-order mark, or NUL bytes between ASCII characters) is refused
-        // plainly rather than read as a garbled header.
-        {
-            let start = reader.fill_buf().map_err(io_err)?;
-            let utf16 = start.starts_with(&[0xFF, 0xFE])
-                || start.starts_with(&[0xFE, 0xFF])
-                || start.iter().take(64).filter(|b| **b == 0).count() >= 8;
-            if utf16 {
-                return Err(LogError::NotUtf8 {
-                    path: path.to_path_buf(),
-                    what: "this file is UTF-16 (or binary); save it as UTF-8 CSV".into(),
-                });
-            }
-        }
-        // A UTF-8 byte-order mark (as some Windows tools write) is not part of the header.
-        if reader
-            .fill_buf()
-            .map_err(io_err)?
-            .starts_with(&[0xEF, 0xBB, 0xBF])
-        {
-            reader.consume(3);
-            prelude_bytes += 3;
-        }
-        loop {
-            let buf = reader.fill_buf().map_err(io_err)?;
-            if buf.first() != Some(&b'#') {
-                break;
-            }
-            // Comments may be in any encoding (a Latin-1 "é" in a note): read as bytes.
-            let mut bytes = Vec::new();
-            prelude_bytes += reader.read_until(b'\n', &mut bytes).map_err(io_err)? as u64;
-            prelude_lines += 1;
-            let line = String::from_utf8_lossy(&bytes);
-            if let Some((key, value)) = line.trim_start_matches('#').split_once(':') {
-                let (key, value) = (key.trim(), value.trim());
-                if key == crate::SAMPLE_RATE_KEY {
-                    crate::check_rate_metadata(value, metadata.get(key).map(String::as_str))
-                        .map_err(|message| LogError::Metadata {
-                            path: path.to_path_buf(),
-                            line: Some(prelude_lines),
-                            message,
-                        })?;
-                }
-                metadata.insert(key.to_string(), value.to_string());
-            }
-        }
+        let prelude = read_prelude(&mut reader, path)?;
 
         let mut csv = csv::ReaderBuilder::new()
             .has_headers(true)
             .comment(Some(b'#'))
             .from_reader(Box::new(reader) as Box<dyn Read + Send>);
-        let header_line = prelude_lines + 1;
         let headers = csv
             .byte_headers()
-            .map_err(|e| csv_error(path, prelude_lines, e))?
+            .map_err(|e| csv_error(path, prelude.lines, e))?
             .clone();
-        if headers.is_empty() || headers.iter().all(|h| h.is_empty()) {
-            return Err(LogError::NoHeader {
-                path: path.to_path_buf(),
-            });
-        }
-        let names: Vec<String> = headers
-            .iter()
-            .map(|h| String::from_utf8_lossy(h).trim().to_string())
-            .collect();
-        // One field holding tabs or semicolons: another separator, not a missing column.
-        if let [only] = names.as_slice() {
-            let separator = [
-                ('\t', "tabs", r"tr '\t' ','"),
-                (';', "semicolons", "sed 's/,/./g; s/;/,/g'"),
-            ]
-            .into_iter()
-            .find(|(c, _, _)| only.contains(*c));
-            if let Some((_, what, fix)) = separator {
-                return Err(LogError::Csv {
-                    path: path.to_path_buf(),
-                    line: header_line,
-                    message: format!(
-                        "the header is separated by {what}, not commas (`{}`): a log must be comma-separated with `.` as the decimal point (for example `{fix}`)",
-                        excerpt(only.as_bytes())
-                    ),
-                });
-            }
-        }
-        // Two columns of one name: which one is meant cannot be known.
-        for (i, name) in names.iter().enumerate() {
-            if let Some(j) = names[..i].iter().position(|n| !n.is_empty() && n == name) {
-                return Err(LogError::Csv {
-                    path: path.to_path_buf(),
-                    line: header_line,
-                    message: format!(
-                        "column `{}` appears twice in the header (fields {} and {}); rename one",
-                        excerpt(name.as_bytes()),
-                        j + 1,
-                        i + 1
-                    ),
-                });
-            }
-        }
-        let find = |name: &str| names.iter().position(|n| n == name);
-        // A missing time or rate column comes with the flags that read one that looks meant.
-        let required = |name: &str, role: Option<Role>| {
-            find(name).ok_or_else(|| LogError::MissingColumn {
-                path: path.to_path_buf(),
-                line: header_line,
-                column: excerpt(name.as_bytes()),
-                available: column_list(&names),
-                hint: role.map_or(String::new(), |role| hint(&names, role)),
-            })
-        };
-        let time = required(&columns.time_column, Some(Role::Time))?;
-        let rate = required(&columns.rate_column, Some(Role::Rate))?;
-        let columns = Columns {
-            path: path.to_path_buf(),
-            names: columns.clone(),
-            len: headers.len(),
-            time,
-            rate,
-            reference: match &columns.reference_column {
-                Some(name) => Some(required(name, None)?),
-                None => find(DEFAULT_REFERENCE_COLUMN),
-            },
-            temperature: match &columns.temperature_column {
-                Some(name) => Some(required(name, None)?),
-                None => find(DEFAULT_TEMPERATURE_COLUMN),
-            },
-            time_scale: columns.time_unit.to_seconds(),
-            rate_scale: match columns.rate_unit {
-                RateUnit::Dps => 1.0,
-                RateUnit::Rads => 180.0 / std::f64::consts::PI,
-            },
-            prelude_lines,
-        };
+        let columns = Columns::find(path, columns, &headers, prelude.lines)?;
 
         // Where the reader stands after the header: the data's first byte, and the line
         // its first row is numbered with.
         let after_header = csv.position().clone();
-        let start = prelude_bytes + after_header.byte();
-        let line = prelude_lines + after_header.line();
+        let start = prelude.bytes + after_header.byte();
+        let line = prelude.lines + after_header.line();
         let lines = lines_file.and_then(|mut file| {
             file.seek(SeekFrom::Start(start)).ok()?;
             Some(Lines::new(file, line))
@@ -412,14 +281,14 @@ impl CsvRows {
             None => Data::Csv(CsvData {
                 reader: csv,
                 record: csv::ByteRecord::new(),
-                line_offset: prelude_lines,
+                line_offset: prelude.lines,
                 first_line: None,
                 checks_lengths: true,
             }),
         };
         Ok(Self {
             columns,
-            metadata,
+            metadata: prelude.metadata,
             data,
             done: false,
         })
@@ -483,6 +352,150 @@ impl CsvRows {
             Data::Lines(_) => Ok(None), // replaced above
         }
     }
+}
+
+/// What comes before the header: the metadata, and how many lines and bytes it takes.
+struct Prelude {
+    metadata: BTreeMap<String, String>,
+    /// Metadata lines before the header.
+    lines: u64,
+    /// Bytes before the header (a UTF-8 byte-order mark included).
+    bytes: u64,
+}
+
+/// The error of an I/O failure on `path`.
+fn io_error(path: &Path) -> impl Fn(std::io::Error) -> LogError + '_ {
+    move |cause| LogError::Io {
+        path: path.to_path_buf(),
+        cause,
+    }
+}
+
+/// Read what precedes the header: refuse UTF-16, skip a UTF-8 byte-order mark, then read
+/// the metadata lines.
+fn read_prelude(reader: &mut BufReader<File>, path: &Path) -> Result<Prelude, LogError> {
+    let io_err = io_error(path);
+    // Metadata: `# key: value` lines before the header.
+    let mut metadata = BTreeMap::new();
+    let mut prelude_lines = 0_u64;
+    let mut prelude_bytes = 0_u64;
+    refuse_utf16(reader, path)?;
+    // A UTF-8 byte-order mark (as some Windows tools write) is not part of the header.
+    if reader
+        .fill_buf()
+        .map_err(&io_err)?
+        .starts_with(&[0xEF, 0xBB, 0xBF])
+    {
+        reader.consume(3);
+        prelude_bytes += 3;
+    }
+    loop {
+        let buf = reader.fill_buf().map_err(&io_err)?;
+        if buf.first() != Some(&b'#') {
+            break;
+        }
+        // Comments may be in any encoding (a Latin-1 "é" in a note): read as bytes.
+        let mut bytes = Vec::new();
+        prelude_bytes += reader.read_until(b'\n', &mut bytes).map_err(&io_err)? as u64;
+        prelude_lines += 1;
+        add_metadata_line(&mut metadata, &bytes, path, prelude_lines)?;
+    }
+    Ok(Prelude {
+        metadata,
+        lines: prelude_lines,
+        bytes: prelude_bytes,
+    })
+}
+
+/// Refuse a file that starts as UTF-16 or binary: it would be read as a garbled header.
+fn refuse_utf16(reader: &mut BufReader<File>, path: &Path) -> Result<(), LogError> {
+    // UTF-16 (a byte-order mark, or NUL bytes between ASCII characters) is refused
+    // plainly rather than read as a garbled header.
+    let start = reader.fill_buf().map_err(io_error(path))?;
+    let utf16 = start.starts_with(&[0xFF, 0xFE])
+        || start.starts_with(&[0xFE, 0xFF])
+        || start.iter().take(64).filter(|b| **b == 0).count() >= 8;
+    if utf16 {
+        return Err(LogError::NotUtf8 {
+            path: path.to_path_buf(),
+            what: "this file is UTF-16 (or binary); save it as UTF-8 CSV".into(),
+        });
+    }
+    Ok(())
+}
+
+/// Add the metadata line `bytes` (line `line` of the file) to `metadata` if it is
+/// `# key: value`, checking a sample rate against one given before.
+fn add_metadata_line(
+    metadata: &mut BTreeMap<String, String>,
+    bytes: &[u8],
+    path: &Path,
+    line: u64,
+) -> Result<(), LogError> {
+    let text = String::from_utf8_lossy(bytes);
+    if let Some((key, value)) = text.trim_start_matches('#').split_once(':') {
+        let (key, value) = (key.trim(), value.trim());
+        if key == crate::SAMPLE_RATE_KEY {
+            crate::check_rate_metadata(value, metadata.get(key).map(String::as_str)).map_err(
+                |message| LogError::Metadata {
+                    path: path.to_path_buf(),
+                    line: Some(line),
+                    message,
+                },
+            )?;
+        }
+        metadata.insert(key.to_string(), value.to_string());
+    }
+    Ok(())
+}
+
+/// Refuse a header of one field holding tabs or semicolons: another separator, not a
+/// missing column.
+fn refuse_other_separator(path: &Path, header_line: u64, names: &[String]) -> Result<(), LogError> {
+    // One field holding tabs or semicolons: another separator, not a missing column.
+    if let [only] = names {
+        let separator = [
+            ('\t', "tabs", r"tr '\t' ','"),
+            (';', "semicolons", "sed 's/,/./g; s/;/,/g'"),
+        ]
+        .into_iter()
+        .find(|(c, _, _)| only.contains(*c));
+        if let Some((_, what, fix)) = separator {
+            return Err(LogError::Csv {
+                path: path.to_path_buf(),
+                line: header_line,
+                message: format!(
+                    "the header is separated by {what}, not commas (`{}`): a log must be comma-separated with `.` as the decimal point (for example `{fix}`)",
+                    excerpt(only.as_bytes())
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Refuse a header naming one column twice.
+fn refuse_duplicate_columns(
+    path: &Path,
+    header_line: u64,
+    names: &[String],
+) -> Result<(), LogError> {
+    // Two columns of one name: which one is meant cannot be known.
+    for (i, name) in names.iter().enumerate() {
+        if let Some(j) = names[..i].iter().position(|n| !n.is_empty() && n == name) {
+            return Err(LogError::Csv {
+                path: path.to_path_buf(),
+                line: header_line,
+                message: format!(
+                    "column `{}` appears twice in the header (fields {} and {}); rename one",
+                    excerpt(name.as_bytes()),
+                    j + 1,
+                    i + 1
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The header's columns as an error lists them: the first few, each as [`excerpt`]
@@ -580,6 +593,61 @@ pub fn excerpt(raw: &[u8]) -> String {
 }
 
 impl Columns {
+    /// The columns `options` names, found in `headers` (the header, after
+    /// `prelude_lines` metadata lines); an error for a header that cannot be read right.
+    fn find(
+        path: &Path,
+        options: &ColumnOptions,
+        headers: &csv::ByteRecord,
+        prelude_lines: u64,
+    ) -> Result<Self, LogError> {
+        let header_line = prelude_lines + 1;
+        if headers.is_empty() || headers.iter().all(|h| h.is_empty()) {
+            return Err(LogError::NoHeader {
+                path: path.to_path_buf(),
+            });
+        }
+        let names: Vec<String> = headers
+            .iter()
+            .map(|h| String::from_utf8_lossy(h).trim().to_string())
+            .collect();
+        refuse_other_separator(path, header_line, &names)?;
+        refuse_duplicate_columns(path, header_line, &names)?;
+        let find = |name: &str| names.iter().position(|n| n == name);
+        // A missing time or rate column comes with the flags that read one that looks meant.
+        let required = |name: &str, role: Option<Role>| {
+            find(name).ok_or_else(|| LogError::MissingColumn {
+                path: path.to_path_buf(),
+                line: header_line,
+                column: excerpt(name.as_bytes()),
+                available: column_list(&names),
+                hint: role.map_or(String::new(), |role| hint(&names, role)),
+            })
+        };
+        let time = required(&options.time_column, Some(Role::Time))?;
+        let rate = required(&options.rate_column, Some(Role::Rate))?;
+        Ok(Columns {
+            path: path.to_path_buf(),
+            names: options.clone(),
+            len: headers.len(),
+            time,
+            rate,
+            reference: match &options.reference_column {
+                Some(name) => Some(required(name, None)?),
+                None => find(DEFAULT_REFERENCE_COLUMN),
+            },
+            temperature: match &options.temperature_column {
+                Some(name) => Some(required(name, None)?),
+                None => find(DEFAULT_TEMPERATURE_COLUMN),
+            },
+            time_scale: options.time_unit.to_seconds(),
+            rate_scale: match options.rate_unit {
+                RateUnit::Dps => 1.0,
+                RateUnit::Rads => 180.0 / std::f64::consts::PI,
+            },
+            prelude_lines,
+        })
+    }
     /// The row of the fields `field(i)` (as many as the header has), at `line`.
     fn row<'a>(&self, line: u64, field: impl Fn(usize) -> &'a [u8]) -> Result<Row, LogError> {
         let value = |idx: usize, column: &str| -> Result<Option<f64>, LogError> {
@@ -749,65 +817,87 @@ impl Lines {
         }
     }
 
+    /// The next line, without its line feed, in one pass: where its commas are (in
+    /// `self.commas`), whether it has quotes or carriage returns. `None` at the end.
+    #[inline]
+    fn scan_line(&mut self, columns: &Columns) -> Result<Option<ScannedLine>, LogError> {
+        self.commas.clear();
+        let (mut quotes, mut returns) = (false, 0_usize);
+        let mut scanned = 0;
+        let (start, end, terminated) = loop {
+            let line = &self.buf[self.start..self.end];
+            let mut feed = None;
+            for (i, &b) in line.iter().enumerate().skip(scanned) {
+                match b {
+                    b',' => self.commas.push(i),
+                    b'\n' => {
+                        feed = Some(i);
+                        break;
+                    }
+                    b'"' => quotes = true,
+                    b'\r' => returns += 1,
+                    _ => {}
+                }
+            }
+            if let Some(i) = feed {
+                break (self.start, self.start + i, true);
+            }
+            scanned = line.len();
+            if !self.fill(columns)? {
+                if self.start == self.end {
+                    return Ok(None);
+                }
+                break (self.start, self.end, false);
+            }
+        };
+        Ok(Some(ScannedLine {
+            start,
+            end,
+            terminated,
+            quotes,
+            returns,
+        }))
+    }
+
+    /// Hand the rest of the file, from the line `line` starting at `line_start`, to the
+    /// `csv` crate.
+    fn not_plain(&mut self, line_start: usize, line: u64) -> Record {
+        // A line feed first: the `csv` crate reads on as from a line start, and
+        // does not take a byte-order mark there for the file's.
+        let mut rest = Vec::with_capacity(self.end - line_start + 1);
+        rest.push(b'\n');
+        rest.extend_from_slice(&self.buf[line_start..self.end]);
+        let reader: Box<dyn Read + Send> = match self.file.take() {
+            Some(file) => Box::new(std::io::Cursor::new(rest).chain(file)),
+            None => Box::new(std::io::Cursor::new(rest)),
+        };
+        Record::NotPlain {
+            rest: reader,
+            line_offset: line.saturating_sub(2),
+            first_line: self.row_line,
+        }
+    }
+
     /// The next row, the end, or the first line that is not plain.
     fn next_record(&mut self, columns: &Columns) -> Result<Record, LogError> {
         loop {
             // The next line, without its line feed (`terminated`: it has one), in one pass:
             // where its commas are, whether it has quotes or carriage returns.
-            self.commas.clear();
-            let (mut quotes, mut returns) = (false, 0_usize);
-            let mut scanned = 0;
-            let (line_start, line_end, terminated) = loop {
-                let line = &self.buf[self.start..self.end];
-                let mut feed = None;
-                for (i, &b) in line.iter().enumerate().skip(scanned) {
-                    match b {
-                        b',' => self.commas.push(i),
-                        b'\n' => {
-                            feed = Some(i);
-                            break;
-                        }
-                        b'"' => quotes = true,
-                        b'\r' => returns += 1,
-                        _ => {}
-                    }
-                }
-                if let Some(i) = feed {
-                    break (self.start, self.start + i, true);
-                }
-                scanned = line.len();
-                if !self.fill(columns)? {
-                    if self.start == self.end {
-                        return Ok(Record::End);
-                    }
-                    break (self.start, self.end, false);
-                }
+            let Some(scanned) = self.scan_line(columns)? else {
+                return Ok(Record::End);
             };
             let line = self.line;
-            let mut text = &self.buf[line_start..line_end];
+            let mut text = &self.buf[scanned.start..scanned.end];
             let crlf = text.last() == Some(&b'\r');
             if crlf {
                 text = &text[..text.len() - 1];
             }
             // The last line without a line feed also goes to the `csv` crate (which reads
             // a comment there as a row of one field).
-            if !terminated || quotes || returns > usize::from(crlf) {
-                // A line feed first: the `csv` crate reads on as from a line start, and
-                // does not take a byte-order mark there for the file's.
-                let mut rest = Vec::with_capacity(self.end - line_start + 1);
-                rest.push(b'\n');
-                rest.extend_from_slice(&self.buf[line_start..self.end]);
-                let reader: Box<dyn Read + Send> = match self.file.take() {
-                    Some(file) => Box::new(std::io::Cursor::new(rest).chain(file)),
-                    None => Box::new(std::io::Cursor::new(rest)),
-                };
-                return Ok(Record::NotPlain {
-                    rest: reader,
-                    line_offset: line.saturating_sub(2),
-                    first_line: self.row_line,
-                });
+            if !scanned.terminated || scanned.quotes || scanned.returns > usize::from(crlf) {
+                return Ok(self.not_plain(scanned.start, line));
             }
-            self.start = line_end + 1;
+            self.start = scanned.end + 1;
             self.line += 1;
             // Blank lines and comments are skipped.
             if text.is_empty() || text[0] == b'#' {
@@ -832,6 +922,18 @@ impl Lines {
             return columns.row(row_line, field).map(Record::Row);
         }
     }
+}
+
+/// A line [`Lines::scan_line`] found: `buf[start..end]`, without its line feed.
+struct ScannedLine {
+    start: usize,
+    end: usize,
+    /// It ends with a line feed (not the end of the file).
+    terminated: bool,
+    /// It has a quote.
+    quotes: bool,
+    /// How many carriage returns it has.
+    returns: usize,
 }
 
 impl Iterator for CsvRows {

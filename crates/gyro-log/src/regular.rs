@@ -751,65 +751,8 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
             return;
         }
         if let Some(prev) = self.previous {
-            if same_row(&prev, row) {
-                self.quality.duplicate_rows += 1;
-                self.quality.note("duplicate row dropped", row.line);
+            if !self.step_to(&prev, row) {
                 return;
-            }
-            let dt = row.time_s - prev.time_s;
-            self.quality.longest_step_s = self.quality.longest_step_s.max(dt);
-            if dt < 0.0 {
-                if let Some(e) = time_backwards(self.path, &prev, row, self.max_gap_s) {
-                    self.row_error = Some(e);
-                    return;
-                }
-                self.quality.backward_steps += 1;
-                self.quality
-                    .note("time stamp before the previous row", row.line);
-            } else if dt == 0.0 {
-                self.quality.same_time_rows += 1;
-                self.quality
-                    .note("same time stamp as the previous row", row.line);
-            }
-            if self.resampler.is_some() {
-                if dt > self.gap_step_s {
-                    if dt > self.max_gap_s {
-                        self.row_error = Some(self.gap_error(&prev, row, dt));
-                        return;
-                    }
-                    self.quality.gaps += 1;
-                    self.quality
-                        .note("gap bridged by the resampled angle", row.line);
-                } else if dt > 0.0 && (dt - self.period_s).abs() > 0.05 * self.period_s {
-                    self.quality.jittered_steps += 1;
-                }
-            } else {
-                let steps = if dt <= 0.0 {
-                    1
-                } else {
-                    ((dt / self.period_s).round() as u64).max(1)
-                };
-                if steps > 1 {
-                    if dt > self.max_gap_s {
-                        self.row_error = Some(self.gap_error(&prev, row, dt));
-                        return;
-                    }
-                    self.quality.gaps += 1;
-                    self.quality.note("gap filled by interpolation", row.line);
-                    for j in 1..steps {
-                        let time_s = prev.time_s + dt * j as f64 / steps as f64;
-                        self.rate(Slot {
-                            time_s,
-                            rate_dps: f64::NAN,
-                            reference_deg: None,
-                            temperature_c: None,
-                            line: 0,
-                            filled: true,
-                        });
-                    }
-                } else if dt > 0.0 && (dt - self.period_s).abs() > 0.05 * self.period_s {
-                    self.quality.jittered_steps += 1;
-                }
             }
         }
         if row.rate_dps.is_none() {
@@ -838,6 +781,81 @@ impl<'p, S: SlotSink + ?Sized> Placer<'p, S> {
             });
         }
         self.previous = Some(*row);
+    }
+
+    /// The step from the row kept before, `prev`, to `row`: counted (duplicate, backwards,
+    /// same time, gap, jitter), a gap's slots placed. False if `row` is not to be placed
+    /// (a duplicate dropped, or a step that is an error, now in `row_error`).
+    fn step_to(&mut self, prev: &Row, row: &Row) -> bool {
+        if same_row(prev, row) {
+            self.quality.duplicate_rows += 1;
+            self.quality.note("duplicate row dropped", row.line);
+            return false;
+        }
+        let dt = row.time_s - prev.time_s;
+        self.quality.longest_step_s = self.quality.longest_step_s.max(dt);
+        if dt < 0.0 {
+            if let Some(e) = time_backwards(self.path, prev, row, self.max_gap_s) {
+                self.row_error = Some(e);
+                return false;
+            }
+            self.quality.backward_steps += 1;
+            self.quality
+                .note("time stamp before the previous row", row.line);
+        } else if dt == 0.0 {
+            self.quality.same_time_rows += 1;
+            self.quality
+                .note("same time stamp as the previous row", row.line);
+        }
+        if self.resampler.is_some() {
+            if dt > self.gap_step_s {
+                if dt > self.max_gap_s {
+                    self.row_error = Some(self.gap_error(prev, row, dt));
+                    return false;
+                }
+                self.quality.gaps += 1;
+                self.quality
+                    .note("gap bridged by the resampled angle", row.line);
+            } else if dt > 0.0 && (dt - self.period_s).abs() > 0.05 * self.period_s {
+                self.quality.jittered_steps += 1;
+            }
+            true
+        } else {
+            self.fill_gap(prev, row, dt)
+        }
+    }
+
+    /// A step of `dt` from `prev` to `row` on the grid (no resampler): the slots of a gap
+    /// between them, rate missing, or a jittered step counted. False if the gap is too
+    /// long (the error in `row_error`).
+    fn fill_gap(&mut self, prev: &Row, row: &Row, dt: f64) -> bool {
+        let steps = if dt <= 0.0 {
+            1
+        } else {
+            ((dt / self.period_s).round() as u64).max(1)
+        };
+        if steps > 1 {
+            if dt > self.max_gap_s {
+                self.row_error = Some(self.gap_error(prev, row, dt));
+                return false;
+            }
+            self.quality.gaps += 1;
+            self.quality.note("gap filled by interpolation", row.line);
+            for j in 1..steps {
+                let time_s = prev.time_s + dt * j as f64 / steps as f64;
+                self.rate(Slot {
+                    time_s,
+                    rate_dps: f64::NAN,
+                    reference_deg: None,
+                    temperature_c: None,
+                    line: 0,
+                    filled: true,
+                });
+            }
+        } else if dt > 0.0 && (dt - self.period_s).abs() > 0.05 * self.period_s {
+            self.quality.jittered_steps += 1;
+        }
+        true
     }
 
     /// A step between rows too long to bridge.

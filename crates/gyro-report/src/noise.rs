@@ -37,6 +37,14 @@ pub fn answer(c: &Characterization) -> Vec<String> {
             ""
         }
     ));
+    lines.push(fitted_terms_line(c));
+    lines
+}
+
+/// The fitted terms beside the white noise in one line: those the fit finds significant,
+/// in words and units, then those it does not.
+fn fitted_terms_line(c: &Characterization) -> String {
+    let f = &c.fit;
     let mut found = Vec::new();
     let mut not_found = Vec::new();
     let mut term = |significant: bool, found_text: String, name: &str| {
@@ -85,7 +93,7 @@ pub fn answer(c: &Characterization) -> Vec<String> {
         ),
         "Gauss-Markov bias wander",
     );
-    lines.push(format!(
+    format!(
         "beside the white noise the fit finds {}{}",
         if found.is_empty() {
             "nothing significant".to_string()
@@ -97,8 +105,7 @@ pub fn answer(c: &Characterization) -> Vec<String> {
         } else {
             format!("; not significant: {}", not_found.join(", "))
         }
-    ));
-    lines
+    )
 }
 
 /// The Allan table, the fitted terms and the PSD summary of one data set, titled `label`:

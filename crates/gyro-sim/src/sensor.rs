@@ -308,68 +308,14 @@ pub fn simulate_series(
     };
     let n = (motion.duration_s() * fs * slowest_clock).floor() as usize + 1;
 
-    let mut white_rng = stream(options.seed, Stream::White);
-    let mut gm_rng = stream(options.seed, Stream::GaussMarkov);
-    let mut flicker_rng = stream(options.seed, Stream::Flicker);
-    let mut walk_rng = stream(options.seed, Stream::RandomWalk);
-    let mut turn_on_rng = stream(options.seed, Stream::TurnOn);
-    let mut dropout_rng = stream(options.seed, Stream::Dropout);
-    let mut temp_rng = stream(options.seed, Stream::Temperature);
-
-    let white_sigma = model.white_sigma_dps();
-    let mut gm = GaussMarkovProcess::new(model.gm_sigma_dps, model.gm_tau_s, dt, &mut gm_rng);
-
     // Effect terms (identity unless present).
-    let terms = SimTerms::of(effects);
-    let limit = model.range_dps.min(terms.limit_dps);
-    let dropout = terms
-        .dropouts
-        .map(|(rate_per_s, mean_samples)| (rate_per_s / fs, 1.0 - 1.0 / mean_samples));
-    // Six processes, τ from 1 s to 1000 s (half-decade steps): a flat floor.
-    let mut flicker: Vec<GaussMarkovProcess> = terms
-        .flicker_sigma_dps
-        .map(|sigma_dps| {
-            crate::bias_instability_components(sigma_dps)
-                .iter()
-                .map(|&(sigma_i, tau_s)| {
-                    GaussMarkovProcess::new(sigma_i, tau_s, dt, &mut flicker_rng)
-                })
-                .collect()
-        })
-        .unwrap_or_default();
-    // The sensor's low-pass on the rate and on the white noise (it filters its sensing
-    // element's noise as an MEMS gyro's digital low-pass does; the bias terms are slow
-    // and pass it unchanged).
-    let low_pass = |initial: f64| {
-        terms
-            .bandwidth_hz
-            .map(|cutoff_hz| crate::TwoPoleLowPass::new(cutoff_hz, fs, initial))
-    };
-    let (mut rate_low_pass, mut noise_low_pass) =
-        (low_pass(motion.rate_dps(-terms.delay_s)), low_pass(0.0));
-    let (scale_k, asym_k, k3, k2) = (
-        terms.scale_k,
-        terms.asymmetry_k,
-        terms.k3_per_dps2,
-        terms.k2_per_dps,
-    );
-    let (temp_bias, temp_scale) = (terms.bias_dps_per_c, terms.scale_per_c);
-    let (delay_s, clock_ppm) = (terms.delay_s, terms.clock_ppm);
-    let (turn_on_sigma, walk_k, extra_lsb) = (
-        terms.turn_on_sigma_dps,
-        terms.walk_dps_per_rt_s,
-        terms.extra_lsb_dps,
-    );
-    let turn_on_draw: f64 = StandardNormal.sample(&mut turn_on_rng);
-    let turn_on = turn_on_sigma * turn_on_draw;
-    let clock = 1.0 + clock_ppm * 1e-6;
+    let mut sensor = SimSensor::new(model, SimTerms::of(effects), motion, options.seed);
+    let clock = 1.0 + sensor.terms.clock_ppm * 1e-6;
     // Rows stamped by the sensor's count: the gyro's sample k is taken earlier (a fast
     // clock) than the reference of its row.
-    let count_clock = 1.0 + terms.count_clock_ppm * 1e-6;
-    let vibration = terms.vibration;
-    let mut walk = 0.0;
-    let mut dropout_left = false;
+    let count_clock = 1.0 + sensor.terms.count_clock_ppm * 1e-6;
     let temperature_c_is_recorded = temperature_c.is_some();
+    let mut temperature = SimTemperature::new(temperature_c, options);
 
     let mut out = SimSeries {
         sample_rate_hz: fs,
@@ -378,77 +324,21 @@ pub fn simulate_series(
         temperature_c: Vec::with_capacity(n),
         dropped: 0,
     };
-    let recorded_start_c = temperature_c
-        .and_then(|t| t.iter().copied().find(|v| v.is_finite()))
-        .unwrap_or(options.temperature_start_c);
-    let mut recorded_last_c = recorded_start_c;
     let reference_step = options.reference_step_deg.filter(|s| *s > 0.0).or(options
         .encoder_counts
         .map(|counts| 360.0 / f64::from(counts.max(1))));
     for k in 0..n {
         let label_s = k as f64 * dt;
         let true_s = label_s / clock;
-        let (temperature_c, delta_c) = match temperature_c {
-            Some(recorded) => {
-                if let Some(t) = recorded.get(k).copied().filter(|t| t.is_finite()) {
-                    recorded_last_c = t;
-                }
-                (recorded_last_c, recorded_last_c - recorded_start_c)
-            }
-            None => {
-                let t = options.temperature_start_c
-                    + options.temperature_rise_c
-                        * (1.0 - (-true_s / options.temperature_tau_s).exp());
-                (t, t - options.temperature_start_c)
-            }
-        };
+        let (temperature_c, delta_c) = temperature.at(k, true_s);
 
         let gyro_s = true_s / count_clock;
-        let mut rate = motion.rate_dps(gyro_s - delay_s);
-        if let Some(filter) = rate_low_pass.as_mut() {
-            rate = filter.step(rate);
-        }
-        let scale = 1.0 + scale_k + asym_k * rate.signum() + temp_scale * delta_c;
-        let mut measured = rate * scale + k3 * rate * rate * rate + k2 * rate * rate;
-        if let Some((amplitude_dps, frequency_hz)) = vibration {
-            measured += amplitude_dps * (2.0 * std::f64::consts::PI * frequency_hz * gyro_s).sin();
-        }
+        let mut measured = sensor.sensed_dps(gyro_s, delta_c);
+        measured += sensor.bias_and_noise_dps(delta_c);
+        measured = sensor.output_dps(measured);
 
-        let flicker_dps: f64 = flicker.iter_mut().map(|p| p.step(&mut flicker_rng)).sum();
-        if walk_k > 0.0 {
-            let w: f64 = StandardNormal.sample(&mut walk_rng);
-            walk += walk_k * dt.sqrt() * w;
-        }
-        let white: f64 = StandardNormal.sample(&mut white_rng);
-        let mut white_dps = white_sigma * white;
-        if let Some(filter) = noise_low_pass.as_mut() {
-            white_dps = filter.step(white_dps);
-        }
-        measured += model.bias_dps
-            + turn_on
-            + gm.step(&mut gm_rng)
-            + temp_bias * delta_c
-            + flicker_dps
-            + walk
-            + white_dps;
-        for lsb in [model.lsb_dps, extra_lsb] {
-            if lsb > 0.0 {
-                measured = (measured / lsb).round() * lsb;
-            }
-        }
-        measured = measured.clamp(-limit, limit);
-
-        let temp_noise: f64 = StandardNormal.sample(&mut temp_rng);
-        let mut dropped = false;
-        if let Some((start_p, continue_p)) = dropout {
-            let u: f64 = dropout_rng.random();
-            dropout_left = if dropout_left {
-                u < continue_p
-            } else {
-                u < start_p
-            };
-            dropped = dropout_left;
-        }
+        let temp_noise: f64 = StandardNormal.sample(&mut sensor.streams.temperature);
+        let dropped = sensor.dropped();
         let mut reference_deg = motion.angle_deg(true_s);
         if let Some(step) = reference_step {
             reference_deg = (reference_deg / step).round() * step;
@@ -466,6 +356,231 @@ pub fn simulate_series(
         });
     }
     out
+}
+
+/// The random streams of a run, one per noise source (see [`Stream`]).
+struct Streams {
+    white: ChaCha8Rng,
+    gm: ChaCha8Rng,
+    flicker: ChaCha8Rng,
+    walk: ChaCha8Rng,
+    turn_on: ChaCha8Rng,
+    dropout: ChaCha8Rng,
+    temperature: ChaCha8Rng,
+}
+
+impl Streams {
+    /// Every stream of `seed`.
+    fn new(seed: u64) -> Self {
+        Self {
+            white: stream(seed, Stream::White),
+            gm: stream(seed, Stream::GaussMarkov),
+            flicker: stream(seed, Stream::Flicker),
+            walk: stream(seed, Stream::RandomWalk),
+            turn_on: stream(seed, Stream::TurnOn),
+            dropout: stream(seed, Stream::Dropout),
+            temperature: stream(seed, Stream::Temperature),
+        }
+    }
+}
+
+/// The simulated sensor from sample to sample: the model, the effects' terms, the random
+/// streams and the state of every process (Gauss-Markov, flicker, walk, low-passes,
+/// dropouts).
+struct SimSensor<'a> {
+    model: &'a SensorModel,
+    motion: &'a Motion,
+    terms: SimTerms,
+    streams: Streams,
+    /// Sample period (s).
+    dt_s: f64,
+    white_sigma_dps: f64,
+    gm: GaussMarkovProcess,
+    flicker: Vec<GaussMarkovProcess>,
+    rate_low_pass: Option<crate::TwoPoleLowPass>,
+    noise_low_pass: Option<crate::TwoPoleLowPass>,
+    /// Clip level (deg/s): the range, or an effect's lower one.
+    limit_dps: f64,
+    /// Per sample: the chance a dropout starts, and the chance it goes on.
+    dropout: Option<(f64, f64)>,
+    turn_on_dps: f64,
+    walk_dps: f64,
+    dropout_left: bool,
+}
+
+impl<'a> SimSensor<'a> {
+    /// The sensor at the start of a run of `motion` seeded with `seed`.
+    fn new(model: &'a SensorModel, terms: SimTerms, motion: &'a Motion, seed: u64) -> Self {
+        let fs = model.sample_rate_hz;
+        let dt = 1.0 / fs;
+        let mut streams = Streams::new(seed);
+        let white_sigma = model.white_sigma_dps();
+        let gm = GaussMarkovProcess::new(model.gm_sigma_dps, model.gm_tau_s, dt, &mut streams.gm);
+        let limit = model.range_dps.min(terms.limit_dps);
+        let dropout = terms
+            .dropouts
+            .map(|(rate_per_s, mean_samples)| (rate_per_s / fs, 1.0 - 1.0 / mean_samples));
+        // Six processes, τ from 1 s to 1000 s (half-decade steps): a flat floor.
+        let flicker: Vec<GaussMarkovProcess> = terms
+            .flicker_sigma_dps
+            .map(|sigma_dps| {
+                crate::bias_instability_components(sigma_dps)
+                    .iter()
+                    .map(|&(sigma_i, tau_s)| {
+                        GaussMarkovProcess::new(sigma_i, tau_s, dt, &mut streams.flicker)
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        // The sensor's low-pass on the rate and on the white noise (it filters its sensing
+        // element's noise as an MEMS gyro's digital low-pass does; the bias terms are slow
+        // and pass it unchanged).
+        let low_pass = |initial: f64| {
+            terms
+                .bandwidth_hz
+                .map(|cutoff_hz| crate::TwoPoleLowPass::new(cutoff_hz, fs, initial))
+        };
+        let (rate_low_pass, noise_low_pass) =
+            (low_pass(motion.rate_dps(-terms.delay_s)), low_pass(0.0));
+        let turn_on_draw: f64 = StandardNormal.sample(&mut streams.turn_on);
+        let turn_on = terms.turn_on_sigma_dps * turn_on_draw;
+        Self {
+            model,
+            motion,
+            terms,
+            streams,
+            dt_s: dt,
+            white_sigma_dps: white_sigma,
+            gm,
+            flicker,
+            rate_low_pass,
+            noise_low_pass,
+            limit_dps: limit,
+            dropout,
+            turn_on_dps: turn_on,
+            walk_dps: 0.0,
+            dropout_left: false,
+        }
+    }
+
+    /// The rate the sensing element sees at `gyro_s` (the motion, delayed and low-passed),
+    /// with its scale errors at `delta_c` from the start temperature, plus a vibration.
+    fn sensed_dps(&mut self, gyro_s: f64, delta_c: f64) -> f64 {
+        let terms = &self.terms;
+        let (scale_k, asym_k, k3, k2) = (
+            terms.scale_k,
+            terms.asymmetry_k,
+            terms.k3_per_dps2,
+            terms.k2_per_dps,
+        );
+        let mut rate = self.motion.rate_dps(gyro_s - terms.delay_s);
+        if let Some(filter) = self.rate_low_pass.as_mut() {
+            rate = filter.step(rate);
+        }
+        let scale = 1.0 + scale_k + asym_k * rate.signum() + terms.scale_per_c * delta_c;
+        let mut measured = rate * scale + k3 * rate * rate * rate + k2 * rate * rate;
+        if let Some((amplitude_dps, frequency_hz)) = terms.vibration {
+            measured += amplitude_dps * (2.0 * std::f64::consts::PI * frequency_hz * gyro_s).sin();
+        }
+        measured
+    }
+
+    /// The sum of the bias terms and the noise at this sample (`delta_c` from the start
+    /// temperature): each process steps once.
+    fn bias_and_noise_dps(&mut self, delta_c: f64) -> f64 {
+        let flicker_dps: f64 = self
+            .flicker
+            .iter_mut()
+            .map(|p| p.step(&mut self.streams.flicker))
+            .sum();
+        let walk_k = self.terms.walk_dps_per_rt_s;
+        if walk_k > 0.0 {
+            let w: f64 = StandardNormal.sample(&mut self.streams.walk);
+            self.walk_dps += walk_k * self.dt_s.sqrt() * w;
+        }
+        let white: f64 = StandardNormal.sample(&mut self.streams.white);
+        let mut white_dps = self.white_sigma_dps * white;
+        if let Some(filter) = self.noise_low_pass.as_mut() {
+            white_dps = filter.step(white_dps);
+        }
+        self.model.bias_dps
+            + self.turn_on_dps
+            + self.gm.step(&mut self.streams.gm)
+            + self.terms.bias_dps_per_c * delta_c
+            + flicker_dps
+            + self.walk_dps
+            + white_dps
+    }
+
+    /// `measured` as the sensor outputs it: rounded to its word (and an effect's), clipped.
+    fn output_dps(&self, mut measured: f64) -> f64 {
+        for lsb in [self.model.lsb_dps, self.terms.extra_lsb_dps] {
+            if lsb > 0.0 {
+                measured = (measured / lsb).round() * lsb;
+            }
+        }
+        measured.clamp(-self.limit_dps, self.limit_dps)
+    }
+
+    /// True if this sample is dropped (a dropout starts or goes on).
+    fn dropped(&mut self) -> bool {
+        let mut dropped = false;
+        if let Some((start_p, continue_p)) = self.dropout {
+            let u: f64 = self.streams.dropout.random();
+            self.dropout_left = if self.dropout_left {
+                u < continue_p
+            } else {
+                u < start_p
+            };
+            dropped = self.dropout_left;
+        }
+        dropped
+    }
+}
+
+/// The temperature at each sample: a recorded run's (a NaN entry holds the value before
+/// it), or the warm-up curve of the options.
+struct SimTemperature<'a> {
+    recorded: Option<&'a [f64]>,
+    options: &'a SimOptions,
+    recorded_start_c: f64,
+    recorded_last_c: f64,
+}
+
+impl<'a> SimTemperature<'a> {
+    fn new(recorded: Option<&'a [f64]>, options: &'a SimOptions) -> Self {
+        let recorded_start_c = recorded
+            .and_then(|t| t.iter().copied().find(|v| v.is_finite()))
+            .unwrap_or(options.temperature_start_c);
+        Self {
+            recorded,
+            options,
+            recorded_start_c,
+            recorded_last_c: recorded_start_c,
+        }
+    }
+
+    /// The temperature at sample `k` (taken at `true_s`), and its change from the start (°C).
+    fn at(&mut self, k: usize, true_s: f64) -> (f64, f64) {
+        let options = self.options;
+        match self.recorded {
+            Some(recorded) => {
+                if let Some(t) = recorded.get(k).copied().filter(|t| t.is_finite()) {
+                    self.recorded_last_c = t;
+                }
+                (
+                    self.recorded_last_c,
+                    self.recorded_last_c - self.recorded_start_c,
+                )
+            }
+            None => {
+                let t = options.temperature_start_c
+                    + options.temperature_rise_c
+                        * (1.0 - (-true_s / options.temperature_tau_s).exp());
+                (t, t - options.temperature_start_c)
+            }
+        }
+    }
 }
 
 #[cfg(test)]

@@ -199,6 +199,17 @@ impl StepCounts {
     pub fn total(&self) -> usize {
         self.reflect + self.expand + self.contract_outside + self.contract_inside + self.shrink
     }
+
+    /// Count one step of `kind`.
+    fn count(&mut self, kind: Kind) {
+        match kind {
+            Kind::Reflect => self.reflect += 1,
+            Kind::Expand => self.expand += 1,
+            Kind::ContractOutside => self.contract_outside += 1,
+            Kind::ContractInside => self.contract_inside += 1,
+            Kind::Shrink => self.shrink += 1,
+        }
+    }
 }
 
 /// The result of a run, in the original coordinates.
@@ -309,51 +320,10 @@ impl NelderMead {
             best_f: f64::INFINITY,
             best_x: vertices[0].clone(),
         };
-        for j in 0..=n {
-            let rows = j * n..(j + 1) * n;
-            // The budget check above guarantees these n + 1 calls.
-            if let Some(v) = ev
-                .call(&st.u[rows.clone()], &mut st.x[rows])
-                .map_err(Error::Objective)?
-            {
-                st.f[j] = v;
-            }
-        }
-        if st.f.iter().all(|&v| v == f64::INFINITY) {
-            return Err(ProblemError::NoFiniteValue.into());
-        }
-        st.sort();
-
-        let mut work = Work::new(n);
-        let mut iterations = 0;
-        let mut steps = StepCounts::default();
-        let termination = loop {
-            if st.converged(self.x_tolerance, self.f_tolerance) {
-                break Termination::Converged;
-            }
-            if ev.used >= ev.max {
-                break Termination::MaxEvaluations;
-            }
-            if iterations >= max_iterations {
-                break Termination::MaxIterations;
-            }
-            match st
-                .step(&coefficients, &mut work, &mut ev)
-                .map_err(Error::Objective)?
-            {
-                Some(kind) => {
-                    iterations += 1;
-                    match kind {
-                        Kind::Reflect => steps.reflect += 1,
-                        Kind::Expand => steps.expand += 1,
-                        Kind::ContractOutside => steps.contract_outside += 1,
-                        Kind::ContractInside => steps.contract_inside += 1,
-                        Kind::Shrink => steps.shrink += 1,
-                    }
-                }
-                None => break Termination::MaxEvaluations,
-            }
-        };
+        evaluate_initial(&mut st, &mut ev)?;
+        let (termination, iterations, steps) = self
+            .iterate(&mut st, &coefficients, &mut ev, max_iterations)
+            .map_err(Error::Objective)?;
         st.sort();
 
         Ok(Outcome {
@@ -366,6 +336,42 @@ impl NelderMead {
             simplex: st.order.iter().map(|&j| st.x_row(j).to_vec()).collect(),
             simplex_values: st.order.iter().map(|&j| st.f[j]).collect(),
         })
+    }
+
+    /// Iterate on the evaluated simplex `st` until it converges or the iteration or
+    /// evaluation limit is reached: why it stopped, the iterations completed and their kinds.
+    fn iterate<E, F>(
+        &self,
+        st: &mut State,
+        coefficients: &Coefficients,
+        ev: &mut Evaluator<'_, F>,
+        max_iterations: usize,
+    ) -> Result<(Termination, usize, StepCounts), E>
+    where
+        F: FnMut(&[f64]) -> Result<f64, E>,
+    {
+        let mut work = Work::new(st.n);
+        let mut iterations = 0;
+        let mut steps = StepCounts::default();
+        let termination = loop {
+            if st.converged(self.x_tolerance, self.f_tolerance) {
+                break Termination::Converged;
+            }
+            if ev.used >= ev.max {
+                break Termination::MaxEvaluations;
+            }
+            if iterations >= max_iterations {
+                break Termination::MaxIterations;
+            }
+            match st.step(coefficients, &mut work, ev)? {
+                Some(kind) => {
+                    iterations += 1;
+                    steps.count(kind);
+                }
+                None => break Termination::MaxEvaluations,
+            }
+        };
+        Ok((termination, iterations, steps))
     }
 
     /// The n + 1 vertices in the original space, checked against the settings.
@@ -476,6 +482,30 @@ impl NelderMead {
         }
         Ok(())
     }
+}
+
+/// Evaluate the n + 1 vertices of the initial simplex `st` and sort them; an error if the
+/// objective fails or is NaN or +∞ at every one.
+fn evaluate_initial<E, F>(st: &mut State, ev: &mut Evaluator<'_, F>) -> Result<(), Error<E>>
+where
+    F: FnMut(&[f64]) -> Result<f64, E>,
+{
+    let n = st.n;
+    for j in 0..=n {
+        let rows = j * n..(j + 1) * n;
+        // The budget check above guarantees these n + 1 calls.
+        if let Some(v) = ev
+            .call(&st.u[rows.clone()], &mut st.x[rows])
+            .map_err(Error::Objective)?
+        {
+            st.f[j] = v;
+        }
+    }
+    if st.f.iter().all(|&v| v == f64::INFINITY) {
+        return Err(ProblemError::NoFiniteValue.into());
+    }
+    st.sort();
+    Ok(())
 }
 
 /// Counts and performs objective calls; remembers the best point seen.
@@ -613,15 +643,7 @@ impl State {
         let (best, worst) = (self.order[0], self.order[n]);
         let (f_best, f_next, f_worst) = (self.f[best], self.f[self.order[n - 1]], self.f[worst]);
 
-        // Centroid of all but the worst, summed in order as scipy does.
-        w.centroid.copy_from_slice(self.u_row(best));
-        for &j in &self.order[1..n] {
-            for (ci, &ui) in w.centroid.iter_mut().zip(&self.u[j * n..(j + 1) * n]) {
-                *ci += ui;
-            }
-        }
-        let nf = n as f64;
-        w.centroid.iter_mut().for_each(|ci| *ci /= nf);
+        self.centroid_into(&mut w.centroid);
         let uw = &self.u[worst * n..(worst + 1) * n];
 
         // Trial points with scipy's exact expressions.
@@ -671,7 +693,36 @@ impl State {
                 return Ok(Some(Kind::ContractInside));
             }
         }
+        self.shrink(s, w, ev)
+    }
 
+    /// The centroid of all vertices but the worst into `centroid`, summed in order as
+    /// scipy does.
+    fn centroid_into(&self, centroid: &mut [f64]) {
+        let n = self.n;
+        centroid.copy_from_slice(self.u_row(self.order[0]));
+        for &j in &self.order[1..n] {
+            for (ci, &ui) in centroid.iter_mut().zip(&self.u[j * n..(j + 1) * n]) {
+                *ci += ui;
+            }
+        }
+        let nf = n as f64;
+        centroid.iter_mut().for_each(|ci| *ci /= nf);
+    }
+
+    /// Shrink every vertex towards the best by `s`; `Ok(None)` if the evaluation budget
+    /// ran out during it.
+    fn shrink<E, F>(
+        &mut self,
+        s: f64,
+        w: &mut Work,
+        ev: &mut Evaluator<'_, F>,
+    ) -> Result<Option<Kind>, E>
+    where
+        F: FnMut(&[f64]) -> Result<f64, E>,
+    {
+        let n = self.n;
+        let best = self.order[0];
         // Shrink towards the best vertex, in order; a vertex is only replaced once evaluated.
         for k in 1..=n {
             let j = self.order[k];

@@ -1,7 +1,9 @@
 //! `gyro-cli calibrate`: fit the error model on bench runs and write a model file.
 
 use anyhow::{Context, Result};
-use gyro_analysis::calibrate::{calibrate, BenchRun, CalibrateOptions, ChoiceReason, Objective};
+use gyro_analysis::calibrate::{
+    calibrate, BenchRun, CalibrateOptions, Calibration, ChoiceReason, Objective,
+};
 use gyro_analysis::model;
 use gyro_analysis::replay::{config_for_rate, lowered_rate_note};
 use gyro_core::Config;
@@ -86,20 +88,7 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let train = load_runs(&args.logs, args)?;
     let holdout = load_runs(&args.holdout, args)?;
-    for run in train.iter().chain(&holdout) {
-        let (placed, lowered) = config_for_rate(&base.config, run.log.sample_rate_hz);
-        if let Some(configured_hz) = lowered {
-            super::warn(&format!(
-                "{}: {}; the written model keeps the configured rates",
-                run.name,
-                lowered_rate_note(
-                    run.log.sample_rate_hz,
-                    configured_hz,
-                    placed.filter.cutoff_hz
-                )
-            ));
-        }
-    }
+    warn_lowered_rates(&base, train.iter().chain(&holdout));
     let bar = ProgressBar::new_spinner();
     bar.set_style(
         ProgressStyle::with_template("{spinner} {elapsed} {msg}")
@@ -133,18 +122,53 @@ pub fn run(args: &Args) -> Result<()> {
         say!("{}: {note}", args.out.display());
     }
     model::save(&args.out, &out).with_context(|| "writing the model file".to_string())?;
+    report(args, &train, &holdout, &result)?;
+    if let Some(path) = &args.plot {
+        gyro_report::plot::calibrate_plot(path, &result)?;
+        say!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// Warn of each run whose sample rate lowers the configured filter rates (the model
+/// written keeps them).
+fn warn_lowered_rates<'a>(base: &model::ModelFile, runs: impl Iterator<Item = &'a BenchRun>) {
+    for run in runs {
+        let (placed, lowered) = config_for_rate(&base.config, run.log.sample_rate_hz);
+        if let Some(configured_hz) = lowered {
+            super::warn(&format!(
+                "{}: {}; the written model keeps the configured rates",
+                run.name,
+                lowered_rate_note(
+                    run.log.sample_rate_hz,
+                    configured_hz,
+                    placed.filter.cutoff_hz
+                )
+            ));
+        }
+    }
+}
+
+/// The calibration's report on stdout (with what was read of each run), then on stderr
+/// which model was written.
+fn report(
+    args: &Args,
+    train: &[BenchRun],
+    holdout: &[BenchRun],
+    result: &Calibration,
+) -> Result<()> {
     let inputs: Vec<_> = train
         .iter()
-        .chain(&holdout)
+        .chain(holdout)
         .map(|run| gyro_report::input::InputJson {
             file: &run.name,
             input: &run.log.quality,
         })
         .collect();
     let text = match args.format {
-        super::run::Format::Json => gyro_report::calibrate::json(&inputs, &result)? + "\n",
+        super::run::Format::Json => gyro_report::calibrate::json(&inputs, result)? + "\n",
         _ => gyro_report::calibrate::table_with_inputs(
-            &result,
+            result,
             &gyro_report::input::tables(inputs.iter().map(|i| (i.file, i.input))),
         ),
     };
@@ -152,14 +176,10 @@ pub fn run(args: &Args) -> Result<()> {
     say!(
         "wrote {}: {}",
         args.out.display(),
-        gyro_report::calibrate::choice_text(&result)
+        gyro_report::calibrate::choice_text(result)
     );
     if result.choice.reason == ChoiceReason::NoRefits && args.no_leave_one_out {
         say!("drop --no-leave-one-out to let calibrate write a fitted model");
-    }
-    if let Some(path) = &args.plot {
-        gyro_report::plot::calibrate_plot(path, &result)?;
-        say!("wrote {}", path.display());
     }
     Ok(())
 }

@@ -130,42 +130,11 @@ fn load_error(e: LoadError) -> anyhow::Error {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
-    if args.self_test && args.noise_yaml.noise_yaml.is_some() {
-        bail!("--noise-yaml writes the noise of diagnosed logs, not of --self-test");
-    }
-    let report_files = args.report.iter().flat_map(|dir| {
-        gyro_report::diagnose::REPORT_FILES
-            .iter()
-            .map(|name| dir.join(name))
-    });
-    let outputs: Vec<PathBuf> = args
-        .out
-        .iter()
-        .chain(&args.noise_yaml.noise_yaml)
-        .cloned()
-        .chain(report_files)
-        .collect();
-    let inputs = args.train.iter().chain(&args.holdout).map(PathBuf::as_path);
-    args.force.check(
-        outputs.iter().map(PathBuf::as_path),
-        inputs.chain(args.model.as_deref()),
-    )?;
+    check_outputs(args)?;
     if args.self_test {
         return self_test(args);
     }
-    let mut options = Options {
-        seed: args.seed,
-        members: args.members,
-        candidate_members: args.candidate_members,
-        score_every_candidate: args.score_every_candidate,
-        ..Options::default()
-    };
-    if args.members < 2 || args.candidate_members < 2 {
-        bail!("--members and --candidate-members must be at least 2");
-    }
-    if let Some(path) = &args.model {
-        options = options.with_fixed_model(model::load(path)?);
-    }
+    let options = diagnose_options(args)?;
     let FileRuns {
         train,
         holdout,
@@ -199,34 +168,89 @@ pub fn run(args: &Args) -> Result<()> {
         write_noise_yaml(out, args, &result)?;
     }
     if let Some(out) = &args.out {
-        let mut file = result
-            .corrected_model
-            .clone()
-            .unwrap_or_else(|| options.base_model.clone());
-        let largest = model::largest_plausible_abs_rate(
-            train
-                .iter()
-                .chain(&holdout)
-                .map(|r| r.features.max_abs_rate_dps),
-            options.base_model.config.max_abs_rate_dps,
-        );
-        if let Some(note) = file.drop_contradicted_range(largest) {
-            say!("{}: {note}", out.display());
-        }
-        model::save(out, &file)?;
-        say!(
-            "wrote {} ({})",
-            out.display(),
-            match &result.compensation {
-                Some(c) if !c.corrected.is_empty() =>
-                    format!("corrections for {}", c.corrected.join(", ")),
-                Some(_) =>
-                    "no correction lowered the held-out angle error: the base model unchanged"
-                        .into(),
-                None => "no correctable effect selected: the base model unchanged".into(),
-            }
-        );
+        write_model(out, &result, &train, &holdout, &options)?;
     }
+    Ok(())
+}
+
+/// Refuse outputs that cannot be written: `--noise-yaml` with `--self-test`, and files
+/// that would overwrite without `--force` (or an input).
+fn check_outputs(args: &Args) -> Result<()> {
+    if args.self_test && args.noise_yaml.noise_yaml.is_some() {
+        bail!("--noise-yaml writes the noise of diagnosed logs, not of --self-test");
+    }
+    let report_files = args.report.iter().flat_map(|dir| {
+        gyro_report::diagnose::REPORT_FILES
+            .iter()
+            .map(|name| dir.join(name))
+    });
+    let outputs: Vec<PathBuf> = args
+        .out
+        .iter()
+        .chain(&args.noise_yaml.noise_yaml)
+        .cloned()
+        .chain(report_files)
+        .collect();
+    let inputs = args.train.iter().chain(&args.holdout).map(PathBuf::as_path);
+    args.force.check(
+        outputs.iter().map(PathBuf::as_path),
+        inputs.chain(args.model.as_deref()),
+    )?;
+    Ok(())
+}
+
+/// The diagnosis options from the arguments (a model file fixes the base model).
+fn diagnose_options(args: &Args) -> Result<Options> {
+    let mut options = Options {
+        seed: args.seed,
+        members: args.members,
+        candidate_members: args.candidate_members,
+        score_every_candidate: args.score_every_candidate,
+        ..Options::default()
+    };
+    if args.members < 2 || args.candidate_members < 2 {
+        bail!("--members and --candidate-members must be at least 2");
+    }
+    if let Some(path) = &args.model {
+        options = options.with_fixed_model(model::load(path)?);
+    }
+    Ok(options)
+}
+
+/// `--out`: write the corrected model (else the base model), and say what it corrects.
+fn write_model(
+    out: &Path,
+    result: &Diagnosis,
+    train: &[RealRun],
+    holdout: &[RealRun],
+    options: &Options,
+) -> Result<()> {
+    let mut file = result
+        .corrected_model
+        .clone()
+        .unwrap_or_else(|| options.base_model.clone());
+    let largest = model::largest_plausible_abs_rate(
+        train
+            .iter()
+            .chain(holdout)
+            .map(|r| r.features.max_abs_rate_dps),
+        options.base_model.config.max_abs_rate_dps,
+    );
+    if let Some(note) = file.drop_contradicted_range(largest) {
+        say!("{}: {note}", out.display());
+    }
+    model::save(out, &file)?;
+    say!(
+        "wrote {} ({})",
+        out.display(),
+        match &result.compensation {
+            Some(c) if !c.corrected.is_empty() =>
+                format!("corrections for {}", c.corrected.join(", ")),
+            Some(_) =>
+                "no correction lowered the held-out angle error: the base model unchanged".into(),
+            None => "no correctable effect selected: the base model unchanged".into(),
+        }
+    );
     Ok(())
 }
 

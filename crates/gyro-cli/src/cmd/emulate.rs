@@ -149,6 +149,18 @@ pub fn run(args: &Args) -> Result<()> {
     if unread > 0 {
         say!("warning: {unread} bytes were still unread when the port was closed");
     }
+    say_sent(&report, emulator.source_gaps());
+    if let Some(path) = &args.fault_log {
+        super::output::write(path, |out| {
+            serde_json::to_writer_pretty(&mut *out, &report)?;
+            writeln!(out)
+        })?;
+    }
+    Ok(())
+}
+
+/// Say what was sent: frames, time, bytes, and each fault counted.
+fn say_sent(report: &bridge::EmulatorReport, source_gaps: u64) {
     say!(
         "sent {} frames in {:.1} s ({} bytes){}: intact {}, dropped {}, byte loss {}, bit flips {}, bad checksums {}, status faults {}, stalls {} ({} ms), clipped {}, source gaps {}",
         report.frames,
@@ -164,15 +176,8 @@ pub fn run(args: &Args) -> Result<()> {
         report.stalls,
         report.stall_ms,
         report.clipped,
-        emulator.source_gaps(),
+        source_gaps,
     );
-    if let Some(path) = &args.fault_log {
-        super::output::write(path, |out| {
-            serde_json::to_writer_pretty(&mut *out, &report)?;
-            writeln!(out)
-        })?;
-    }
-    Ok(())
 }
 
 /// Waits until the bytes written are read (a pseudo-terminal's other end: its input

@@ -154,6 +154,53 @@ fn refuse_unused_inputs(input: &log::LogOptions) -> Result<()> {
 
 /// Run the command.
 pub fn run(args: &Args) -> Result<()> {
+    check_args(args)?;
+    let base = match &args.model {
+        Some(path) => Some(model::load(path)?),
+        None => None,
+    };
+    let config = base
+        .as_ref()
+        .map_or_else(gyro_core::Config::default, |m| m.config);
+    let options = noise_options(args);
+
+    let loaded = args
+        .logs
+        .iter()
+        .map(|path| load(path, args, &config))
+        .collect::<Result<Vec<_>>>()?;
+    let run = noise::characterize_logs(&loaded, &options)?;
+    if run.rates_differ {
+        say!("note: the logs differ in sample rate; no pooled result");
+    }
+
+    if let Some(out) = &args.model_out {
+        write_model_out(out, base, &loaded, &run)?;
+    }
+    if let Some(out) = &args.noise_yaml.noise_yaml {
+        write_noise_yaml(out, args, &loaded, &run)?;
+    }
+    if let Some(out) = &args.psd_out {
+        write_psd(out, &loaded, &run)?;
+    }
+    if let Some(path) = &args.plot {
+        plot(path, &loaded, &run)?;
+    }
+
+    let text = match args.format {
+        Format::Table => gyro_report::noise::tables(&loaded, &run),
+        Format::Json => {
+            let model_out = args.model_out.as_ref().map(|p| p.display().to_string());
+            gyro_report::noise::json(&loaded, &run, args.static_only, model_out.as_deref())? + "\n"
+        }
+    };
+    super::to_stdout(|out| out.write_all(text.as_bytes()))?;
+    Ok(())
+}
+
+/// Refuse arguments that cannot work (outputs that would overwrite, unused inputs, values
+/// out of range) before any log is read.
+fn check_args(args: &Args) -> Result<()> {
     refuse_unused_inputs(&args.input)?;
     let outputs = [
         &args.model_out,
@@ -180,14 +227,13 @@ pub fn run(args: &Args) -> Result<()> {
             bail!("--psd-segment must be a power of two >= 2");
         }
     }
-    let base = match &args.model {
-        Some(path) => Some(model::load(path)?),
-        None => None,
-    };
-    let config = base
-        .as_ref()
-        .map_or_else(gyro_core::Config::default, |m| m.config);
-    let options = NoiseOptions {
+    Ok(())
+}
+
+/// The characterisation's options from the arguments: averaging times, confidence, PSD
+/// segment.
+fn noise_options(args: &Args) -> NoiseOptions {
+    NoiseOptions {
         taus: match args.tau_grid {
             Grid::Log => TauGrid::PerDecade(args.per_decade.max(1)),
             Grid::Octave => TauGrid::Octave,
@@ -199,107 +245,106 @@ pub fn run(args: &Args) -> Result<()> {
             ..PsdOptions::default()
         },
         ..NoiseOptions::default()
+    }
+}
+
+/// `--model-out`: write the model file whose sensor comes from the fit (`base`'s, if
+/// given, with its sensor replaced but its range kept), and say what it holds.
+fn write_model_out(
+    out: &Path,
+    base: Option<model::ModelFile>,
+    loaded: &[NoiseLog],
+    run: &noise::NoiseRun,
+) -> Result<()> {
+    let Some(source) = run.single() else {
+        bail!("--model-out needs one log, or logs of one sample rate to pool")
     };
-
-    let loaded = args
-        .logs
-        .iter()
-        .map(|path| load(path, args, &config))
-        .collect::<Result<Vec<_>>>()?;
-    let run = noise::characterize_logs(&loaded, &options)?;
-    if run.rates_differ {
-        say!("note: the logs differ in sample rate; no pooled result");
-    }
-
-    if let Some(out) = &args.model_out {
-        let Some(source) = run.single() else {
-            bail!("--model-out needs one log, or logs of one sample rate to pool")
-        };
-        let mut file = match base {
-            Some(base) => model::ModelFile {
-                sensor: gyro_sim::SensorModel {
-                    range_dps: base.sensor.range_dps,
-                    ..source.sensor_model()
-                },
-                ..base
+    let mut file = match base {
+        Some(base) => model::ModelFile {
+            sensor: gyro_sim::SensorModel {
+                range_dps: base.sensor.range_dps,
+                ..source.sensor_model()
             },
-            None => source.model_file(),
-        };
-        let largest = model::largest_plausible_abs_rate(
-            loaded.iter().flat_map(|l| l.rate_dps.iter().copied()),
-            file.config.max_abs_rate_dps,
-        );
-        if let Some(note) = file.drop_contradicted_range(largest) {
-            say!("{}: {note}", out.display());
-        }
-        model::save(out, &file)?;
-        let s = &file.sensor;
-        say!(
-            "wrote {}: sensor at {} Hz, bias {:.5} deg/s, ARW {:.4} deg/√h, Gauss-Markov σ {:.4e} deg/s T {:.4} s, step {} deg/s",
-            out.display(),
-            s.sample_rate_hz,
-            s.bias_dps,
-            s.arw_deg_per_rt_h,
-            s.gm_sigma_dps,
-            s.gm_tau_s,
-            s.lsb_dps
-        );
-    }
-
-    if let Some(out) = &args.noise_yaml.noise_yaml {
-        let Some(fitted) = run.single() else {
-            bail!("--noise-yaml needs one log, or logs of one sample rate to pool")
-        };
-        let files: Vec<&str> = loaded.iter().map(|l| l.file.as_str()).collect();
-        let source = format!(
-            "static Allan deviation (gyro-cli noise) of {}{}",
-            match files.as_slice() {
-                [one] => one.to_string(),
-                all => format!("{} logs pooled: {}", all.len(), all.join(", ")),
-            },
-            if args.static_only {
-                ", rest stretches only (--static-only)".to_string()
-            } else {
-                loaded
-                    .iter()
-                    .filter_map(noise::moving_warning)
-                    .map(|w| format!("; warning: {w}"))
-                    .collect()
-            }
-        );
-        let params = noise::NoiseParams::from_allan(fitted, source)?;
-        args.noise_yaml.write(out, &params)?;
-    }
-
-    if let Some(out) = &args.psd_out {
-        super::output::write(out, |w| {
-            writeln!(w, "log,frequency_hz,psd_dps2_per_hz")?;
-            for (l, r) in loaded.iter().zip(&run.results) {
-                gyro_report::noise::psd_csv(w, &l.file, r)?;
-            }
-            if let Some(c) = &run.combined {
-                gyro_report::noise::psd_csv(w, "combined", c)?;
-            }
-            Ok(())
-        })?;
-    }
-
-    if let Some(path) = &args.plot {
-        let (title, result) = match (&run.combined, loaded.as_slice(), run.results.as_slice()) {
-            (Some(c), ..) => (format!("all {} logs pooled", loaded.len()), c),
-            (None, [l, ..], [r, ..]) => (l.file.clone(), r),
-            _ => bail!("no result to plot"),
-        };
-        gyro_report::plot::noise_plot(path, &title, result)?;
-    }
-
-    let text = match args.format {
-        Format::Table => gyro_report::noise::tables(&loaded, &run),
-        Format::Json => {
-            let model_out = args.model_out.as_ref().map(|p| p.display().to_string());
-            gyro_report::noise::json(&loaded, &run, args.static_only, model_out.as_deref())? + "\n"
-        }
+            ..base
+        },
+        None => source.model_file(),
     };
-    super::to_stdout(|out| out.write_all(text.as_bytes()))?;
+    let largest = model::largest_plausible_abs_rate(
+        loaded.iter().flat_map(|l| l.rate_dps.iter().copied()),
+        file.config.max_abs_rate_dps,
+    );
+    if let Some(note) = file.drop_contradicted_range(largest) {
+        say!("{}: {note}", out.display());
+    }
+    model::save(out, &file)?;
+    let s = &file.sensor;
+    say!(
+        "wrote {}: sensor at {} Hz, bias {:.5} deg/s, ARW {:.4} deg/√h, Gauss-Markov σ {:.4e} deg/s T {:.4} s, step {} deg/s",
+        out.display(),
+        s.sample_rate_hz,
+        s.bias_dps,
+        s.arw_deg_per_rt_h,
+        s.gm_sigma_dps,
+        s.gm_tau_s,
+        s.lsb_dps
+    );
+    Ok(())
+}
+
+/// `--noise-yaml`: write the fitted noise parameters, with where they come from.
+fn write_noise_yaml(
+    out: &Path,
+    args: &Args,
+    loaded: &[NoiseLog],
+    run: &noise::NoiseRun,
+) -> Result<()> {
+    let Some(fitted) = run.single() else {
+        bail!("--noise-yaml needs one log, or logs of one sample rate to pool")
+    };
+    let files: Vec<&str> = loaded.iter().map(|l| l.file.as_str()).collect();
+    let source = format!(
+        "static Allan deviation (gyro-cli noise) of {}{}",
+        match files.as_slice() {
+            [one] => one.to_string(),
+            all => format!("{} logs pooled: {}", all.len(), all.join(", ")),
+        },
+        if args.static_only {
+            ", rest stretches only (--static-only)".to_string()
+        } else {
+            loaded
+                .iter()
+                .filter_map(noise::moving_warning)
+                .map(|w| format!("; warning: {w}"))
+                .collect()
+        }
+    );
+    let params = noise::NoiseParams::from_allan(fitted, source)?;
+    args.noise_yaml.write(out, &params)?;
+    Ok(())
+}
+
+/// `--psd-out`: write every log's PSD (and the pooled one) as CSV.
+fn write_psd(out: &Path, loaded: &[NoiseLog], run: &noise::NoiseRun) -> Result<()> {
+    super::output::write(out, |w| {
+        writeln!(w, "log,frequency_hz,psd_dps2_per_hz")?;
+        for (l, r) in loaded.iter().zip(&run.results) {
+            gyro_report::noise::psd_csv(w, &l.file, r)?;
+        }
+        if let Some(c) = &run.combined {
+            gyro_report::noise::psd_csv(w, "combined", c)?;
+        }
+        Ok(())
+    })?;
+    Ok(())
+}
+
+/// `--plot`: plot the pooled result, else the first log's.
+fn plot(path: &Path, loaded: &[NoiseLog], run: &noise::NoiseRun) -> Result<()> {
+    let (title, result) = match (&run.combined, loaded, run.results.as_slice()) {
+        (Some(c), ..) => (format!("all {} logs pooled", loaded.len()), c),
+        (None, [l, ..], [r, ..]) => (l.file.clone(), r),
+        _ => bail!("no result to plot"),
+    };
+    gyro_report::plot::noise_plot(path, &title, result)?;
     Ok(())
 }

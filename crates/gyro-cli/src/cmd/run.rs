@@ -113,30 +113,11 @@ pub fn run(args: &Args) -> Result<()> {
             .into_iter()
             .chain(args.model.as_deref()),
     )?;
-    let settings = replay::RunSettings {
-        model: args.model.clone(),
-        compensation: args.compensation.map(|c| match c {
-            CompensationArg::None => Compensation::None,
-            CompensationArg::Paper => Compensation::Paper,
-            CompensationArg::Kalman => Compensation::Kalman,
-        }),
-        range_dps: args.range_dps,
-        target_deg: args.target_deg,
-        tolerance_deg: args.tolerance_deg,
-        k_sigma: args.k_sigma,
-        tightening_direction: match args.tightening_direction {
-            DirectionArg::Positive => Direction::Positive,
-            DirectionArg::Negative => Direction::Negative,
-        },
-        scale_sigma: args.scale_sigma,
-        reference_delay_s: args.reference_delay_s,
-        offline: args.offline,
-    };
     let replay::Resolved {
         config,
         options,
         mode,
-    } = settings.resolve()?;
+    } = settings(args).resolve()?;
     // One pass: rows are read, placed on the grid and replayed as they come. The output
     // series is kept only for the plot, which needs it whole, or for an `--out` that is a
     // stream (`/dev/stdout`: written after the report, as the report may share it);
@@ -177,24 +158,7 @@ pub fn run(args: &Args) -> Result<()> {
     // comments, and stderr (the log's notices went there as they came).
     let findings = gyro_analysis::findings::of_run(&result, &notices);
     let file = args.log.display().to_string();
-    let json = match args.format {
-        Format::Json => Some(report::json(&file, &result, &findings)?),
-        _ => None,
-    };
-    super::to_stdout(|out| match args.format {
-        Format::Table => write!(out, "{}", report::table(&file, &result, &findings)),
-        Format::Json => writeln!(out, "{}", json.unwrap_or_default()),
-        Format::Csv => report::movements_csv(&mut &mut *out, &result.movements),
-    })?;
-    if args.format != Format::Table {
-        // The table carries them on stdout; for the JSON and the CSV, stderr says them too.
-        for f in findings
-            .iter()
-            .filter(|f| f.code != gyro_analysis::findings::LOG)
-        {
-            super::warn(&f.message);
-        }
-    }
+    report_run(args, &file, &result, &findings)?;
     if let Some(out) = &args.out {
         match series_file {
             Some(file) => file
@@ -209,6 +173,58 @@ pub fn run(args: &Args) -> Result<()> {
             .file_name()
             .map_or(file.clone(), |n| n.to_string_lossy().into());
         gyro_report::plot::run_plot(path, &name, &result)?;
+    }
+    Ok(())
+}
+
+/// The replay's settings as the arguments give them (the model's fill in the rest).
+fn settings(args: &Args) -> replay::RunSettings {
+    replay::RunSettings {
+        model: args.model.clone(),
+        compensation: args.compensation.map(|c| match c {
+            CompensationArg::None => Compensation::None,
+            CompensationArg::Paper => Compensation::Paper,
+            CompensationArg::Kalman => Compensation::Kalman,
+        }),
+        range_dps: args.range_dps,
+        target_deg: args.target_deg,
+        tolerance_deg: args.tolerance_deg,
+        k_sigma: args.k_sigma,
+        tightening_direction: match args.tightening_direction {
+            DirectionArg::Positive => Direction::Positive,
+            DirectionArg::Negative => Direction::Negative,
+        },
+        scale_sigma: args.scale_sigma,
+        reference_delay_s: args.reference_delay_s,
+        offline: args.offline,
+    }
+}
+
+/// The report of the run of `file` on stdout in the chosen format; for the JSON and the
+/// CSV, the findings on stderr too.
+fn report_run(
+    args: &Args,
+    file: &str,
+    result: &replay::RunReport,
+    findings: &[Finding],
+) -> Result<()> {
+    let json = match args.format {
+        Format::Json => Some(report::json(file, result, findings)?),
+        _ => None,
+    };
+    super::to_stdout(|out| match args.format {
+        Format::Table => write!(out, "{}", report::table(file, result, findings)),
+        Format::Json => writeln!(out, "{}", json.unwrap_or_default()),
+        Format::Csv => report::movements_csv(&mut &mut *out, &result.movements),
+    })?;
+    if args.format != Format::Table {
+        // The table carries them on stdout; for the JSON and the CSV, stderr says them too.
+        for f in findings
+            .iter()
+            .filter(|f| f.code != gyro_analysis::findings::LOG)
+        {
+            super::warn(&f.message);
+        }
     }
     Ok(())
 }

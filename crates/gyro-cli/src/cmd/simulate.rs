@@ -7,7 +7,7 @@ use gyro_log as log;
 use gyro_log::value;
 use gyro_sim::{self as sim, BenchProfile, Effect, Motion, SensorModel, SimOptions};
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -116,83 +116,15 @@ pub fn run(args: &Args) -> Result<()> {
     // MCAP for a `.mcap` name, else CSV (the format the command always wrote).
     let format = log::LogFormat::from_extension(out).unwrap_or(log::LogFormat::Csv);
     let compression = args.compression.for_output(out, format)?;
-    let mut sensor = match &args.model {
-        Some(path) => model::load(path)?.sensor,
-        None => SensorModel::default(),
-    };
-    if let Some(rate) = args.sample_rate_hz {
-        sensor.sample_rate_hz = rate;
-    }
-    sensor.validate()?;
+    let sensor = sensor_model(args)?;
     let effects = args
         .effects
         .iter()
         .map(|spec| Effect::parse(spec).map_err(anyhow::Error::from))
         .collect::<Result<Vec<_>>>()?;
     let motion = match &args.motion_from {
-        Some(path) => {
-            let regular = super::load(
-                path,
-                &log::LogOptions::default(),
-                &log::GridOptions::default(),
-            )?;
-            // What was read of it, as every command that reads a log shows it.
-            say_part!(
-                "{}",
-                gyro_report::input::tables([(
-                    path.display().to_string().as_str(),
-                    &regular.quality
-                )])
-            );
-            if !regular.has_reference {
-                anyhow::bail!(
-                    "{}: no reference_deg column to take the motion from",
-                    path.display()
-                );
-            }
-            let reference: Vec<f64> = regular
-                .slots
-                .iter()
-                .map(|s| s.reference_deg)
-                .collect::<Option<Vec<_>>>()
-                .with_context(|| {
-                    format!(
-                        "{}: the reference has gaps longer than 0.5 s",
-                        path.display()
-                    )
-                })?;
-            // A log of a row or two gives a motion of no length: said, as `run` says it
-            // of such a log (finding `short_log`), not written as if it were a run.
-            let span_s = reference.len().saturating_sub(1) as f64 / regular.sample_rate_hz;
-            if span_s < gyro_analysis::findings::SHORT_LOG_S {
-                super::warn(&format!(
-                    "{}: its reference spans {span_s:.3} s ({} samples), under {} s: the simulated log is as short, too short for any figure; give a log of at least a few seconds",
-                    path.display(),
-                    reference.len(),
-                    gyro_analysis::findings::SHORT_LOG_S
-                ));
-            }
-            // As `diagnose` re-simulates a run: smoothed when the reference is an
-            // encoder's, one-sided beside a step of the acceleration.
-            gyro_diagnose::motion_from_reference(&reference, regular.sample_rate_hz).0
-        }
-        None => {
-            if !(args.duration_s > 0.0 && args.duration_s <= 86_400.0) {
-                anyhow::bail!("--duration-s must be in (0, 86400]");
-            }
-            if args.at_rest {
-                // No rotation at all: the angle and the rate are 0 throughout.
-                Motion::from_rotations(Vec::new(), args.duration_s)
-            } else {
-                Motion::bench(
-                    &BenchProfile {
-                        duration_s: args.duration_s,
-                        ..BenchProfile::default()
-                    },
-                    args.seed,
-                )
-            }
-        }
+        Some(path) => motion_from_log(path)?,
+        None => generated_motion(args)?,
     };
     let options = SimOptions {
         seed: args.seed,
@@ -209,6 +141,97 @@ pub fn run(args: &Args) -> Result<()> {
     })?;
     let log = sim::simulate(&sensor, &effects, &motion, &options);
     log::write_log_with(out, &log, Some(format), compression)?;
+    say_written(args, out, &log, &motion, &sensor, &effects);
+    Ok(())
+}
+
+/// The sensor model: the model file's (or the default), at `--sample-rate-hz` if given,
+/// checked.
+fn sensor_model(args: &Args) -> Result<SensorModel> {
+    let mut sensor = match &args.model {
+        Some(path) => model::load(path)?.sensor,
+        None => SensorModel::default(),
+    };
+    if let Some(rate) = args.sample_rate_hz {
+        sensor.sample_rate_hz = rate;
+    }
+    sensor.validate()?;
+    Ok(sensor)
+}
+
+/// `--motion-from`: the motion of the log's reference angle, as `diagnose` takes it.
+fn motion_from_log(path: &Path) -> Result<Motion> {
+    let regular = super::load(
+        path,
+        &log::LogOptions::default(),
+        &log::GridOptions::default(),
+    )?;
+    // What was read of it, as every command that reads a log shows it.
+    say_part!(
+        "{}",
+        gyro_report::input::tables([(path.display().to_string().as_str(), &regular.quality)])
+    );
+    if !regular.has_reference {
+        anyhow::bail!(
+            "{}: no reference_deg column to take the motion from",
+            path.display()
+        );
+    }
+    let reference: Vec<f64> = regular
+        .slots
+        .iter()
+        .map(|s| s.reference_deg)
+        .collect::<Option<Vec<_>>>()
+        .with_context(|| {
+            format!(
+                "{}: the reference has gaps longer than 0.5 s",
+                path.display()
+            )
+        })?;
+    // A log of a row or two gives a motion of no length: said, as `run` says it
+    // of such a log (finding `short_log`), not written as if it were a run.
+    let span_s = reference.len().saturating_sub(1) as f64 / regular.sample_rate_hz;
+    if span_s < gyro_analysis::findings::SHORT_LOG_S {
+        super::warn(&format!(
+            "{}: its reference spans {span_s:.3} s ({} samples), under {} s: the simulated log is as short, too short for any figure; give a log of at least a few seconds",
+            path.display(),
+            reference.len(),
+            gyro_analysis::findings::SHORT_LOG_S
+        ));
+    }
+    // As `diagnose` re-simulates a run: smoothed when the reference is an
+    // encoder's, one-sided beside a step of the acceleration.
+    Ok(gyro_diagnose::motion_from_reference(&reference, regular.sample_rate_hz).0)
+}
+
+/// The motion made up for `--duration-s`: at rest with `--static`, else bench-like.
+fn generated_motion(args: &Args) -> Result<Motion> {
+    if !(args.duration_s > 0.0 && args.duration_s <= 86_400.0) {
+        anyhow::bail!("--duration-s must be in (0, 86400]");
+    }
+    Ok(if args.at_rest {
+        // No rotation at all: the angle and the rate are 0 throughout.
+        Motion::from_rotations(Vec::new(), args.duration_s)
+    } else {
+        Motion::bench(
+            &BenchProfile {
+                duration_s: args.duration_s,
+                ..BenchProfile::default()
+            },
+            args.seed,
+        )
+    })
+}
+
+/// Say what was written to `out`: samples, duration, rate, motion and effects.
+fn say_written(
+    args: &Args,
+    out: &Path,
+    log: &log::Log,
+    motion: &Motion,
+    sensor: &SensorModel,
+    effects: &[Effect],
+) {
     say!(
         "wrote {} samples ({:.1} s at {} Hz, {}, effects: {}) to {}",
         log.rows.len(),
@@ -233,5 +256,4 @@ pub fn run(args: &Args) -> Result<()> {
         },
         out.display()
     );
-    Ok(())
 }

@@ -95,70 +95,7 @@ pub(super) fn scan(file: &mut File) -> io::Result<Layout> {
         });
         return Ok(layout);
     }
-    let mut offset = MAGIC.len() as u64;
-    let mut footer = false;
-    let mut head = [0_u8; RECORD_HEADER_LEN as usize + 16];
-    while offset < len {
-        let got = read_some_at(file, offset, &mut head)?;
-        let fail = |what: String, cut: bool| Damage { offset, what, cut };
-        if got < RECORD_HEADER_LEN as usize {
-            layout.damage = Some(fail("the file ends inside a record header".into(), true));
-            break;
-        }
-        let opcode = head[0];
-        let body_len = u64::from_le_bytes(le8(&head[1..9]));
-        if body_len > RECORD_LENGTH_LIMIT {
-            layout.damage = Some(fail(
-                if body_len == u64::MAX {
-                    format!("a record (opcode {opcode:#04x}) whose length was never written: an unfinished chunk")
-                } else {
-                    format!("a record (opcode {opcode:#04x}) claims {body_len} bytes: corrupt")
-                },
-                false,
-            ));
-            break;
-        }
-        let record_len = RECORD_HEADER_LEN + body_len;
-        if offset + record_len > len {
-            layout.damage = Some(fail(
-                format!("the file ends inside a record (opcode {opcode:#04x}, {record_len} bytes)"),
-                true,
-            ));
-            break;
-        }
-        let body = &head[RECORD_HEADER_LEN as usize..got];
-        match opcode {
-            op::HEADER => layout.saw_header = true,
-            op::FOOTER => {
-                footer = true;
-                break;
-            }
-            op::CHUNK | op::MESSAGE => {
-                let chunk = opcode == op::CHUNK;
-                let start = if chunk { 0..8 } else { 6..MESSAGE_TIME_END };
-                if (body_len as usize) < start.end {
-                    layout.damage = Some(fail(
-                        format!("a record (opcode {opcode:#04x}) too short to be read"),
-                        false,
-                    ));
-                    break;
-                }
-                layout.units.push(Unit {
-                    offset,
-                    len: record_len,
-                    start_ns: u64::from_le_bytes(le8(&body[start])),
-                    chunk,
-                });
-            }
-            op::SCHEMA | op::CHANNEL | op::METADATA => {
-                let mut body = vec![0_u8; body_len as usize];
-                read_at(file, offset + RECORD_HEADER_LEN, &mut body)?;
-                layout.definitions.push(Definition { opcode, body });
-            }
-            _ => {}
-        }
-        offset += record_len;
-    }
+    let (offset, footer) = walk_records(file, &mut layout)?;
     if layout.damage.is_none() && !layout.finished {
         // Cut at a record boundary, or inside the closing magic.
         layout.damage = Some(Damage {
@@ -174,6 +111,104 @@ pub(super) fn scan(file: &mut File) -> io::Result<Layout> {
     // Stable: units with one start time keep their file order.
     layout.units.sort_by_key(|u| u.start_ns);
     Ok(layout)
+}
+
+/// Walk the records after the opening magic into `layout` (units, definitions, the header,
+/// the damage met) up to the footer, damage or the end of the file: where it stopped, and
+/// whether at the footer.
+fn walk_records(file: &mut File, layout: &mut Layout) -> io::Result<(u64, bool)> {
+    let len = layout.len;
+    let mut offset = MAGIC.len() as u64;
+    let mut footer = false;
+    let mut head = [0_u8; RECORD_HEADER_LEN as usize + 16];
+    while offset < len {
+        let got = read_some_at(file, offset, &mut head)?;
+        let (opcode, body_len, record_len) = match record_header(&head[..got], offset, len) {
+            Ok(header) => header,
+            Err(damage) => {
+                layout.damage = Some(damage);
+                break;
+            }
+        };
+        let body = &head[RECORD_HEADER_LEN as usize..got];
+        match opcode {
+            op::HEADER => layout.saw_header = true,
+            op::FOOTER => {
+                footer = true;
+                break;
+            }
+            op::CHUNK | op::MESSAGE => match unit(opcode, body, body_len, offset, record_len) {
+                Ok(unit) => layout.units.push(unit),
+                Err(damage) => {
+                    layout.damage = Some(damage);
+                    break;
+                }
+            },
+            op::SCHEMA | op::CHANNEL | op::METADATA => {
+                let mut body = vec![0_u8; body_len as usize];
+                read_at(file, offset + RECORD_HEADER_LEN, &mut body)?;
+                layout.definitions.push(Definition { opcode, body });
+            }
+            _ => {}
+        }
+        offset += record_len;
+    }
+    Ok((offset, footer))
+}
+
+/// The record at `offset` from the bytes read of it (`head`), in a file of `len` bytes:
+/// its opcode, body length and whole length, or the damage if it cannot be read.
+fn record_header(head: &[u8], offset: u64, len: u64) -> Result<(u8, u64, u64), Damage> {
+    let fail = |what: String, cut: bool| Damage { offset, what, cut };
+    if head.len() < RECORD_HEADER_LEN as usize {
+        return Err(fail("the file ends inside a record header".into(), true));
+    }
+    let opcode = head[0];
+    let body_len = u64::from_le_bytes(le8(&head[1..9]));
+    if body_len > RECORD_LENGTH_LIMIT {
+        return Err(fail(
+            if body_len == u64::MAX {
+                format!("a record (opcode {opcode:#04x}) whose length was never written: an unfinished chunk")
+            } else {
+                format!("a record (opcode {opcode:#04x}) claims {body_len} bytes: corrupt")
+            },
+            false,
+        ));
+    }
+    let record_len = RECORD_HEADER_LEN + body_len;
+    if offset + record_len > len {
+        return Err(fail(
+            format!("the file ends inside a record (opcode {opcode:#04x}, {record_len} bytes)"),
+            true,
+        ));
+    }
+    Ok((opcode, body_len, record_len))
+}
+
+/// The unit of a chunk or message record at `offset` (`body`: its body's first bytes),
+/// or the damage if it is too short to hold its start time.
+fn unit(
+    opcode: u8,
+    body: &[u8],
+    body_len: u64,
+    offset: u64,
+    record_len: u64,
+) -> Result<Unit, Damage> {
+    let chunk = opcode == op::CHUNK;
+    let start = if chunk { 0..8 } else { 6..MESSAGE_TIME_END };
+    if (body_len as usize) < start.end {
+        return Err(Damage {
+            offset,
+            what: format!("a record (opcode {opcode:#04x}) too short to be read"),
+            cut: false,
+        });
+    }
+    Ok(Unit {
+        offset,
+        len: record_len,
+        start_ns: u64::from_le_bytes(le8(&body[start])),
+        chunk,
+    })
 }
 
 fn le8(bytes: &[u8]) -> [u8; 8] {

@@ -752,12 +752,8 @@ impl State {
         }
         channel.count += 1;
         let index = channel.count;
-        let fail = |message: String| LogError::McapMessage {
-            path: self.path.to_path_buf(),
-            channel: channel.topic.clone(),
-            index,
-            message,
-        };
+        let channel: &ChannelInfo = channel;
+        let fail = message_error(&self.path, channel, index);
         match channel.kind {
             Kind::Ignored => {}
             Kind::ReferenceCdr => {
@@ -772,65 +768,28 @@ impl State {
                     .reference(header.log_time, angle.filter(|a| a.is_finite()));
             }
             Kind::GyroCdr { .. } | Kind::GyroJson | Kind::Imu => {
-                match &self.rate_channel {
-                    None => {
-                        self.rate_channel = Some((
-                            header.channel_id,
-                            channel.topic.clone(),
-                            channel.kind.clone(),
-                        ));
-                        if channel.kind == Kind::Imu
-                            && self.options.time_source == TimeSource::Header
-                        {
-                            self.attacher.rows_not_at_log_time();
-                        }
-                    }
-                    Some((_, topic, _)) if *topic == channel.topic => {}
-                    Some((_, topic, _)) => {
-                        return Err(LogError::McapSecondRate {
-                            path: self.path.to_path_buf(),
-                            channel: channel.topic.clone(),
-                            first: topic.clone(),
-                        })
-                    }
+                let first = claim_rate_channel(
+                    &mut self.rate_channel,
+                    header.channel_id,
+                    channel,
+                    &self.path,
+                )?;
+                if first
+                    && channel.kind == Kind::Imu
+                    && self.options.time_source == TimeSource::Header
+                {
+                    self.attacher.rows_not_at_log_time();
                 }
-                let (time_ns, rate_dps, temperature_c) = if channel.kind == Kind::Imu {
-                    let sample =
-                        decode_imu(data, self.options.axis, self.options.flip).map_err(fail)?;
-                    let time_ns = match self.options.time_source {
-                        TimeSource::LogTime => header.log_time,
-                        TimeSource::Header => {
-                            sample.stamp_ns.ok_or_else(|| LogError::McapZeroStamp {
-                                path: self.path.to_path_buf(),
-                                channel: channel.topic.clone(),
-                                index,
-                            })?
-                        }
-                    };
-                    (time_ns, sample.rate_dps, None)
-                } else if let Kind::GyroCdr { temperature } = channel.kind {
-                    let sample = binary::decode_sample(data).map_err(fail)?;
-                    self.has_temperature |= temperature;
-                    (header.log_time, sample.rate_dps, sample.temperature_c)
-                } else {
-                    let message = json::gyro(data)
-                        .map_err(|e| fail(format!("not a gyro JSON message: {e}")))?;
-                    let rate = message
-                        .rate_dps
-                        .ok_or_else(|| fail("no `rate_dps` field".into()))?;
-                    if message.temperature_c.is_some() {
-                        self.has_temperature = true;
-                    }
-                    (header.log_time, rate, message.temperature_c.flatten())
-                };
+                let sample = decode_rate(channel, header, data, &self.options, &self.path, index)?;
+                self.has_temperature |= sample.has_temperature;
                 let row = Row {
                     line: index,
                     time_s: 0.0, // from `time_ns` when the row is given
-                    rate_dps: rate_dps.filter(|r| r.is_finite()),
+                    rate_dps: sample.rate_dps.filter(|r| r.is_finite()),
                     reference_deg: None,
-                    temperature_c: temperature_c.filter(|t| t.is_finite()),
+                    temperature_c: sample.temperature_c.filter(|t| t.is_finite()),
                 };
-                self.attacher.row(time_ns, row);
+                self.attacher.row(sample.time_ns, row);
             }
         }
         Ok(())
@@ -873,6 +832,98 @@ impl State {
             message: format!("{what}{damage}; channels: {listed}"),
         }
     }
+}
+
+/// The error of message `index` of `channel` in the file at `path`, saying `message`.
+fn message_error<'a>(
+    path: &'a Path,
+    channel: &'a ChannelInfo,
+    index: u64,
+) -> impl Fn(String) -> LogError + 'a {
+    move |message: String| LogError::McapMessage {
+        path: path.to_path_buf(),
+        channel: channel.topic.clone(),
+        index,
+        message,
+    }
+}
+
+/// Take `channel` (id `channel_id`) as the rate channel if there is none yet (true), or
+/// check that it is the one taken (false); a second rate channel is an error.
+fn claim_rate_channel(
+    rate_channel: &mut Option<(u16, String, Kind)>,
+    channel_id: u16,
+    channel: &ChannelInfo,
+    path: &Path,
+) -> Result<bool, LogError> {
+    match rate_channel {
+        None => {
+            *rate_channel = Some((channel_id, channel.topic.clone(), channel.kind.clone()));
+            Ok(true)
+        }
+        Some((_, topic, _)) if *topic == channel.topic => Ok(false),
+        Some((_, topic, _)) => Err(LogError::McapSecondRate {
+            path: path.to_path_buf(),
+            channel: channel.topic.clone(),
+            first: topic.clone(),
+        }),
+    }
+}
+
+/// One message of the rate channel, decoded.
+struct RateSample {
+    time_ns: u64,
+    rate_dps: Option<f64>,
+    temperature_c: Option<f64>,
+    /// The message shows the log has a temperature column.
+    has_temperature: bool,
+}
+
+/// Decode message `index` (`data`, stamped `header`) of the rate channel `channel`, as
+/// its kind says, its time from the log time or (for an Imu message, as `options` say)
+/// its header stamp.
+fn decode_rate(
+    channel: &ChannelInfo,
+    header: &mcap::records::MessageHeader,
+    data: &[u8],
+    options: &McapOptions,
+    path: &Path,
+    index: u64,
+) -> Result<RateSample, LogError> {
+    let fail = message_error(path, channel, index);
+    let mut has_temperature = false;
+    let (time_ns, rate_dps, temperature_c) = if channel.kind == Kind::Imu {
+        let sample = decode_imu(data, options.axis, options.flip).map_err(fail)?;
+        let time_ns = match options.time_source {
+            TimeSource::LogTime => header.log_time,
+            TimeSource::Header => sample.stamp_ns.ok_or_else(|| LogError::McapZeroStamp {
+                path: path.to_path_buf(),
+                channel: channel.topic.clone(),
+                index,
+            })?,
+        };
+        (time_ns, sample.rate_dps, None)
+    } else if let Kind::GyroCdr { temperature } = channel.kind {
+        let sample = binary::decode_sample(data).map_err(fail)?;
+        has_temperature = temperature;
+        (header.log_time, sample.rate_dps, sample.temperature_c)
+    } else {
+        let message =
+            json::gyro(data).map_err(|e| fail(format!("not a gyro JSON message: {e}")))?;
+        let rate = message
+            .rate_dps
+            .ok_or_else(|| fail("no `rate_dps` field".into()))?;
+        if message.temperature_c.is_some() {
+            has_temperature = true;
+        }
+        (header.log_time, rate, message.temperature_c.flatten())
+    };
+    Ok(RateSample {
+        time_ns,
+        rate_dps,
+        temperature_c,
+        has_temperature,
+    })
 }
 
 /// Check a CDR channel's schema: `name` in `ros2msg`, declaring the fields the reader

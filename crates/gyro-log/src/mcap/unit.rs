@@ -117,122 +117,17 @@ impl Units {
     /// The chunk in `raw`, if compressed with lz4, zstd or not at all: decompressed into
     /// `batch.data`, CRC-checked, its records listed. `Ok(false)` for another compression.
     fn chunk(&mut self, offset: u64, batch: &mut Batch) -> Result<bool, UnitError> {
-        let damaged = |what: String| UnitError::Damaged { offset, what };
         let body = self
             .raw
             .get(RECORD_HEADER_LEN as usize..self.raw_len)
             .unwrap_or_default();
-        let u64_at = |i: usize| -> Option<u64> {
-            Some(u64::from_le_bytes(body.get(i..i + 8)?.try_into().ok()?))
+        let Some(chunk) = ChunkBody::parse(body, offset)? else {
+            return Ok(false);
         };
-        let u32_at = |i: usize| -> Option<u32> {
-            Some(u32::from_le_bytes(body.get(i..i + 4)?.try_into().ok()?))
-        };
-        let too_short = || damaged("a chunk too short for its header".into());
-        let uncompressed_size = u64_at(16).ok_or_else(too_short)?;
-        let crc = u32_at(24).ok_or_else(too_short)?;
-        let name_len = u32_at(28).ok_or_else(too_short)? as usize;
-        let name_end = CHUNK_FIXED_LEN
-            .checked_add(name_len)
-            .filter(|&end| end <= body.len())
-            .ok_or_else(too_short)?;
-        let compression = &body[CHUNK_FIXED_LEN..name_end];
-        let codec = match compression {
-            b"zstd" => Codec::Zstd,
-            b"lz4" => Codec::Lz4,
-            b"" => Codec::None,
-            _ => return Ok(false),
-        };
-        let compressed_size = u64_at(name_end).ok_or_else(too_short)?;
-        let data_start = name_end + 8;
-        let compressed = usize::try_from(compressed_size)
-            .ok()
-            .and_then(|size| body.get(data_start..data_start.checked_add(size)?))
-            .ok_or_else(|| {
-                damaged(format!(
-                    "a chunk whose compressed size ({compressed_size} bytes) exceeds the record"
-                ))
-            })?;
-        if uncompressed_size > RECORD_LENGTH_LIMIT {
-            return Err(damaged(format!(
-                "a chunk claims {uncompressed_size} uncompressed bytes: corrupt"
-            )));
-        }
         let start = batch.data.len();
-        let size = uncompressed_size as usize;
-        match codec {
-            Codec::Lz4 => {
-                batch.data.resize(start + size, 0);
-                let decoded = lz4::decompress_frame(compressed, &mut batch.data[start..]);
-                if let Err(what) = decoded {
-                    batch.data.truncate(start);
-                    return Err(damaged(format!(
-                        "the chunk does not decompress (lz4: {what})"
-                    )));
-                }
-            }
-            Codec::Zstd => {
-                batch.data.reserve(size);
-                let decompressor = match &mut self.zstd {
-                    Some(d) => d,
-                    empty => empty.insert(zstd::bulk::Decompressor::new().map_err(UnitError::Io)?),
-                };
-                let mut out = io::Cursor::new(&mut batch.data);
-                out.set_position(start as u64);
-                let wrote = decompressor
-                    .decompress_to_buffer(compressed, &mut out)
-                    .map_err(|e| damaged(format!("the chunk does not decompress (zstd: {e})")))?;
-                if wrote != size {
-                    batch.data.truncate(start);
-                    return Err(damaged(format!(
-                        "the chunk decompresses to {wrote} bytes, its header says {size}"
-                    )));
-                }
-            }
-            Codec::None => {
-                if compressed_size != uncompressed_size {
-                    return Err(damaged(format!(
-                    "an uncompressed chunk of {compressed_size} bytes whose header says {uncompressed_size}"
-                )));
-                }
-                batch.data.extend_from_slice(compressed);
-            }
-        }
-        let records = &batch.data[start..];
-        if crc != 0 {
-            let calculated = crc32fast::hash(records);
-            if calculated != crc {
-                batch.data.truncate(start);
-                return Err(damaged(format!(
-                    "chunk CRC mismatch (stored {crc:08x}, computed {calculated:08x})"
-                )));
-            }
-        }
-        let header_len = RECORD_HEADER_LEN as usize;
-        let end = batch.data.len();
-        let mut at = start;
-        while at < end {
-            let rest = &batch.data[at..end];
-            let Some(len) = rest
-                .get(1..header_len)
-                .and_then(|b| Some(u64::from_le_bytes(b.try_into().ok()?)))
-            else {
-                return Err(damaged("the chunk ends inside a record header".into()));
-            };
-            let opcode = rest[0];
-            let Some(record_end) = usize::try_from(len)
-                .ok()
-                .and_then(|len| len.checked_add(at + header_len))
-                .filter(|&e| e <= end)
-            else {
-                return Err(damaged(format!(
-                    "a record (opcode {opcode:#04x}) of {len} bytes overruns its chunk"
-                )));
-            };
-            let range = at + header_len..record_end;
-            batch.items.push((Item::Record { opcode, range }, offset));
-            at = record_end;
-        }
+        chunk.decompress(&mut self.zstd, &mut batch.data, offset)?;
+        check_crc(chunk.crc, &mut batch.data, start, offset)?;
+        list_records(batch, start, offset)?;
         Ok(true)
     }
 
@@ -282,6 +177,173 @@ impl Units {
             }
         }
     }
+}
+
+/// A chunk record's body, read as far as its compressed records.
+struct ChunkBody<'a> {
+    codec: Codec,
+    /// CRC of the uncompressed records (0: none stored).
+    crc: u32,
+    uncompressed_size: u64,
+    compressed_size: u64,
+    compressed: &'a [u8],
+}
+
+impl<'a> ChunkBody<'a> {
+    /// The chunk record `body` of the unit at `offset`; `None` for a compression other
+    /// than lz4, zstd or none, an error for a header that does not fit the record.
+    fn parse(body: &'a [u8], offset: u64) -> Result<Option<Self>, UnitError> {
+        let damaged = |what: String| UnitError::Damaged { offset, what };
+        let u64_at = |i: usize| -> Option<u64> {
+            Some(u64::from_le_bytes(body.get(i..i + 8)?.try_into().ok()?))
+        };
+        let u32_at = |i: usize| -> Option<u32> {
+            Some(u32::from_le_bytes(body.get(i..i + 4)?.try_into().ok()?))
+        };
+        let too_short = || damaged("a chunk too short for its header".into());
+        let uncompressed_size = u64_at(16).ok_or_else(too_short)?;
+        let crc = u32_at(24).ok_or_else(too_short)?;
+        let name_len = u32_at(28).ok_or_else(too_short)? as usize;
+        let name_end = CHUNK_FIXED_LEN
+            .checked_add(name_len)
+            .filter(|&end| end <= body.len())
+            .ok_or_else(too_short)?;
+        let compression = &body[CHUNK_FIXED_LEN..name_end];
+        let codec = match compression {
+            b"zstd" => Codec::Zstd,
+            b"lz4" => Codec::Lz4,
+            b"" => Codec::None,
+            _ => return Ok(None),
+        };
+        let compressed_size = u64_at(name_end).ok_or_else(too_short)?;
+        let data_start = name_end + 8;
+        let compressed = usize::try_from(compressed_size)
+            .ok()
+            .and_then(|size| body.get(data_start..data_start.checked_add(size)?))
+            .ok_or_else(|| {
+                damaged(format!(
+                    "a chunk whose compressed size ({compressed_size} bytes) exceeds the record"
+                ))
+            })?;
+        if uncompressed_size > RECORD_LENGTH_LIMIT {
+            return Err(damaged(format!(
+                "a chunk claims {uncompressed_size} uncompressed bytes: corrupt"
+            )));
+        }
+        Ok(Some(Self {
+            codec,
+            crc,
+            uncompressed_size,
+            compressed_size,
+            compressed,
+        }))
+    }
+
+    /// Decompress the records onto the end of `data` (`zstd`: the context, made at the
+    /// first use); on an error `data` is as it was (`offset`: the unit's, for the error).
+    fn decompress(
+        &self,
+        zstd: &mut Option<zstd::bulk::Decompressor<'static>>,
+        data: &mut Vec<u8>,
+        offset: u64,
+    ) -> Result<(), UnitError> {
+        let damaged = |what: String| UnitError::Damaged { offset, what };
+        let (compressed, compressed_size, uncompressed_size) = (
+            self.compressed,
+            self.compressed_size,
+            self.uncompressed_size,
+        );
+        let start = data.len();
+        let size = uncompressed_size as usize;
+        match self.codec {
+            Codec::Lz4 => {
+                data.resize(start + size, 0);
+                let decoded = lz4::decompress_frame(compressed, &mut data[start..]);
+                if let Err(what) = decoded {
+                    data.truncate(start);
+                    return Err(damaged(format!(
+                        "the chunk does not decompress (lz4: {what})"
+                    )));
+                }
+            }
+            Codec::Zstd => {
+                data.reserve(size);
+                let decompressor = match zstd {
+                    Some(d) => d,
+                    empty => empty.insert(zstd::bulk::Decompressor::new().map_err(UnitError::Io)?),
+                };
+                let mut out = io::Cursor::new(&mut *data);
+                out.set_position(start as u64);
+                let wrote = decompressor
+                    .decompress_to_buffer(compressed, &mut out)
+                    .map_err(|e| damaged(format!("the chunk does not decompress (zstd: {e})")))?;
+                if wrote != size {
+                    data.truncate(start);
+                    return Err(damaged(format!(
+                        "the chunk decompresses to {wrote} bytes, its header says {size}"
+                    )));
+                }
+            }
+            Codec::None => {
+                if compressed_size != uncompressed_size {
+                    return Err(damaged(format!(
+                    "an uncompressed chunk of {compressed_size} bytes whose header says {uncompressed_size}"
+                )));
+                }
+                data.extend_from_slice(compressed);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Check the records decompressed into `data[start..]` against the chunk's `crc` (0: none
+/// stored); on a mismatch they are dropped.
+fn check_crc(crc: u32, data: &mut Vec<u8>, start: usize, offset: u64) -> Result<(), UnitError> {
+    let records = &data[start..];
+    if crc != 0 {
+        let calculated = crc32fast::hash(records);
+        if calculated != crc {
+            data.truncate(start);
+            return Err(UnitError::Damaged {
+                offset,
+                what: format!("chunk CRC mismatch (stored {crc:08x}, computed {calculated:08x})"),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// List the records in `batch.data[start..]` (a chunk's, of the unit at `offset`) as
+/// the batch's items, each a range of that data.
+fn list_records(batch: &mut Batch, start: usize, offset: u64) -> Result<(), UnitError> {
+    let damaged = |what: String| UnitError::Damaged { offset, what };
+    let header_len = RECORD_HEADER_LEN as usize;
+    let end = batch.data.len();
+    let mut at = start;
+    while at < end {
+        let rest = &batch.data[at..end];
+        let Some(len) = rest
+            .get(1..header_len)
+            .and_then(|b| Some(u64::from_le_bytes(b.try_into().ok()?)))
+        else {
+            return Err(damaged("the chunk ends inside a record header".into()));
+        };
+        let opcode = rest[0];
+        let Some(record_end) = usize::try_from(len)
+            .ok()
+            .and_then(|len| len.checked_add(at + header_len))
+            .filter(|&e| e <= end)
+        else {
+            return Err(damaged(format!(
+                "a record (opcode {opcode:#04x}) of {len} bytes overruns its chunk"
+            )));
+        };
+        let range = at + header_len..record_end;
+        batch.items.push((Item::Record { opcode, range }, offset));
+        at = record_end;
+    }
+    Ok(())
 }
 
 /// How a chunk's records are compressed (the chunk record's `compression`).

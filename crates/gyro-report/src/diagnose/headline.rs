@@ -69,6 +69,8 @@ fn value(e: &EffectResult, name: &str, unit: f64, interval: bool) -> Option<Stri
     })
 }
 
+// Longer than a screen: one match over every effect id, a table of clauses that reads
+// best whole (split, each part would be an arbitrary slice of the table).
 /// What a named effect does, as a clause whose subject is the gyro ("lags the reference
 /// by 12.6 ms"), with each value's 95% interval when `interval`.
 pub fn clause(e: &EffectResult, interval: bool) -> String {

@@ -427,26 +427,7 @@ fn xcorr_plot(f: &Envelopes) -> (EnvelopePlot, String) {
             })
             .collect()
     };
-    let ms = |v: Option<f64>| v.map_or("–".to_string(), |s| sig(s * 1e3, 3));
-    let mut peaks = format!(
-        "Peak lag (positive: the gyro lags the reference): real runs {} ms",
-        ms(peak_lag(&real, &lags_s))
-    );
-    for (m, v) in f.models.iter().zip(&per_model) {
-        let lags: Vec<f64> = v.iter().filter_map(|c| peak_lag(c, &lags_s)).collect();
-        let lo = lags.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = lags.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        if lo.is_finite() {
-            let _ = write!(
-                peaks,
-                "; {} {} to {} ms",
-                esc(&m.label),
-                sig(lo * 1e3, 3),
-                sig(hi * 1e3, 3)
-            );
-        }
-    }
-    peaks.push('.');
+    let peaks = peak_lags_text(f, &real, &per_model, &lags_s);
     let real_line = |y: Vec<f64>| Measured {
         label: "real runs".into(),
         x: x.clone(),
@@ -480,6 +461,32 @@ fn xcorr_plot(f: &Envelopes) -> (EnvelopePlot, String) {
         panels: vec![top, bottom],
     };
     (plot, peaks)
+}
+
+/// The peak lags in words: the real runs' (`real`), then each model's range over its
+/// simulated sets (`per_model`); `lags_s` are the curves' lags.
+fn peak_lags_text(f: &Envelopes, real: &[f64], per_model: &[Curves], lags_s: &[f64]) -> String {
+    let ms = |v: Option<f64>| v.map_or("–".to_string(), |s| sig(s * 1e3, 3));
+    let mut peaks = format!(
+        "Peak lag (positive: the gyro lags the reference): real runs {} ms",
+        ms(peak_lag(real, lags_s))
+    );
+    for (m, v) in f.models.iter().zip(per_model) {
+        let lags: Vec<f64> = v.iter().filter_map(|c| peak_lag(c, lags_s)).collect();
+        let lo = lags.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = lags.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if lo.is_finite() {
+            let _ = write!(
+                peaks,
+                "; {} {} to {} ms",
+                esc(&m.label),
+                sig(lo * 1e3, 3),
+                sig(hi * 1e3, 3)
+            );
+        }
+    }
+    peaks.push('.');
+    peaks
 }
 
 fn gap_map(d: &Diagnosis) -> GapMapPlot {
@@ -1076,6 +1083,13 @@ held-out z the same coefficient's test on the held-out runs, in the same directi
 
     unexplained_table(s, d);
 
+    where_table(s, d);
+
+    runs_table(s, d);
+}
+
+/// Where the gap lies: the statistics with the largest |z| of real against nominal.
+fn where_table(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(s, "<h2>Where the gap lies</h2>");
     let _ = writeln!(
         s,
@@ -1097,7 +1111,10 @@ combined over all runs (Σz/√n). Positive: the real value is above the simulat
         );
     }
     let _ = writeln!(s, "</table>");
+}
 
+/// The runs: each one's role, duration and gap before and after the selected effects.
+fn runs_table(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(s, "<h2>Runs</h2>");
     let _ = writeln!(
         s,

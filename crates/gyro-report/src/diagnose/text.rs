@@ -27,6 +27,14 @@ pub fn self_test_table(t: &selftest::SelfTest) -> String {
     for e in &t.magnitudes {
         let _ = writeln!(s, "  {}", serde_json::to_string(e).unwrap_or_default());
     }
+    cases_table(&mut s, t);
+    scores_table(&mut s, t);
+    s
+}
+
+/// The self-check's cases, one line each: what was injected and named, the held-out gap
+/// before and after, the coverage of the intervals.
+fn cases_table(s: &mut String, t: &selftest::SelfTest) {
     let _ = writeln!(
         s,
         "
@@ -60,6 +68,10 @@ cases:"
             if c.model_fits { "" } else { "  (does not fit)" }
         );
     }
+}
+
+/// The self-check's scores: the confusion of single effects, then each share of cases.
+fn scores_table(s: &mut String, t: &selftest::SelfTest) {
     let _ = writeln!(
         s,
         "
@@ -106,7 +118,6 @@ top-1 accuracy (single effects): {} strict, {} counting confounded pairs ({}) as
         "cases whose selected model leaves nothing unexplained on the training runs: {}",
         pct(t.model_fits)
     );
-    s
 }
 
 /// The matrix plan's answer first: each effect's detection limit, then every cell.
