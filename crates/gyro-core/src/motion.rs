@@ -249,7 +249,7 @@ impl MotionDetector {
     /// movement if it is further (1–3 deg/s at the end of a tightening); before the first
     /// rest the bias is unknown, so a steady level up to `5 × enter_dps` is the rest (the
     /// power-up bias), not a movement.
-    #[inline]
+    #[inline(always)]
     pub fn update(&mut self, rate_dps: f32) -> Phase {
         let deviation = libm::fabsf(rate_dps - self.bias_dps);
         let quiet = deviation <= self.exit_dps;
@@ -268,7 +268,7 @@ impl MotionDetector {
     }
 
     /// A quiet sample while static: a rest sample, ending a run that was not a movement.
-    #[inline]
+    #[inline(always)]
     fn static_quiet(&mut self, rate_dps: f32) -> Phase {
         let aborted = self.run > 0;
         if aborted {
@@ -285,7 +285,7 @@ impl MotionDetector {
     /// A sample beyond `exit_dps` (by `deviation`) while static: the run goes on, and may
     /// turn out a bias change (a steady level within `near_dps`, or the power-up bias
     /// while the bias is not `bias_known`) or a movement.
-    #[inline]
+    #[inline(always)]
     fn static_run(
         &mut self,
         rate_dps: f32,
@@ -326,7 +326,7 @@ impl MotionDetector {
 
     /// A quiet sample while moving: the quiet run goes on, and ends the movement once it
     /// is `min_rest` long.
-    #[inline]
+    #[inline(always)]
     fn dynamic_quiet(&mut self, rate_dps: f32) -> Phase {
         self.run = self.run.saturating_add(1);
         self.run_mean.add(rate_dps);
@@ -347,7 +347,7 @@ impl MotionDetector {
 
     /// A sample beyond `exit_dps` while moving: still moving, unless the level has been
     /// steady within `near_dps` of the bias long enough to be the rest after it.
-    #[inline]
+    #[inline(always)]
     fn dynamic_moving(&mut self, rate_dps: f32, near_dps: f32) -> Phase {
         self.run = 0;
         self.run_mean = Mean::default();

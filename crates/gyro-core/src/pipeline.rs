@@ -664,7 +664,7 @@ impl Pipeline {
     /// terms are not (as if ΔT were 0): use [`Self::push_with_temperature`] where the
     /// sensor's temperature is known. [`Self::push_block`] takes many samples at once, with
     /// the same outputs.
-    #[inline]
+    #[inline(always)]
     pub fn push(&mut self, time_s: f64, rate_dps: f32) -> Option<Output> {
         self.segment::<false>(&[time_s], &[rate_dps], &[])
     }
@@ -677,7 +677,7 @@ impl Pipeline {
     /// one has been seen the temperature terms are 0. The first valid temperature is the
     /// reference of ΔT unless the correction sets one (`temperature_ref_c`). With the identity
     /// correction this gives exactly what [`Self::push`] gives.
-    #[inline]
+    #[inline(always)]
     pub fn push_with_temperature(
         &mut self,
         time_s: f64,
@@ -1210,7 +1210,7 @@ impl Pipeline {
 
     /// Predict the filter over this step, and integrate `rate_dps` (raw and corrected)
     /// if `phase` integrates.
-    #[inline]
+    #[inline(always)]
     fn integrate(&mut self, phase: Phase, rate_dps: f32) {
         // With `min_rest` of one sample, `Ended` comes on the first quiet sample, which is
         // the movement's last: it is integrated like `SettleFirst`.
@@ -1239,7 +1239,7 @@ impl Pipeline {
     }
 
     /// Hand the clip flags pending from this block on, as `phase` decides.
-    #[inline]
+    #[inline(always)]
     fn hand_over_saturation(&mut self, phase: Phase) {
         // Saturation seen in this block goes to the movement in progress; during a run that
         // may become one it waits; at rest, or when the run is dropped, it is forgotten.
@@ -1255,7 +1255,7 @@ impl Pipeline {
     }
 
     /// A rest sample `rate_dps`: when it completes a block pair, observe the bias with it.
-    #[inline]
+    #[inline(always)]
     fn observe_rest(&mut self, rate_dps: f32) {
         if let Some((mean_dps, samples, next_mean_dps, first)) = self.rest_blocks.push(rate_dps) {
             if first {
@@ -1309,7 +1309,7 @@ impl Pipeline {
     }
 
     /// The output of this step: `rate_dps` at `time_s`, `event`, and the angles and bias now.
-    #[inline]
+    #[inline(always)]
     fn output(&self, time_s: f64, rate_dps: f32, event: Option<Event>) -> Output {
         Output {
             time_s,
