@@ -412,6 +412,8 @@ def matrix_case(gyro, directory, name, effect, param, value, seed, label, noise)
     row["first"] = named[0] if named else None
     row["extra"] = [n for n in named if n != effect and n != LOOKALIKE.get(effect)]
     row["lookalike"] = [n for n in named if effect and n == LOOKALIKE.get(effect)]
+    # The verdict's doubts on what it names (`doubts`: e.g. a latency beside low-passed rests).
+    row["doubted"] = bool(d.get("doubts"))
     row["top_strict"] = effect is not None and row["first"] == effect
     row["top_group"] = effect is not None and row["first"] is not None and row["first"] in (effect, LOOKALIKE.get(effect))
     row["injected_named"] = effect in named
@@ -444,7 +446,8 @@ def matrix_failures(row):
     elif not row["top_strict"]:
         why.append(f"{row['first']} named first" + (" (look-alike)" if row["top_group"] else ""))
     if row["lookalike"]:
-        why.append(f"look-alike {', '.join(row['lookalike'])} named")
+        why.append(f"look-alike {', '.join(row['lookalike'])} named"
+                   + (", with a doubt in the verdict" if row.get("doubted") else ", undoubted"))
     if row["extra"]:
         why.append(f"extra {', '.join(row['extra'])}")
     if row["injected_named"] and not row["covered"]:
@@ -517,7 +520,8 @@ def matrix_main(args):
             say(f"  - named first (latency~bandwidth as one): {sum(r['top_group'] for r in group)}/{len(group)}")
             say(f"  - injected effect named at all: {len(named)}/{len(group)}")
             say(f"  - nothing extra named (look-alike not counted): {sum(not r['extra'] for r in group)}/{len(group)}")
-            say(f"  - look-alike named: {sum(bool(r['lookalike']) for r in group)}/{len(group)}")
+            say(f"  - look-alike named: {sum(bool(r['lookalike']) for r in group)}/{len(group)}"
+                f" (the verdict doubts it: {sum(bool(r['lookalike']) and r.get('doubted', False) for r in group)})")
             say(f"  - 95% interval covers the injected value, where named: "
                 f"{sum(bool(r['covered']) for r in named)}/{len(named)}")
             say(f"  - model fits: {sum(r['model_fits'] for r in group)}/{len(group)}")
