@@ -1566,11 +1566,10 @@ fn regression_procedure(
             // A two-pole low-pass delays slow motion by a delay inverse to its cutoff
             // (`low_pass_delay_s`): fitted as a delay (its first-order parameter),
             // calibrated as a low-pass.
-            let per_delay = gyro_sim::low_pass_delay_s(1.0);
             let nyquist = 0.5 * input.model.sample_rate_hz;
             let to_cutoff = |d: f64| -> f64 {
                 if d > 0.0 {
-                    (per_delay / d).min(nyquist)
+                    gyro_sim::low_pass_cutoff_hz(d).min(nyquist)
                 } else {
                     nyquist
                 }

@@ -359,7 +359,7 @@ fn delay_doubt(
     if super::select::rests_delay(Some(w)) != Some("bandwidth") {
         return None;
     }
-    let cutoff_hz = gyro_sim::low_pass_delay_s(1.0) / delay_s;
+    let cutoff_hz = gyro_sim::low_pass_cutoff_hz(delay_s);
     let nyquist_hz = 0.5 * sample_rate_hz;
     let why = if cutoff_hz > nyquist_hz {
         format!(

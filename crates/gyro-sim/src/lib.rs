@@ -19,9 +19,9 @@ mod motion;
 mod sensor;
 
 pub use effects::{
-    bias_instability_components, effect_info, low_pass_delay_s, Bound, CoreCorrection, Effect,
-    EffectError, EffectInfo, FitProcedure, ParamRange, ParamSpec, Reading, Regressor, WanderShape,
-    EFFECTS, LOW_PASS_POLE_RATIO,
+    bias_instability_components, effect_info, low_pass_cutoff_hz, low_pass_delay_s, Bound,
+    CoreCorrection, Effect, EffectError, EffectInfo, FitProcedure, ParamRange, ParamSpec, Reading,
+    Regressor, WanderShape, EFFECTS, LOW_PASS_POLE_RATIO,
 };
 pub use low_pass::TwoPoleLowPass;
 pub use motion::{rounding_noise_dps, BenchProfile, Motion, Rotation};

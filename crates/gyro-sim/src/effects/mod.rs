@@ -194,6 +194,12 @@ pub fn low_pass_delay_s(cutoff_hz: f64) -> f64 {
     1.0 / (std::f64::consts::PI * LOW_PASS_POLE_RATIO * cutoff_hz)
 }
 
+/// The cutoff (Hz) of the `bandwidth` low-pass that holds back slow motion by `delay_s`:
+/// the inverse of [`low_pass_delay_s`].
+pub fn low_pass_cutoff_hz(delay_s: f64) -> f64 {
+    low_pass_delay_s(1.0) / delay_s
+}
+
 /// The `bias_instability` effect of standard deviation `sigma_dps` as the sum of its six
 /// first-order Gauss-Markov processes: `(σ_i, τ_i)` with τ_i = 10^(0.6 i) s, i = 0..5
 /// (1 s to 1000 s), each σ_i = σ/√6, so that the variances add up to σ².
