@@ -363,14 +363,13 @@ fn delay_doubt(
     let nyquist_hz = 0.5 * sample_rate_hz;
     let why = if cutoff_hz > nyquist_hz {
         format!(
-            ": a two-pole low-pass that delays slow motion by {:.1} ms has its cutoff at {cutoff_hz:.0} Hz, above the {nyquist_hz:.0} Hz this sample rate allows the bandwidth effect",
-            delay_s * 1e3
+            ": a two-pole low-pass with this lag has its cutoff at {cutoff_hz:.0} Hz, above the {nyquist_hz:.0} Hz this sample rate allows"
         )
     } else {
         String::new()
     };
     Some(format!(
-        "The lag of {:.1} ms named latency may be the gyro's own low-pass filter, not a delay: the training rests' noise is low-passed (their {:.2} s blocks read {:.3} deg/sqrt(h), their first differences {:.3}; z {:.0}), which a delay alone does not do, and the bandwidth effect could not match the lag{why}",
+        "The {:.1} ms lag may be the gyro's own low-pass filter, not a delay: its noise at rest is low-passed too, which a delay does not do (the training rests' {:.2} s blocks read {:.3} deg/sqrt(h), their first differences {:.3}; z {:.0}), and the bandwidth effect could not match the lag{why}",
         delay_s * 1e3,
         w.tau_s,
         w.block_arw_deg_per_rt_h,
@@ -471,10 +470,10 @@ mod tests {
     #[test]
     fn a_latency_beside_low_passed_rests_is_doubted() {
         let latency = [Effect::Latency { delay_s: 0.0023 }];
-        // At 100 Hz: a 2.3 ms two-pole delay is a cutoff near 98 Hz, above Nyquist.
+        // At 100 Hz: a 2.3 ms two-pole delay is a cutoff near 89 Hz, above Nyquist.
         let w = delay_doubt(&latency, Some(&rests(19.0)), 100.0).expect("a warning");
         assert!(
-            w.contains("The lag of 2.3 ms named latency may be the gyro's own low-pass"),
+            w.contains("The 2.3 ms lag may be the gyro's own low-pass filter"),
             "{w}"
         );
         assert!(w.contains("above the 50 Hz"), "{w}");
