@@ -250,7 +250,7 @@ pub enum GridKind {
 /// takes it, and the reference's grid step (deg) when it is quantised. An encoder's
 /// ([`reference_step`]) is smoothed over `reference.quantised_smooth_s` (its steps would otherwise
 /// be rate spikes in the simulated gyro) and rounded again by the re-simulation; a
-/// print's ([`print_step`]) keeps its angle and takes its rate through a cubic smoothing
+/// print's ([`print_step`]) keeps its angle and takes its rate through a quintic smoothing
 /// of [`print_half_width`] ([`Motion::from_rounded_reference`]: the real gyro does not
 /// see the rounding, and the re-simulated residual holds the real one's). Either rate is
 /// a one-sided derivative beside each step of the acceleration
@@ -324,11 +324,11 @@ pub fn print_step(values: &[f64], fs: f64, settings: &ReferenceSettings) -> Opti
     (moves && rounding_noise_dps(step, fs, 0) >= settings.print_rounding_floor_dps).then_some(step)
 }
 
-/// Half width (samples) of the cubic smoothing of a reference printed to `step` deg at
+/// Half width (samples) of the quintic smoothing of a reference printed to `step` deg at
 /// `fs` Hz: the smallest that brings the rounding noise of the re-simulated rate under
 /// `reference.print_rounding_floor_dps` ([`gyro_sim::rounding_noise_dps`]), at most
-/// `reference.print_max_half_width_s`. At 0.001°: the longest, 4 samples at 100 Hz and 40 at
-/// 1 kHz; at 0.0001° and 1 kHz, 7.
+/// `reference.print_max_half_width_s`. At 0.001°: the longest, 8 samples at 100 Hz, and 70
+/// at 1 kHz; at 0.0001° and 1 kHz, 10.
 pub fn print_half_width(step: f64, fs: f64, settings: &ReferenceSettings) -> usize {
     let longest = ((settings.print_max_half_width_s * fs).round() as usize).max(2);
     (2..=longest)
@@ -698,12 +698,12 @@ mod tests {
         // The motion taken from a printed reference carries the grid to the re-simulation.
         let grid = motion_from_reference(&printed, 1000.0).1.unwrap();
         assert_eq!((grid.step_deg, grid.kind), (0.001, GridKind::Print));
-        assert_eq!(grid.smoothing_half_width_s, 0.04);
+        assert_eq!(grid.smoothing_half_width_s, 0.07);
         assert_eq!(motion_from_reference(&exact, 1000.0).1, None);
-        // Smoothed as far as the rounding needs, no further than ±40 ms.
-        assert_eq!(print_half_width(0.001, 100.0, &REF), 4);
-        assert_eq!(print_half_width(0.001, 1000.0, &REF), 40);
-        assert_eq!(print_half_width(0.0001, 1000.0, &REF), 7);
+        // Smoothed as far as the rounding needs, no further than ±80 ms.
+        assert_eq!(print_half_width(0.001, 100.0, &REF), 8);
+        assert_eq!(print_half_width(0.001, 1000.0, &REF), 70);
+        assert_eq!(print_half_width(0.0001, 1000.0, &REF), 10);
     }
 
     #[test]

@@ -178,8 +178,9 @@ pub struct Reference {
     /// Finest decimal grid looked for, 10⁻ᵈ°. Unit decimals, valid [0, 12]. 6: finer
     /// prints are exact at any sample rate a gyro logs at.
     pub print_max_decimals: i32,
-    /// Longest half width of a print's smoothing. Unit s, valid (0, 1]. 0.04: a cubic
-    /// smoothing of ±40 ms passes a wrench's turns (gain 0.998 at 3 Hz, 0.99 at 5 Hz).
+    /// Longest half width of a print's smoothing. Unit s, valid (0, 1]. 0.08: a quintic
+    /// smoothing of ±80 ms passes a wrench's turns (rate gain 0.9995 at 3 Hz, 0.992 at
+    /// 5 Hz) and brings a 0.001° print at 100 Hz to 0.006 °/s of rounding.
     pub print_max_half_width_s: f64,
 }
 
@@ -406,7 +407,7 @@ impl Settings {
             grid_share: 0.9,
             print_rounding_floor_dps: 0.005,
             print_max_decimals: 6,
-            print_max_half_width_s: 0.04,
+            print_max_half_width_s: 0.08,
         },
         envelopes: Envelopes {
             rate_quantile: 0.995,
@@ -513,7 +514,7 @@ impl Settings {
             count("reference.print_max_decimals", f64::from(r.print_max_decimals), "decimals", 0.0, 12.0,
                 "finest decimal grid a printed reference is looked for on"),
             entry("reference.print_max_half_width_s", r.print_max_half_width_s, "s", (OPEN, 0.0, 1.0, CLOSED),
-                "longest half width of a print's smoothing: ±40 ms passes a wrench's turns"),
+                "longest half width of a print's smoothing: ±80 ms (quintic) passes a wrench's turns"),
             entry("envelopes.rate_quantile", e.rate_quantile, "1", (OPEN, 0.0, 1.0, CLOSED),
                 "quantile of the \\|reference rate\\| that spans the figures' rate axis"),
             entry("envelopes.acceleration_quantile", e.acceleration_quantile, "1", (OPEN, 0.0, 1.0, CLOSED),
