@@ -479,7 +479,7 @@ fn rest_white_target(
         avar_dps2: diff_var,
         block: 1,
     };
-    let diff_sigma = solve_white_sigma(diff_target, model, &[model.lsb_dps], None);
+    let diff_sigma = solve_white_sigma(diff_target, model, model.lsb_dps, None);
     let mut chosen = (diff_target, diff_sigma);
     let block = super::features::white_check_block(
         model.sample_rate_hz,
@@ -490,7 +490,7 @@ fn rest_white_target(
             avar_dps2: block_var,
             block,
         };
-        let block_sigma = solve_white_sigma(block_target, model, &[model.lsb_dps], None);
+        let block_sigma = solve_white_sigma(block_target, model, model.lsb_dps, None);
         let ratio = (block_sigma / diff_sigma).powi(2);
         let z = (ratio - 1.0) / (3.0 / block_count as f64).sqrt();
         let coloured = z.abs() >= settings.tests.z_critical
@@ -639,7 +639,8 @@ pub fn rests_suffice(train: &[&RealRun]) -> bool {
 
 /// The white-noise σ (deg/s per sample) whose simulated static output — bias, the
 /// Gauss-Markov wander, white noise (through the sensor's low-pass of `cutoff_hz`, when
-/// given, as the simulator's `bandwidth` filters it), rounded to each of `lsbs` in turn —
+/// given, as the simulator's `bandwidth` filters it), rounded to the output step `lsb_dps`
+/// ([`gyro_sim::output_step_dps`]) —
 /// has the Allan variance `target` at its block length (at one sample: half the mean
 /// squared first difference). Rounding a signal that barely moves is not the textbook
 /// lsb²/12, so the match is by simulation (40 000 samples, or 40 000 blocks, fixed seed,
@@ -647,7 +648,7 @@ pub fn rests_suffice(train: &[&RealRun]) -> bool {
 pub fn solve_white_sigma(
     target: WhiteTarget,
     model: &SensorModel,
-    lsbs: &[f64],
+    lsb_dps: f64,
     cutoff_hz: Option<f64>,
 ) -> f64 {
     use rand::SeedableRng;
@@ -682,10 +683,8 @@ pub fn solve_white_sigma(
         let (mut acc, mut filled) = (0.0, 0usize);
         for k in 0..n {
             let mut x = model.bias_dps + wander[k] + sigma * white[k];
-            for &q in lsbs {
-                if q > 0.0 {
-                    x = (x / q).round() * q;
-                }
+            if lsb_dps > 0.0 {
+                x = (x / lsb_dps).round() * lsb_dps;
             }
             if block > 1 {
                 acc += x;
@@ -737,7 +736,7 @@ pub fn model_with(
         return model;
     };
     let active = || effects.iter().filter(|e| !e.is_neutral(nominal));
-    // An effect read from the output grid is an extra rounding of the output.
+    // An effect read from the output grid is the output's step, in place of the model's.
     let extra_lsb = active().find_map(|e| match (e.info().fit, e.params().as_slice()) {
         (FitProcedure::OutputGrid, [lsb_dps]) => Some(*lsb_dps),
         _ => None,
@@ -749,8 +748,8 @@ pub fn model_with(
         })
         .filter(|_| target.block > 1);
     if extra_lsb.is_some() || cutoff_hz.is_some() {
-        let lsbs = [nominal.lsb_dps, extra_lsb.unwrap_or(0.0)];
-        let sigma = solve_white_sigma(target, nominal, &lsbs, cutoff_hz);
+        let lsb_dps = gyro_sim::output_step_dps(nominal.lsb_dps, extra_lsb.unwrap_or(0.0));
+        let sigma = solve_white_sigma(target, nominal, lsb_dps, cutoff_hz);
         model.arw_deg_per_rt_h = sigma * 60.0 / model.sample_rate_hz.sqrt();
     }
     model

@@ -26,6 +26,6 @@ pub use effects::{
 pub use low_pass::TwoPoleLowPass;
 pub use motion::{rounding_noise_dps, BenchProfile, Motion, Rotation};
 pub use sensor::{
-    check_size, sample_count, simulate, simulate_series, InvalidSensorModel, SensorModel,
-    SimOptions, SimSeries, TooManySamples, BYTES_PER_SAMPLE, MAX_SAMPLES,
+    check_size, output_step_dps, sample_count, simulate, simulate_series, InvalidSensorModel,
+    SensorModel, SimOptions, SimSeries, TooManySamples, BYTES_PER_SAMPLE, MAX_SAMPLES,
 };

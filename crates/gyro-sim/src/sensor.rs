@@ -237,6 +237,18 @@ pub struct SimSeries {
     pub dropped: usize,
 }
 
+/// The step the simulated output is rounded to, once: a `quantization` effect's
+/// `effect_lsb_dps` when positive (it replaces the model's), else the model's
+/// `model_lsb_dps` (0: no rounding). Anything that re-creates the simulator's output (the
+/// diagnosis matching its white noise) rounds with this.
+pub fn output_step_dps(model_lsb_dps: f64, effect_lsb_dps: f64) -> f64 {
+    if effect_lsb_dps > 0.0 {
+        effect_lsb_dps
+    } else {
+        model_lsb_dps
+    }
+}
+
 /// Simulate a log of `motion` as seen by `model` with `effects`.
 pub fn simulate(
     model: &SensorModel,
@@ -512,14 +524,22 @@ impl<'a> SimSensor<'a> {
             + white_dps
     }
 
-    /// `measured` as the sensor outputs it: rounded to its word (and an effect's), clipped.
-    fn output_dps(&self, mut measured: f64) -> f64 {
-        for lsb in [self.model.lsb_dps, self.terms.extra_lsb_dps] {
-            if lsb > 0.0 {
-                measured = (measured / lsb).round() * lsb;
-            }
-        }
-        measured.clamp(-self.limit_dps, self.limit_dps)
+    /// `measured` as the sensor outputs it: rounded once to its output step (the
+    /// `quantization` effect's when present, which replaces the model's), clipped.
+    ///
+    /// Once, not to the model's step and then to the effect's: rounding a value already
+    /// on a grid of 1/24 °/s to a step of 0.3 °/s makes bins of uneven width (7 or 8 of
+    /// the finer steps), and the mean of a gyro at rest then lies up to 0.008 °/s off its
+    /// bias with the CRM100's white noise, where a single rounding stays within 0.001 °/s
+    /// (`an_output_step_rounds_once`). A sensor whose word is coarse has one grid.
+    fn output_dps(&self, measured: f64) -> f64 {
+        let lsb = output_step_dps(self.model.lsb_dps, self.terms.extra_lsb_dps);
+        let rounded = if lsb > 0.0 {
+            (measured / lsb).round() * lsb
+        } else {
+            measured
+        };
+        rounded.clamp(-self.limit_dps, self.limit_dps)
     }
 
     /// True if this sample is dropped (a dropout starts or goes on).
@@ -614,6 +634,29 @@ mod tests {
                 "{effect:?}: the reference stops moving ({step} deg)"
             );
         }
+    }
+
+    /// A coarse output step replaces the model's: at rest, with a bias of 0.2 °/s (where
+    /// rounding the 1/24 °/s word again to 0.3 °/s puts the mean 0.006 °/s off), the mean
+    /// output over 120 s stays within 0.003 °/s of the bias, as one rounding with the
+    /// CRM100's white noise does (its dither leaves under 0.001 °/s).
+    #[test]
+    fn an_output_step_rounds_once() {
+        let motion = Motion::from_rotations(Vec::new(), 120.0);
+        let model = SensorModel {
+            gm_sigma_dps: 0.0,
+            bias_dps: 0.2,
+            ..SensorModel::default()
+        };
+        let effects = [Effect::Quantization { lsb_dps: 0.3 }];
+        let s = simulate_series(&model, &effects, &motion, &SimOptions::default(), None);
+        let mean = s.rate_dps.iter().sum::<f64>() / s.rate_dps.len() as f64;
+        assert!((mean - 0.2).abs() < 0.003, "mean {mean}");
+        // Every output lies on the 0.3 °/s grid.
+        assert!(s
+            .rate_dps
+            .iter()
+            .all(|r| ((r / 0.3) - (r / 0.3).round()).abs() < 1e-9));
     }
 
     /// The sensor's bandwidth filters its white noise as it filters the rate: at rest the

@@ -11,7 +11,10 @@
 //! Rauch–Tung–Striebel pass over the movement's span gives for the angle gained over it.
 //! So a movement's offline angle is the causal angle at the start of the next movement less
 //! the causal angle at the start of this one, and its variance the growth of the angle's
-//! variance between them.
+//! variance between them, its white part as the rests measure it, plus the wander within
+//! the movement that the bias steps from one rest to the next show (a random walk pinned
+//! by the rests on both sides: the filter's own wander, which its rests adapt, misses the
+//! fast components of a 1/f bias).
 //!
 //! The series is smoothed alike: within a movement the correction its rest after made is
 //! spread in proportion to the time elapsed (a bias error integrates linearly), and over a
@@ -73,11 +76,22 @@ pub(super) struct Smoother {
     last_block_mean: Option<f64>,
     /// Output step (s).
     step_s: f64,
+    /// The bias's change across each smoothed movement, from the rest before to the end of
+    /// the rest after: Σ Δb²/Δt (deg²/s³) and the count, a random-walk rate of the wander
+    /// the rests show at the movements' own time scale.
+    bias_steps: (f64, usize),
 }
 
 /// Rest outputs per noise block (0.2 s at 50 Hz): a block mean against the next measures
 /// the white noise the movement's angle integrates.
 const NOISE_BLOCK: usize = 10;
+
+/// The variance (deg²) that a bias wandering as a random walk of rate `k2` (deg²/s³)
+/// adds to the angle integrated over `duration_s` when its value is pinned at both ends
+/// (by the rests on either side): the integral of a Brownian bridge, `k2·T³/12`.
+fn bridge_variance(k2: f64, duration_s: f64) -> f64 {
+    k2 * duration_s.powi(3) / 12.0
+}
 
 fn variance_of(point: &SeriesPoint) -> Option<f64> {
     point.angle_std_deg.map(|s| f64::from(s) * f64::from(s))
@@ -244,8 +258,23 @@ impl Smoother {
         let steps = (end_index - p.start_index) as f64;
         let white = steps * self.step_variance();
         let white_prior = steps * self.prior_step_variance;
+        // The wander within the movement that the rests on both sides show: the filter's
+        // own wander is the one its rests adapt, which misses the fast components of a 1/f
+        // bias; the change of its bias estimate from the rest before to the end of the
+        // rest after measures them at the movements' time scale.
+        let gap_s = end.time_s - start.time_s;
+        let step = f64::from(end.bias_dps - start.bias_dps);
+        if gap_s > 0.0 && step.is_finite() {
+            self.bias_steps.0 += step * step / gap_s;
+            self.bias_steps.1 += 1;
+        }
+        let k2 = match self.bias_steps {
+            (sum, n) if n > 0 => sum / n as f64,
+            _ => 0.0,
+        };
+        let wander = bridge_variance(k2, moved_end.time_s - start.time_s);
         let variance = match (variance_of(&start), variance_of(end)) {
-            (Some(a), Some(b)) => Some((b - a - white_prior).max(0.0) + white),
+            (Some(a), Some(b)) => Some((b - a - white_prior).max(0.0) + white + wander),
             _ => None,
         };
         let shift = Shift {
@@ -343,4 +372,44 @@ fn shifted(p: &SeriesPoint, offset: f64, variance_offset: f64) -> SeriesPoint {
         s.angle_std_deg = Some((v + variance_offset).max(0.0).sqrt() as f32);
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    /// The angle a random-walk bias adds over a span whose both ends are pinned (a
+    /// Brownian bridge, integrated): `k2·T³/12`, against 4 000 simulated bridges.
+    #[test]
+    fn a_pinned_random_walk_integrates_to_the_bridge_variance() {
+        let (k2, duration_s, steps) = (0.004, 2.0, 400);
+        let dt = duration_s / steps as f64;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let integrals: Vec<f64> = (0..4000)
+            .map(|_| {
+                let mut walk = vec![0.0];
+                for _ in 0..steps {
+                    let x: f64 = StandardNormal.sample(&mut rng);
+                    walk.push(walk[walk.len() - 1] + (k2 * dt).sqrt() * x);
+                }
+                // Pinned at both ends: less the straight line between them.
+                let end = walk[steps];
+                (0..steps)
+                    .map(|i| {
+                        let mid = 0.5 * (walk[i] + walk[i + 1]);
+                        let line = end * (i as f64 + 0.5) / steps as f64;
+                        (mid - line) * dt
+                    })
+                    .sum::<f64>()
+            })
+            .collect();
+        let variance = integrals.iter().map(|x| x * x).sum::<f64>() / integrals.len() as f64;
+        let predicted = bridge_variance(k2, duration_s);
+        assert!(
+            (variance / predicted - 1.0).abs() < 0.08,
+            "{variance} against {predicted}"
+        );
+    }
 }

@@ -1,6 +1,6 @@
 //! The causal `run` held to the per-rest mean on every bench kind of
 //! [`gyro_analysis::rest_mean::bench`] (simulated CRM100 runs of 90 s at 1 kHz, the
-//! development seeds 1–20): at most 1.2 times its error on every kind, at most 1.0 in
+//! development seeds 1–40): at most 1.2 times its error on every kind, at most 1.0 in
 //! geometric mean, below it where the bias drifts; the 95% intervals' coverage, pooled,
 //! between 90% and 99%. `cargo run --release -p gyro-analysis --example bench_kinds`
 //! prints the table (docs/figures.md).
@@ -16,13 +16,15 @@ fn the_causal_run_is_never_far_behind_the_rest_mean_and_ahead_in_the_mean() {
     let (mut covered, mut total) = (0, 0);
     let mut failures = vec![];
     for kind in bench_kinds() {
-        let score = score_kind(&kind, &config, 1..21).unwrap();
+        // Forty runs: the median of each run's largest error moves by about ±0.1 from one
+        // set of twenty seeds to the next (docs/figures.md), as much as the margin.
+        let score = score_kind(&kind, &config, 1..41).unwrap();
         let (c, o) = (score.causal_ratio(), score.offline_ratio());
         println!("{}: causal {c:.2}, offline {o:.2}", kind.name);
-        // Measured (seeds 1–20): at most 1.05 where the bias holds still, 0.43–0.75 where
-        // it drifts; the offline series is read where the causal one has had most of the
-        // same corrections.
-        let limit = if kind.drifting { 0.85 } else { 1.15 };
+        // Measured (seeds 1–40): 0.89–1.19 where the bias holds still (the coarse output
+        // step of 0.3 °/s the most), 0.47–0.69 where it drifts; the offline series is read
+        // where the causal one has had most of the same corrections.
+        let limit = if kind.drifting { 0.85 } else { 1.2 };
         if c > limit || o > limit {
             failures.push(format!("{}: causal {c:.2}, offline {o:.2}", kind.name));
         }
@@ -36,12 +38,12 @@ fn the_causal_run_is_never_far_behind_the_rest_mean_and_ahead_in_the_mean() {
         geometric_mean(causal.iter().copied()),
         geometric_mean(offline.iter().copied()),
     );
-    // Measured: 0.81 both.
+    // Measured: 0.87 both.
     assert!(
         gc <= 0.9 && go <= 0.9,
         "geometric mean causal {gc:.3}, offline {go:.3}"
     );
     let share = covered as f64 / total as f64;
-    // Measured: 94.0% of 1570.
+    // Measured: 97.8% of 3080.
     assert!((0.90..=0.99).contains(&share), "{covered} of {total}");
 }
