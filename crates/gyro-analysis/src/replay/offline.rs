@@ -10,11 +10,12 @@
 //! filter's prior at the movement's start) and the rest after (its updates), which is what a
 //! Rauch–Tung–Striebel pass over the movement's span gives for the angle gained over it.
 //! So a movement's offline angle is the causal angle at the start of the next movement less
-//! the causal angle at the start of this one, and its variance the growth of the angle's
-//! variance between them, its white part as the rests measure it, plus the wander within
-//! the movement that the bias steps from one rest to the next show (a random walk pinned
-//! by the rests on both sides: the filter's own wander, which its rests adapt, misses the
-//! fast components of a 1/f bias).
+//! the causal angle at the start of this one. Its variance is measured from the log's own
+//! rests rather than taken from the filter, whose wander prior the rests bring down only
+//! slowly: the white noise integrated over the movement (consecutive rest blocks), the bias
+//! error at the movement's two ends interpolated through it, and the wander within it (a
+//! random walk pinned by the rests on both sides), the last two from the change of the bias
+//! estimate across each movement so far ([`BiasSteps`]).
 //!
 //! The series is smoothed alike: within a movement the correction its rest after made is
 //! spread in proportion to the time elapsed (a bias error integrates linearly), and over a
@@ -65,7 +66,8 @@ pub(super) struct Smoother {
     ready: Vec<SeriesPoint>,
     /// The most outputs held at once.
     most_held: usize,
-    /// The filter's prior for the white rate noise integrated over one output step (deg²).
+    /// The filter's prior for the white rate noise integrated over one output step (deg²),
+    /// until the rests have measured it.
     prior_step_variance: f64,
     /// The white rate noise integrated over one output step as the rests show it (deg²):
     /// half the mean square of the difference of consecutive rest blocks' mean rates,
@@ -74,12 +76,46 @@ pub(super) struct Smoother {
     /// The rest block being summed: (sum of rates, samples), and the last complete one's mean.
     block: (f64, usize),
     last_block_mean: Option<f64>,
+    /// The last pair's half squared difference, counted once a further rest block follows.
+    pair_pending: Option<f64>,
     /// Output step (s).
     step_s: f64,
-    /// The bias's change across each smoothed movement, from the rest before to the end of
-    /// the rest after: Σ Δb²/Δt (deg²/s³) and the count, a random-walk rate of the wander
-    /// the rests show at the movements' own time scale.
-    bias_steps: (f64, usize),
+    /// The bias's change across each smoothed movement so far.
+    bias_steps: BiasSteps,
+}
+
+/// The bias's change Δb across each smoothed movement, from the rest before it to the end of
+/// the rest after it (over Δt): what the rests say of the bias error at a movement's ends
+/// and of its wander between them.
+#[derive(Clone, Copy, Debug, Default)]
+struct BiasSteps {
+    /// Σ Δb² (deg²/s²).
+    squares: f64,
+    /// Σ Δb²/Δt (deg²/s³): a random-walk rate of the wander at the movements' time scale.
+    rates: f64,
+    count: usize,
+}
+
+impl BiasSteps {
+    fn observe(&mut self, step_dps: f64, gap_s: f64) {
+        self.squares += step_dps * step_dps;
+        self.rates += step_dps * step_dps / gap_s;
+        self.count += 1;
+    }
+
+    /// The variance (deg²) the bias adds to the angle of a movement of `duration_s`: its
+    /// error at the two ends, independent, interpolated through the movement
+    /// (`T²·(v₀ + v₁)/4`, with `v₀ + v₁` at most the mean Δb², which holds the wander
+    /// between the rests too), and the wander within it ([`bridge_variance`]). Zero
+    /// before any step.
+    fn variance(&self, duration_s: f64) -> f64 {
+        if self.count == 0 {
+            return 0.0;
+        }
+        let n = self.count as f64;
+        duration_s * duration_s * self.squares / n / 4.0
+            + bridge_variance(self.rates / n, duration_s)
+    }
 }
 
 /// Rest outputs per noise block (0.2 s at 50 Hz): a block mean against the next measures
@@ -123,11 +159,18 @@ impl Smoother {
             self.block.1 += 1;
             if self.block.1 == NOISE_BLOCK {
                 let mean = self.block.0 / NOISE_BLOCK as f64;
+                // The pair before this block counts now that a further block at rest
+                // follows it: the last block before a movement is declared holds the
+                // turn's first rise (below the detector's entry level, labelled static),
+                // and its pair is dropped with it.
+                if let Some(half_square) = self.pair_pending.take() {
+                    self.block_pairs.0 += half_square;
+                    self.block_pairs.1 += 1;
+                }
                 if let Some(last) = self.last_block_mean {
                     let d = mean - last;
                     if d.is_finite() {
-                        self.block_pairs.0 += 0.5 * d * d;
-                        self.block_pairs.1 += 1;
+                        self.pair_pending = Some(0.5 * d * d);
                     }
                 }
                 self.last_block_mean = Some(mean);
@@ -136,6 +179,7 @@ impl Smoother {
         } else {
             self.block = (0.0, 0);
             self.last_block_mean = None;
+            self.pair_pending = None;
         }
         self.held.push_back(point);
         self.most_held = self.most_held.max(self.held.len());
@@ -254,27 +298,22 @@ impl Smoother {
         // The angle the rest after added: the correction of the movement's bias.
         let correction = f64::from(end.angle_deg - moved_end.angle_deg);
         let angle = f64::from(end.angle_deg - start.angle_deg);
-        // The filter's variance gained, its white-noise part as the rests measure it.
+        // The movement's variance, each part as the rests measure it: the white noise
+        // integrated over the movement (rest blocks), the error of the bias at its two
+        // ends and the wander between them (the bias steps from the rest before to the end
+        // of the rest after, over every movement so far). Not the filter's own growth: its
+        // wander prior, which its rests bring down only slowly, made the interval hold 99–100%
+        // where the bias holds still, and missed the fast components of a 1/f bias.
         let steps = (end_index - p.start_index) as f64;
         let white = steps * self.step_variance();
-        let white_prior = steps * self.prior_step_variance;
-        // The wander within the movement that the rests on both sides show: the filter's
-        // own wander is the one its rests adapt, which misses the fast components of a 1/f
-        // bias; the change of its bias estimate from the rest before to the end of the
-        // rest after measures them at the movements' time scale.
         let gap_s = end.time_s - start.time_s;
-        let step = f64::from(end.bias_dps - start.bias_dps);
-        if gap_s > 0.0 && step.is_finite() {
-            self.bias_steps.0 += step * step / gap_s;
-            self.bias_steps.1 += 1;
+        let bias_step = f64::from(end.bias_dps - start.bias_dps);
+        if gap_s > 0.0 && bias_step.is_finite() {
+            self.bias_steps.observe(bias_step, gap_s);
         }
-        let k2 = match self.bias_steps {
-            (sum, n) if n > 0 => sum / n as f64,
-            _ => 0.0,
-        };
-        let wander = bridge_variance(k2, moved_end.time_s - start.time_s);
+        let duration_s = moved_end.time_s - start.time_s;
         let variance = match (variance_of(&start), variance_of(end)) {
-            (Some(a), Some(b)) => Some((b - a - white_prior).max(0.0) + white + wander),
+            (Some(_), Some(_)) => Some(white + self.bias_steps.variance(duration_s)),
             _ => None,
         };
         let shift = Shift {

@@ -1,9 +1,9 @@
 //! The causal `run` held to the per-rest mean on every bench kind of
 //! [`gyro_analysis::rest_mean::bench`] (simulated CRM100 runs of 90 s at 1 kHz, the
 //! development seeds 1–40): at most 1.2 times its error on every kind, at most 1.0 in
-//! geometric mean, below it where the bias drifts; the 95% intervals' coverage, pooled,
-//! between 90% and 99%. `cargo run --release -p gyro-analysis --example bench_kinds`
-//! prints the table (docs/figures.md).
+//! geometric mean, below it where the bias drifts; the offline 95% intervals' coverage
+//! between 90% and 99%, on every kind and pooled. `cargo run --release -p gyro-analysis
+//! --example bench_kinds` prints the table (docs/figures.md).
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use gyro_analysis::rest_mean::bench::{bench_kinds, geometric_mean, score_kind};
@@ -28,10 +28,19 @@ fn the_causal_run_is_never_far_behind_the_rest_mean_and_ahead_in_the_mean() {
         if c > limit || o > limit {
             failures.push(format!("{}: causal {c:.2}, offline {o:.2}", kind.name));
         }
+        // The offline 95% interval on each kind (measured, seeds 1–40: 90.3–97.4%).
+        let (k_covered, k_total) = score.offline_covered;
+        let k_share = k_covered as f64 / k_total.max(1) as f64;
+        if !(0.90..=0.99).contains(&k_share) {
+            failures.push(format!(
+                "{}: offline interval covers {k_covered} of {k_total}",
+                kind.name
+            ));
+        }
         causal.push(c);
         offline.push(o);
-        covered += score.offline_covered.0;
-        total += score.offline_covered.1;
+        covered += k_covered;
+        total += k_total;
     }
     assert!(failures.is_empty(), "{failures:?}");
     let (gc, go) = (
@@ -44,6 +53,6 @@ fn the_causal_run_is_never_far_behind_the_rest_mean_and_ahead_in_the_mean() {
         "geometric mean causal {gc:.3}, offline {go:.3}"
     );
     let share = covered as f64 / total as f64;
-    // Measured: 97.8% of 3080.
+    // Measured: 94.7% of 3080.
     assert!((0.90..=0.99).contains(&share), "{covered} of {total}");
 }
