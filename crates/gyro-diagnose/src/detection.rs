@@ -66,9 +66,61 @@ pub fn not_seen(named: &[&str]) -> Vec<NotSeen> {
         .collect()
 }
 
+/// Effects whose first parameter is a size, zero when absent (a scale, a delay, a σ, an
+/// amplitude), so that a fit can be set against the size at the detection limit. Not the
+/// clip level, the output step, the cutoff or the dropouts, whose parameters are not.
+const SIZED: &[&str] = &[
+    "scale_factor",
+    "scale_asymmetry",
+    "nonlinearity",
+    "nonlinearity_even",
+    "latency",
+    "clock_error",
+    "clock_error_count_stamped",
+    "temperature_bias",
+    "temperature_scale",
+    "bias_instability",
+    "rate_random_walk",
+    "turn_on_bias",
+    "vibration",
+];
+
+/// True when the whole 95% interval `ci95` of `effect`'s first parameter (both ends
+/// bounded) lies under `share` of the size at the effect's detection limit ([`limit`]),
+/// either sign: what it could be is too small to tell on runs like the self-check's
+/// (`fit.negligible_limit_share`). False for an effect without a sized parameter or a
+/// limit.
+pub fn below_limit(effect: &Effect, ci95: &[(Option<f64>, Option<f64>)], share: f64) -> bool {
+    if !SIZED.contains(&effect.id()) {
+        return false;
+    }
+    let (Some(Some(at_limit)), Some((Some(lo), Some(hi)))) = (limit(effect.id()), ci95.first())
+    else {
+        return false;
+    };
+    let Some(size) = at_limit.params().first().map(|p| p.abs()) else {
+        return false;
+    };
+    let bound = share * size;
+    bound > 0.0 && lo.abs() < bound && hi.abs() < bound
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A turn-on bias of σ 0.0023 [0.0011, 0.0089] °/s beside a bias instability is far
+    /// under a tenth of its limit (σ 0.3 °/s); one whose interval reaches 0.05 is not; an
+    /// output step is never sized.
+    #[test]
+    fn an_interval_far_under_the_limit_is_negligible() {
+        let turn_on = Effect::TurnOnBias { sigma_dps: 0.0023 };
+        assert!(below_limit(&turn_on, &[(Some(0.0011), Some(0.0089))], 0.1));
+        assert!(!below_limit(&turn_on, &[(Some(0.0011), Some(0.05))], 0.1));
+        assert!(!below_limit(&turn_on, &[(Some(0.0011), None)], 0.1));
+        let step = Effect::Quantization { lsb_dps: 0.001 };
+        assert!(!below_limit(&step, &[(Some(0.001), Some(0.001))], 0.1));
+    }
 
     #[test]
     fn every_effect_has_a_limit_inside_its_range() {

@@ -574,12 +574,14 @@ fn prior_wander(
             (true, _) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, against {k:.3e} fitted to the training residual (a larger wander is the vocabulary's to name)"),
             (false, true) => format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, against the bound the training residual allows ({k:.3e}): kept"),
             (false, false) => {
-                // A prior that wanders more than the runs allow is not this sensor's:
-                // its σ comes down to the bound (never up: a larger wander is an effect
-                // to name), so that a quiet sensor's own wander is its model's.
+                // A prior that wanders more than the runs allow is not this sensor's: it
+                // is set aside (σ 0), and the wander the runs do show is the vocabulary's
+                // to name by its shape (`bias_instability`, `rate_random_walk`). Lowered
+                // to the bound instead, it would hold that wander before any candidate is
+                // tried: a 45 °/h bias instability at the CRM100's noise went unnamed.
                 let sigma_prior = model.gm_sigma_dps;
-                model.gm_sigma_dps *= k / k_prior;
-                format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, and the training residual allows at most {k:.3e}, under {floor} of it: the prior's wander is larger than these runs show, so its sigma is lowered from {sigma_prior} to {:.4} deg/s, at that bound", model.gm_sigma_dps)
+                model.gm_sigma_dps = 0.0;
+                format!("K {k_prior:.3e} deg/s/sqrt(s) at tau = 3 s, and the training residual allows at most {k:.3e}, under {floor} of it: the prior's wander is larger than these runs show, so it is set aside (sigma {sigma_prior} -> 0 deg/s) and what wander the runs show is for the vocabulary to name")
             }
         };
         wander.push_str("; its wander: ");

@@ -727,15 +727,33 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
             .map(|&i| candidates[i].fit.effect)
             .collect();
         // Not refitted, a latency whose interval lies under a tenth of a sample either way
-        // is as good as absent too ([`fit::negligible`]).
-        let negligible_delay = scorer.options.settings.fit.negligible_delay_samples;
+        // is as good as absent too ([`fit::negligible`]); and so, beside another effect,
+        // is one whose interval lies far under its detection limit
+        // ([`crate::detection::below_limit`]: a turn-on bias of σ 0.0023 °/s beside a bias
+        // instability, an even nonlinearity named at 6.8e-8 /(°/s) at its nearest bound).
+        let fit_settings = &scorer.options.settings.fit;
+        let negligible_delay = fit_settings.negligible_delay_samples;
+        let beside_another = selection.selected.len() > 1;
+        let tiny = |f: &Fit| {
+            beside_another
+                && crate::detection::below_limit(
+                    &f.effect,
+                    &f.ci95,
+                    fit_settings.negligible_limit_share,
+                )
+        };
         let absent = selection
             .selected
             .iter()
             .zip(scorer.joint.fits(&set))
             .find(|(&i, refit)| match refit {
-                Some(f) => fit::interval_holds_absence(f, scorer.nominal(), negligible_delay),
-                None => fit::negligible(&candidates[i].fit, scorer.nominal(), negligible_delay),
+                Some(f) => {
+                    fit::interval_holds_absence(f, scorer.nominal(), negligible_delay) || tiny(f)
+                }
+                None => {
+                    fit::negligible(&candidates[i].fit, scorer.nominal(), negligible_delay)
+                        || tiny(&candidates[i].fit)
+                }
             })
             .map(|(&i, _)| i);
         if let Some(i) = absent {

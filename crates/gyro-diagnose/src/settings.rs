@@ -113,6 +113,12 @@ pub struct Fit {
     /// sample by more than that share of its step. Unit samples, valid [0, 1]. 0.1: below
     /// what the log's timing resolves.
     pub negligible_delay_samples: f64,
+    /// An effect whose whole 95% interval lies under this share of its detection limit
+    /// (`gyro_diagnose::detection`, the self-check's matrix) is negligible: what it could be
+    /// is too small to tell on runs like the self-check's, so it is not named beside what
+    /// is. Unit 1, valid [0, 1]. 0.1: the smallest magnitudes of the matrix's ranges lie at
+    /// a quarter of their limits or above.
+    pub negligible_limit_share: f64,
     /// Share of the null's chi-square above which the real runs' scatter of a regression
     /// coefficient is larger than the null's, and its own error is used. Unit 1, valid
     /// (0, 1). 0.99: one-sided 1%.
@@ -121,9 +127,10 @@ pub struct Fit {
     /// wander statistic for a wander to pass. Unit 1, valid [1, 10⁶]. 3.0: the sampling
     /// spread of a 16 s Allan variance from five one-minute runs (about 15 windows).
     pub wander_overshoot: f64,
-    /// The prior's Gauss-Markov wander is lowered to the bound the training residual
-    /// allows when that bound (its random walk coefficient at τ = 3 s) is under this
-    /// share of the prior's; never raised (a larger wander is an effect to name). Unit 1,
+    /// The prior's Gauss-Markov wander is set aside (σ 0) when the bound the training
+    /// residual allows (its random walk coefficient at τ = 3 s) is under this share of the
+    /// prior's: the wander the runs do show is then the vocabulary's to name; never raised
+    /// (a larger wander is an effect to name). Unit 1,
     /// valid (0, 1]. 0.5: a bound that close to the prior is the prior's own wander drawn
     /// low in five one-minute runs, not a quieter sensor (nearer 1, a null case of the
     /// self-check names a random walk).
@@ -390,6 +397,7 @@ impl Settings {
             white_check_min: 0.1,
             min_white_check_diffs: 20,
             negligible_delay_samples: 0.1,
+            negligible_limit_share: 0.1,
             scatter_p: 0.99,
             wander_overshoot: 3.0,
             wander_prior_floor: 0.5,
@@ -487,12 +495,14 @@ impl Settings {
                 "fewest block differences for the whiteness check"),
             entry("fit.negligible_delay_samples", f.negligible_delay_samples, "samples", (CLOSED, 0.0, 1.0, CLOSED),
                 "a delay under this share of a sample period is negligible"),
+            entry("fit.negligible_limit_share", f.negligible_limit_share, "1", (CLOSED, 0.0, 1.0, CLOSED),
+                "an effect whose 95% interval lies under this share of its detection limit is negligible"),
             entry("fit.scatter_p", f.scatter_p, "1", (OPEN, 0.0, 1.0, OPEN),
                 "null chi-square share above which the runs' own scatter of a coefficient is used: one-sided 1%"),
             entry("fit.wander_overshoot", f.wander_overshoot, "1", (CLOSED, 1.0, 1e6, CLOSED),
                 "largest fitted-over-real Allan variance of a wander at any τ: the spread of a 16 s Allan variance from five one-minute runs"),
             entry("fit.wander_prior_floor", f.wander_prior_floor, "1", (OPEN, 0.0, 1.0, CLOSED),
-                "the prior's wander comes down to the runs' bound when that is under this share of it"),
+                "the prior's wander is set aside when the runs' bound is under this share of it"),
             entry("fit.gain_ratio_max", f.gain_ratio_max, "1", (OPEN, 1.0, 1e6, CLOSED),
                 "a regression effect's simulated gain is used within (1/r, r)"),
             entry("fit.wander_gain_ratio_max", f.wander_gain_ratio_max, "1", (OPEN, 1.0, 1e6, CLOSED),
