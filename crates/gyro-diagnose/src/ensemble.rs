@@ -158,8 +158,13 @@ impl RealRun {
         stats.extend(feature_stats(&features));
         let fs = log.sample_rate_hz;
         let reference: Vec<f64> = filled_reference(&log);
+        // The reference was read when each sample was taken: by the stamps' clock, a
+        // true one, the motion runs at the sample clock's rate, not the declared one
+        // (else a re-simulation with the clock error would speed it up a second time).
+        let clock = StampedClock::of(&log);
+        let motion_fs = clock.map_or(fs, |c| fs * (1.0 + c.ppm * 1e-6));
         let (motion, reference_grid) =
-            motion_from_reference_with(&reference, fs, &settings.reference);
+            motion_from_reference_with(&reference, motion_fs, &settings.reference);
         let temperature_c = log.has_temperature.then(|| {
             log.slots
                 .iter()
@@ -190,7 +195,7 @@ impl RealRun {
                 .count() as u64
                 + u64::from(log.slots.first().is_some_and(|s| s.filled)),
             filled_slots: log.slots.iter().filter(|s| s.filled).count() as u64,
-            clock: StampedClock::of(&log),
+            clock,
             log,
             statistics: settings.statistics,
             reference_settings: settings.reference,
@@ -232,7 +237,7 @@ pub struct ReferenceGrid {
     /// What made it: an encoder's counts, or a print's decimals.
     pub kind: GridKind,
     /// Half width of the smoothing before the re-simulated rate is taken (s): an
-    /// encoder's moving average, a print's cubic smoothing.
+    /// encoder's moving average, a print's quintic smoothing.
     pub smoothing_half_width_s: f64,
 }
 
@@ -483,7 +488,9 @@ pub fn simulate_residuals(
         fill_gaps(&mut s.rate_dps);
     }
     let fs = run.sample_rate_hz;
-    let time: Vec<f64> = (0..n).map(|k| k as f64 / fs).collect();
+    // Stamped as the real run's are (a logger-stamped clock error drifts from k / fs).
+    let period_s = gyro_sim::stamp_period_s(effects, fs);
+    let time: Vec<f64> = (0..n).map(|k| k as f64 * period_s).collect();
     let temperature = if run.temperature_c.is_some() {
         s.temperature_c
     } else {
@@ -731,11 +738,66 @@ mod tests {
             / 19_800.0)
             .sqrt();
         assert!(plain_rms > 0.2, "plain rms {plain_rms}");
-        // The angle is the printed one, rounding and all.
-        assert!(
-            (motion.angle_deg(0.0123) - (printed[12] + 0.3 * (printed[13] - printed[12]))).abs()
-                < 1e-12
+        // The angle at the samples is the printed one, rounding and all.
+        for k in [12, 13, 4567] {
+            let at = motion.angle_deg(k as f64 / fs);
+            assert!((at - (printed[k] - printed[0])).abs() < 1e-9, "{k}: {at}");
+        }
+    }
+
+    /// A gyro whose clock runs 3% fast, its rows stamped by the logger at their true
+    /// times: the run's motion is read in true time (its stamps' clock), so the
+    /// re-simulation with that clock error samples it where the real gyro did, and its
+    /// moving residual (3% of the rate, as the reference's difference is taken over the
+    /// nominal period) is the real one's, sample for sample; without the clock it is not.
+    #[test]
+    fn a_logger_stamped_clock_re_simulates_where_the_gyro_sampled() {
+        let fs = 100.0;
+        let model = SensorModel {
+            sample_rate_hz: fs,
+            range_dps: 1000.0,
+            ..SensorModel::default()
+        }
+        .noise_free();
+        let profile = gyro_sim::BenchProfile {
+            duration_s: 60.0,
+            ..Default::default()
+        };
+        let motion = Motion::bench(&profile, 5);
+        let fast = [Effect::ClockError { ppm: 30_000.0 }];
+        let sim = gyro_sim::simulate(&model, &fast, &motion, &SimOptions::default());
+        let log = gyro_log::RegularLog::with_reference(
+            fs,
+            sim.rows.iter().map(|r| {
+                (
+                    r.time_s,
+                    r.rate_dps.unwrap_or(f64::NAN),
+                    r.reference_deg.unwrap_or(0.0),
+                )
+            }),
         );
+        let run = RealRun::prepare("fast".into(), log).unwrap();
+        let ppm = run.clock.map(|c| c.ppm).unwrap_or(f64::NAN);
+        assert!((ppm - 30_000.0).abs() < 1.0, "stamped clock {ppm} ppm");
+        let real = residuals(&run.log, &run.statistics).unwrap();
+        let moving_rms = |a: &Residuals, b: Option<&Residuals>| {
+            let d: Vec<f64> = (0..a.residual_dps.len())
+                .filter(|&i| !a.is_static[i] && a.residual_dps[i].is_finite())
+                .map(|i| a.residual_dps[i] - b.map_or(0.0, |b| b.residual_dps[i]))
+                .collect();
+            (d.iter().map(|v| v * v).sum::<f64>() / d.len() as f64).sqrt()
+        };
+        let with_clock = simulate_residuals(&run, &model, &fast, 1).unwrap();
+        let nominal = simulate_residuals(&run, &model, &[], 1).unwrap();
+        assert_eq!(with_clock.residual_dps.len(), real.residual_dps.len());
+        let (spread, off, off_nominal) = (
+            moving_rms(&real, None),
+            moving_rms(&real, Some(&with_clock)),
+            moving_rms(&real, Some(&nominal)),
+        );
+        assert!(spread > 1.0, "the clock's residual {spread} deg/s rms");
+        assert!(off < 0.01 * spread, "{off} of {spread} deg/s rms");
+        assert!(off_nominal > 0.5 * spread, "nominal {off_nominal}");
     }
 
     /// The moving residual's spread of a nominal CRM100 bench run at 1 kHz whose reference

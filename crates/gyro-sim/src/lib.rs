@@ -24,8 +24,9 @@ pub use effects::{
     Regressor, WanderShape, EFFECTS, LOW_PASS_POLE_RATIO,
 };
 pub use low_pass::TwoPoleLowPass;
-pub use motion::{rounding_noise_dps, BenchProfile, Motion, Rotation};
+pub use motion::{rounding_noise_dps, AccelerationStep, BenchProfile, Motion, Rotation};
 pub use sensor::{
-    check_size, output_step_dps, sample_count, simulate, simulate_series, InvalidSensorModel,
-    SensorModel, SimOptions, SimSeries, TooManySamples, BYTES_PER_SAMPLE, MAX_SAMPLES,
+    check_size, output_step_dps, sample_count, simulate, simulate_series, stamp_period_s,
+    InvalidSensorModel, SensorModel, SimOptions, SimSeries, TooManySamples, BYTES_PER_SAMPLE,
+    MAX_SAMPLES,
 };

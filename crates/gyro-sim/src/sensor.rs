@@ -249,6 +249,20 @@ pub fn output_step_dps(model_lsb_dps: f64, effect_lsb_dps: f64) -> f64 {
     }
 }
 
+/// The period (s) between the time stamps of the samples of a sensor at `fs` Hz with
+/// `effects`: samples are stamped when they are taken, by the logger's (accurate) clock,
+/// so a sensor clock error ([`Effect::ClockError`]) shows as stamps that drift from the
+/// nominal `k / fs`; `1 / fs` otherwise (a clock stamped by the sensor's own count keeps
+/// the nominal grid).
+pub fn stamp_period_s(effects: &[Effect], fs: f64) -> f64 {
+    let clock = 1.0 + SimTerms::of(effects).clock_ppm * 1e-6;
+    if clock == 1.0 {
+        1.0 / fs
+    } else {
+        1.0 / (fs * clock)
+    }
+}
+
 /// Simulate a log of `motion` as seen by `model` with `effects`.
 pub fn simulate(
     model: &SensorModel,
@@ -258,19 +272,17 @@ pub fn simulate(
 ) -> Log {
     let series = simulate_series(model, effects, motion, options, None);
     let fs = series.sample_rate_hz;
-    // Samples are stamped when they are taken, by the logger's (accurate) clock: a
-    // sensor clock error shows as stamps that drift from the nominal k / fs.
-    let clock = 1.0 + SimTerms::of(effects).clock_ppm * 1e-6;
+    let period_s = stamp_period_s(effects, fs);
     // Rounded to what a logger would keep (and what reads back short from CSV).
     let round = |x: f64, step: f64| (x / step).round() * step;
     let rows = (0..series.rate_dps.len())
         .filter(|&k| series.rate_dps[k].is_finite())
         .map(|k| Row {
             line: 0,
-            time_s: if clock == 1.0 {
+            time_s: if period_s == 1.0 / fs {
                 k as f64 / fs
             } else {
-                round(k as f64 / (fs * clock), 1e-9)
+                round(k as f64 * period_s, 1e-9)
             },
             rate_dps: Some(round(series.rate_dps[k], 1e-6)),
             reference_deg: Some(round(series.reference_deg[k], 1e-6)),
@@ -312,13 +324,17 @@ pub fn simulate_series(
 ) -> SimSeries {
     let fs = model.sample_rate_hz;
     let dt = 1.0 / fs;
-    // A slow sample clock (either stamping) reaches the motion's end before the nominal
-    // count: the samples past it would read a held reference beside a held rate.
-    let slowest_clock = {
+    // The samples taken within the motion: a sample clock fast by ε takes 1 + ε times the
+    // nominal count in its time. Stamped by its own count, the rows' reference is read
+    // on the nominal grid, and a slow clock's gyro reaches the motion's end first (the
+    // samples past it would read a held reference beside a held rate).
+    let reach = {
         let terms = SimTerms::of(effects);
-        ((1.0 + terms.clock_ppm * 1e-6) * (1.0 + terms.count_clock_ppm * 1e-6)).min(1.0)
+        (1.0 + terms.clock_ppm * 1e-6) * (1.0 + terms.count_clock_ppm * 1e-6).min(1.0)
     };
-    let n = (motion.duration_s() * fs * slowest_clock).floor() as usize + 1;
+    // (A millionth of a sample spared: a motion read from a log at its stamps' clock ends
+    // on a sample that rounding would otherwise drop.)
+    let n = (motion.duration_s() * fs * reach + 1e-6).floor() as usize + 1;
 
     // Effect terms (identity unless present).
     let mut sensor = SimSensor::new(model, SimTerms::of(effects), motion, options.seed);
@@ -634,6 +650,36 @@ mod tests {
                 "{effect:?}: the reference stops moving ({step} deg)"
             );
         }
+    }
+
+    /// A fast sample clock takes more samples within the motion: stamped by the logger,
+    /// the rows of a 10 s motion at 100 Hz with a clock 3% fast are 1 031, their stamps
+    /// reach the motion's end and no further, and the last reference still moves.
+    #[test]
+    fn a_fast_clock_takes_more_samples_within_the_motion() {
+        let fs = 100.0;
+        let angles: Vec<f64> = (0..1001).map(|k| 50.0 * k as f64 / fs).collect();
+        let motion = Motion::from_reference(0.0, 1.0 / fs, &angles, 1);
+        let model = SensorModel {
+            sample_rate_hz: fs,
+            bias_dps: 0.0,
+            ..SensorModel::default()
+        }
+        .noise_free();
+        let fast = [Effect::ClockError { ppm: 30_000.0 }];
+        assert_eq!(stamp_period_s(&fast, fs), 1.0 / (fs * 1.03));
+        assert_eq!(stamp_period_s(&[], fs), 1.0 / fs);
+        let log = simulate(&model, &fast, &motion, &SimOptions::default());
+        assert_eq!(log.rows.len(), 1031);
+        let last = &log.rows[log.rows.len() - 1];
+        assert!(
+            last.time_s <= 10.0 && last.time_s > 10.0 - 1.0 / fs,
+            "{}",
+            last.time_s
+        );
+        let before = &log.rows[log.rows.len() - 2];
+        let moved = last.reference_deg.unwrap_or(0.0) - before.reference_deg.unwrap_or(0.0);
+        assert!(moved > 0.4, "the reference stops moving ({moved} deg)");
     }
 
     /// A coarse output step replaces the model's: at rest, with a bias of 0.2 °/s (where

@@ -32,7 +32,7 @@ pub struct Args {
     at_rest: bool,
     /// Re-simulate the motion of this log's `reference_deg` instead of generating motion
     /// (as `diagnose` re-simulates a run: smoothed over 20 ms when the reference is an
-    /// encoder's, the rate through a cubic smoothing when it is printed with few decimals,
+    /// encoder's, the rate through a quintic smoothing when it is printed with few decimals,
     /// one-sided beside a step of the acceleration).
     #[arg(long)]
     motion_from: Option<PathBuf>,

@@ -678,7 +678,7 @@ pub fn reference_grid_lines(runs: &[gyro_diagnose::RunSummary]) -> Vec<String> {
                     "the reference of {n} of {total} runs lies on an encoder's grid of {step} deg: the re-simulation takes the motion's rate over a ±{half_ms:.0} ms moving average and rounds its own reference to the grid"
                 ),
                 GridKind::Print => format!(
-                    "the reference of {n} of {total} runs is printed to {step} deg: the re-simulation keeps that rounding in the reference and out of the gyro's rate (a cubic smoothing of ±{half_ms:.0} ms), as the real gyro never saw it"
+                    "the reference of {n} of {total} runs is printed to {step} deg: the re-simulation keeps that rounding in the reference and out of the gyro's rate (a quintic smoothing of ±{half_ms:.0} ms), as the real gyro never saw it"
                 ),
             })
         })
