@@ -1,6 +1,7 @@
 //! The causal `run` and `run --offline` beside the per-rest mean on the bench kinds of
 //! [`gyro_analysis::rest_mean::bench`], one kind per line: the median over runs of the max
-//! |accumulated angle error| at mid-rest as a ratio to the per-rest mean's; the median |error|
+//! |accumulated angle error| at mid-rest as a ratio to the per-rest mean's (and that of an
+//! estimate that knows the bias exactly, the floor of any); the median |error|
 //! of each movement's own angle (causal, offline, per-rest mean); how often the 95% interval
 //! (1.96 σ) covers the true angle, offline and causal.
 //!
@@ -15,18 +16,19 @@ fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
     let first_seed: u64 = std::env::args().nth(2).map_or(Ok(1), |a| a.parse())?;
     let config = Config::default();
     println!("seeds {first_seed}..{}", first_seed + runs - 1);
-    println!("| kind | causal / rest mean | offline / rest mean | movement: causal | offline | rest mean | 95% covers: offline | causal |");
-    println!("|---|---|---|---|---|---|---|---|");
-    let (mut causal, mut offline) = (vec![], vec![]);
+    println!("| kind | causal / rest mean | offline / rest mean | bias known / rest mean | movement: causal | offline | rest mean | 95% covers: offline | causal |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let (mut causal, mut offline, mut known) = (vec![], vec![], vec![]);
     let (mut cover_o, mut cover_c) = ((0, 0), (0, 0));
     for kind in bench_kinds() {
         let s = score_kind(&kind, &config, first_seed..first_seed + runs)?;
         let pct = |c: (usize, usize)| 100.0 * c.0 as f64 / c.1.max(1) as f64;
         println!(
-            "| {} | {:.2} | {:.2} | {:.4}° | {:.4}° | {:.4}° | {:.1}% | {:.1}% |",
+            "| {} | {:.2} | {:.2} | {:.2} | {:.4}° | {:.4}° | {:.4}° | {:.1}% | {:.1}% |",
             kind.name,
             s.causal_ratio(),
             s.offline_ratio(),
+            s.bias_known_ratio(),
             s.movement_deg[0],
             s.movement_deg[1],
             s.movement_deg[2],
@@ -35,6 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
         );
         causal.push(s.causal_ratio());
         offline.push(s.offline_ratio());
+        known.push(s.bias_known_ratio());
         cover_o = (
             cover_o.0 + s.offline_covered.0,
             cover_o.1 + s.offline_covered.1,
@@ -45,10 +48,11 @@ fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
         );
     }
     println!(
-        "geometric mean: causal {:.2} (worst {:.2}), offline {:.2}; 95% covers offline {:.1}%, causal {:.1}% of {} movements",
+        "geometric mean: causal {:.2} (worst {:.2}), offline {:.2}, bias known {:.2}; 95% covers offline {:.1}%, causal {:.1}% of {} movements",
         geometric_mean(causal.iter().copied()),
         causal.iter().copied().fold(0.0, f64::max),
         geometric_mean(offline.iter().copied()),
+        geometric_mean(known.iter().copied()),
         100.0 * cover_o.0 as f64 / cover_o.1.max(1) as f64,
         100.0 * cover_c.0 as f64 / cover_c.1.max(1) as f64,
         cover_o.1,

@@ -30,13 +30,26 @@ pub struct Rest {
 /// and including the first slot of rest `i + 1`, where `mean_i` is the mean rate over rest
 /// `i`. Rests must be in order and within `rates_dps`.
 pub fn per_rest_angles(rates_dps: &[f64], period_s: f64, rests: &[Rest]) -> Vec<f64> {
+    rest_angles(rates_dps, period_s, rests, |quiet| {
+        quiet.iter().sum::<f64>() / quiet.len() as f64
+    })
+}
+
+/// [`per_rest_angles`] with the bias of each movement given by `bias_dps` from the rates
+/// of the rest before it: their mean for the per-rest estimator, zero for a bias known
+/// exactly on a run without one (the floor the white noise alone sets).
+pub fn rest_angles(
+    rates_dps: &[f64],
+    period_s: f64,
+    rests: &[Rest],
+    bias_dps: impl Fn(&[f64]) -> f64,
+) -> Vec<f64> {
     let mut angles = Vec::with_capacity(rests.len());
     let mut angle_deg = 0.0;
     for (i, rest) in rests.iter().enumerate() {
         if i > 0 {
             let before = rests[i - 1];
-            let quiet = &rates_dps[before.start..=before.end];
-            let mean_dps = quiet.iter().sum::<f64>() / quiet.len() as f64;
+            let mean_dps = bias_dps(&rates_dps[before.start..=before.end]);
             angle_deg += rates_dps[before.end + 1..=rest.start]
                 .iter()
                 .map(|r| (r - mean_dps) * period_s)
@@ -67,6 +80,11 @@ mod tests {
             Rest { start: 7, end: 7 },
         ];
         assert_eq!(per_rest_angles(&rates, 1.0, &rests), vec![0.0, 10.5, 5.5]);
+        // A bias known to be zero keeps the whole rate of the movements.
+        assert_eq!(
+            rest_angles(&rates, 1.0, &rests, |_| 0.0),
+            vec![0.0, 12.0, 9.0]
+        );
     }
 }
 

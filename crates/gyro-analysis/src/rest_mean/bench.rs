@@ -123,6 +123,11 @@ pub struct KindScore {
     pub offline_covered: (usize, usize),
     /// Movements whose causal 95% interval covers the truth, of how many.
     pub causal_covered: (usize, usize),
+    /// Median over runs of the max |accumulated error| at mid-rest (deg) of an estimate
+    /// that knows the bias exactly and that the rests are still: the same runs' white
+    /// noise (and the kind's output step) integrated over the movements alone, what no
+    /// estimate of the bias removes ([`bias_known_max_deg`]).
+    pub bias_known_deg: f64,
 }
 
 impl KindScore {
@@ -135,6 +140,48 @@ impl KindScore {
     pub fn offline_ratio(&self) -> f64 {
         self.offline_deg / self.rest_mean_deg
     }
+
+    /// The bias known exactly, over the per-rest mean: the floor of any estimate's ratio.
+    pub fn bias_known_ratio(&self) -> f64 {
+        self.bias_known_deg / self.rest_mean_deg
+    }
+}
+
+/// The max |accumulated angle error| at mid-rest (deg) of run `seed` of `kind` for an
+/// estimate that knows the bias exactly: the run simulated again with no bias, no wander
+/// and no bias effect (the same seed draws the same white noise and the same motion; the
+/// kind's output step is kept), its movements integrated with a bias of zero.
+pub fn bias_known_max_deg(
+    kind: &BenchKind,
+    seed: u64,
+) -> Result<f64, Box<dyn std::error::Error + Send + Sync>> {
+    let sensor = SensorModel {
+        bias_dps: 0.0,
+        gm_sigma_dps: 0.0,
+        ..kind.sensor
+    };
+    let steps = kind
+        .effects
+        .iter()
+        .map(|s| Effect::parse(s))
+        .filter(|e| matches!(e, Ok(Effect::Quantization { .. })))
+        .collect::<Result<Vec<_>, _>>()?;
+    let run = simulate_bench_run(&sensor, &steps, seed)?;
+    let times_s: Vec<f64> = run.log.slots.iter().map(|s| s.time_s).collect();
+    let rates_dps: Vec<f64> = run.log.slots.iter().map(|s| s.rate_dps).collect();
+    let rests = super::rests_between(&run.rotations, &times_s);
+    let angles = super::rest_angles(&rates_dps, 1.0 / run.log.sample_rate_hz, &rests, |_| 0.0);
+    let reference = |rest: &super::Rest| {
+        run.log.slots[(rest.start + rest.end) / 2]
+            .reference_deg
+            .unwrap_or(f64::NAN)
+    };
+    let origin = rests.first().map_or(0.0, reference);
+    Ok(rests
+        .iter()
+        .zip(angles)
+        .map(|(rest, angle)| (angle - (reference(rest) - origin)).abs())
+        .fold(0.0, f64::max))
 }
 
 /// The crate's one median ([`crate::median`]), NaN for none.
@@ -157,7 +204,9 @@ pub fn score_kind(
     let (mut max_c, mut max_o, mut max_r) = (vec![], vec![], vec![]);
     let (mut mv_c, mut mv_o, mut mv_r) = (vec![], vec![], vec![]);
     let (mut cover_o, mut cover_c) = ((0, 0), (0, 0));
+    let mut known = vec![];
     for seed in seeds {
+        known.push(bias_known_max_deg(kind, seed)?);
         let run = simulate_bench_run(&kind.sensor, &effects, seed)?;
         let causal = replay_with_mode(&run.log, config, &options, Mode::Causal)?;
         let offline = replay_with_mode(&run.log, config, &options, Mode::Offline)?;
@@ -194,6 +243,7 @@ pub fn score_kind(
         movement_deg: [median(mv_c), median(mv_o), median(mv_r)],
         offline_covered: cover_o,
         causal_covered: cover_c,
+        bias_known_deg: median(known),
     })
 }
 
