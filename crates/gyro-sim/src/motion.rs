@@ -390,6 +390,9 @@ impl Samples<'_> {
             return first;
         }
         let (i, w) = locate(offset_s, self.period_s, n);
+        if let Some(k) = on_sample(i, w) {
+            return self.angle_deg[k];
+        }
         let ends = [self.angle_deg[i], self.angle_deg[i + 1]];
         let slope = |k: usize| self.rate_dps.get(k).copied().unwrap_or(0.0);
         match self.step_after(i) {
@@ -409,6 +412,9 @@ impl Samples<'_> {
         let (i, w) = locate(offset_s, self.period_s, n);
         if i + 1 >= n {
             return self.rate_dps[n - 1];
+        }
+        if let Some(k) = on_sample(i, w) {
+            return self.rate_dps[k];
         }
         let ends = [self.rate_dps[i], self.rate_dps[i + 1]];
         if let Some(step) = self.step_after(i) {
@@ -435,6 +441,20 @@ impl Samples<'_> {
             return 0.0;
         }
         (self.rate_dps[hi] - self.rate_dps[lo]) / (self.period_s * (hi - lo) as f64)
+    }
+}
+
+/// The sample that fraction `w` of the interval after sample `i` falls on, within 10⁻⁹ of
+/// a period (a simulation on the trajectory's own grid reads its samples; every interpolant
+/// here is exact there).
+fn on_sample(i: usize, w: f64) -> Option<usize> {
+    const ON_SAMPLE: f64 = 1e-9;
+    if w < ON_SAMPLE {
+        Some(i)
+    } else if w > 1.0 - ON_SAMPLE {
+        Some(i + 1)
+    } else {
+        None
     }
 }
 
