@@ -101,10 +101,17 @@ pub(crate) fn within_reference(
             let mut log = run.log.clone();
             let keep = ((log.slots.len().saturating_sub(1)) as f64 * keep_share).floor() as usize + 1;
             log.slots.truncate(keep);
-            RealRun::prepare_with(run.name.clone(), log, &run.settings()).map_err(|e| crate::DiagnoseError::Run {
-                name: run.name.clone(),
-                message: format!("shortened to where its reference reaches under a count-stamped clock {ppm:.0} ppm slow: {e}"),
-            })
+            RealRun::prepare_with(run.name.clone(), log, &run.settings())
+                .map(|mut shortened| {
+                    // The kept rows' gyro reads the motion up to the reference's end: the
+                    // whole run's motion, which the re-simulation samples as the clock does.
+                    shortened.motion = run.motion.clone();
+                    shortened
+                })
+                .map_err(|e| crate::DiagnoseError::Run {
+                    name: run.name.clone(),
+                    message: format!("shortened to where its reference reaches under a count-stamped clock {ppm:.0} ppm slow: {e}"),
+                })
         })
         .collect()
 }
