@@ -421,20 +421,26 @@ impl Samples<'_> {
             let per_sample = ends.map(|r| r * self.period_s);
             return across_step(step, w, per_sample, 1) / self.period_s;
         }
+        // No step lies between samples i and i + 1 here: only the intervals beyond them
+        // can hold one.
+        let before = i > 0 && self.step_after(i - 1).is_some();
+        let after = self.step_after(i + 1).is_some();
         hermite(
             ends,
-            [self.acceleration(i), self.acceleration(i + 1)],
+            [
+                self.acceleration(i, before, false),
+                self.acceleration(i + 1, false, after),
+            ],
             self.period_s,
             w,
         )
     }
 
     /// The acceleration at sample `k`: the difference of the rates centred on it, or on
-    /// its own side of an acceleration step beside it (one-sided at the ends).
-    fn acceleration(&self, k: usize) -> f64 {
+    /// its own side of an acceleration step just before it (`step_before`) or just after
+    /// it (`step_after`) (one-sided at the ends).
+    fn acceleration(&self, k: usize, step_before: bool, step_after: bool) -> f64 {
         let n = self.rate_dps.len();
-        let step_before = k > 0 && self.step_after(k - 1).is_some();
-        let step_after = self.step_after(k).is_some();
         let lo = if step_before { k } else { k.saturating_sub(1) };
         let hi = if step_after { k } else { (k + 1).min(n - 1) };
         if hi == lo {
@@ -911,16 +917,7 @@ mod tests {
         ];
         let (mut angle, mut rate) = (Vec::new(), Vec::new());
         for k in 0..800 {
-            let t = k as f64 / fs;
-            let (mut a, mut r) = (0.0, 0.0);
-            for &(start, d, turn) in &turns {
-                let x = ((t - start) / d).clamp(0.0, 1.0);
-                a += turn * (1.0 - (std::f64::consts::PI * x).cos()) / 2.0;
-                if t > start && t < start + d {
-                    r += turn * std::f64::consts::PI / (2.0 * d)
-                        * (std::f64::consts::PI * (t - start) / d).sin();
-                }
-            }
+            let (a, r) = turns_at(&turns, k as f64 / fs);
             angle.push(if round_deg > 0.0 {
                 (a / round_deg).round() * round_deg
             } else {
@@ -991,6 +988,42 @@ mod tests {
         }
     }
 
+    /// `count` turns (start s, duration s, angle deg) of alternating sign, the `i`-th
+    /// starting at `start.0 + i·start.1`, lasting `duration.0 + i·duration.1` and turning by
+    /// `angle.0 + i·angle.1` degrees.
+    fn alternating_turns(
+        count: i32,
+        start: (f64, f64),
+        duration: (f64, f64),
+        angle: (f64, f64),
+    ) -> Vec<(f64, f64, f64)> {
+        (0..count)
+            .map(|i| {
+                let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+                let i = f64::from(i);
+                (
+                    start.0 + start.1 * i,
+                    duration.0 + duration.1 * i,
+                    sign * (angle.0 + angle.1 * i),
+                )
+            })
+            .collect()
+    }
+
+    /// The exact angle (deg) and rate (deg/s) at `t` of raised-cosine `turns`, whose
+    /// acceleration steps where each starts and ends.
+    fn turns_at(turns: &[(f64, f64, f64)], t: f64) -> (f64, f64) {
+        let pi = std::f64::consts::PI;
+        let (mut a, mut r) = (0.0, 0.0);
+        for &(start, d, turn) in turns {
+            a += turn * (1.0 - (pi * ((t - start) / d).clamp(0.0, 1.0)).cos()) / 2.0;
+            if t > start && t < start + d {
+                r += turn * pi / (2.0 * d) * (pi * (t - start) / d).sin();
+            }
+        }
+        (a, r)
+    }
+
     /// Beside the acceleration steps of raised-cosine turns printed to 0.001° at 100 Hz,
     /// the re-simulated rate of a print ([`Motion::from_rounded_reference`], half width 4)
     /// is within 0.05 °/s rms of the exact rate; the four-point derivative there carries
@@ -998,25 +1031,11 @@ mod tests {
     #[test]
     fn one_sided_rate_of_a_print_averages_its_rounding() {
         let (fs, step, half_width) = (100.0, 0.001, 4);
-        let pi = std::f64::consts::PI;
-        let turns: Vec<(f64, f64, f64)> = (0..24)
-            .map(|i| {
-                let i = f64::from(i);
-                let sign = if i % 2.0 == 0.0 { 1.0 } else { -1.0 };
-                (1.0 + 2.6137 * i, 0.6 + 0.035 * i, sign * (45.0 + 3.9 * i))
-            })
-            .collect();
+        let turns = alternating_turns(24, (1.0, 2.6137), (0.6, 0.035), (45.0, 3.9));
         let n = 6500;
         let (mut printed, mut rate) = (Vec::new(), Vec::new());
         for k in 0..n {
-            let t = k as f64 / fs;
-            let (mut a, mut r) = (0.0, 0.0);
-            for &(start, d, turn) in &turns {
-                a += turn * (1.0 - (pi * ((t - start) / d).clamp(0.0, 1.0)).cos()) / 2.0;
-                if t > start && t < start + d {
-                    r += turn * pi / (2.0 * d) * (pi * (t - start) / d).sin();
-                }
-            }
+            let (a, r) = turns_at(&turns, k as f64 / fs);
             printed.push((a / step).round() * step);
             rate.push(r);
         }
@@ -1053,25 +1072,9 @@ mod tests {
     #[test]
     fn a_trajectory_read_between_samples_keeps_its_acceleration_steps() {
         let (fs, step, half_width) = (100.0, 0.001, 8);
-        let pi = std::f64::consts::PI;
         // Turns starting at every place within a sample interval.
-        let turns: Vec<(f64, f64, f64)> = (0..20)
-            .map(|i| {
-                let i = f64::from(i);
-                let sign = if i % 2.0 == 0.0 { 1.0 } else { -1.0 };
-                (1.0 + 2.3771 * i, 0.5 + 0.03 * i, sign * (60.0 + 3.7 * i))
-            })
-            .collect();
-        let exact = |t: f64| {
-            let (mut a, mut r) = (0.0, 0.0);
-            for &(start, d, turn) in &turns {
-                a += turn * (1.0 - (pi * ((t - start) / d).clamp(0.0, 1.0)).cos()) / 2.0;
-                if t > start && t < start + d {
-                    r += turn * pi / (2.0 * d) * (pi * (t - start) / d).sin();
-                }
-            }
-            (a, r)
-        };
+        let turns = alternating_turns(20, (1.0, 2.3771), (0.5, 0.03), (60.0, 3.7));
+        let exact = |t: f64| turns_at(&turns, t);
         let n = 5000;
         let printed: Vec<f64> = (0..n)
             .map(|k| (exact(k as f64 / fs).0 / step).round() * step)

@@ -623,11 +623,9 @@ impl<'a> SimTemperature<'a> {
 mod tests {
     use super::*;
 
-    /// A recorded trajectory re-simulated with a slow sample clock (either stamping)
-    /// ends where the motion ends: no sample reads the held last rate beside the held
-    /// last reference angle.
-    #[test]
-    fn a_slow_clock_stops_at_the_motions_end() {
+    /// A recorded trajectory of 10 s at 100 Hz turning at a steady 50 °/s (its sample rate,
+    /// angles and motion), and a noise-free sensor without bias at that rate.
+    fn steady_turn() -> (f64, Vec<f64>, Motion, SensorModel) {
         let fs = 100.0;
         let angles: Vec<f64> = (0..1001).map(|k| 50.0 * k as f64 / fs).collect();
         let motion = Motion::from_reference(0.0, 1.0 / fs, &angles, 1);
@@ -637,6 +635,15 @@ mod tests {
             ..SensorModel::default()
         }
         .noise_free();
+        (fs, angles, motion, model)
+    }
+
+    /// A recorded trajectory re-simulated with a slow sample clock (either stamping)
+    /// ends where the motion ends: no sample reads the held last rate beside the held
+    /// last reference angle.
+    #[test]
+    fn a_slow_clock_stops_at_the_motions_end() {
+        let (_, angles, motion, model) = steady_turn();
         for effect in [
             Effect::ClockError { ppm: -5000.0 },
             Effect::ClockErrorCountStamped { ppm: -5000.0 },
@@ -657,15 +664,7 @@ mod tests {
     /// reach the motion's end and no further, and the last reference still moves.
     #[test]
     fn a_fast_clock_takes_more_samples_within_the_motion() {
-        let fs = 100.0;
-        let angles: Vec<f64> = (0..1001).map(|k| 50.0 * k as f64 / fs).collect();
-        let motion = Motion::from_reference(0.0, 1.0 / fs, &angles, 1);
-        let model = SensorModel {
-            sample_rate_hz: fs,
-            bias_dps: 0.0,
-            ..SensorModel::default()
-        }
-        .noise_free();
+        let (fs, _, motion, model) = steady_turn();
         let fast = [Effect::ClockError { ppm: 30_000.0 }];
         assert_eq!(stamp_period_s(&fast, fs), 1.0 / (fs * 1.03));
         assert_eq!(stamp_period_s(&[], fs), 1.0 / fs);
