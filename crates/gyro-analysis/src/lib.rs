@@ -11,6 +11,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod bias_path;
 pub mod calibrate;
 pub mod findings;
 pub mod lag;

@@ -22,6 +22,7 @@ use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
 mod offline;
+use crate::bias_path::BiasPath;
 pub mod settings;
 
 pub use settings::{Resolved, RunSettings, SettingsError};
@@ -33,8 +34,8 @@ pub enum Mode {
     /// As the wrench does: each movement at its end, from the rests before it.
     #[default]
     Causal,
-    /// For a log analysed after the fact: each movement after the rest that follows it, so
-    /// that its bias comes from the rests on both sides ([`offline`]).
+    /// For a log analysed after the fact: each movement's bias from the rests of the whole
+    /// log on both sides, read in a first pass ([`crate::bias_path`]).
     Offline,
 }
 
@@ -311,13 +312,43 @@ pub fn replay_with_mode(
     options: &ReplayOptions,
     mode: Mode,
 ) -> Result<RunReport, gyro_core::Error> {
-    let mut replayer =
-        Replayer::new(log.sample_rate_hz, config, options, log.has_temperature)?.with_mode(mode);
+    let replayer = || -> Result<Replayer, gyro_core::Error> {
+        Ok(
+            Replayer::new(log.sample_rate_hz, config, options, log.has_temperature)?
+                .with_mode(mode),
+        )
+    };
+    let mut replayer = match mode {
+        Mode::Causal => replayer()?,
+        // A first pass reads the bias through the whole log from its rests.
+        Mode::Offline => {
+            let mut first = replayer()?;
+            replay_slots(&mut first, log, options, &mut ());
+            match first.finish_bias_path() {
+                Some(path) => replayer()?.with_bias_path(path),
+                None => replayer()?,
+            }
+        }
+    };
     let mut series = Vec::new();
+    replay_slots(&mut replayer, log, options, &mut series);
+    let mut report = replayer.finish_into(log.quality.clone(), &mut series);
+    report.series = series;
+    Ok(report)
+}
+
+/// Every slot of `log` through `replayer`, its outputs to `series`, the reference shifted
+/// as `options` say.
+fn replay_slots(
+    replayer: &mut Replayer,
+    log: &RegularLog,
+    options: &ReplayOptions,
+    series: &mut dyn SeriesSink,
+) {
     if !options.shifts_reference() {
         for slot in &log.slots {
             if let Some(point) = replayer.push(slot) {
-                replayer.emit(point, &mut series);
+                replayer.emit(point, series);
             }
         }
     } else {
@@ -327,13 +358,10 @@ pub fn replay_with_mode(
             let shift = options.shift_slots(i, log.sample_rate_hz);
             if let Some(point) = replayer.push_scored(slot, shifted_reference(&log.slots, i, shift))
             {
-                replayer.emit(point, &mut series);
+                replayer.emit(point, series);
             }
         }
     }
-    let mut report = replayer.finish_into(log.quality.clone(), &mut series);
-    report.series = series;
-    Ok(report)
 }
 
 /// Why [`replay_file`] failed.
@@ -464,8 +492,10 @@ pub fn replay_file_into(
     )
 }
 
-/// [`replay_file_into`] in `mode`. Offline, memory holds the outputs from a movement's
-/// start to the next one's ([`offline`]) besides what the causal replay holds.
+/// [`replay_file_into`] in `mode`. Offline, the file is read twice (the first pass reads
+/// the bias through the log from its rests, [`crate::bias_path`]), and memory holds the
+/// outputs from a movement's start to the next one's and three numbers per 0.2 s block of
+/// rest, besides what the causal replay holds.
 #[allow(clippy::too_many_arguments)]
 pub fn replay_file_into_mode(
     path: &Path,
@@ -493,12 +523,35 @@ pub fn replay_file_into_mode(
         }
         return Ok(report);
     }
+    // Offline, a first pass reads the bias through the whole log from its rests; the
+    // second replays the log with it (the file is read twice, memory does not grow).
+    let (bias_path, warn): (_, &mut dyn FnMut(&str)) = match mode {
+        Mode::Causal => (None, warn),
+        Mode::Offline => {
+            let mut first = ReplaySink {
+                config,
+                options: replay_options,
+                mode,
+                has_temperature: false,
+                replayer: None,
+                bias_path: None,
+                series: &mut (),
+            };
+            gyro_log::stream(path, options, grid, &mut first, warn)?;
+            let bias_path = match first.replayer {
+                Some(Ok(replayer)) => replayer.finish_bias_path(),
+                _ => None,
+            };
+            (bias_path, &mut |_: &str| {})
+        }
+    };
     let mut sink = ReplaySink {
         config,
         options: replay_options,
         mode,
         has_temperature: false,
         replayer: None,
+        bias_path,
         series,
     };
     let quality = gyro_log::stream(path, options, grid, &mut sink, warn)?;
@@ -530,6 +583,8 @@ struct ReplaySink<'c> {
     mode: Mode,
     has_temperature: bool,
     replayer: Option<Result<Replayer, gyro_core::Error>>,
+    /// Offline: the bias through the log from a first pass.
+    bias_path: Option<BiasPath>,
     series: &'c mut dyn SeriesSink,
 }
 
@@ -546,7 +601,13 @@ impl SlotSink for ReplaySink<'_> {
             self.options,
             self.has_temperature,
         )
-        .map(|r| r.with_mode(mode));
+        .map(|r| {
+            let r = r.with_mode(mode);
+            match self.bias_path.take() {
+                Some(path) => r.with_bias_path(path),
+                None => r,
+            }
+        });
         if let Ok(replayer) = &replayer {
             self.series.start(replayer.output_rate_hz);
         }
@@ -717,6 +778,27 @@ impl Replayer {
             Mode::Causal => series.point(&point),
             Mode::Offline => self.emit_smoothed(series),
         }
+    }
+
+    /// Offline, each movement's bias from `path`, the bias through the whole log that a first
+    /// pass gave ([`Replayer::finish_bias_path`]), in place of the causal filter's.
+    pub fn with_bias_path(mut self, path: BiasPath) -> Self {
+        if self.mode == Mode::Offline && self.config.compensation == gyro_core::Compensation::Kalman
+        {
+            self.smoother = std::mem::take(&mut self.smoother).with_path(path);
+        }
+        self
+    }
+
+    /// The end of a first offline pass: the bias through the log smoothed from its rests
+    /// ([`offline::Smoother::bias_path`]); `None` when causal or without a rest.
+    pub fn finish_bias_path(mut self) -> Option<BiasPath> {
+        if self.mode != Mode::Offline {
+            return None;
+        }
+        let smoothed = self.smoother.finish();
+        self.apply(smoothed);
+        self.smoother.bias_path()
     }
 
     /// Score the smoothed outputs made ready and give them to `series`.

@@ -347,8 +347,9 @@ pub fn run_arrays(
         })
     };
     let delay = replay_options.reference_delay_s;
-    let report = if delay.is_finite() && delay != 0.0 {
-        // The shifted reference needs the log whole, as `replay_file_into` does.
+    let report = if (delay.is_finite() && delay != 0.0) || mode == replay::Mode::Offline {
+        // The shifted reference needs the log whole, as `replay_file_into` does; offline
+        // replays it twice (the arrays are in memory already).
         let regular = arrays.regular(name, &options.grid)?;
         replay::replay_with_mode(&regular, &config, &replay_options, mode)
             .map_err(|cause| config_error(cause, regular.sample_rate_hz))?

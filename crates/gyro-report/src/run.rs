@@ -58,7 +58,7 @@ fn processing_lines(s: &mut String, report: &RunReport) {
     if report.mode == gyro_analysis::replay::Mode::Offline {
         let _ = writeln!(
             s,
-            "mode: offline (each movement's angle and σ from the rests before and after it)"
+            "mode: offline (each movement's angle and σ from the log's rests before and after it)"
         );
     }
     let k = &c.correction;

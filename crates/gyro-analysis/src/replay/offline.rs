@@ -1,29 +1,36 @@
 //! The offline mode of a replay (`run --offline`): each movement's angle read after the rest
-//! that follows it, so that its bias comes from the rests on both sides.
+//! that follows it, its bias from the rests of the whole log on both sides.
 //!
-//! The Kalman form's state is `[θ, b]`. While a movement integrates, θ's error and the bias
-//! error become correlated; the zero-rate updates of the rest after the movement correct the
-//! bias and, through that correlation, the angle the movement added (the core's
-//! `update_at_rest` returns that angle correction). The causal filter reports a movement at
-//! its end, before those updates; the angle it holds at the end of the rest after is the
-//! fixed-interval smoothed estimate of the movement's angle given the rest before (the
-//! filter's prior at the movement's start) and the rest after (its updates), which is what a
-//! Rauch–Tung–Striebel pass over the movement's span gives for the angle gained over it.
-//! So a movement's offline angle is the causal angle at the start of the next movement less
-//! the causal angle at the start of this one. Its variance is measured from the log's own
-//! rests rather than taken from the filter, whose wander prior the rests bring down only
-//! slowly: the white noise integrated over the movement (consecutive rest blocks), the bias
-//! error at the movement's two ends interpolated through it, and the wander within it (a
-//! random walk pinned by the rests on both sides), the last two from the change of the bias
-//! estimate across each movement so far ([`BiasSteps`]).
+//! Two passes. The first reads every rest in blocks of about [`NOISE_BLOCK`] outputs
+//! ([`REST_MARGIN`] in from each movement) and fits the bias through the log to them
+//! ([`Smoother::bias_path`], [`crate::bias_path`]: a random walk smoothed by
+//! Rauch–Tung–Striebel, its rate the most likely for these readings). A bias that holds still
+//! fits a walk near zero, and every rest counts for every movement; one that drifts, a larger
+//! walk, and each movement's bias comes from the rests next to it. The second pass
+//! ([`Smoother::with_path`]) gives each movement its uncompensated angle less that bias
+//! integrated over it, and a variance of the white noise integrated over the movement (from
+//! consecutive rest blocks) plus the path's own over the movement.
 //!
-//! The series is smoothed alike: within a movement the correction its rest after made is
-//! spread in proportion to the time elapsed (a bias error integrates linearly), and over a
-//! rest the angle is the smoothed one at its end. That needs the outputs from a movement's
-//! start to the next movement's start: memory holds one movement and the rest after it, not
-//! the log.
+//! Without a path (a single pass, as a streaming caller that cannot read the log twice
+//! has), a movement's angle is the causal angle at the start of the next movement less the
+//! causal angle at the start of this one: the Kalman form's zero-rate updates in the rest
+//! after the movement correct its bias and, through the angle–bias correlation, the angle
+//! it added, so the bias comes from the rest before (the filter's prior) and the rest after
+//! (its updates). Its variance is then measured from the log's own rests: the white noise
+//! integrated over the movement, the bias error at the movement's two ends interpolated
+//! through it, and the wander within it (a random walk pinned by the rests on both sides),
+//! the last two from the change of the bias estimate across each movement so far
+//! ([`BiasSteps`]).
+//!
+//! The series is smoothed alike: within a movement, the uncompensated angle since its start
+//! less the path's bias (without a path, the correction the rest after made spread in
+//! proportion to the elapsed time); over a rest, the angle is the smoothed one at its end.
+//! That needs the outputs from a movement's start to the next movement's start: memory holds
+//! one movement and the rest after it, and the first pass's rest blocks (three numbers per
+//! block of rest), not the log.
 
 use super::SeriesPoint;
+use crate::bias_path::{BiasPath, Reading};
 use std::collections::VecDeque;
 
 /// A movement waiting for the rest after it.
@@ -82,7 +89,27 @@ pub(super) struct Smoother {
     step_s: f64,
     /// The bias's change across each smoothed movement so far.
     bias_steps: BiasSteps,
+    /// The rests' blocks read so far: what [`Smoother::bias_path`] is fitted to.
+    rest_blocks: Vec<RestBlock>,
+    /// The index of the first output after the last movement's end, where the next rest's
+    /// blocks start (0: from the log's start).
+    rest_from: usize,
+    /// The bias through the whole log from a first pass ([`Smoother::with_path`]): each
+    /// movement's bias from it, in place of the causal filter's.
+    path: Option<BiasPath>,
 }
+
+/// One block of a rest: its middle (s), mean rate (deg/s) and outputs.
+#[derive(Clone, Copy, Debug)]
+struct RestBlock {
+    time_s: f64,
+    mean_dps: f64,
+    outputs: usize,
+}
+
+/// Outputs left out of a rest's blocks next to a movement (0.1 s at 50 Hz): the filtered
+/// rate's rise into the movement, and its tail after, below the detector's levels.
+const REST_MARGIN: usize = 5;
 
 /// The bias's change Δb across each smoothed movement, from the rest before it to the end of
 /// the rest after it (over Δt): what the rests say of the bias error at a movement's ends
@@ -141,6 +168,72 @@ impl Smoother {
             prior_step_variance: (rate_noise_dps * step_s).powi(2),
             step_s,
             ..Self::default()
+        }
+    }
+
+    /// The smoother with `path`, the bias through the whole log ([`Smoother::bias_path`] of a
+    /// first pass over it): each movement's angle is then its uncompensated angle less the
+    /// path's bias integrated over it, and its variance the white noise's and the path's.
+    pub fn with_path(self, path: BiasPath) -> Self {
+        Self {
+            path: Some(path),
+            ..self
+        }
+    }
+
+    /// The bias through the log so far, smoothed from every rest's blocks (call after
+    /// [`Smoother::finish`]): the blocks' means, each with the white noise over its
+    /// outputs as the rests measure it, fitted by [`BiasPath::fit`]. `None` without a rest.
+    pub fn bias_path(&self) -> Option<BiasPath> {
+        let per_output = self.step_variance() / (self.step_s * self.step_s);
+        let readings: Vec<Reading> = self
+            .rest_blocks
+            .iter()
+            .map(|b| Reading {
+                time_s: b.time_s,
+                bias_dps: b.mean_dps,
+                variance: per_output / b.outputs as f64,
+            })
+            .filter(|r| r.bias_dps.is_finite() && r.variance > 0.0)
+            .collect();
+        BiasPath::fit(&readings)
+    }
+
+    /// Read the rest that ends at output `last` (held) into blocks: from the first output
+    /// after the last movement's end, [`REST_MARGIN`] outputs in from each movement, in
+    /// blocks of equal length near [`NOISE_BLOCK`] outputs, static outputs only.
+    /// `after_movement` / `before_movement`: a movement lies on that side.
+    fn read_rest(&mut self, last: usize, after_movement: bool, before_movement: bool) {
+        let from = self.rest_from + if after_movement { REST_MARGIN } else { 0 };
+        let to = if before_movement {
+            last.saturating_sub(REST_MARGIN)
+        } else {
+            last
+        };
+        if to < from + 1 || from < self.first {
+            return;
+        }
+        let len = to + 1 - from;
+        let blocks = (len / NOISE_BLOCK).max(1);
+        for k in 0..blocks {
+            let (i, j) = (from + k * len / blocks, from + (k + 1) * len / blocks);
+            let (mut time, mut sum, mut n) = (0.0, 0.0, 0usize);
+            for index in i..j {
+                if let Some(p) = self.at(index) {
+                    if p.motion == gyro_core::MotionState::Static && p.rate_dps.is_finite() {
+                        time += p.time_s;
+                        sum += f64::from(p.rate_dps);
+                        n += 1;
+                    }
+                }
+            }
+            if n >= NOISE_BLOCK / 2 {
+                self.rest_blocks.push(RestBlock {
+                    time_s: time / n as f64,
+                    mean_dps: sum / n as f64,
+                    outputs: n,
+                });
+            }
         }
     }
 
@@ -203,7 +296,7 @@ impl Smoother {
     /// A movement started at output `start_index` (already pushed): the pending one, if any,
     /// is smoothed with the rest up to there.
     pub fn movement_started(&mut self, start_index: usize) -> Option<Smoothed> {
-        let smoothed = self.close(start_index);
+        let smoothed = self.close(start_index, true);
         self.pending = Some(Pending {
             movement: None,
             start_index,
@@ -219,15 +312,20 @@ impl Smoother {
             p.movement = Some(movement);
             p.end_index = Some(end_index);
         }
+        self.rest_from = end_index + 1;
     }
 
     /// The log has ended: smooth what is pending with the rest up to the last output.
     pub fn finish(&mut self) -> Option<Smoothed> {
         let last = (self.first + self.held.len()).checked_sub(1)?;
+        if self.pending.is_none() {
+            // A log without a movement: one rest.
+            self.read_rest(last, false, false);
+        }
         let smoothed = match self.pending {
             Some(Pending {
                 end_index: Some(_), ..
-            }) => self.close(last),
+            }) => self.close(last, false),
             _ => None,
         };
         // What is left (a movement the log ends in, or a log without movements) keeps the
@@ -247,8 +345,9 @@ impl Smoother {
 
     /// Smooth the pending movement with the rest that ends at output `until` (held), and
     /// release the outputs before `until`.
-    fn close(&mut self, until: usize) -> Option<Smoothed> {
+    fn close(&mut self, until: usize, before_movement: bool) -> Option<Smoothed> {
         let end = *self.at(until)?;
+        self.read_rest(until, self.pending.is_some(), before_movement);
         let pending = self.pending.take();
         match pending {
             None => {
@@ -316,7 +415,20 @@ impl Smoother {
             (Some(_), Some(_)) => Some(white + self.bias_steps.variance(duration_s)),
             _ => None,
         };
+        // With the bias through the whole log: the movement's uncompensated angle less
+        // that bias integrated over it, its variance the white noise's and the path's.
+        let path = self.path.take();
+        let (angle, variance) = match &path {
+            Some(path) => {
+                let (bias_deg, bias_variance) = path.integral(start.time_s, moved_end.time_s);
+                let raw = f64::from(moved_end.raw_angle_deg) - f64::from(start.raw_angle_deg);
+                (raw - bias_deg, variance.map(|_| white + bias_variance))
+            }
+            None => (angle, variance),
+        };
         let shift = Shift {
+            path: path.as_ref(),
+            raw_start_deg: f64::from(start.raw_angle_deg),
             end_index,
             t0_s: start.time_s,
             t1_s: moved_end.time_s,
@@ -336,12 +448,18 @@ impl Smoother {
             self.first += 1;
             self.ready.push(shift.smoothed(index, &q));
         }
+        let (offset_deg, base_angle_deg, variance_offset, base_variance) = (
+            shift.offset_deg,
+            shift.base_angle_deg,
+            shift.variance_offset,
+            shift.base_variance,
+        );
+        self.path = path;
         // From `until` on the smoothed angle is the causal one plus this offset.
-        self.offset_deg =
-            shift.offset_deg + shift.base_angle_deg + angle - f64::from(end.angle_deg);
+        self.offset_deg = offset_deg + base_angle_deg + angle - f64::from(end.angle_deg);
         if let Some(v) = variance {
             self.variance_offset =
-                shift.variance_offset + shift.base_variance + v - variance_of(end).unwrap_or(0.0);
+                variance_offset + base_variance + v - variance_of(end).unwrap_or(0.0);
         }
         movement.map(|movement| Smoothed {
             movement,
@@ -352,7 +470,12 @@ impl Smoother {
 }
 
 /// How a movement and the rest after it are smoothed ([`Smoother::close_movement`]).
-struct Shift {
+struct Shift<'a> {
+    /// The bias through the whole log, if a first pass gave it: within the movement the
+    /// uncompensated angle since its start less the path's bias over that time.
+    path: Option<&'a BiasPath>,
+    /// The uncompensated angle at the movement's start (deg).
+    raw_start_deg: f64,
     /// Output index of the movement's end.
     end_index: usize,
     /// Times of the movement's start and end (s).
@@ -372,7 +495,7 @@ struct Shift {
     variance: Option<f64>,
 }
 
-impl Shift {
+impl Shift<'_> {
     /// The output `q` at `index` smoothed: within the movement, the causal angle plus the
     /// correction's share by time; in the rest after, the smoothed angle at its end.
     fn smoothed(&self, index: usize, q: &SeriesPoint) -> SeriesPoint {
@@ -388,6 +511,10 @@ impl Shift {
         if index > self.end_index {
             // The rest after: the smoothed angle at its end.
             s.angle_deg = (self.offset_deg + self.base_angle_deg + self.angle_deg) as f32;
+        } else if let Some(path) = self.path {
+            let raw = f64::from(q.raw_angle_deg) - self.raw_start_deg;
+            let moved = raw - path.integral(t0, q.time_s.clamp(t0, t1)).0;
+            s.angle_deg = (self.offset_deg + self.base_angle_deg + moved) as f32;
         } else {
             s.angle_deg =
                 (self.offset_deg + f64::from(q.angle_deg) + share * self.correction_deg) as f32;
