@@ -264,7 +264,7 @@ fn not_seen_line(d: &Diagnosis) -> Option<String> {
         .map(|r| r.duration_s)
         .collect();
     let mut line = format!(
-        "not named, so absent or smaller than what {} training runs of {} s show (these: {} runs, {:.0} s in all); the self-check names from {}",
+        "{NOT_NAMED} or smaller than what {} training runs of {} s show (these: {} runs, {:.0} s in all); the self-check names from {}",
         gyro_diagnose::selftest::TRAIN_RUNS,
         gyro_diagnose::selftest::RUN_S,
         train.len(),
@@ -481,10 +481,17 @@ pub struct Findings {
     /// What the model still misses, in words and units: the statistics it leaves
     /// unexplained, the effective noise on moving data, lines in the motion.
     pub missed: Vec<String>,
+    /// How many lines after the first of [`Findings::missed`] are the statistics that first
+    /// line introduces ("the largest:"); 0 when the model fits.
+    pub missed_listed: usize,
     /// How the data were taken (a quantised reference) and what makes part of the
     /// diagnosis unreliable.
     pub notes: Vec<String>,
 }
+
+/// How the findings line that lists what was not named, with the self-check's detection
+/// limits, starts (the HTML report folds it).
+pub const NOT_NAMED: &str = "not named, so absent";
 
 /// Most unexplained statistics listed in words in [`Findings::missed`] (the rest are in
 /// the details' table).
@@ -492,11 +499,23 @@ pub const MISSED_LINES: usize = 5;
 
 /// The diagnosis's findings below the verdict ([`Findings`]).
 pub fn findings(d: &Diagnosis) -> Findings {
+    let missed = missed_lines(d);
+    let missed_listed = if d.verdict.model_fits {
+        0
+    } else {
+        missed_by_statistic_count(d)
+    };
     Findings {
         named: named_lines(d),
-        missed: missed_lines(d),
+        missed,
+        missed_listed,
         notes: note_lines(d),
     }
+}
+
+/// How many statistics [`missed_lines`] lists under its first line.
+fn missed_by_statistic_count(d: &Diagnosis) -> usize {
+    super::words::missed_by_statistic(&d.unexplained, MISSED_LINES).len()
 }
 
 /// [`Findings::notes`]: how the references were quantised, then the warnings.

@@ -762,26 +762,56 @@ fn summary(s: &mut String, d: &Diagnosis, page: &Path) -> Result<(), ReportError
         }
     }
     let f = super::findings(d);
-    for (title, lines) in [
-        ("Named", f.named),
-        ("What the model still misses", f.missed),
-        ("Notes", f.notes),
+    for (title, lines, listed) in [
+        ("Named", f.named, 0),
+        ("What the model still misses", f.missed, f.missed_listed),
+        ("Notes", f.notes, 0),
     ] {
         if lines.is_empty() {
             continue;
         }
-        let _ = writeln!(s, "<h2>{title}</h2>\n<ul>");
-        for line in lines {
-            let class = if line.starts_with("warning:") {
-                " class=\"warn\""
-            } else {
-                ""
-            };
-            let _ = writeln!(s, "<li{class}>{}</li>", esc(&line));
-        }
-        let _ = writeln!(s, "</ul>");
+        let _ = writeln!(s, "<h2>{title}</h2>");
+        findings_list(s, &lines, listed);
     }
     Ok(())
+}
+
+/// A list of findings: warnings marked, the detection limits folded, and the `listed`
+/// lines after the first nested under it (the statistics it introduces).
+fn findings_list(s: &mut String, lines: &[String], listed: usize) {
+    let _ = writeln!(s, "<ul>");
+    for (i, line) in lines.iter().enumerate() {
+        let class = if line.starts_with("warning:") {
+            " class=\"warn\""
+        } else {
+            ""
+        };
+        // Long and rarely the answer: folded.
+        let item = if line.starts_with(super::headline::NOT_NAMED) {
+            format!(
+                "<details><summary>Not named: absent, or smaller than these runs can show \
+                 (the self-check's detection limits)</summary>{}</details>",
+                esc(line)
+            )
+        } else {
+            esc(line)
+        };
+        let open = i == 0 && listed > 0;
+        let close = listed > 0 && i == listed;
+        let _ = write!(s, "<li{class}>{item}");
+        if open {
+            let _ = writeln!(s, "\n<ul>");
+        } else {
+            let _ = writeln!(s, "</li>");
+        }
+        if close {
+            let _ = writeln!(s, "</ul></li>");
+        }
+    }
+    if listed > 0 && lines.len() <= listed {
+        let _ = writeln!(s, "</ul></li>");
+    }
+    let _ = writeln!(s, "</ul>");
 }
 
 /// The gap G with its explanation, the ensembles, the turns and the nominal model.
@@ -1431,6 +1461,33 @@ mod tests {
     use gyro_diagnose::{
         CompensationRun, CompensationSummary, GapSummary, ModelSummary, RunSummary, Verdict,
     };
+
+    /// The statistics a "the largest:" line introduces are nested under it, the line after
+    /// them is not, and the detection limits are folded with their text kept.
+    #[test]
+    fn findings_nest_the_largest_and_fold_the_limits() {
+        let lines: Vec<String> = [
+            "the model does not explain the training runs: ...; the largest:",
+            "statistic a",
+            "statistic b",
+            "effective noise on moving data",
+            "not named, so absent or smaller than what 5 runs show",
+        ]
+        .map(String::from)
+        .to_vec();
+        let mut s = String::new();
+        findings_list(&mut s, &lines, 2);
+        let nested = s.find("<ul>\n<li>statistic a").is_some()
+            && s.find("statistic b</li>\n</ul></li>").is_some();
+        assert!(nested, "{s}");
+        assert!(s.contains("<li>effective noise on moving data</li>"), "{s}");
+        assert!(
+            s.contains("<details><summary>Not named")
+                && s.contains("not named, so absent or smaller than what 5 runs show</details>"),
+            "{s}"
+        );
+        assert_eq!(s.matches("<ul>").count(), s.matches("</ul>").count(), "{s}");
+    }
 
     fn diagnosis() -> Diagnosis {
         let run = |name: &str, role: &'static str, z: f64| RunSummary {

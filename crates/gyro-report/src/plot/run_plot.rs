@@ -5,7 +5,7 @@ use super::{
     colour, corner_legend, draw_err, draw_segments, envelope, line_swatch, padded, save, thin,
     tick, titled, DrawResult, Figure, PlotError, RenderError, Stroke, LABEL_PX, TICK_PX,
 };
-use gyro_analysis::replay::{RunReport, SeriesPoint, Summary};
+use gyro_analysis::replay::{Mode, RunReport, SeriesPoint, Summary};
 use gyro_core::{Compensation, MotionState};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
@@ -17,7 +17,7 @@ const MAX_POINTS: usize = 3000;
 
 const REFERENCE_LABEL: &str = "reference (encoder, filtered)";
 const ERROR_LABEL: &str = "angle − reference";
-const SIGMA_LABEL: &str = "±1σ of the angle (Kalman)";
+const SIGMA_LABEL: &str = "±1σ of the angle";
 const RATE_LABEL: &str = "rate (decimated, low-passed)";
 
 /// The plot of one replayed run.
@@ -195,17 +195,18 @@ impl Lines {
     }
 }
 
-/// How the angle was compensated, in words.
-fn mode_text(compensation: Compensation) -> &'static str {
-    match compensation {
-        Compensation::None => "no compensation",
-        Compensation::Paper => "paper error model",
-        Compensation::Kalman => "Kalman form",
+/// How the angle was compensated, in words; offline said so.
+fn mode_text(compensation: Compensation, mode: Mode) -> &'static str {
+    match (compensation, mode) {
+        (Compensation::None, _) => "no compensation",
+        (Compensation::Paper, _) => "paper error model",
+        (Compensation::Kalman, Mode::Causal) => "Kalman form",
+        (Compensation::Kalman, Mode::Offline) => "Kalman form, offline",
     }
 }
 
 /// The subtitle: the compensation, the error figures and the movements.
-fn subtitle(s: &Summary) -> String {
+fn subtitle(s: &Summary, mode: Mode) -> String {
     let errors = match (s.max_abs_error_deg, s.rms_error_deg, s.final_error_deg) {
         (Some(max), Some(rms), Some(fin)) => {
             format!("max |error| {max:.3}°, RMS {rms:.3}°, final {fin:+.3}°")
@@ -214,7 +215,7 @@ fn subtitle(s: &Summary) -> String {
     };
     format!(
         "{}  ·  {errors}  ·  {} movement{} in {:.1} s",
-        mode_text(s.compensation),
+        mode_text(s.compensation, mode),
         s.movements,
         if s.movements == 1 { "" } else { "s" },
         s.duration_s
@@ -481,7 +482,7 @@ impl Figure for RunPlot<'_> {
         };
         let summary = &self.report.summary;
         let title = format!("run: {}", self.title);
-        let body = titled(root, &title, &subtitle(summary))?;
+        let body = titled(root, &title, &subtitle(summary, self.report.mode))?;
         let lines = Lines::of(series);
         // Thinned lines are drawn thin: plotters' bitmap backend leaves gaps in thick,
         // near-vertical segments.
@@ -501,7 +502,11 @@ impl Figure for RunPlot<'_> {
         let areas = body.split_by_breakpoints::<i32, i32, _, _>([], cuts);
         let mut areas = areas.iter();
         let mut next = || areas.next().ok_or(RenderError::Draw("layout".into()));
-        frame.angle_panel(next()?, &lines, mode_text(summary.compensation))?;
+        frame.angle_panel(
+            next()?,
+            &lines,
+            mode_text(summary.compensation, self.report.mode),
+        )?;
         if has_error {
             frame.error_panel(next()?, &lines)?;
         }
