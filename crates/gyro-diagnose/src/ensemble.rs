@@ -123,6 +123,15 @@ impl StampedClock {
     }
 }
 
+/// The rate (Hz) a run's motion is read at from a log on a grid of `fs` Hz whose stamps
+/// show `clock`: the stamped sample rate. The reference was read when each sample was
+/// taken, and by the stamps' clock, a true one, the motion runs at the sample clock's
+/// rate, not the declared one (else a re-simulation with the clock error would speed it
+/// up a second time).
+fn motion_rate_hz(fs: f64, clock: Option<StampedClock>) -> f64 {
+    clock.map_or(fs, |c| fs * (1.0 + c.ppm * 1e-6))
+}
+
 /// Consecutive windows of `window_s` seconds of `log` (a last window shorter than half of
 /// that is dropped), each a log of its own.
 pub fn split(log: &RegularLog, window_s: f64) -> Vec<RegularLog> {
@@ -158,13 +167,9 @@ impl RealRun {
         stats.extend(feature_stats(&features));
         let fs = log.sample_rate_hz;
         let reference: Vec<f64> = filled_reference(&log);
-        // The reference was read when each sample was taken: by the stamps' clock, a
-        // true one, the motion runs at the sample clock's rate, not the declared one
-        // (else a re-simulation with the clock error would speed it up a second time).
         let clock = StampedClock::of(&log);
-        let motion_fs = clock.map_or(fs, |c| fs * (1.0 + c.ppm * 1e-6));
         let (motion, reference_grid) =
-            motion_from_reference_with(&reference, motion_fs, &settings.reference);
+            motion_from_reference_with(&reference, motion_rate_hz(fs, clock), &settings.reference);
         let temperature_c = log.has_temperature.then(|| {
             log.slots
                 .iter()
@@ -216,6 +221,12 @@ impl RealRun {
     /// run's statistics, features and motion are read with).
     pub fn prepared_with(&self, settings: &crate::Settings) -> bool {
         self.statistics == settings.statistics && self.reference_settings == settings.reference
+    }
+
+    /// The time (s) in [`Self::motion`] of the run's row `k`: its stamp in the motion's
+    /// time base, which runs at [`motion_rate_hz`].
+    pub fn motion_time_s(&self, k: usize) -> f64 {
+        k as f64 / motion_rate_hz(self.sample_rate_hz, self.clock)
     }
 
     /// Number of samples.
