@@ -52,6 +52,8 @@ pub struct BiasPath {
     next_covariances: Vec<f64>,
     walk: f64,
     jitter: f64,
+    /// What the bias's variances are multiplied by ([`BiasPath::calibrated`]).
+    variance_scale: f64,
 }
 
 /// The forward (filtered) pass at each reading: the prediction made before it and the
@@ -138,7 +140,47 @@ impl BiasPath {
             next_covariances,
             walk,
             jitter,
+            variance_scale: 1.0,
         })
+    }
+
+    /// The path with its variances scaled so that they hold the changes the bias shows
+    /// across the gaps between `readings` (the path's own) at `across` (each `i`: readings
+    /// `i − 1` and `i`, a movement between them): the mean of the squared changes over
+    /// their mean variance under the walk and the readings' noise, when above 1. A walk
+    /// fitted over every lag can understate the wander at a movement's (a 1/f bias's
+    /// is larger at short lags than a walk's); the rests on both sides of each movement
+    /// say how much.
+    pub fn calibrated(self, readings: &[Reading], across: &[usize]) -> Self {
+        let (mut observed, mut predicted) = (0.0, 0.0);
+        for &i in across {
+            let (Some(a), Some(b)) = (
+                i.checked_sub(1).and_then(|j| readings.get(j)),
+                readings.get(i),
+            ) else {
+                continue;
+            };
+            let change = b.bias_dps - a.bias_dps;
+            observed += change * change;
+            predicted += self.walk * (b.time_s - a.time_s).abs()
+                + a.variance
+                + b.variance
+                + 2.0 * self.jitter;
+        }
+        let scale = if predicted > 0.0 && observed.is_finite() {
+            (observed / predicted).max(1.0)
+        } else {
+            1.0
+        };
+        Self {
+            variance_scale: scale,
+            ..self
+        }
+    }
+
+    /// What the variances are multiplied by ([`BiasPath::calibrated`]; 1 otherwise).
+    pub fn variance_scale(&self) -> f64 {
+        self.variance_scale
     }
 
     /// The walk rate (deg²/s³) the path was smoothed with.
@@ -170,7 +212,10 @@ impl BiasPath {
         let (a, b) = self.around(time_s);
         if a == b {
             let gap = (time_s - self.times_s[a]).abs();
-            return (self.means_dps[a], self.variances[a] + self.walk * gap);
+            return (
+                self.means_dps[a],
+                self.variance_scale * (self.variances[a] + self.walk * gap),
+            );
         }
         let (t0, t1) = (self.times_s[a], self.times_s[b]);
         let w = ((time_s - t0) / (t1 - t0)).clamp(0.0, 1.0);
@@ -179,7 +224,7 @@ impl BiasPath {
             + w * w * self.variances[b]
             + 2.0 * w * (1.0 - w) * self.next_covariances[a]
             + self.walk * (time_s - t0) * (t1 - time_s) / (t1 - t0);
-        (mean, variance)
+        (mean, self.variance_scale * variance)
     }
 
     /// The bias integrated from `from_s` to `to_s` (deg) and that integral's variance
@@ -197,9 +242,11 @@ impl BiasPath {
                 .filter(|t| *t > from_s && *t < to_s),
         );
         cuts.push(to_s);
-        cuts.windows(2)
+        let (angle, variance) = cuts
+            .windows(2)
             .map(|w| self.stretch(w[0], w[1]))
-            .fold((0.0, 0.0), |(a, v), (da, dv)| (a + da, v + dv))
+            .fold((0.0, 0.0), |(a, v), (da, dv)| (a + da, v + dv));
+        (angle, self.variance_scale * variance)
     }
 
     /// [`BiasPath::integral`] over a stretch with no reading inside.
@@ -442,5 +489,45 @@ mod tests {
         }
         let mean = z2.iter().sum::<f64>() / z2.len() as f64;
         assert!((mean - 1.0).abs() < 0.2, "mean z² {mean}");
+    }
+
+    /// Where the bias jumps across the movements more than a walk fitted over every lag
+    /// says, the calibration widens the variances by the jumps' share; where the walk is
+    /// the truth, it leaves them within a third of one.
+    #[test]
+    fn the_calibration_widens_only_for_jumps_the_walk_understates() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
+        let noise: f64 = 0.003;
+        // Rests of 10 blocks, 0.2 s apart; movements of 2 s between them.
+        let mut make = |jump: f64, walk: f64| -> f64 {
+            let (mut b, mut readings, mut across) = (0.0f64, Vec::new(), Vec::new());
+            let mut t = 0.0f64;
+            for rest in 0..40 {
+                if rest > 0 {
+                    let x: f64 = StandardNormal.sample(&mut rng);
+                    let w: f64 = StandardNormal.sample(&mut rng);
+                    b += jump * x + (walk * 2.0f64).sqrt() * w;
+                    t += 2.0;
+                    across.push(readings.len());
+                }
+                for _ in 0..10 {
+                    let x: f64 = StandardNormal.sample(&mut rng);
+                    let y: f64 = StandardNormal.sample(&mut rng);
+                    b += (walk * 0.2f64).sqrt() * x;
+                    readings.push(Reading {
+                        time_s: t,
+                        bias_dps: b + noise * y,
+                        variance: noise * noise,
+                    });
+                    t += 0.2;
+                }
+            }
+            let path = BiasPath::fit(&readings).expect("readings");
+            path.calibrated(&readings, &across).variance_scale()
+        };
+        let walk_only = make(0.0, 1e-4);
+        assert!((1.0..1.34).contains(&walk_only), "{walk_only}");
+        let jumps = make(0.02, 1e-6);
+        assert!(jumps > 2.0, "{jumps}");
     }
 }

@@ -105,6 +105,8 @@ struct RestBlock {
     time_s: f64,
     mean_dps: f64,
     outputs: usize,
+    /// The first block of a rest after a movement.
+    after_movement: bool,
 }
 
 /// Outputs left out of a rest's blocks next to a movement (0.1 s at 50 Hz): the filtered
@@ -186,17 +188,21 @@ impl Smoother {
     /// outputs as the rests measure it, fitted by [`BiasPath::fit`]. `None` without a rest.
     pub fn bias_path(&self) -> Option<BiasPath> {
         let per_output = self.step_variance() / (self.step_s * self.step_s);
-        let readings: Vec<Reading> = self
+        let (readings, after): (Vec<Reading>, Vec<bool>) = self
             .rest_blocks
             .iter()
-            .map(|b| Reading {
-                time_s: b.time_s,
-                bias_dps: b.mean_dps,
-                variance: per_output / b.outputs as f64,
+            .map(|b| {
+                let reading = Reading {
+                    time_s: b.time_s,
+                    bias_dps: b.mean_dps,
+                    variance: per_output / b.outputs as f64,
+                };
+                (reading, b.after_movement)
             })
-            .filter(|r| r.bias_dps.is_finite() && r.variance > 0.0)
-            .collect();
-        BiasPath::fit(&readings)
+            .filter(|(r, _)| r.bias_dps.is_finite() && r.variance > 0.0)
+            .unzip();
+        let across: Vec<usize> = (1..readings.len()).filter(|&i| after[i]).collect();
+        Some(BiasPath::fit(&readings)?.calibrated(&readings, &across))
     }
 
     /// Read the rest that ends at output `last` (held) into blocks: from the first output
@@ -215,6 +221,7 @@ impl Smoother {
         }
         let len = to + 1 - from;
         let blocks = (len / NOISE_BLOCK).max(1);
+        let mut read_one = false;
         for k in 0..blocks {
             let (i, j) = (from + k * len / blocks, from + (k + 1) * len / blocks);
             let (mut time, mut sum, mut n) = (0.0, 0.0, 0usize);
@@ -232,7 +239,9 @@ impl Smoother {
                     time_s: time / n as f64,
                     mean_dps: sum / n as f64,
                     outputs: n,
+                    after_movement: after_movement && !read_one,
                 });
+                read_one = true;
             }
         }
     }
