@@ -259,9 +259,7 @@ impl BiasPath {
             let (d0, d1) = ((s - t0).abs(), (e - t0).abs());
             let (near, far) = (d0.min(d1), d0.max(d1));
             // ∫∫ walk·min(u, v) over [near, far]², u, v from the reading.
-            let walk_part = self.walk
-                * ((far.powi(3) - near.powi(3)) / 3.0 - near * near * (far - near)
-                    + near * (far - near) * (far - near));
+            let walk_part = self.walk * walk_integral(near, far);
             return (
                 self.means_dps[a] * duration,
                 duration * duration * self.variances[a] + walk_part.max(0.0),
@@ -280,6 +278,13 @@ impl BiasPath {
             + self.walk * bridge_integral(span, u0, u1);
         (mean, variance)
     }
+}
+
+/// ∫∫ of a unit-rate random walk's covariance `min(u, v)` over `[near, far]²` (s³), u and v
+/// from where the walk is pinned: the variance of the walk integrated over that stretch.
+fn walk_integral(near: f64, far: f64) -> f64 {
+    // 2 ∫_{near}^{far} ∫_{near}^{v} u du dv = ∫ (v² − near²) dv.
+    ((far.powi(3) - near.powi(3)) / 3.0 - near * near * (far - near)).max(0.0)
 }
 
 /// ∫∫ of a unit-rate Brownian bridge's covariance `min(u,v)·(L − max(u,v))/L` over
@@ -435,7 +440,8 @@ mod tests {
     }
 
     /// The bridge's integrated variance over its whole span is `L³/12`, and the integral
-    /// over a stretch matches a direct quadrature of the covariance.
+    /// over a stretch matches a direct quadrature of the covariance; so does the free
+    /// walk's beyond a reading.
     #[test]
     fn the_bridge_integral_matches_quadrature() {
         assert!((bridge_integral(2.0, 0.0, 2.0) - 8.0 / 12.0).abs() < 1e-12);
@@ -450,6 +456,18 @@ mod tests {
             }
         }
         assert!((bridge_integral(span, u0, u1) / sum - 1.0).abs() < 1e-3);
+        // The walk beyond the last reading, the same way.
+        let (near, far) = (1.0, 3.0);
+        let h = (far - near) / n as f64;
+        let mut sum = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let (u, v) = (near + (i as f64 + 0.5) * h, near + (j as f64 + 0.5) * h);
+                sum += u.min(v) * h * h;
+            }
+        }
+        assert!((walk_integral(near, far) / sum - 1.0).abs() < 1e-3);
+        assert!((walk_integral(0.0, 2.0) - 8.0 / 3.0).abs() < 1e-12);
     }
 
     /// The integral's variance is calibrated: over simulated walks read with noise, the
