@@ -297,27 +297,9 @@ fn bridge_integral(span: f64, u0: f64, u1: f64) -> f64 {
     ((antiderivative(u1) - antiderivative(u0)) / span).max(0.0)
 }
 
-/// Golden-section search for the maximum of `f` on `[a, b]`.
-fn golden_max(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
-    let ratio = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut c, mut d) = (b - ratio * (b - a), a + ratio * (b - a));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..30 {
-        if fc >= fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - ratio * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + ratio * (b - a);
-            fd = f(d);
-        }
-    }
-    0.5 * (a + b)
+/// Golden-section search for the maximum of `f` on `[a, b]` ([`crate::golden`]).
+fn golden_max(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    crate::golden::minimize(f, |y| -y, a, b, 30).middle()
 }
 
 /// The jitters (deg²/s²) the fit compares beside none, a factor of √10 apart.

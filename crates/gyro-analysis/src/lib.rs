@@ -14,6 +14,7 @@
 pub mod bias_path;
 pub mod calibrate;
 pub mod findings;
+mod golden;
 pub mod lag;
 pub mod model;
 pub mod noise;

@@ -398,28 +398,12 @@ fn solve(data: &Data, mask: u8) -> Solution {
     }
     let mut best = scanned[best_k];
     // Golden-section refinement between the neighbours of the best grid point.
-    let (mut a, mut b) = (
+    let (a, b) = (
         grid[best_k.saturating_sub(1)],
         grid[(best_k + 1).min(steps)],
     );
-    let r = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
-    let (mut fc, mut fd) = (at(c), at(d));
-    for _ in 0..40 {
-        if fc.cost < fd.cost {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - r * (b - a);
-            fc = at(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + r * (b - a);
-            fd = at(d);
-        }
-    }
+    let end = crate::golden::minimize(at, |s: &Solution| s.cost, a, b, 40);
+    let [(_, fc), (_, fd)] = end.inner;
     for s in [fc, fd] {
         if s.cost < best.cost {
             best = s;
