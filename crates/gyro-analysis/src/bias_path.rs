@@ -234,18 +234,19 @@ impl BiasPath {
         if to_s <= from_s {
             return (0.0, 0.0);
         }
-        let mut cuts: Vec<f64> = vec![from_s];
-        cuts.extend(
-            self.times_s
-                .iter()
-                .copied()
-                .filter(|t| *t > from_s && *t < to_s),
-        );
-        cuts.push(to_s);
-        let (angle, variance) = cuts
-            .windows(2)
-            .map(|w| self.stretch(w[0], w[1]))
-            .fold((0.0, 0.0), |(a, v), (da, dv)| (a + da, v + dv));
+        // The readings strictly inside cut it into stretches (none for a movement between
+        // two rests): walked in place, without a list.
+        let first = self.times_s.partition_point(|t| *t <= from_s);
+        let last = self.times_s.partition_point(|t| *t < to_s);
+        let inside = self.times_s[first..last.max(first)].iter().copied();
+        let mut start_s = from_s;
+        let (mut angle, mut variance) = (0.0, 0.0);
+        for end_s in inside.chain(std::iter::once(to_s)) {
+            let (da, dv) = self.stretch(start_s, end_s);
+            angle += da;
+            variance += dv;
+            start_s = end_s;
+        }
         (angle, self.variance_scale * variance)
     }
 

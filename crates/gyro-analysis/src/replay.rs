@@ -796,8 +796,8 @@ impl Replayer {
         if self.mode != Mode::Offline {
             return None;
         }
-        let smoothed = self.smoother.finish();
-        self.apply(smoothed);
+        // Its rests are what counts: the movements' angles of this pass are not reported.
+        self.smoother.finish();
         self.smoother.bias_path()
     }
 

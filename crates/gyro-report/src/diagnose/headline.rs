@@ -499,23 +499,13 @@ pub const MISSED_LINES: usize = 5;
 
 /// The diagnosis's findings below the verdict ([`Findings`]).
 pub fn findings(d: &Diagnosis) -> Findings {
-    let missed = missed_lines(d);
-    let missed_listed = if d.verdict.model_fits {
-        0
-    } else {
-        missed_by_statistic_count(d)
-    };
+    let (missed, missed_listed) = missed_lines(d);
     Findings {
         named: named_lines(d),
         missed,
         missed_listed,
         notes: note_lines(d),
     }
-}
-
-/// How many statistics [`missed_lines`] lists under its first line.
-fn missed_by_statistic_count(d: &Diagnosis) -> usize {
-    super::words::missed_by_statistic(&d.unexplained, MISSED_LINES).len()
 }
 
 /// [`Findings::notes`]: how the references were quantised, then the warnings.
@@ -606,15 +596,16 @@ fn correction_lines(d: &Diagnosis, c: &gyro_diagnose::CompensationSummary) -> Ve
 }
 
 /// [`Findings::missed`]: the unexplained statistics (if the model does not fit), the
-/// effective noise on moving data and the lines in the motion; "nothing" if none.
-fn missed_lines(d: &Diagnosis) -> Vec<String> {
+/// effective noise on moving data and the lines in the motion; "nothing" if none. With
+/// how many statistics its first line introduces ([`Findings::missed_listed`]).
+fn missed_lines(d: &Diagnosis) -> (Vec<String>, usize) {
     let mut missed = Vec::new();
+    let mut listed = 0;
     if !d.verdict.model_fits {
         missed.push(unexplained_line(d));
-        missed.extend(super::words::missed_by_statistic(
-            &d.unexplained,
-            MISSED_LINES,
-        ));
+        let statistics = super::words::missed_by_statistic(&d.unexplained, MISSED_LINES);
+        listed = statistics.len();
+        missed.extend(statistics);
     }
     if let Some(line) = effective_noise_line(&d.effective_noise) {
         missed.push(match d.residual_caveat() {
@@ -629,7 +620,7 @@ fn missed_lines(d: &Diagnosis) -> Vec<String> {
             gyro_diagnose::locate::UNEXPLAINED_Z
         ));
     }
-    missed
+    (missed, listed)
 }
 
 /// A line in the motion (the rig vibrating), and how much of it the gyro passes.
