@@ -23,12 +23,15 @@ the training runs, and G (training and held out, after selection) against its fl
 Usage: python3 scripts/diagnose_unseen.py [--gyro target/release/gyro-cli] [--keep DIR]
        python3 scripts/diagnose_unseen.py --matrix [--gyro ...] [--keep DIR] [--out FILE]
                                           [--only EFFECT_ID|none]
+                                          [--draw N [--first SEED]]
 
 `--matrix`: each effect alone at three magnitudes of its realistic range (`gyro-cli
 simulate --list-effects`), on the wrench's rest-turn-rest only, plus null cases; the
 generator of each effect is this script's own (see `matrix_make`). Prints a markdown table
 per case and a summary, and the first three lines of `diagnose`'s text output for the
 null cases and the failures; `--out FILE` writes the same text to FILE as well.
+`--draw N`: instead of the fixed magnitudes, N cases each with one effect at a magnitude
+drawn over its range (`DRAW_RANGES`; development seeds from 6000, judging from 5000).
 """
 import json
 import os
@@ -242,6 +245,39 @@ MATRIX = [
     (None, None, [(None, 4931, "null 1"), (None, 4932, "null 2")], "default"),
     (None, None, [(None, 4933, "null, low noise")], "low"),
 ]
+
+
+# `--draw N`: N cases, each one effect at a magnitude drawn over its realistic range (the
+# issue's and `gyro-cli simulate --list-effects`' ranges; at 100 Hz a Butterworth cutoff
+# stops at 40 Hz), log-uniform in size, either sign where the effect has one, at the
+# default noise or (one case in three) the CRM100's low noise. Case i draws from the numpy
+# stream [seed, 99] with seed = --first + i. Development draws start at 6000 (the default);
+# judging draws start at 5000 and are run only to report, never to choose anything.
+DRAW_DEVELOPMENT_FIRST = 6000
+DRAW_JUDGING_FIRST = 5000
+# (effect id, parameter, smallest, largest size, signed, unit's scale, unit)
+DRAW_RANGES = [
+    ("scale_factor", "k", 0.001, 0.03, True, 100.0, "%"),
+    ("scale_asymmetry", "k", 0.001, 0.03, True, 100.0, "%"),
+    ("latency", "delay_s", 0.001, 0.05, True, 1e3, " ms"),
+    ("bandwidth", "cutoff_hz", 10.0, 40.0, False, 1.0, " Hz"),
+    ("clock_error_count_stamped", "ppm", 500.0, 30000.0, True, 1e-4, "%"),
+    ("clock_error", "ppm", 500.0, 30000.0, True, 1e-4, "%"),
+    ("turn_on_bias", "sigma_dps", 0.05, 1.0, False, 1.0, " deg/s"),
+    ("bias_instability", "sigma_dps", 5 / 3600.0, 200 / 3600.0, False, 3600.0, " deg/h"),
+    ("temperature_bias", "dps_per_c", 0.01, 0.15, True, 1.0, " deg/s/degC"),
+    ("quantization", "lsb_dps", 0.05, 0.3, False, 1.0, " deg/s"),
+]
+
+
+def draw_case(seed):
+    """One drawn case: (effect, parameter, value, seed, label, noise)."""
+    rng = np.random.default_rng([seed, 99])
+    effect, param, lo, hi, signed, scale, unit = DRAW_RANGES[rng.integers(len(DRAW_RANGES))]
+    size = float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
+    value = size * (rng.choice([-1.0, 1.0]) if signed else 1.0)
+    noise = "low" if rng.uniform() < 1 / 3 else "default"
+    return effect, param, value, seed, f"{value * scale:+.3g}{unit}", noise
 
 
 def turn_plan(rng, speed):
@@ -461,6 +497,13 @@ def matrix_main(args):
     out_path = args[args.index("--out") + 1] if "--out" in args else None
     only = args[args.index("--only") + 1] if "--only" in args else None
     lines = []
+    if "--draw" in args:
+        count = int(args[args.index("--draw") + 1])
+        first = int(args[args.index("--first") + 1]) if "--first" in args else DRAW_DEVELOPMENT_FIRST
+        cases = [draw_case(first + i) for i in range(count)]
+    else:
+        cases = [(effect, param, value, seed, label, noise)
+                 for effect, param, magnitudes, noise in MATRIX for value, seed, label in magnitudes]
 
     def say(text=""):
         print(text, flush=True)
@@ -473,29 +516,28 @@ def matrix_main(args):
         say("| effect | noise | magnitude | seed | named first | all named (95% interval) | injected: fitted [95%] "
             "covers | extra | look-alike | model fits | held-out max abs err before -> after (median) | s |")
         say("|---|---|---|---|---|---|---|---|---|---|---|---|")
-        for effect, param, magnitudes, noise in MATRIX:
+        for effect, param, value, seed, label, noise in cases:
             if only is not None and only != (effect or "none"):
                 continue
-            for value, seed, label in magnitudes:
-                name = f"m{seed}"
-                row = matrix_case(gyro, directory, name, effect, param, value, seed, label, noise)
-                rows.append(row)
-                if row["error"]:
-                    say(f"| {effect or 'none'} | {noise} | {label} | {seed} | diagnose failed: "
-                        f"{row['error'][:200]} | | | | | | | {row['seconds']:.0f} |")
-                    continue
-                if row["fit"] is None:
-                    fit = "-"
-                else:
-                    v, (lo, hi), sig = row["fit"]
-                    fit = (f"{v:.4g} [{'-inf' if lo is None else f'{lo:.4g}'}, "
-                           f"{'inf' if hi is None else f'{hi:.4g}'}] "
-                           f"{'yes' if row['covered'] else 'no'}{'' if sig else ' (not named)'}")
-                comp = "-" if row["comp"] is None else f"{row['comp'][0]:.2f} -> {row['comp'][1]:.2f}"
-                fits = "yes" if row["model_fits"] else f"no ({row['unexplained']} unexplained)"
-                say(f"| {effect or 'none'} | {noise} | {label} | {seed} | {row['first'] or 'nothing'} | "
-                    f"{'; '.join(row['named_text']) or 'nothing'} | {fit} | {', '.join(row['extra']) or '-'} | "
-                    f"{', '.join(row['lookalike']) or '-'} | {fits} | {comp} | {row['seconds']:.0f} |")
+            name = f"m{seed}"
+            row = matrix_case(gyro, directory, name, effect, param, value, seed, label, noise)
+            rows.append(row)
+            if row["error"]:
+                say(f"| {effect or 'none'} | {noise} | {label} | {seed} | diagnose failed: "
+                    f"{row['error'][:200]} | | | | | | | {row['seconds']:.0f} |")
+                continue
+            if row["fit"] is None:
+                fit = "-"
+            else:
+                v, (lo, hi), sig = row["fit"]
+                fit = (f"{v:.4g} [{'-inf' if lo is None else f'{lo:.4g}'}, "
+                       f"{'inf' if hi is None else f'{hi:.4g}'}] "
+                       f"{'yes' if row['covered'] else 'no'}{'' if sig else ' (not named)'}")
+            comp = "-" if row["comp"] is None else f"{row['comp'][0]:.2f} -> {row['comp'][1]:.2f}"
+            fits = "yes" if row["model_fits"] else f"no ({row['unexplained']} unexplained)"
+            say(f"| {effect or 'none'} | {noise} | {label} | {seed} | {row['first'] or 'nothing'} | "
+                f"{'; '.join(row['named_text']) or 'nothing'} | {fit} | {', '.join(row['extra']) or '-'} | "
+                f"{', '.join(row['lookalike']) or '-'} | {fits} | {comp} | {row['seconds']:.0f} |")
 
         say()
         say("Notes on what was drawn:")
