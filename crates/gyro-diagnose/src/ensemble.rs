@@ -553,6 +553,8 @@ pub fn simulate_member(
                 temperature_varies: false,
                 static_diff_var: (f64::NAN, 0),
                 static_block_var: (f64::NAN, 0),
+                static_mean_dps: (f64::NAN, 0),
+                moving_mean_dps: (f64::NAN, 0),
                 bias_dps: f64::NAN,
                 incoherent_psd: Vec::new(),
                 reference_psd: Vec::new(),

@@ -150,6 +150,14 @@ pub struct Features {
     /// [`white_check_block`] samples ((deg/s)²: half the mean squared difference of
     /// consecutive block means inside one rest) and how many differences.
     pub static_block_var: (f64, usize),
+    /// Mean of the gyro at rest ([`super::stats::Residuals::is_rest`]; deg/s) and how
+    /// many samples: the output as rounded, which a step coarse against the noise moves
+    /// off the bias ([`super::fit::solve_white_and_bias`]).
+    pub static_mean_dps: (f64, usize),
+    /// Mean residual (gyro − reference rate, deg/s) over the moving samples (not
+    /// static) and how many: there the motion dithers the output's rounding, so a
+    /// coarse step leaves the bias as it is.
+    pub moving_mean_dps: (f64, usize),
     /// The run's bias (deg/s): the regression intercept (the bias at zero rate and the
     /// starting temperature) when at least 2 s of static samples pin it; on continuous
     /// motion the intercept trades with the |rate| and rate³ terms (at a near-constant
@@ -341,6 +349,9 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
         white_check_block(fs, r.statistics.white_check_tau_s),
     );
 
+    let static_mean_dps = mean_where(&r.rate_dps, |i| r.is_rest[i]);
+    let moving_mean_dps = mean_where(&r.residual_dps, |i| !r.is_static[i]);
+
     let features = Features {
         coef,
         samples,
@@ -350,6 +361,8 @@ fn features_of(r: &Residuals, plateau_tol_dps: f64, wander: bool) -> (Features, 
         temperature_varies: regressors.temperature_varies,
         static_diff_var,
         static_block_var,
+        static_mean_dps,
+        moving_mean_dps,
         bias_dps: run_bias(r, full_band_intercept),
         incoherent_psd: Vec::new(),
         reference_psd: Vec::new(),
@@ -653,6 +666,20 @@ fn rest_difference_variance(r: &Residuals) -> (f64, usize) {
     }
     if count > 0 {
         (sum / count as f64 / 2.0, count)
+    } else {
+        (f64::NAN, 0)
+    }
+}
+
+/// Mean of the finite samples of `x` where `ok`, and how many (NaN and 0 when none).
+fn mean_where(x: &[f64], ok: impl Fn(usize) -> bool) -> (f64, usize) {
+    let (sum, count) = x
+        .iter()
+        .enumerate()
+        .filter(|(i, v)| ok(*i) && v.is_finite())
+        .fold((0.0, 0usize), |(s, c), (_, v)| (s + v, c + 1));
+    if count > 0 {
+        (sum / count as f64, count)
     } else {
         (f64::NAN, 0)
     }

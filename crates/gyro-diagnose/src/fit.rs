@@ -317,14 +317,24 @@ pub struct Untestable {
     pub reason: String,
 }
 
-/// A static noise statistic the white noise is matched to: the Allan variance at
-/// `block` samples ((deg/s)²; at one sample, half the mean squared first difference).
+/// The static statistics the white noise is matched to: the Allan variance at `block`
+/// samples ((deg/s)²; at one sample, half the mean squared first difference), and, for
+/// the bias under a coarse output step ([`solve_white_and_bias`]), the rests' mean and
+/// the moving residual's.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct WhiteTarget {
     /// The measured Allan variance ((deg/s)²).
     pub avar_dps2: f64,
     /// Its averaging time in samples.
     pub block: usize,
+    /// Mean of the gyro at rest, as rounded (deg/s; NaN: not measured).
+    pub rest_mean_dps: f64,
+    /// How far a simulated rest mean may lie from `rest_mean_dps` and match it (deg/s):
+    /// `tests.z_critical` standard errors.
+    pub rest_mean_tol_dps: f64,
+    /// Mean residual over the moving samples (deg/s; NaN: none), where the motion
+    /// dithers the rounding.
+    pub moving_mean_dps: f64,
 }
 
 /// The whiteness check of the training runs' rests: the white noise their first
@@ -415,13 +425,17 @@ pub fn nominal_model(
     if rests_suffice(train) {
         let (chosen, rest_whiteness, count) = rest_white_target(train, &model, settings);
         whiteness = rest_whiteness;
-        model.arw_deg_per_rt_h = arw_of(chosen.1, &model);
+        model.arw_deg_per_rt_h = arw_of(chosen.1.sigma_dps, &model);
         target = Some(chosen.0);
         notes.push(rest_white_note(
             model.arw_deg_per_rt_h,
             whiteness.as_ref(),
             count,
         ));
+        if chosen.1.shift_dps != 0.0 {
+            notes.push(rounded_bias_note(model.bias_dps, &chosen.1, model.lsb_dps));
+            model.bias_dps = chosen.1.bias_dps;
+        }
     } else if let Some(m) = moving.filter(|m| m.white_level_deg_per_rt_h > 0.0) {
         notes.push(moving_white(&mut model, prior, m, short));
     } else {
@@ -464,23 +478,42 @@ fn pooled_rest(train: &[&RealRun], pick: fn(&RealRun) -> (f64, usize)) -> (f64, 
 }
 
 /// The white noise matched at rest ([`nominal_model`]): the target and the per-sample σ
-/// (deg/s) solved for `model`, from the first differences unless the rests' whiteness
-/// check finds them coloured (then from the block's Allan variance), the check when it
-/// ran, and how many first differences the rests hold.
+/// (deg/s) solved for `model` with the bias that goes with it under the model's output
+/// step ([`solve_white_and_bias`]), from the first differences unless the rests'
+/// whiteness check finds them coloured (then from the block's Allan variance), the check
+/// when it ran, and how many first differences the rests hold.
 fn rest_white_target(
     train: &[&RealRun],
     model: &SensorModel,
     settings: &Settings,
-) -> ((WhiteTarget, f64), Option<RestWhiteness>, usize) {
+) -> ((WhiteTarget, RestMatch), Option<RestWhiteness>, usize) {
     let (diff_var, count) = pooled_rest(train, |r| r.features.static_diff_var);
     let (block_var, block_count) = pooled_rest(train, |r| r.features.static_block_var);
+    let (rest_mean_dps, rest_count) = pooled_rest(train, |r| r.features.static_mean_dps);
+    let (moving_mean_dps, moving_count) = pooled_rest(train, |r| r.features.moving_mean_dps);
+    // The rests' mean is known to its standard error: white samples of the first
+    // differences' variance.
+    let rest_mean_tol_dps =
+        settings.tests.z_critical * (diff_var / rest_count.max(1) as f64).sqrt();
     let mut whiteness = None;
     let diff_target = WhiteTarget {
         avar_dps2: diff_var,
         block: 1,
+        rest_mean_dps: if rest_count > 0 {
+            rest_mean_dps
+        } else {
+            f64::NAN
+        },
+        rest_mean_tol_dps,
+        moving_mean_dps: if moving_count > 0 {
+            moving_mean_dps
+        } else {
+            f64::NAN
+        },
     };
-    let diff_sigma = solve_white_sigma(diff_target, model, model.lsb_dps, None);
-    let mut chosen = (diff_target, diff_sigma);
+    let diff = solve_white_and_bias(diff_target, model, model.lsb_dps, None);
+    let diff_sigma = diff.sigma_dps;
+    let mut chosen = (diff_target, diff);
     let block = super::features::white_check_block(
         model.sample_rate_hz,
         settings.statistics.white_check_tau_s,
@@ -489,14 +522,16 @@ fn rest_white_target(
         let block_target = WhiteTarget {
             avar_dps2: block_var,
             block,
+            ..diff_target
         };
-        let block_sigma = solve_white_sigma(block_target, model, model.lsb_dps, None);
+        let block_match = solve_white_and_bias(block_target, model, model.lsb_dps, None);
+        let block_sigma = block_match.sigma_dps;
         let ratio = (block_sigma / diff_sigma).powi(2);
         let z = (ratio - 1.0) / (3.0 / block_count as f64).sqrt();
         let coloured = z.abs() >= settings.tests.z_critical
             && (ratio - 1.0).abs() >= settings.fit.white_check_min;
         if coloured {
-            chosen = (block_target, block_sigma);
+            chosen = (block_target, block_match);
         }
         whiteness = Some(RestWhiteness {
             tau_s: block as f64 / model.sample_rate_hz,
@@ -508,6 +543,15 @@ fn rest_white_target(
         });
     }
     (chosen, whiteness, count)
+}
+
+/// The note on a bias `was_dps` replaced by the pre-rounding bias of `matched`, solved
+/// with the white noise under an output step `lsb_dps` coarse against it.
+fn rounded_bias_note(was_dps: f64, matched: &RestMatch, lsb_dps: f64) -> String {
+    format!(
+        "bias {:.4} deg/s (was {was_dps:.4}): the output step {lsb_dps:.5} deg/s is coarse against the noise, so the rests' mean is the bias rounded towards the level the output sits on most ({:+.4} deg/s); bias and white noise solved together so that the simulated rounded rest output matches both the rests' mean and their Allan variance, the bias nearest the moving residual's mean, where the motion dithers the rounding",
+        matched.bias_dps, matched.shift_dps
+    )
 }
 
 /// The note on the white noise measured at rest: `arw_deg_per_rt_h`, matched to the first
@@ -644,50 +688,177 @@ pub fn rests_suffice(train: &[&RealRun]) -> bool {
 /// given, as the simulator's `bandwidth` filters it), rounded to the output step `lsb_dps`
 /// ([`gyro_sim::output_step_dps`]) —
 /// has the Allan variance `target` at its block length (at one sample: half the mean
-/// squared first difference). Rounding a signal that barely moves is not the textbook
-/// lsb²/12, so the match is by simulation (40 000 samples, or 40 000 blocks, fixed seed,
-/// bisection).
+/// squared first difference), at the bias of `model`. Rounding a signal that barely moves
+/// is not the textbook lsb²/12, so the match is by simulation ([`StaticOutput`]).
 pub fn solve_white_sigma(
     target: WhiteTarget,
     model: &SensorModel,
     lsb_dps: f64,
     cutoff_hz: Option<f64>,
 ) -> f64 {
-    use rand::SeedableRng;
-    use rand_distr::{Distribution, StandardNormal};
-    let block = target.block.max(1);
-    let n = 40_000 * block;
-    let target = target.avar_dps2;
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x000A_11A4);
-    let mut white: Vec<f64> = (0..n).map(|_| StandardNormal.sample(&mut rng)).collect();
-    // The filter is linear: filtering the unit noise once scales with σ.
-    if let Some(cutoff_hz) = cutoff_hz {
-        let mut filter = gyro_sim::TwoPoleLowPass::new(cutoff_hz, model.sample_rate_hz, 0.0);
-        white.iter_mut().for_each(|w| *w = filter.step(*w));
-    }
-    let dt = 1.0 / model.sample_rate_hz;
-    let phi = (-dt / model.gm_tau_s).exp();
-    let drive = model.gm_sigma_dps * (1.0 - phi * phi).sqrt();
-    let mut g = model.gm_sigma_dps * {
-        let x: f64 = StandardNormal.sample(&mut rng);
-        x
+    StaticOutput::new(target.block, model, lsb_dps, cutoff_hz)
+        .sigma_for(target.avar_dps2, model.bias_dps)
+}
+
+/// The pre-rounding bias and the white noise matched jointly at rest
+/// ([`solve_white_and_bias`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RestMatch {
+    /// Bias before the output's rounding (deg/s).
+    pub bias_dps: f64,
+    /// White noise per sample (deg/s).
+    pub sigma_dps: f64,
+    /// What the rounding adds to the mean at rest (deg/s): the rests' mean reads
+    /// `bias_dps` plus this. Zero where the step is fine against the noise.
+    pub shift_dps: f64,
+}
+
+/// The bias and white σ whose simulated static output, rounded to `lsb_dps`
+/// ([`solve_white_sigma`]'s simulation), matches both the rests' Allan variance `target`
+/// and their mean (`target.rest_mean_dps`, within `target.rest_mean_tol_dps`).
+///
+/// Under a step coarse against the noise the output sits on one or two levels, and the
+/// rests' mean reads the bias pulled towards the level it sits on most (0.15 deg/s under
+/// a 0.264 step with 0.047 of noise reads 0.17): the bias, not the mean, is what the
+/// motion carries, where it dithers the rounding. Both static statistics then read only
+/// how often the output leaves its level, so they pin the bias and σ along a curve (the
+/// bias nearer the rounding threshold, σ smaller), not each: the bias on that curve is the
+/// one nearest the moving residual's mean (`target.moving_mean_dps`, the bias where the
+/// motion dithers the rounding) among those whose simulated rest mean matches the rests'
+/// (without it, the one whose rest mean is the rests'). Where the rounding's shift of the
+/// mean is within the simulation's resolution (the step fine against the noise), the
+/// bias stays `model`'s and σ is [`solve_white_sigma`]'s.
+pub fn solve_white_and_bias(
+    target: WhiteTarget,
+    model: &SensorModel,
+    lsb_dps: f64,
+    cutoff_hz: Option<f64>,
+) -> RestMatch {
+    let sim = StaticOutput::new(target.block, model, lsb_dps, cutoff_hz);
+    let today = RestMatch {
+        bias_dps: model.bias_dps,
+        sigma_dps: sim.sigma_for(target.avar_dps2, model.bias_dps),
+        shift_dps: 0.0,
     };
-    let wander: Vec<f64> = (0..n)
-        .map(|_| {
+    let mean_dps = target.rest_mean_dps;
+    if lsb_dps <= 0.0 || !mean_dps.is_finite() {
+        return today;
+    }
+    let tol_dps = target.rest_mean_tol_dps.max(0.0);
+    // The pre-rounding bias `b` on the curve of static matches, its σ, and the rest mean
+    // it gives (the rounding's shift added: the draw's own mean is not the data's).
+    let on_curve = |bias_dps: f64| {
+        let sigma_dps = sim.sigma_for(target.avar_dps2, bias_dps);
+        let shift_dps = sim.rounding_shift(bias_dps, sigma_dps);
+        RestMatch {
+            bias_dps,
+            sigma_dps,
+            shift_dps,
+        }
+    };
+    let rest_mean = |m: &RestMatch| m.bias_dps + m.shift_dps;
+    // The rest mean along the curve rises with the bias (in steps where the output
+    // changes level): bisection for the bias where it crosses `level`, within a step.
+    let crossing = |level: f64| {
+        let (mut lo, mut hi) = (level - lsb_dps, level + lsb_dps);
+        for _ in 0..30 {
+            let mid = 0.5 * (lo + hi);
+            if rest_mean(&on_curve(mid)) < level {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        on_curve(0.5 * (lo + hi))
+    };
+    let found = match target.moving_mean_dps {
+        anchor if anchor.is_finite() => {
+            let at = on_curve(anchor);
+            let m = rest_mean(&at);
+            if m < mean_dps - tol_dps {
+                crossing(mean_dps - tol_dps)
+            } else if m > mean_dps + tol_dps {
+                crossing(mean_dps + tol_dps)
+            } else {
+                at
+            }
+        }
+        _ => crossing(mean_dps),
+    };
+    if found.shift_dps.abs() <= 3.0 * sim.mean_resolution_dps() {
+        return today;
+    }
+    found
+}
+
+/// The static output a white noise is matched through: bias, the Gauss-Markov wander of
+/// the model, white noise (low-passed at `cutoff_hz` when given), rounded to the output
+/// step; one fixed draw (40 000 samples, or 40 000 blocks; fixed seed), so that every
+/// bias and σ tried sees the same noise.
+struct StaticOutput {
+    /// Unit white noise, low-passed when the sensor has a cutoff.
+    white: Vec<f64>,
+    /// The Gauss-Markov wander (deg/s).
+    wander: Vec<f64>,
+    /// Samples per block of the Allan variance.
+    block: usize,
+    /// Output step (deg/s; 0: none).
+    lsb_dps: f64,
+}
+
+impl StaticOutput {
+    fn new(block: usize, model: &SensorModel, lsb_dps: f64, cutoff_hz: Option<f64>) -> Self {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        let block = block.max(1);
+        let n = 40_000 * block;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x000A_11A4);
+        let mut white: Vec<f64> = (0..n).map(|_| StandardNormal.sample(&mut rng)).collect();
+        // The filter is linear: filtering the unit noise once scales with σ.
+        if let Some(cutoff_hz) = cutoff_hz {
+            let mut filter = gyro_sim::TwoPoleLowPass::new(cutoff_hz, model.sample_rate_hz, 0.0);
+            white.iter_mut().for_each(|w| *w = filter.step(*w));
+        }
+        let dt = 1.0 / model.sample_rate_hz;
+        let phi = (-dt / model.gm_tau_s).exp();
+        let drive = model.gm_sigma_dps * (1.0 - phi * phi).sqrt();
+        let mut g = model.gm_sigma_dps * {
             let x: f64 = StandardNormal.sample(&mut rng);
-            g = phi * g + drive * x;
-            g
-        })
-        .collect();
-    let block_var = |sigma: f64| -> f64 {
+            x
+        };
+        let wander: Vec<f64> = (0..n)
+            .map(|_| {
+                let x: f64 = StandardNormal.sample(&mut rng);
+                g = phi * g + drive * x;
+                g
+            })
+            .collect();
+        Self {
+            white,
+            wander,
+            block,
+            lsb_dps,
+        }
+    }
+
+    /// Sample `k` before and after rounding (deg/s).
+    fn sample(&self, k: usize, bias_dps: f64, sigma_dps: f64) -> (f64, f64) {
+        let x = bias_dps + self.wander[k] + sigma_dps * self.white[k];
+        if self.lsb_dps > 0.0 {
+            (x, (x / self.lsb_dps).round() * self.lsb_dps)
+        } else {
+            (x, x)
+        }
+    }
+
+    /// Allan variance at the block length ((deg/s)²) of the rounded output.
+    fn block_var(&self, bias_dps: f64, sigma_dps: f64) -> f64 {
+        let block = self.block;
         let mut prev = f64::NAN;
         let (mut sum, mut count) = (0.0, 0usize);
         let (mut acc, mut filled) = (0.0, 0usize);
-        for k in 0..n {
-            let mut x = model.bias_dps + wander[k] + sigma * white[k];
-            if lsb_dps > 0.0 {
-                x = (x / lsb_dps).round() * lsb_dps;
-            }
+        for k in 0..self.white.len() {
+            let mut x = self.sample(k, bias_dps, sigma_dps).1;
             if block > 1 {
                 acc += x;
                 filled += 1;
@@ -704,25 +875,54 @@ pub fn solve_white_sigma(
             prev = x;
         }
         sum / count.max(1) as f64 / 2.0
-    };
-    let (mut lo, mut hi) = (0.0, (2.0 * target * block as f64).sqrt().max(1e-6) * 2.0);
-    if block_var(lo) >= target {
-        return 0.0;
     }
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        if block_var(mid) < target {
-            lo = mid;
-        } else {
-            hi = mid;
+
+    /// What the rounding adds to the mean (deg/s): the rounded output's mean less the
+    /// unrounded's, over the same draw (so that the draw's own mean cancels).
+    fn rounding_shift(&self, bias_dps: f64, sigma_dps: f64) -> f64 {
+        let n = self.white.len();
+        let sum: f64 = (0..n)
+            .map(|k| {
+                let (x, rounded) = self.sample(k, bias_dps, sigma_dps);
+                rounded - x
+            })
+            .sum();
+        sum / n.max(1) as f64
+    }
+
+    /// The standard error of [`Self::rounding_shift`] where the rounding is dithered
+    /// (errors uniform over a step, independent): step / √(12 n).
+    fn mean_resolution_dps(&self) -> f64 {
+        self.lsb_dps / (12.0 * self.white.len().max(1) as f64).sqrt()
+    }
+
+    /// The σ (deg/s) at `bias_dps` whose Allan variance is `target_dps2` (bisection; 0
+    /// when the rounding alone reaches it).
+    fn sigma_for(&self, target_dps2: f64, bias_dps: f64) -> f64 {
+        let (mut lo, mut hi) = (
+            0.0,
+            (2.0 * target_dps2 * self.block as f64).sqrt().max(1e-6) * 2.0,
+        );
+        if self.block_var(bias_dps, lo) >= target_dps2 {
+            return 0.0;
         }
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if self.block_var(bias_dps, mid) < target_dps2 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
     }
-    0.5 * (lo + hi)
 }
 
 /// The model to simulate with `effects` added. The white noise is matched again to the
 /// measured static statistic `white_target` where an effect changes what it measured:
-/// with quantisation (it was measured with the rounding in it), and with a `bandwidth`
+/// with quantisation (it was measured with the rounding in it; the bias is solved with
+/// it, [`solve_white_and_bias`], since a coarse step moves the rests' mean off the bias),
+/// and with a `bandwidth`
 /// when the statistic is the rests' block Allan variance (the low band the angle
 /// integrates, which the sensor's low-pass must keep: a cutoff near the block's
 /// frequency still lowers it). First differences stay as they are under a bandwidth:
@@ -751,8 +951,16 @@ pub fn model_with(
         .filter(|_| target.block > 1);
     if extra_lsb.is_some() || cutoff_hz.is_some() {
         let lsb_dps = gyro_sim::output_step_dps(nominal.lsb_dps, extra_lsb.unwrap_or(0.0));
-        let sigma = solve_white_sigma(target, nominal, lsb_dps, cutoff_hz);
-        model.arw_deg_per_rt_h = sigma * 60.0 / model.sample_rate_hz.sqrt();
+        // Under a named step the bias is solved with the white noise: the nominal's is
+        // the rests' mean as rounded, off the bias by what a coarse step adds.
+        let sigma_dps = if extra_lsb.is_some() {
+            let matched = solve_white_and_bias(target, nominal, lsb_dps, cutoff_hz);
+            model.bias_dps = matched.bias_dps;
+            matched.sigma_dps
+        } else {
+            solve_white_sigma(target, nominal, lsb_dps, cutoff_hz)
+        };
+        model.arw_deg_per_rt_h = arw_of(sigma_dps, &model);
     }
     model
 }
@@ -2377,6 +2585,108 @@ mod whiteness_tests {
             .notes
             .iter()
             .any(|s| s.contains("the rest noise is not white")));
+    }
+}
+
+#[cfg(test)]
+mod rounded_bias_tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    const FS: f64 = 100.0;
+    const STEP_DPS: f64 = 0.264;
+
+    /// A gyro at `bias_dps` with white noise `sigma_dps`, its output rounded to `step_dps`:
+    /// the target of 20 000 static samples (first-difference Allan variance, mean) and the
+    /// mean residual of 20 000 samples turning at up to 60 deg/s (the motion dithers the
+    /// rounding), as `rest_white_target` reads them.
+    fn target(bias_dps: f64, sigma_dps: f64, step_dps: f64) -> WhiteTarget {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(6030);
+        let mut out = |rate_dps: f64| {
+            let w: f64 = StandardNormal.sample(&mut rng);
+            ((bias_dps + rate_dps + sigma_dps * w) / step_dps).round() * step_dps
+        };
+        let n = 20_000;
+        let rest: Vec<f64> = (0..n).map(|_| out(0.0)).collect();
+        let moving_sum: f64 = (0..n)
+            .map(|k| {
+                let rate_dps = 60.0 * (std::f64::consts::TAU * 0.2 * k as f64 / FS).sin();
+                out(rate_dps) - rate_dps
+            })
+            .sum();
+        let diff_var =
+            rest.windows(2).map(|d| (d[1] - d[0]).powi(2)).sum::<f64>() / (n - 1) as f64 / 2.0;
+        WhiteTarget {
+            avar_dps2: diff_var,
+            block: 1,
+            rest_mean_dps: rest.iter().sum::<f64>() / n as f64,
+            rest_mean_tol_dps: Settings::DEFAULT.tests.z_critical * (diff_var / n as f64).sqrt(),
+            moving_mean_dps: moving_sum / n as f64,
+        }
+    }
+
+    /// The nominal model as `nominal_model` leaves it: the bias the rests' mean reads.
+    fn nominal(target: &WhiteTarget) -> SensorModel {
+        SensorModel {
+            sample_rate_hz: FS,
+            bias_dps: target.rest_mean_dps,
+            gm_sigma_dps: 0.0,
+            lsb_dps: 0.0,
+            ..SensorModel::default()
+        }
+    }
+
+    /// A step coarse against the noise (0.264 deg/s over 0.047 of noise at a bias of
+    /// 0.15): the rests' mean reads about 0.17, and σ solved at that bias alone is about
+    /// twice the truth; solved with the bias, the bias is within 0.003 deg/s and σ within
+    /// 10%, and the simulated rest mean matches the rests'.
+    #[test]
+    fn a_coarse_step_solves_the_bias_with_the_white_noise() {
+        let (bias_dps, sigma_dps) = (0.15, 0.047);
+        let t = target(bias_dps, sigma_dps, STEP_DPS);
+        let model = nominal(&t);
+        assert!(t.rest_mean_dps > bias_dps + 0.015, "{t:?}");
+        let old = solve_white_sigma(t, &model, STEP_DPS, None);
+        assert!(old > 1.5 * sigma_dps, "the single-sigma solve: {old}");
+        let m = solve_white_and_bias(t, &model, STEP_DPS, None);
+        assert!((m.bias_dps - bias_dps).abs() < 0.003, "{m:?} {t:?}");
+        assert!((m.sigma_dps / sigma_dps - 1.0).abs() < 0.1, "{m:?} {t:?}");
+        assert!(
+            (m.bias_dps + m.shift_dps - t.rest_mean_dps).abs() <= t.rest_mean_tol_dps,
+            "{m:?} {t:?}"
+        );
+    }
+
+    /// A moving mean the rests cannot have (0.25: the output would sit on the upper level
+    /// far more often) is not taken: the bias is the nearest whose rest mean matches.
+    #[test]
+    fn the_moving_mean_is_taken_only_where_the_rests_allow_it() {
+        let t = WhiteTarget {
+            moving_mean_dps: 0.25,
+            ..target(0.15, 0.047, STEP_DPS)
+        };
+        let m = solve_white_and_bias(t, &nominal(&t), STEP_DPS, None);
+        assert!(m.bias_dps < 0.2, "{m:?}");
+        let rest_mean = m.bias_dps + m.shift_dps;
+        assert!(
+            (rest_mean - t.rest_mean_dps).abs() <= 1.01 * t.rest_mean_tol_dps,
+            "{m:?} {t:?}"
+        );
+    }
+
+    /// A step fine against the noise (the CRM100's 1/24 deg/s under 0.127 of noise)
+    /// dithers the rests: the bias stays the nominal's and σ is the single solve's.
+    #[test]
+    fn a_fine_step_keeps_the_bias_and_the_single_solve() {
+        let step_dps = 1.0 / 24.0;
+        let t = target(0.15, 0.127, step_dps);
+        let model = nominal(&t);
+        let m = solve_white_and_bias(t, &model, step_dps, None);
+        assert_eq!(m.bias_dps, model.bias_dps);
+        assert_eq!(m.shift_dps, 0.0);
+        assert_eq!(m.sigma_dps, solve_white_sigma(t, &model, step_dps, None));
+        assert!((m.sigma_dps / 0.127 - 1.0).abs() < 0.05, "{m:?}");
     }
 }
 
