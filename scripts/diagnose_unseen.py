@@ -446,6 +446,13 @@ def matrix_case(gyro, directory, name, effect, param, value, seed, label, noise)
                unexplained=len(d["unexplained"]), error=None)
     row["named_text"] = [f"{n} {fmt_ci(effects[n]['params'], effects[n]['ci95'])}" for n in named]
     row["first"] = named[0] if named else None
+    # The detection limit `diagnose` states for the injected effect when it does not name it.
+    row["limit"] = None
+    for seen in d.get("not_seen", []):
+        if seen["id"] == effect and seen.get("limit") and param in seen["limit"]["params"]:
+            row["limit"] = seen["limit"]["params"][param]
+    row["below_limit"] = row["limit"] is not None and (
+        value > row["limit"] if effect == "bandwidth" else abs(value) < abs(row["limit"]))
     row["extra"] = [n for n in named if n != effect and n != LOOKALIKE.get(effect)]
     row["lookalike"] = [n for n in named if effect and n == LOOKALIKE.get(effect)]
     # The verdict's doubts on what it names (`doubts`: e.g. a latency beside low-passed rests).
@@ -478,7 +485,9 @@ def matrix_failures(row):
         return [f"null names {', '.join(row['named'])}"] if row["named"] else []
     why = []
     if not row["named"]:
-        why.append("silent")
+        why.append("silent" + ("" if row["limit"] is None else
+                               f" ({'below' if row['below_limit'] else 'at or above'} the limit it states, "
+                               f"{row['limit']:.4g})"))
     elif not row["top_strict"]:
         why.append(f"{row['first']} named first" + (" (look-alike)" if row["top_group"] else ""))
     if row["lookalike"]:
@@ -561,6 +570,12 @@ def matrix_main(args):
             say(f"  - named first (strict id): {sum(r['top_strict'] for r in group)}/{len(group)}")
             say(f"  - named first (latency~bandwidth as one): {sum(r['top_group'] for r in group)}/{len(group)}")
             say(f"  - injected effect named at all: {len(named)}/{len(group)}")
+            silent = [r for r in group if not r["named"]]
+            say(f"  - silent: {len(silent)}, of which below the detection limit `diagnose` states: "
+                f"{sum(r['below_limit'] for r in silent)}")
+            above = [r for r in group if not r["below_limit"]]
+            say(f"  - named first where not below the stated limit: "
+                f"{sum(r['top_strict'] for r in above)}/{len(above)}")
             say(f"  - nothing extra named (look-alike not counted): {sum(not r['extra'] for r in group)}/{len(group)}")
             say(f"  - look-alike named: {sum(bool(r['lookalike']) for r in group)}/{len(group)}"
                 f" (the verdict doubts it: {sum(bool(r['lookalike']) and r.get('doubted', False) for r in group)})")

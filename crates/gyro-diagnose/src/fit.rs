@@ -598,17 +598,24 @@ fn prior_wander(
     moving: Option<&super::effective::MeasuredNoise>,
     floor: f64,
 ) -> String {
-    let mut wander = format!(
-        "Gauss-Markov bias sigma {} deg/s, T {} s, range {} deg/s: from the prior model",
-        model.gm_sigma_dps, model.gm_tau_s, model.range_dps
-    );
+    let mut wander = if model.gm_sigma_dps == 0.0 {
+        format!(
+            "no bias wander (Gauss-Markov sigma 0): a wander the runs show is the vocabulary's to name (bias_instability, rate_random_walk), a spread of their biases turn_on_bias; range {} deg/s: from the prior model",
+            model.range_dps
+        )
+    } else {
+        format!(
+            "Gauss-Markov bias sigma {} deg/s, T {} s, range {} deg/s: from the prior model",
+            model.gm_sigma_dps, model.gm_tau_s, model.range_dps
+        )
+    };
     if model.lsb_dps == prior.lsb_dps {
         wander = format!(
             "{wander}; output step {:.5} deg/s: the prior's",
             model.lsb_dps
         );
     }
-    if let Some(m) = moving {
+    if let Some(m) = moving.filter(|_| model.gm_sigma_dps > 0.0) {
         let k_prior = gyro_analysis::noise::export::gauss_markov_random_walk(
             model.gm_sigma_dps,
             model.gm_tau_s,
@@ -1014,6 +1021,9 @@ pub struct FitInput<'a> {
     /// A count-stamped clock read from the lag lines, beyond the per-sample statistics'
     /// reach ([`super::lag_line::grown_clock_fit`]), its test passed: held as known.
     pub grown_clock: Option<&'a Fit>,
+    /// The effects `null` and `holdout_null` were simulated with beyond the nominal model:
+    /// none, but for a wander refitted beside deterministic effects ([`Joint::fits`]).
+    pub null_effects: &'a [Effect],
 }
 
 impl FitInput<'_> {
@@ -1071,6 +1081,9 @@ struct Known {
     effects: Vec<Effect>,
     /// Noise-free coefficients with `effects`.
     with_effects: [f64; N_REG],
+    /// Bias wanders fitted beside: a spread between runs is read against ensembles
+    /// simulated with them ([`between_run_fit`]).
+    wanders: Vec<Effect>,
 }
 
 impl Known {
@@ -1084,6 +1097,7 @@ impl Known {
             quiet,
             effects,
             with_effects,
+            wanders: Vec::new(),
         }
     }
 }
@@ -1126,9 +1140,21 @@ pub(crate) fn negligible(fit: &Fit, model: &SensorModel, negligible_delay_sample
     bound_s.is_finite() && lo.abs() < bound_s && hi.abs() < bound_s
 }
 
-/// Effects fitted from the joint regression, which [`Joint`] refits given the others.
+/// Effects which [`Joint`] refits given the others: those fitted from the joint
+/// regression; the spread of the bias between runs, into which a deterministic effect
+/// leaks by as much as the runs' turns differ (a 50 ms latency: σ 0.036 °/s over four
+/// runs of one bias) and which a wander spreads too; and a wander, whose excess holds
+/// what deterministic effects leave in the residual.
 fn conditional(effect: &Effect) -> bool {
-    matches!(effect.info().fit, FitProcedure::Regression { .. })
+    matches!(
+        effect.info().fit,
+        FitProcedure::Regression { .. } | FitProcedure::BetweenRunSpread | FitProcedure::Wander(_)
+    )
+}
+
+/// A bias wander, whose ensembles a spread between runs is read against beside it.
+fn wander(effect: &Effect) -> bool {
+    matches!(effect.info().fit, FitProcedure::Wander(_))
 }
 
 /// Deterministic effects, which a noise-free calibration can hold as known.
@@ -1174,11 +1200,40 @@ impl Joint<'_> {
                 continue;
             }
             let others = known_besides(&self.clock, &current, i);
-            if others.len() == self.clock.len() {
+            let wanders: Vec<Effect> = match set[i].info().fit {
+                FitProcedure::BetweenRunSpread => (current.iter().enumerate())
+                    .filter(|&(j, e)| j != i && wander(e))
+                    .map(|(_, e)| *e)
+                    .collect(),
+                _ => Vec::new(),
+            };
+            if others.len() == self.clock.len() && wanders.is_empty() {
                 continue;
             }
-            let known = Known::new(self.input, self.quiet, others);
-            if let Ok(f) = fit_one(self.input, &known, set[i].info()) {
+            // A wander beside deterministic effects is read against ensembles simulated
+            // with them: alone, its Allan-variance excess over the nominal model holds
+            // what they leave in the residual (a 50 ms latency read as a random walk of
+            // 0.044 °/s/√s).
+            let beside_null = wander(&set[i]).then(|| {
+                let members = |_: usize| self.input.settings.fit.wander_gain_members;
+                let train = simulate_runs_with(self.input, self.input.train, 0, &others, &members);
+                let first = self.input.train.len();
+                let holdout =
+                    simulate_runs_with(self.input, self.input.holdout, first, &others, &members);
+                (train, holdout)
+            });
+            let beside = beside_null.as_ref().map(|(train, holdout)| FitInput {
+                null: train,
+                holdout_null: holdout,
+                null_effects: &others,
+                ..*self.input
+            });
+            let input = beside.as_ref().unwrap_or(self.input);
+            let known = Known {
+                wanders,
+                ..Known::new(input, self.quiet, others.clone())
+            };
+            if let Ok(f) = fit_one(input, &known, set[i].info()) {
                 current[i] = f.effect;
                 out[i] = Some(f);
             }
@@ -1804,7 +1859,10 @@ fn between_run_fit(
     if input.train.len() < 3 {
         return Err(FitError::TooFewRunsForSpread);
     }
-    let (z, s2, v0, k) = bias_spread(input.train, input.null, input.model, &known.effects);
+    let beside_wanders =
+        (!known.wanders.is_empty()).then(|| simulate_train_with(input, &known.wanders));
+    let null = beside_wanders.as_deref().unwrap_or(input.null);
+    let (z, s2, v0, k) = bias_spread(input.train, null, input.model, &known.effects);
     let sigma = (s2 - v0).max(0.0).sqrt();
     let lo = (k * s2 / chi2_quantile(0.975, k) - v0).max(0.0).sqrt();
     let hi = (k * s2 / chi2_quantile(0.025, k) - v0).max(0.0).sqrt();
@@ -1942,20 +2000,36 @@ fn wander_shape_solve(per_tau: &[(f64, f64, f64, f64)], excess: &dyn Fn(usize) -
 /// members as `fit.wander_gain_members` allows (and its null ensemble holds), on the null
 /// members' seeds.
 fn simulate_train_with(input: &FitInput, effect: &[Effect]) -> Vec<Vec<Member>> {
-    (0..input.train.len())
+    let effects: Vec<Effect> = input.null_effects.iter().chain(effect).copied().collect();
+    let members = |r: usize| {
+        input
+            .settings
+            .fit
+            .wander_gain_members
+            .min(input.null[r].len())
+    };
+    simulate_runs_with(input, input.train, 0, &effects, &members)
+}
+
+/// `runs` simulated with `effects` on `input`'s model, `members(r)` members of run `r`,
+/// seeded as the ensembles of run index `first + r` are.
+fn simulate_runs_with(
+    input: &FitInput,
+    runs: &[&RealRun],
+    first: usize,
+    effects: &[Effect],
+    members: &(dyn Fn(usize) -> usize + Sync),
+) -> Vec<Vec<Member>> {
+    (0..runs.len())
         .into_par_iter()
         .map(|r| {
-            (0..input
-                .settings
-                .fit
-                .wander_gain_members
-                .min(input.null[r].len()))
+            (0..members(r))
                 .map(|j| {
                     simulate_member(
-                        input.train[r],
+                        runs[r],
                         input.model,
-                        effect,
-                        super::ensemble::member_seed(input.seed, r, j),
+                        effects,
+                        super::ensemble::member_seed(input.seed, first + r, j),
                     )
                 })
                 .collect()

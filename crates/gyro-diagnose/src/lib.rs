@@ -369,6 +369,7 @@ fn diagnose_prepared(
         holdout_null: &base.holdout.members,
         settings: &options.settings,
         grown_clock,
+        null_effects: &[],
     };
     let (fits, untestable, joint) = fit::fit_all(&input);
 

@@ -521,7 +521,21 @@ fn swaps(
             let look_alike = look_alike
                 || (rests_delay(scorer.baseline.whiteness.as_ref()) == Some(out_id)
                     && DELAYS.contains(&in_id));
-            if selected.contains(&a) || candidates[selected[slot]].fit.direct || look_alike {
+            // One delay and one wander per model, as in the forward step: a swap for
+            // another effect does not bring in a second beside the one kept (a latency
+            // for a scale factor beside the bandwidth the rests chose, after which
+            // leave-one-out dropped the bandwidth: a 10.7 Hz Butterworth at the CRM100's
+            // noise named as a 20 ms latency, development draw 6114).
+            let kept = |like: fn(&Fit) -> bool| {
+                (selected.iter().enumerate()).any(|(k, &j)| k != slot && like(&candidates[j].fit))
+            };
+            let second = (is_delay(&candidates[a].fit) && kept(is_delay))
+                || (is_wander(&candidates[a].fit) && kept(is_wander));
+            if selected.contains(&a)
+                || candidates[selected[slot]].fit.direct
+                || look_alike
+                || second
+            {
                 continue;
             }
             let set: Vec<Effect> = selected

@@ -12,7 +12,8 @@
 //! sensor's own sample count (its clock 500 ppm fast: the lag grows over each window; and
 //! 1.5% fast, a lag of up to 0.9 s).
 //! And one with rests: a gyro whose digital low-pass filters its noise as well as the
-//! rate (the rests' noise coloured). Small ensembles keep it quick.
+//! rate (the rests' noise coloured), at the noise of the other cases and at the CRM100's.
+//! Small ensembles keep it quick.
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use gyro_diagnose::{diagnose, split, Options, RealRun, Silent};
@@ -216,4 +217,15 @@ fn a_low_passed_gyro_with_rests_gets_its_low_band_noise_and_its_lag() {
         "{:?}",
         c.runs
     );
+}
+
+#[test]
+fn a_quiet_low_passed_gyro_keeps_the_bandwidth_its_rests_point_to() {
+    // At the CRM100's noise a 10 Hz Butterworth's lag is read so precisely that a
+    // `latency` wins the held-out ΔBIC; the rests' coloured noise chooses the `bandwidth`,
+    // and no later swap brings the latency in beside it (one delay per model).
+    let d = diagnosed("quiet_dlpf_train.csv", "quiet_dlpf_holdout.csv");
+    let w = d.model.rest_noise.clone().unwrap();
+    assert!(w.coloured && w.z > 4.0, "{w:?}");
+    assert_eq!(d.verdict.unmodelled, ["bandwidth"], "{:?}", d.verdict);
 }
