@@ -132,12 +132,25 @@ impl Default for Options {
             candidate_members: 20,
             seed: 1,
             bootstrap: 2000,
-            prior: SensorModel::default(),
+            prior: default_prior(),
             fixed_model: false,
             base_model: ModelFile::new(gyro_core::Config::default()),
             score_every_candidate: false,
             settings: Settings::default(),
         }
+    }
+}
+
+/// The sensor model a diagnosis starts from without `--model`, and the self-check
+/// simulates its runs from: the simulator's nominal sensor without its Gauss–Markov bias
+/// wander. What the runs show of bias, white noise, output step and range is read from
+/// them ([`fit::nominal_model`]); a bias wander the runs show is what the vocabulary's
+/// `bias_instability` and `rate_random_walk` name, so a prior wander would hold it unnamed
+/// (a prior of σ 0.05 °/s over 100 s wanders as a 180 °/h bias instability does).
+pub fn default_prior() -> SensorModel {
+    SensorModel {
+        gm_sigma_dps: 0.0,
+        ..SensorModel::default()
     }
 }
 

@@ -20,7 +20,7 @@ use super::ensemble::RealRun;
 use super::{diagnose, Diagnosis, Options, Silent};
 use gyro_analysis::seed::derive_seed;
 use gyro_log::{regularize, GridOptions};
-use gyro_sim::{simulate, BenchProfile, Effect, Motion, SensorModel, SimOptions, EFFECTS};
+use gyro_sim::{simulate, BenchProfile, Effect, Motion, SimOptions, EFFECTS};
 use serde::Serialize;
 
 /// Training runs per case.
@@ -255,7 +255,7 @@ fn same_group(a: &str, b: &str) -> bool {
 
 /// Simulate the runs of a case.
 pub fn case_runs(effects: &[Effect], seed: u64) -> (Vec<RealRun>, Vec<RealRun>) {
-    let model = SensorModel::default();
+    let model = crate::default_prior();
     let profile = BenchProfile {
         duration_s: RUN_S,
         ..BenchProfile::default()

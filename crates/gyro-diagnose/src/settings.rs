@@ -70,7 +70,8 @@ pub struct Tests {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Locate {
     /// Relative tolerance of the unexplained test: each run's z is taken against at least
-    /// this share of the statistic's size (max(|real|, |simulated|)) as its spread. Unit 1,
+    /// this share of the statistic's size (max(|real|, |simulated|), and for a segment's
+    /// mean residual the residual's spread there, what the mean is left of) as its spread. Unit 1,
     /// valid [0, 1). 0.02: a model is judged at the precision its parameters are known to
     /// (the regression parameters carry a 2% systematic uncertainty,
     /// [`Fit::systematic_rel`]); a correct model fitted to a long run leaves a z of 5 to 10
@@ -478,7 +479,7 @@ impl Settings {
             entry("tests.p_value", t.p_value, "1", (OPEN, 0.0, 1.0, OPEN),
                 "bootstrap P over held-out runs under which an improvement (held-out ΔBIC, a swap, a correction) is significant"),
             entry("locate.unexplained_tolerance", l.unexplained_tolerance, "1", (CLOSED, 0.0, 1.0, OPEN),
-                "least spread of a statistic in the unexplained test, as a share of its size: the parameters' 2% systematic uncertainty"),
+                "least spread of a statistic in the unexplained test, as a share of its size (a mean residual's: its segment's spread): the parameters' 2% systematic uncertainty"),
             entry("fit.quant_ratio", f.quant_ratio, "1", (OPEN, 1.0, 100.0, CLOSED),
                 "output grid over the nominal step at which quantisation is named"),
             entry("fit.step_match_rel", f.step_match_rel, "1", (OPEN, 0.0, 1.0, OPEN),

@@ -111,14 +111,12 @@ fn latency_is_named_on_real_yaw_and_its_correction_does_not_hurt() {
         "{:?}",
         scale.ci95
     );
-    // The residual's excess fades from 1 s to 16 s: no bias wander fits its shape.
+    // The residual's excess fades from 1 s to 16 s: no bias wander fits its shape, or
+    // there is none beyond the baseline's (its test does not pass).
     for id in ["rate_random_walk", "bias_instability"] {
         let e = d.effects.iter().find(|e| e.id == id).unwrap();
-        assert!(
-            !e.significant && e.test.contains("not a bias wander"),
-            "{id}: {}",
-            e.test
-        );
+        let why = e.test.contains("not a bias wander") || e.test.ends_with("does not pass");
+        assert!(!e.significant && why, "{id}: {}", e.test);
     }
     // The stepper's vibration is in the motion (both sensors see it), near 12.8 Hz in the
     // slow trial and 40.5 Hz in the medium one: said, and not named as a sensor's.
@@ -150,13 +148,14 @@ fn latency_is_named_on_real_yaw_and_its_correction_does_not_hurt() {
     assert!(t.ratio_to_model > 10.0, "{}", t.describe());
     assert_eq!(t.compared_with, "prior model");
     // These runs never rest: the baseline's white noise is the one measured on their
-    // moving residual, not the CRM100 prior's, and its note says so; the wander stays
-    // the prior's, checked against what the residual allows.
+    // moving residual, not the CRM100 prior's, and its note says so; the starting model
+    // holds no bias wander, and its note says a wander the runs show is for the
+    // vocabulary to name.
     let sensor = &d.model.sensor;
     assert_eq!(sensor.arw_deg_per_rt_h, t.arw_deg_per_rt_h);
     let notes = d.model.notes.join("\n");
     assert!(notes.contains("fitted to the moving residual"), "{notes}");
-    assert!(notes.contains("its wander"), "{notes}");
+    assert!(notes.contains("no bias wander"), "{notes}");
     assert!(
         h.arw_deg_per_rt_h > 1.5 * t.arw_deg_per_rt_h,
         "{} / {}",
@@ -239,8 +238,11 @@ fn the_turns_show_the_lag_the_scale_and_the_tilt() {
 
 /// The pose lags the gyro by about 100 ms, beyond the per-sample statistic: the residual
 /// during turns is the rate times the lag, which the vocabulary's fit on the rate reads as
-/// a scale of about −1.5% on x (trained on the two faster speeds). That scale is not
-/// written; the turns' own, rest to rest (the plain line's −0.9% to −1.3% on x), is.
+/// a scale of about −1.5% on x (trained on the two faster speeds). That scale is never
+/// written: simulated at its fitted value it does not reproduce the low-band slope it was
+/// fitted to (the lag, not a scale, made it), so it is not named; were it named, it would
+/// be set aside for the turns' scale. The turns' own, rest to rest (the plain line's
+/// −0.9% to −1.3% on x), is written.
 #[test]
 fn a_lag_beyond_the_statistic_leaves_the_scale_to_the_turns() {
     let Some((train, holdout)) = rasteiro_x(["V_800", "V1500"], "V_300") else {
@@ -249,13 +251,23 @@ fn a_lag_beyond_the_statistic_leaves_the_scale_to_the_turns() {
     let d = diagnose(&train, &holdout, &quick(500), &Silent).unwrap();
     let c = d.compensation.as_ref().unwrap();
     assert!(!c.corrected.contains(&"scale_factor"), "{c:?}");
-    let from_turns = gyro_diagnose::SCALE_FROM_TURNS;
+    let per_sample = d.effects.iter().find(|e| e.id == "scale_factor").unwrap();
     assert!(
-        c.not_corrected
-            .iter()
-            .any(|n| n.id == "scale_factor" && n.reason == Some(from_turns)),
-        "{c:?}"
+        (-0.02..=-0.01).contains(&per_sample.params["k"]),
+        "{per_sample:?}"
     );
+    if d.verdict.unmodelled.contains(&"scale_factor") {
+        let from_turns = gyro_diagnose::SCALE_FROM_TURNS;
+        assert!(
+            c.not_corrected
+                .iter()
+                .any(|n| n.id == "scale_factor" && n.reason == Some(from_turns)),
+            "{c:?}"
+        );
+    } else {
+        let check = per_sample.posterior_check.as_ref().unwrap();
+        assert!(!check.passes, "{per_sample:?}");
+    }
     let s = d.turns.as_ref().unwrap().scale.as_ref().unwrap();
     assert!(s.named && s.written, "{s:?}");
     let k = f64::from(

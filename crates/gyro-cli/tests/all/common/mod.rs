@@ -132,12 +132,24 @@ pub fn run_csv(
         sample_rate_hz: fs,
         ..gyro_sim::SensorModel::default()
     };
+    run_csv_from(dir, name, &model, duration_s, effects, seed)
+}
+
+/// [`run_csv`] from `model` instead of the simulator's default sensor.
+pub fn run_csv_from(
+    dir: &Path,
+    name: &str,
+    model: &gyro_sim::SensorModel,
+    duration_s: f64,
+    effects: &[gyro_sim::Effect],
+    seed: u64,
+) -> String {
     let profile = gyro_sim::BenchProfile {
         duration_s,
         ..gyro_sim::BenchProfile::default()
     };
     let log = gyro_sim::simulate(
-        &model,
+        model,
         effects,
         &gyro_sim::Motion::bench(&profile, seed),
         &gyro_sim::SimOptions {
