@@ -67,7 +67,7 @@ pub fn not_seen(named: &[&str]) -> Vec<NotSeen> {
 }
 
 /// Effects whose first parameter is a size, zero when absent (a scale, a delay, a σ, an
-/// amplitude), so that a fit can be set against the size at the detection limit. Not the
+/// amplitude), so that a fit can be set against the smallest size of its range. Not the
 /// clip level, the output step, the cutoff or the dropouts, whose parameters are not.
 const SIZED: &[&str] = &[
     "scale_factor",
@@ -86,19 +86,24 @@ const SIZED: &[&str] = &[
 ];
 
 /// True when the whole 95% interval `ci95` of `effect`'s first parameter (both ends
-/// bounded) lies under `share` of the size at the effect's detection limit ([`limit`]),
-/// either sign: what it could be is too small to tell on runs like the self-check's
-/// (`fit.negligible_limit_share`). False for an effect without a sized parameter or a
-/// limit.
-pub fn below_limit(effect: &Effect, ci95: &[(Option<f64>, Option<f64>)], share: f64) -> bool {
+/// bounded) lies under `share` of the smallest size of its realistic range (the first
+/// magnitude of `gyro_sim::EffectInfo::range`, from the datasheets), either sign: what it
+/// could be is smaller than the parts the range was drawn from show
+/// (`fit.negligible_range_share`). The range, not the measured [`LIMITS`], so that a new
+/// measurement of the limits changes no decision that the measurement itself depends on.
+/// False for an effect without a sized parameter.
+pub fn below_range(effect: &Effect, ci95: &[(Option<f64>, Option<f64>)], share: f64) -> bool {
     if !SIZED.contains(&effect.id()) {
         return false;
     }
-    let (Some(Some(at_limit)), Some((Some(lo), Some(hi)))) = (limit(effect.id()), ci95.first())
-    else {
+    let (Some(info), Some((Some(lo), Some(hi)))) = (effect_info(effect.id()), ci95.first()) else {
         return false;
     };
-    let Some(size) = at_limit.params().first().map(|p| p.abs()) else {
+    let Some(size) = info
+        .range
+        .first()
+        .and_then(|smallest| smallest.params().first().map(|p| p.abs()))
+    else {
         return false;
     };
     let bound = share * size;
@@ -109,17 +114,18 @@ pub fn below_limit(effect: &Effect, ci95: &[(Option<f64>, Option<f64>)], share: 
 mod tests {
     use super::*;
 
-    /// A turn-on bias of σ 0.0023 [0.0011, 0.0089] °/s beside a bias instability is far
-    /// under a tenth of its limit (σ 0.3 °/s); one whose interval reaches 0.05 is not; an
-    /// output step is never sized.
+    /// A turn-on bias of σ 0.0023 [0.0011, 0.0089] °/s beside a bias instability is
+    /// under a tenth of the bottom of its range (σ 0.1 °/s); one whose interval reaches
+    /// 0.05 is not; an output step is never sized.
     #[test]
-    fn an_interval_far_under_the_limit_is_negligible() {
+    fn an_interval_under_the_range_is_negligible() {
         let turn_on = Effect::TurnOnBias { sigma_dps: 0.0023 };
-        assert!(below_limit(&turn_on, &[(Some(0.0011), Some(0.0089))], 0.1));
-        assert!(!below_limit(&turn_on, &[(Some(0.0011), Some(0.05))], 0.1));
-        assert!(!below_limit(&turn_on, &[(Some(0.0011), None)], 0.1));
+        assert!(below_range(&turn_on, &[(Some(0.0011), Some(0.0089))], 0.1));
+        assert!(!below_range(&turn_on, &[(Some(0.0011), Some(0.05))], 0.1));
+        assert!(!below_range(&turn_on, &[(Some(0.0011), None)], 0.1));
+        assert!(below_range(&turn_on, &[(Some(-0.02), Some(0.05))], 1.0));
         let step = Effect::Quantization { lsb_dps: 0.001 };
-        assert!(!below_limit(&step, &[(Some(0.001), Some(0.001))], 0.1));
+        assert!(!below_range(&step, &[(Some(0.001), Some(0.001))], 0.1));
     }
 
     #[test]

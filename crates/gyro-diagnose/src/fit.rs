@@ -751,6 +751,16 @@ pub fn solve_white_and_bias(
     if lsb_dps <= 0.0 || !mean_dps.is_finite() {
         return today;
     }
+    // Noise that dithers the rounding at every bias shifts the mean by at most the
+    // first harmonic of a Gaussian's rounding error, (step/π)·e^(−2π²σ²/step²): below
+    // the simulation's resolution (at 0.8 of σ, for the σ's along the curve), no bias
+    // on the curve can move the rest mean, and the search below would return `today`.
+    let dithered_sigma = 0.8 * today.sigma_dps / lsb_dps;
+    let max_shift_dps = lsb_dps / std::f64::consts::PI
+        * (-2.0 * std::f64::consts::PI.powi(2) * dithered_sigma.powi(2)).exp();
+    if max_shift_dps <= 3.0 * sim.mean_resolution_dps() {
+        return today;
+    }
     let tol_dps = target.rest_mean_tol_dps.max(0.0);
     // The pre-rounding bias `b` on the curve of static matches, its σ, and the rest mean
     // it gives (the rounding's shift added: the draw's own mean is not the data's).

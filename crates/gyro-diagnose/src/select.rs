@@ -10,6 +10,7 @@ use super::{Options, Progress};
 use gyro_analysis::seed::derive_seed;
 use gyro_sim::{Effect, SensorModel};
 use std::collections::BTreeMap;
+use std::sync::Mutex;
 
 /// The held-out comparison of one model with another.
 pub(crate) struct Step {
@@ -66,6 +67,11 @@ pub(crate) struct Scorer<'a> {
     pub(crate) before: Vec<RunScore>,
     /// Statistics scored over the held-out runs (the BIC's observation count).
     observations: usize,
+    /// The held-out scores of every set simulated so far, by its joint effects: the
+    /// forward steps, the swaps, the ablations and the selections made again after a
+    /// posterior check meet the same sets (a set's ensembles are seeded by the options
+    /// alone, so a set scores the same every time).
+    scored: Mutex<Vec<(Vec<Effect>, Vec<RunScore>)>>,
 }
 
 impl Candidate {
@@ -112,6 +118,7 @@ impl<'a> Scorer<'a> {
             joint,
             before,
             observations,
+            scored: Mutex::new(Vec::new()),
         }
     }
 
@@ -184,7 +191,17 @@ impl<'a> Scorer<'a> {
             (0..self.per_set()).for_each(|_| self.progress.tick());
             return self.before.clone();
         }
-        evaluate(
+        let known = |scored: &[(Vec<Effect>, Vec<RunScore>)]| {
+            scored
+                .iter()
+                .find(|(s, _)| s == set)
+                .map(|(_, scores)| scores.clone())
+        };
+        if let Some(scores) = known(&self.scored.lock().unwrap_or_else(|e| e.into_inner())) {
+            (0..self.per_set()).for_each(|_| self.progress.tick());
+            return scores;
+        }
+        let scores = evaluate(
             &self.runs.holdout,
             &self.runs.holdout_ids,
             &model,
@@ -193,7 +210,12 @@ impl<'a> Scorer<'a> {
             self.baseline.candidate_members,
             self.progress,
         )
-        .scores
+        .scores;
+        self.scored
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push((set.clone(), scores.clone()));
+        scores
     }
 }
 
@@ -742,19 +764,23 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
             .collect();
         // Not refitted, a latency whose interval lies under a tenth of a sample either way
         // is as good as absent too ([`fit::negligible`]); and so, beside another effect,
-        // is one whose interval lies far under its detection limit
-        // ([`crate::detection::below_limit`]: a turn-on bias of σ 0.0023 °/s beside a bias
-        // instability, an even nonlinearity named at 6.8e-8 /(°/s) at its nearest bound).
+        // is one whose interval lies far under the smallest size of its realistic range
+        // ([`crate::detection::below_range`]: a turn-on bias of σ 0.0023 °/s beside a bias
+        // instability), or under that size while adding it closed none of the held-out gap
+        // (an even nonlinearity of 6.8e-8 /(°/s) at its nearest bound beside a bias
+        // instability).
         let fit_settings = &scorer.options.settings.fit;
         let negligible_delay = fit_settings.negligible_delay_samples;
         let beside_another = selection.selected.len() > 1;
-        let tiny = |f: &Fit| {
+        let tiny = |i: usize, f: &Fit| {
+            let idle = candidates[i]
+                .added
+                .as_ref()
+                .is_some_and(|st| st.gap_after >= st.gap_before);
+            let below = |share: f64| crate::detection::below_range(&f.effect, &f.ci95, share);
             beside_another
-                && crate::detection::below_limit(
-                    &f.effect,
-                    &f.ci95,
-                    fit_settings.negligible_limit_share,
-                )
+                && (below(fit_settings.negligible_range_share)
+                    || idle && below(fit_settings.idle_range_share))
         };
         let absent = selection
             .selected
@@ -762,11 +788,11 @@ pub(crate) fn select_checked(scorer: &Scorer, candidates: &mut [Candidate]) -> S
             .zip(scorer.joint.fits(&set))
             .find(|(&i, refit)| match refit {
                 Some(f) => {
-                    fit::interval_holds_absence(f, scorer.nominal(), negligible_delay) || tiny(f)
+                    fit::interval_holds_absence(f, scorer.nominal(), negligible_delay) || tiny(i, f)
                 }
                 None => {
                     fit::negligible(&candidates[i].fit, scorer.nominal(), negligible_delay)
-                        || tiny(&candidates[i].fit)
+                        || tiny(i, &candidates[i].fit)
                 }
             })
             .map(|(&i, _)| i);

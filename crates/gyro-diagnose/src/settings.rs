@@ -114,12 +114,16 @@ pub struct Fit {
     /// sample by more than that share of its step. Unit samples, valid [0, 1]. 0.1: below
     /// what the log's timing resolves.
     pub negligible_delay_samples: f64,
-    /// An effect whose whole 95% interval lies under this share of its detection limit
-    /// (`gyro_diagnose::detection`, the self-check's matrix) is negligible: what it could be
-    /// is too small to tell on runs like the self-check's, so it is not named beside what
-    /// is. Unit 1, valid [0, 1]. 0.1: the smallest magnitudes of the matrix's ranges lie at
-    /// a quarter of their limits or above.
-    pub negligible_limit_share: f64,
+    /// Beside another effect, an effect whose whole 95% interval lies under this share of
+    /// the smallest size of its realistic range (`gyro_sim::EffectInfo::range`, from the
+    /// datasheets) is negligible, and is not named. Unit 1, valid [0, 1]. 0.1: a tenth of
+    /// the smallest size any of those parts shows.
+    pub negligible_range_share: f64,
+    /// Beside another effect, an effect whose whole 95% interval lies under this share of
+    /// the smallest size of its realistic range and whose addition closed none of the
+    /// held-out gap G is not named: smaller than the parts show, and no closer to the runs
+    /// with it. Unit 1, valid [0, 1]. 1: the smallest size itself.
+    pub idle_range_share: f64,
     /// Share of the null's chi-square above which the real runs' scatter of a regression
     /// coefficient is larger than the null's, and its own error is used. Unit 1, valid
     /// (0, 1). 0.99: one-sided 1%.
@@ -398,7 +402,8 @@ impl Settings {
             white_check_min: 0.1,
             min_white_check_diffs: 20,
             negligible_delay_samples: 0.1,
-            negligible_limit_share: 0.1,
+            negligible_range_share: 0.1,
+            idle_range_share: 1.0,
             scatter_p: 0.99,
             wander_overshoot: 3.0,
             wander_prior_floor: 0.5,
@@ -496,8 +501,10 @@ impl Settings {
                 "fewest block differences for the whiteness check"),
             entry("fit.negligible_delay_samples", f.negligible_delay_samples, "samples", (CLOSED, 0.0, 1.0, CLOSED),
                 "a delay under this share of a sample period is negligible"),
-            entry("fit.negligible_limit_share", f.negligible_limit_share, "1", (CLOSED, 0.0, 1.0, CLOSED),
-                "an effect whose 95% interval lies under this share of its detection limit is negligible"),
+            entry("fit.negligible_range_share", f.negligible_range_share, "1", (CLOSED, 0.0, 1.0, CLOSED),
+                "beside another, an effect whose 95% interval lies under this share of its range's smallest size is negligible"),
+            entry("fit.idle_range_share", f.idle_range_share, "1", (CLOSED, 0.0, 1.0, CLOSED),
+                "beside another, an effect under this share of its range's smallest size that closes no held-out gap is not named"),
             entry("fit.scatter_p", f.scatter_p, "1", (OPEN, 0.0, 1.0, OPEN),
                 "null chi-square share above which the runs' own scatter of a coefficient is used: one-sided 1%"),
             entry("fit.wander_overshoot", f.wander_overshoot, "1", (CLOSED, 1.0, 1e6, CLOSED),

@@ -216,6 +216,10 @@ impl GaussMarkovProcess {
         }
     }
     fn step(&mut self, rng: &mut ChaCha8Rng) -> f64 {
+        // No wander (σ 0): the value stays 0 whatever is drawn, and the stream is its own.
+        if self.drive == 0.0 && self.value == 0.0 {
+            return self.value;
+        }
         let w: f64 = StandardNormal.sample(rng);
         self.value = self.phi * self.value + self.drive * w;
         self.value
@@ -365,7 +369,12 @@ pub fn simulate_series(
         measured += sensor.bias_and_noise_dps(delta_c);
         measured = sensor.output_dps(measured);
 
-        let temp_noise: f64 = StandardNormal.sample(&mut sensor.streams.temperature);
+        // A recorded temperature is taken as it is (its own stream draws nothing then).
+        let temp_noise: f64 = if temperature_c_is_recorded {
+            0.0
+        } else {
+            StandardNormal.sample(&mut sensor.streams.temperature)
+        };
         let dropped = sensor.dropped();
         let mut reference_deg = motion.angle_deg(true_s);
         if let Some(step) = reference_step {
